@@ -1,0 +1,310 @@
+"""Semi-implicit time stepping (2.1) of the DDFV scheme.
+
+One step solves ``(I + tau diag(1/chi^{n-1}) K^{n-1}) X^n = X^{n-1}``
+((2.10), (2.13)) for the stacked ``X = [F; T]`` (stored by components,
+shape (3, n_F + n_T)) as one block system by BiCGStab.
+
+Warm start: ``X^n`` is predicted by linear extrapolation
+``2 X^{n-1} - X^{n-2}`` (``X^0`` at the first step), whose residual is
+O(tau^2) instead of the O(tau) of ``X^{n-1}``; ``warm_start="previous"``
+starts from ``X^{n-1}`` (see ``ddfv/README.md``).
+"""
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+from tqdm import tqdm
+
+from .assembly import Assembler
+from .geometry import covolume_areas, diamond_geometry, t_barycentric, triangle_areas
+from .solver import bicgstab
+from .t_vertices import initial_t_vertices
+from .topology import diamond_mesh
+
+DEFAULT_RTOL = 1e-9
+WARM_STARTS = ("extrapolate", "previous")
+
+
+class FlowBreakdown(RuntimeError):
+    """The flow cannot go on: the solver failed or the mesh degenerated.
+
+    Attributes
+    ----------
+    status : str
+        ``"solver_failed"`` or ``"degenerated"``.
+    step : int
+        The time step ``n`` at which it happened.
+    time : float
+        ``t^n``.
+    """
+
+    def __init__(self, status, step, time, message):
+        super().__init__(message)
+        self.status, self.step, self.time = status, step, time
+
+
+def validate_vertices(vertices, faces):
+    """Check coordinates and triangle areas of an input surface.
+
+    Raises
+    ------
+    ValueError
+        Non-finite coordinates or a (numerically) zero-area triangle,
+        naming the offending vertices or triangles.
+    """
+    V = np.asarray(vertices, dtype=float)
+    if V.ndim != 2 or V.shape[1] != 3:
+        raise ValueError(f"vertices must have shape (n, 3), got {V.shape}")
+    bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
+    if len(bad):
+        raise ValueError(f"NaN or inf coordinates at vertex(es) {bad[:10].tolist()}")
+    faces = np.asarray(faces)
+    if len(faces) and faces.max() < len(V):
+        area = triangle_areas(V, faces)
+        p = V[faces]
+        scale = np.linalg.norm(p - p[:, [1, 2, 0]], axis=2).max(axis=1) ** 2
+        zero = np.flatnonzero(area <= 1e-12 * np.maximum(scale, np.finfo(float).tiny))
+        if len(zero):
+            raise ValueError(f"zero-area (degenerate) triangle(s): {zero[:10].tolist()}")
+    return V
+
+
+class Flow:
+    """DDFV mean curvature flow of one triangulated surface.
+
+    Parameters
+    ----------
+    vertices : (n_f, 3) float array
+        Initial F-vertices ``F^0``.
+    faces : (n_t, 3) int array
+        Consistently oriented triangles.
+    tau : float
+        Time step.
+    T0 : (n_t, 3) float array, optional
+        Initial T-vertices; by default from ``t_init``.
+    t_init : {"paper", "barycenter", "exact"}
+        T-vertex initialisation (see :mod:`ddfv.t_vertices`).
+    rtol : float
+        BiCGStab relative tolerance ``|r| <= rtol |X^{n-1}|``.
+    maxiter : int
+        BiCGStab iteration limit per step.
+    warm_start : {"extrapolate", "previous"}
+        Initial guess of BiCGStab (see module docstring).
+
+    Attributes
+    ----------
+    F, T : float arrays
+        Current state ``F^n``, ``T^n``.
+    n : int
+        Current time level.
+    """
+
+    def __init__(self, vertices, faces, tau, *, T0=None, t_init="paper",
+                 rtol=DEFAULT_RTOL, maxiter=1000, warm_start="extrapolate"):
+        if not (np.isfinite(tau) and tau > 0):
+            raise ValueError(f"tau must be a positive number, got {tau!r}")
+        if not (0 < rtol < 1):
+            raise ValueError(f"rtol must lie in (0, 1), got {rtol!r}")
+        if warm_start not in WARM_STARTS:
+            raise ValueError(f"unknown warm_start {warm_start!r}; choose one of "
+                             f"{', '.join(WARM_STARTS)}")
+        self.mesh = diamond_mesh(faces, len(vertices))
+        F = validate_vertices(vertices, self.mesh.faces)
+        if self.mesh.has_boundary:
+            raise ValueError("the mesh has a boundary "
+                             f"({int(self.mesh.boundary.sum())} boundary edges); "
+                             "open surfaces are not supported yet")
+        T = initial_t_vertices(F, self.mesh.faces, t_init) if T0 is None \
+            else np.asarray(T0, dtype=float)
+        if T.shape != (self.mesh.n_t, 3):
+            raise ValueError(f"T0 must have shape {(self.mesh.n_t, 3)}, got {T.shape}")
+        self.tau, self.rtol, self.maxiter = float(tau), float(rtol), int(maxiter)
+        self.warm_start = warm_start
+        self.n = 0
+        self._X = np.ascontiguousarray(np.concatenate([F, T]).T)
+        self._X_prev = self._X
+        self._assembler = Assembler(self.mesh)
+        try:
+            self._check_geometry()
+        except FlowBreakdown as err:
+            raise ValueError(f"initial surface is degenerate: {err}") from None
+
+    @property
+    def F(self):
+        """(n_f, 3) view of the F-vertices ``F^n``."""
+        return self._X[:, :self.mesh.n_f].T
+
+    @property
+    def T(self):
+        """(n_t, 3) view of the T-vertices ``T^n``."""
+        return self._X[:, self.mesh.n_f:].T
+
+    @property
+    def t(self):
+        return self.n * self.tau
+
+    @cached_property
+    def geometry(self):
+        """:class:`~ddfv.geometry.DiamondGeometry` of the current state."""
+        return diamond_geometry(self.mesh, self.F, self.T)
+
+    @cached_property
+    def covolumes(self):
+        """(n_f + n_t,) covolume areas ``chi^n``, F-vertices first."""
+        return np.concatenate(covolume_areas(self.mesh, self.geometry))
+
+    def t_min_barycentric(self):
+        """Smallest barycentric coordinate of any T-vertex in its triangle."""
+        return float(t_barycentric(self.F, self.T, self.mesh.faces).min())
+
+    def step(self):
+        """Advance one time step.
+
+        Returns
+        -------
+        SolveInfo
+
+        Raises
+        ------
+        FlowBreakdown
+            BiCGStab did not converge (the state stays at ``n - 1``) or the
+            new state is degenerate (the state is the degenerate ``X^n``).
+        """
+        A = self._assembler.system(self.geometry, self.covolumes, self.tau)
+        x0 = self._X
+        if self.warm_start == "extrapolate":
+            x0 = 2.0 * self._X - self._X_prev
+        X, info = bicgstab(A, self._X, x0, rtol=self.rtol, maxiter=self.maxiter)
+        if not info.converged:
+            n = self.n + 1
+            raise FlowBreakdown(
+                "solver_failed", n, n * self.tau,
+                f"BiCGStab did not converge at step {n} (t = {n * self.tau:.6g}): "
+                f"relative residual {info.residual:.3e} > rtol {self.rtol:.1e} "
+                f"after {info.iterations} iterations")
+        self._X_prev, self._X = self._X, X
+        self.n += 1
+        for name in ("geometry", "covolumes"):
+            self.__dict__.pop(name, None)
+        self._check_geometry()
+        return info
+
+    def _check_geometry(self):
+        g = self.geometry
+        if not np.isfinite(self._X).all():
+            raise FlowBreakdown("degenerated", self.n, self.t,
+                                f"mesh degenerated at step {self.n} (t = {self.t:.6g}): "
+                                "non-finite coordinates")
+        J = g.J
+        collapsed = np.flatnonzero(~(J > 1e-10 * J.mean()))
+        if len(collapsed):
+            raise FlowBreakdown("degenerated", self.n, self.t,
+                                f"mesh degenerated at step {self.n} (t = {self.t:.6g}): "
+                                f"{len(collapsed)} diamond cell(s) collapsed, "
+                                f"e.g. diamond {int(collapsed[0])}")
+
+
+@dataclass
+class Trajectory:
+    """Result of :func:`simulate`.
+
+    Attributes
+    ----------
+    F : (frames, n_f, 3) float array
+    T : (frames, n_t, 3) float array
+    t : (frames,) float array
+        Frame 0 is the initial state, the last frame the final (or last
+        computed) state.
+    steps : (frames,) int array
+        Time level of each frame.
+    iterations : (n_steps,) int array
+        BiCGStab iterations of each completed step.
+    t_min_barycentric : (n_steps + 1,) float array
+        The T monitor of every time level reached.
+    status : str
+        ``"ok"``, ``"solver_failed"`` or ``"degenerated"``.
+    message : str
+        Empty when ``status == "ok"``.
+    failed_step : int
+        Time step of the breakdown, ``-1`` when ``status == "ok"``.
+    faces : (n_t, 3) int array
+    """
+
+    F: np.ndarray
+    T: np.ndarray
+    t: np.ndarray
+    steps: np.ndarray
+    iterations: np.ndarray
+    t_min_barycentric: np.ndarray
+    faces: np.ndarray
+    status: str = "ok"
+    message: str = ""
+    failed_step: int = -1
+
+
+def simulate(vertices, faces, tau, steps, *, save_every=1, observer=None,
+             progress=False, **flow_options):
+    """Run the DDFV flow for ``steps`` time steps.
+
+    Parameters
+    ----------
+    vertices : (n_f, 3) float array
+    faces : (n_t, 3) int array
+    tau : float
+    steps : int
+    save_every : int
+        Keep every ``save_every``-th time level as a frame (the first and
+        the last are always kept). ``0`` keeps only those two.
+    observer : callable, optional
+        ``observer(flow)`` is called at every time level, ``n = 0`` included.
+    progress : bool
+        Show a progress bar for runs longer than two seconds.
+    **flow_options
+        Passed to :class:`Flow` (``T0``, ``t_init``, ``rtol``, ``maxiter``,
+        ``warm_start``).
+
+    Returns
+    -------
+    Trajectory
+        On a breakdown, ``status`` and ``message`` say what happened and
+        everything computed before is kept.
+    """
+    if int(steps) != steps or steps < 0:
+        raise ValueError(f"steps must be a whole number >= 0, got {steps!r}")
+    if int(save_every) != save_every or save_every < 0:
+        raise ValueError(f"save_every must be a whole number >= 0, got {save_every!r}")
+    flow = Flow(vertices, faces, tau, **flow_options)
+    frames, iterations, monitor = [], [], []
+    status, message, failed = "ok", "", -1
+
+    def record():
+        monitor.append(flow.t_min_barycentric())
+        if observer is not None:
+            observer(flow)
+
+    def save():
+        frames.append((flow.n, flow.F.copy(), flow.T.copy()))
+
+    record()
+    save()
+    with tqdm(total=int(steps), delay=2.0, disable=not progress, unit="step") as bar:
+        for _ in range(int(steps)):
+            try:
+                iterations.append(flow.step().iterations)
+            except FlowBreakdown as err:
+                status, message, failed = err.status, str(err), err.step
+                break
+            finally:
+                bar.update()
+            record()
+            if save_every and flow.n % save_every == 0:
+                save()
+    if frames[-1][0] != flow.n:
+        save()
+    n, F, T = zip(*frames)
+    return Trajectory(
+        F=np.array(F), T=np.array(T), t=np.array(n) * flow.tau,
+        steps=np.array(n), iterations=np.array(iterations, dtype=int),
+        t_min_barycentric=np.array(monitor), faces=flow.mesh.faces,
+        status=status, message=message, failed_step=failed)
