@@ -161,6 +161,28 @@ def covolume_areas(mesh, geom):
     return chi_f, chi_t
 
 
+def vertex_normals(mesh, geom):
+    """Unit normals at F- and T-vertices for the elimination (3.6).
+
+    The normal of a diamond cell is ``u x v / J`` (one orientation for all
+    diamonds of a consistently oriented mesh); the normal at a vertex is the
+    normalised sum of ``u x v = 2 chi(V^D) N^D`` over the diamonds of its
+    covolume, i.e. the area-weighted mean of the diamond normals.
+
+    Returns
+    -------
+    (3, n_f + n_t) float array
+    """
+    uxv = _cross(geom.u, geom.v)
+    a, b, t1, t2 = mesh.diamonds.T
+    inner = ~mesh.boundary
+    rows = np.concatenate([a, b, mesh.n_f + t1, mesh.n_f + t2[inner]])
+    n = mesh.n_unknowns
+    N = np.stack([np.bincount(rows, np.concatenate([c, c, c, c[inner]]), minlength=n)
+                  for c in uxv])
+    return N / _norm(N)
+
+
 def triangle_areas(F, faces):
     """(n_t,) areas of the triangles of the primal mesh."""
     p0, p1, p2 = (np.take(F.T, faces[:, k], axis=1) for k in range(3))

@@ -4,6 +4,14 @@ One step solves ``(I + tau diag(1/chi^{n-1}) K^{n-1}) X^n = X^{n-1}``
 ((2.10), (2.13)) for the stacked ``X = [F; T]`` (stored by components,
 shape (3, n_F + n_T)) as one block system by BiCGStab.
 
+Open surfaces: boundary F-vertices keep their position (1.2); see
+:mod:`ddfv.assembly`. With ``tangential="eliminate"`` the right-hand side
+becomes ``X^{n-1} - tau (h - (h.N) N)`` (3.6), where
+``h = -diag(1/chi) K X^{n-1} = (X^{n-1} - A X^{n-1}) / tau`` is the
+scheme's own discrete Laplacian of the previous state (zero at Dirichlet
+vertices) and ``N`` the vertex normals of
+:func:`ddfv.geometry.vertex_normals`.
+
 Warm start: ``X^n`` is predicted by linear extrapolation
 ``2 X^{n-1} - X^{n-2}`` (``X^0`` at the first step), whose residual is
 O(tau^2) instead of the O(tau) of ``X^{n-1}``; ``warm_start="previous"``
@@ -17,13 +25,15 @@ import numpy as np
 from tqdm import tqdm
 
 from .assembly import Assembler
-from .geometry import covolume_areas, diamond_geometry, t_barycentric, triangle_areas
+from .geometry import (covolume_areas, diamond_geometry, t_barycentric, triangle_areas,
+                       vertex_normals)
 from .solver import bicgstab
 from .t_vertices import initial_t_vertices
 from .topology import diamond_mesh
 
 DEFAULT_RTOL = 1e-9
 WARM_STARTS = ("extrapolate", "previous")
+TANGENTIAL = ("none", "eliminate")
 
 
 class FlowBreakdown(RuntimeError):
@@ -91,6 +101,9 @@ class Flow:
         BiCGStab iteration limit per step.
     warm_start : {"extrapolate", "previous"}
         Initial guess of BiCGStab (see module docstring).
+    tangential : {"none", "eliminate"}
+        ``"eliminate"`` removes the tangential part of the discrete mean
+        curvature vector from the velocity (3.6).
 
     Attributes
     ----------
@@ -101,7 +114,8 @@ class Flow:
     """
 
     def __init__(self, vertices, faces, tau, *, T0=None, t_init="paper",
-                 rtol=DEFAULT_RTOL, maxiter=1000, warm_start="extrapolate"):
+                 rtol=DEFAULT_RTOL, maxiter=1000, warm_start="extrapolate",
+                 tangential="none"):
         if not (np.isfinite(tau) and tau > 0):
             raise ValueError(f"tau must be a positive number, got {tau!r}")
         if not (0 < rtol < 1):
@@ -109,18 +123,17 @@ class Flow:
         if warm_start not in WARM_STARTS:
             raise ValueError(f"unknown warm_start {warm_start!r}; choose one of "
                              f"{', '.join(WARM_STARTS)}")
+        if tangential not in TANGENTIAL:
+            raise ValueError(f"unknown tangential {tangential!r}; choose one of "
+                             f"{', '.join(TANGENTIAL)}")
         self.mesh = diamond_mesh(faces, len(vertices))
         F = validate_vertices(vertices, self.mesh.faces)
-        if self.mesh.has_boundary:
-            raise ValueError("the mesh has a boundary "
-                             f"({int(self.mesh.boundary.sum())} boundary edges); "
-                             "open surfaces are not supported yet")
-        T = initial_t_vertices(F, self.mesh.faces, t_init) if T0 is None \
+        T = initial_t_vertices(F, self.mesh, t_init) if T0 is None \
             else np.asarray(T0, dtype=float)
         if T.shape != (self.mesh.n_t, 3):
             raise ValueError(f"T0 must have shape {(self.mesh.n_t, 3)}, got {T.shape}")
         self.tau, self.rtol, self.maxiter = float(tau), float(rtol), int(maxiter)
-        self.warm_start = warm_start
+        self.warm_start, self.tangential = warm_start, tangential
         self.n = 0
         self._X = np.ascontiguousarray(np.concatenate([F, T]).T)
         self._X_prev = self._X
@@ -172,10 +185,15 @@ class Flow:
             new state is degenerate (the state is the degenerate ``X^n``).
         """
         A = self._assembler.system(self.geometry, self.covolumes, self.tau)
+        rhs = self._X
+        if self.tangential == "eliminate":
+            h = np.stack([x - A @ x for x in self._X]) / self.tau   # h^{n-1}
+            N = vertex_normals(self.mesh, self.geometry)              # N^{n-1}
+            rhs = self._X - self.tau * (h - (h * N).sum(axis=0) * N)  # (3.6)
         x0 = self._X
         if self.warm_start == "extrapolate":
             x0 = 2.0 * self._X - self._X_prev
-        X, info = bicgstab(A, self._X, x0, rtol=self.rtol, maxiter=self.maxiter)
+        X, info = bicgstab(A, rhs, x0, rtol=self.rtol, maxiter=self.maxiter)
         if not info.converged:
             n = self.n + 1
             raise FlowBreakdown(
@@ -262,7 +280,7 @@ def simulate(vertices, faces, tau, steps, *, save_every=1, observer=None,
         Show a progress bar for runs longer than two seconds.
     **flow_options
         Passed to :class:`Flow` (``T0``, ``t_init``, ``rtol``, ``maxiter``,
-        ``warm_start``).
+        ``warm_start``, ``tangential``).
 
     Returns
     -------

@@ -9,7 +9,10 @@
     lies on the side ``h`` points to; the barycentre projected radially
     from that centre onto it. Flat triangles (``|h| rho < 1e-8``, ``rho``
     the circumradius) keep the barycentre; where ``R < rho`` no such sphere
-    exists and ``R = rho`` is used.
+    exists and ``R = rho`` is used. On open surfaces the cotangent formula
+    does not give the curvature at boundary vertices: ``h`` is averaged
+    over the triangle's interior vertices only, and a triangle with all
+    three vertices on the boundary keeps its barycentre.
 ``barycenter``
     The barycentre of the triangle.
 ``exact``
@@ -24,19 +27,20 @@ import scipy.sparse as sp
 METHODS = ("paper", "barycenter", "exact")
 
 
-def initial_t_vertices(F, faces, method="paper"):
-    """T-vertices for the mesh ``(F, faces)``.
+def initial_t_vertices(F, mesh, method="paper"):
+    """T-vertices for the mesh with F-vertices ``F``.
 
     Parameters
     ----------
     F : (n_f, 3) float array
-    faces : (n_t, 3) int array
+    mesh : DiamondMesh
     method : {"paper", "barycenter", "exact"}
 
     Returns
     -------
     (n_t, 3) float array
     """
+    faces = mesh.faces
     tri = F[faces]
     g = tri.mean(axis=1)
     if method == "barycenter":
@@ -49,7 +53,10 @@ def initial_t_vertices(F, faces, method="paper"):
     if method != "paper":
         raise ValueError(f"unknown T-vertex initialisation {method!r}; "
                          f"choose one of {', '.join(METHODS)}")
-    h = cotangent_mean_curvature_vector(F, faces)[faces].mean(axis=1)
+    interior = ~mesh.boundary_vertices[faces]                  # (n_t, 3)
+    h_corners = cotangent_mean_curvature_vector(F, faces)[faces]
+    count = interior.sum(axis=1)
+    h = (h_corners * interior[..., None]).sum(axis=1) / np.maximum(count, 1)[:, None]
     p0, p1, p2 = tri[:, 0], tri[:, 1], tri[:, 2]
     a, b = p1 - p0, p2 - p0
     n = np.cross(a, b)
@@ -59,7 +66,7 @@ def initial_t_vertices(F, faces, method="paper"):
                        - np.einsum("ij,ij->i", b, b)[:, None] * a, n) / (2 * nn[:, None])
     rho = np.linalg.norm(cc - p0, axis=1)
     hnorm = np.linalg.norm(h, axis=1)
-    curved = hnorm * rho >= 1e-8
+    curved = (hnorm * rho >= 1e-8) & (count > 0)
     R = np.where(curved, 2.0 / np.where(curved, hnorm, 1.0), 0.0)
     R = np.maximum(R, rho)
     side = np.sign(np.einsum("ij,ij->i", h, n))[:, None]
