@@ -10,7 +10,7 @@ import numpy as np
 from .meshio import read_mesh
 from .provenance import provenance
 from .sphere import sphere_table
-from .stepping import DEFAULT_RTOL, WARM_STARTS, simulate
+from .stepping import DEFAULT_RTOL, TANGENTIAL, WARM_STARTS, simulate
 from .t_vertices import METHODS
 
 
@@ -35,6 +35,10 @@ def _solver_options(parser):
                         help=f"BiCGStab relative tolerance (default: {DEFAULT_RTOL:g})")
     parser.add_argument("--warm-start", choices=WARM_STARTS, default="extrapolate",
                         help="BiCGStab initial guess (default: extrapolate)")
+    parser.add_argument("--maxiter", type=_count, default=1000,
+                        help="BiCGStab iterations allowed per step (default: 1000)")
+    parser.add_argument("--tangential", choices=TANGENTIAL, default="none",
+                        help="'eliminate': the tangential-velocity elimination (3.6)")
 
 
 def build_parser():
@@ -51,7 +55,8 @@ def build_parser():
                        "(and its provenance as CSV.json)")
     _solver_options(table)
 
-    run = commands.add_parser("run", help="run the flow on a closed triangle mesh")
+    run = commands.add_parser("run", help="run the flow on a triangle mesh "
+                              "(boundary vertices are held fixed)")
     run.add_argument("mesh", type=Path, help="OBJ, OFF, PLY or STL file")
     run.add_argument("--tau", type=_positive_float, required=True, help="time step")
     run.add_argument("--steps", type=_count, required=True, help="number of time steps")
@@ -74,7 +79,8 @@ def main(argv=None):
 
 
 def _options(args):
-    return {"t_init": args.t_init, "rtol": args.rtol, "warm_start": args.warm_start}
+    return {"t_init": args.t_init, "rtol": args.rtol, "warm_start": args.warm_start,
+            "maxiter": args.maxiter, "tangential": args.tangential}
 
 
 def _sphere_table(args):

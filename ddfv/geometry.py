@@ -80,7 +80,10 @@ def diamond_corners(mesh, F, T):
     return Fa, Fb, T1, T2
 
 
-def diamond_geometry(mesh, F, T):
+DUAL_LENGTHS = ("broken", "chord")
+
+
+def diamond_geometry(mesh, F, T, dual_length="broken"):
     """Geometric factors of all diamonds, see :class:`DiamondGeometry`.
 
     Every length and area follows from the Gram matrix of ``u, v, e``
@@ -92,11 +95,17 @@ def diamond_geometry(mesh, F, T):
     mesh : DiamondMesh
     F : (n_f, 3) float array
     T : (n_t, 3) float array
+    dual_length : {"broken", "chord"}
+        ``|gamma|`` as the paper's broken line through ``S`` (2.5), or as the
+        chord (``|gamma^T| = |v|``, ``|gamma^F| = |u|``).
 
     Returns
     -------
     DiamondGeometry
     """
+    if dual_length not in DUAL_LENGTHS:
+        raise ValueError(f"unknown dual_length {dual_length!r}; choose one of "
+                         f"{', '.join(DUAL_LENGTHS)}")
     Fa, Fb, T1, T2 = diamond_corners(mesh, F, T)
     u = Fb - Fa
     v = T2 - T1
@@ -124,12 +133,16 @@ def diamond_geometry(mesh, F, T):
     quarters *= 0.5
     if mesh.has_boundary:
         quarters[[1, 3]] *= ~mesh.boundary
+    len_u, len_v = np.sqrt(uu), np.sqrt(vv)
+    if dual_length == "chord":
+        gamma_t, gamma_f = len_v, len_u
+    else:
+        gamma_t = np.sqrt(p2) + np.sqrt(q2)    # (2.5)
+        gamma_f = np.sqrt(ra2) + np.sqrt(rb2)  # (2.15), Section 2.2.5
     return DiamondGeometry(
-        u=u, v=v, e=e, len_u=np.sqrt(uu), len_v=np.sqrt(vv),
+        u=u, v=v, e=e, len_u=len_u, len_v=len_v,
         J=np.sqrt(np.maximum(0.0, uu * vv - uv**2)), uv=uv,
-        gamma_t=np.sqrt(p2) + np.sqrt(q2),    # (2.5)
-        gamma_f=np.sqrt(ra2) + np.sqrt(rb2),  # (2.15), Section 2.2.5
-        quarters=quarters)
+        gamma_t=gamma_t, gamma_f=gamma_f, quarters=quarters)
 
 
 def covolume_areas(mesh, geom):

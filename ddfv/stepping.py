@@ -21,6 +21,8 @@ starts from ``X^{n-1}`` (see ``ddfv/README.md``).
 from dataclasses import dataclass
 from functools import cached_property
 
+import time
+
 import numpy as np
 from tqdm import tqdm
 
@@ -104,6 +106,9 @@ class Flow:
     tangential : {"none", "eliminate"}
         ``"eliminate"`` removes the tangential part of the discrete mean
         curvature vector from the velocity (3.6).
+    dual_length : {"broken", "chord"}
+        Length of the dual curves ``|gamma|``: the paper's broken line (2.5)
+        or the chord (see :func:`ddfv.geometry.diamond_geometry`).
 
     Attributes
     ----------
@@ -111,11 +116,14 @@ class Flow:
         Current state ``F^n``, ``T^n``.
     n : int
         Current time level.
+    timings : dict
+        Seconds spent so far in ``"geometry"`` (including the covolumes and
+        the checks of each new state), ``"assembly"`` and ``"solve"``.
     """
 
     def __init__(self, vertices, faces, tau, *, T0=None, t_init="paper",
                  rtol=DEFAULT_RTOL, maxiter=1000, warm_start="extrapolate",
-                 tangential="none"):
+                 tangential="none", dual_length="broken"):
         if not (np.isfinite(tau) and tau > 0):
             raise ValueError(f"tau must be a positive number, got {tau!r}")
         if not (0 < rtol < 1):
@@ -134,10 +142,12 @@ class Flow:
             raise ValueError(f"T0 must have shape {(self.mesh.n_t, 3)}, got {T.shape}")
         self.tau, self.rtol, self.maxiter = float(tau), float(rtol), int(maxiter)
         self.warm_start, self.tangential = warm_start, tangential
+        self.dual_length = dual_length
         self.n = 0
         self._X = np.ascontiguousarray(np.concatenate([F, T]).T)
         self._X_prev = self._X
         self._assembler = Assembler(self.mesh)
+        self.timings = {"geometry": 0.0, "assembly": 0.0, "solve": 0.0}
         try:
             self._check_geometry()
         except FlowBreakdown as err:
@@ -160,7 +170,7 @@ class Flow:
     @cached_property
     def geometry(self):
         """:class:`~ddfv.geometry.DiamondGeometry` of the current state."""
-        return diamond_geometry(self.mesh, self.F, self.T)
+        return diamond_geometry(self.mesh, self.F, self.T, self.dual_length)
 
     @cached_property
     def covolumes(self):
@@ -184,7 +194,11 @@ class Flow:
             BiCGStab did not converge (the state stays at ``n - 1``) or the
             new state is degenerate (the state is the degenerate ``X^n``).
         """
-        A = self._assembler.system(self.geometry, self.covolumes, self.tau)
+        clock = time.perf_counter()
+        geometry, covolumes = self.geometry, self.covolumes
+        self._tick("geometry", clock)
+        clock = time.perf_counter()
+        A = self._assembler.system(geometry, covolumes, self.tau)
         rhs = self._X
         if self.tangential == "eliminate":
             h = np.stack([x - A @ x for x in self._X]) / self.tau   # h^{n-1}
@@ -193,7 +207,9 @@ class Flow:
         x0 = self._X
         if self.warm_start == "extrapolate":
             x0 = 2.0 * self._X - self._X_prev
+        clock = self._tick("assembly", clock)
         X, info = bicgstab(A, rhs, x0, rtol=self.rtol, maxiter=self.maxiter)
+        clock = self._tick("solve", clock)
         if not info.converged:
             n = self.n + 1
             raise FlowBreakdown(
@@ -206,7 +222,13 @@ class Flow:
         for name in ("geometry", "covolumes"):
             self.__dict__.pop(name, None)
         self._check_geometry()
+        self._tick("geometry", clock)
         return info
+
+    def _tick(self, phase, since):
+        now = time.perf_counter()
+        self.timings[phase] += now - since
+        return now
 
     def _check_geometry(self):
         g = self.geometry
@@ -215,7 +237,11 @@ class Flow:
                                 f"mesh degenerated at step {self.n} (t = {self.t:.6g}): "
                                 "non-finite coordinates")
         J = g.J
-        collapsed = np.flatnonzero(~(J > 1e-10 * J.mean()))
+        if self.n == 0:
+            self._J0 = J.mean()
+        # collapsed against the mesh now (a local collapse) or at n = 0 (the
+        # surface shrinking to a point)
+        collapsed = np.flatnonzero(~(J > max(1e-10 * J.mean(), 1e-12 * self._J0)))
         if len(collapsed):
             raise FlowBreakdown("degenerated", self.n, self.t,
                                 f"mesh degenerated at step {self.n} (t = {self.t:.6g}): "
@@ -246,6 +272,8 @@ class Trajectory:
         Empty when ``status == "ok"``.
     failed_step : int
         Time step of the breakdown, ``-1`` when ``status == "ok"``.
+    timings : dict
+        :attr:`Flow.timings` at the end.
     faces : (n_t, 3) int array
     """
 
@@ -259,6 +287,7 @@ class Trajectory:
     status: str = "ok"
     message: str = ""
     failed_step: int = -1
+    timings: dict = None
 
 
 def simulate(vertices, faces, tau, steps, *, save_every=1, observer=None,
@@ -280,7 +309,7 @@ def simulate(vertices, faces, tau, steps, *, save_every=1, observer=None,
         Show a progress bar for runs longer than two seconds.
     **flow_options
         Passed to :class:`Flow` (``T0``, ``t_init``, ``rtol``, ``maxiter``,
-        ``warm_start``, ``tangential``).
+        ``warm_start``, ``tangential``, ``dual_length``).
 
     Returns
     -------
@@ -325,4 +354,4 @@ def simulate(vertices, faces, tau, steps, *, save_every=1, observer=None,
         F=np.array(F), T=np.array(T), t=np.array(n) * flow.tau,
         steps=np.array(n), iterations=np.array(iterations, dtype=int),
         t_min_barycentric=np.array(monitor), faces=flow.mesh.faces,
-        status=status, message=message, failed_step=failed)
+        status=status, message=message, failed_step=failed, timings=dict(flow.timings))

@@ -1,0 +1,81 @@
+"""Slow, literal transcription of the paper's equations (2.10)-(2.15).
+
+Loops over vertices and their ordered one-rings, with the paper's own
+indexing, as an independent check of the vectorized assembly. Only the
+typo in (2.11) is corrected (chi(V_i^F) in b and c).
+"""
+
+import numpy as np
+
+
+def _area(p, q, r):
+    return 0.5 * np.linalg.norm(np.cross(q - p, r - p))
+
+
+def ordered_ring(faces, i):
+    """F_{i,p} and T_{i,p} (triangle (F_i, F_{i,p}, F_{i,p+1})), p = 1..m."""
+    nxt = {}
+    for t, f in enumerate(faces):
+        for k in range(3):
+            if f[k] == i:
+                nxt[f[(k + 1) % 3]] = (f[(k + 2) % 3], t)
+    j = next(iter(nxt))
+    ring, tris = [], []
+    for _ in range(len(nxt)):
+        ring.append(j)
+        j, t = nxt[j]
+        tris.append(t)
+    return ring, tris
+
+
+def literal_system(F, T, faces, tau):
+    """Dense matrix of (2.10) and (2.13) on a closed mesh."""
+    nf, nt = len(F), len(T)
+    A = np.zeros((nf + nt, nf + nt))
+    # F-vertices, (2.10)-(2.12)
+    for i in range(nf):
+        ring, tris = ordered_ring(faces, i)
+        m = len(ring)
+        qF, qT, chi = np.zeros(m), np.zeros(m), 0.0
+        for p in range(m):
+            Tp, Tm = T[tris[p]], T[tris[p - 1]]       # T_{i,p}, T_{i,p-1}
+            u, v = F[ring[p]] - F[i], Tp - Tm
+            S = (F[i] + F[ring[p]] + Tm + Tp) / 4
+            gamma = np.linalg.norm(Tm - S) + np.linalg.norm(Tp - S)       # (2.5)
+            chi_d = 0.5 * np.linalg.norm(np.cross(u, v))
+            d = np.linalg.norm(v)
+            cot = u @ v / np.linalg.norm(np.cross(u, v))
+            qF[p], qT[p] = gamma * d / chi_d, gamma / d * cot             # (2.12)
+            chi += _area(F[i], S, Tp)
+        for p in range(m):  # the other half of each diamond: (F_i, T_{i,p}, S_{i,p+1})
+            q = (p + 1) % m
+            S_next = (F[i] + F[ring[q]] + T[tris[p]] + T[tris[q]]) / 4
+            chi += _area(F[i], T[tris[p]], S_next)
+        A[i, i] = 1 + tau / (2 * chi) * qF.sum()                          # (2.11)
+        for p in range(m):
+            A[i, ring[p]] += -tau / (2 * chi) * qF[p]
+            A[i, nf + tris[p]] += tau / chi * (qT[p] - qT[(p + 1) % m])
+    # T-vertices, (2.13)-(2.15)
+    edge_tri = {}
+    for t, f in enumerate(faces):
+        for k in range(3):
+            edge_tri[(f[k], f[(k + 1) % 3])] = t
+    for i, f in enumerate(faces):
+        qT, qF, chi = np.zeros(3), np.zeros(3), 0.0
+        for p in range(3):
+            Fp, Fq = F[f[p]], F[f[(p + 1) % 3]]
+            Tn = T[edge_tri[(f[(p + 1) % 3], f[p])]]                      # T_{i,p}
+            u, v = Fp - Fq, Tn - T[i]    # u = F_{i,p} - F_{i,p+1}: sign of (2.14)
+            S = (Fp + Fq + T[i] + Tn) / 4
+            gamma = np.linalg.norm(Fp - S) + np.linalg.norm(Fq - S)
+            chi_d = 0.5 * np.linalg.norm(np.cross(u, v))
+            d = np.linalg.norm(u)
+            cot = u @ v / np.linalg.norm(np.cross(u, v))
+            qT[p], qF[p] = gamma * d / chi_d, gamma / d * cot             # (2.15)
+            chi += _area(T[i], Fp, S) + _area(T[i], S, Fq)
+        A[nf + i, nf + i] = 1 + tau / (2 * chi) * qT.sum()                # (2.14)
+        for p in range(3):
+            Tn = edge_tri[(f[(p + 1) % 3], f[p])]
+            A[nf + i, nf + Tn] += -tau / (2 * chi) * qT[p]
+            A[nf + i, f[p]] += tau / chi * (qF[p] - qF[p - 1])
+    return A

@@ -1,0 +1,49 @@
+import numpy as np
+import pytest
+
+from ddfv import SphereL2Error, eoc, simulate, sphere_radius
+from ddfv.surfaces import icosphere
+
+
+def test_l2_error_vanishes_on_the_exact_solution():
+    """Rescaling each state onto r(t^n) makes every term of (3.2) zero."""
+    V, F = icosphere(2)
+    error = SphereL2Error()
+
+    def exact(flow):
+        r = sphere_radius(flow.t)
+        flow._X /= np.linalg.norm(flow._X, axis=0) / r   # project onto the sphere
+        flow.__dict__.pop("covolumes", None)
+        error(flow)
+
+    simulate(V, F, 0.01, 3, observer=exact, t_init="exact")
+    assert error.levels == 3 and error.value < 1e-14
+
+
+def test_l2_error_weights_are_half_the_covolumes():
+    """A constant radial offset d gives sqrt(N tau d^2 area)."""
+    V, F = icosphere(3)
+    error = SphereL2Error()
+    d, tau = 1e-3, 0.001
+
+    class State:
+        n, t = 1, 0.0
+
+    state = State()
+    state.tau = tau
+    state.F, state.T = V * (1 + d), V[F].mean(axis=1)
+    state.T = state.T / np.linalg.norm(state.T, axis=1, keepdims=True) * (1 + d)
+    state.covolumes = np.full(len(V) + len(F), 4 * np.pi / len(V))
+    state.covolumes[len(V):] = 4 * np.pi / len(F)
+    error(state)
+    assert error.value == pytest.approx(np.sqrt(tau * d**2 * 4 * np.pi), rel=1e-10)
+
+
+def test_eoc():
+    np.testing.assert_allclose(eoc([1.0, 0.25, 0.0625 * 2]), [np.nan, 2.0, 1.0])
+    assert np.isnan(eoc([1.0])).all()
+
+
+def test_sphere_radius():
+    assert sphere_radius(0.0, 2.0) == 2.0
+    assert sphere_radius(0.25) == 0.0

@@ -1,0 +1,60 @@
+"""Acceptance: Table 3.1 of the paper (Section 3.1)."""
+
+import numpy as np
+import pytest
+
+from ddfv.sphere import PUBLISHED, level_time_step, sphere_run, sphere_table
+
+
+@pytest.fixture(scope="module")
+def table():
+    return sphere_table([1, 2, 3, 4, 5])
+
+
+def test_table_3_1_l2_errors_reproduced(table):
+    assert (table["status"] == "ok").all()
+    ratio = table.set_index("level")["l2_ratio"]
+    assert abs(ratio[1] - 1) < 0.03
+    for level in (2, 3, 4, 5):
+        assert abs(ratio[level] - 1) < 0.01, (level, ratio[level])
+
+
+def test_table_3_1_orders_reproduced(table):
+    t = table.set_index("level")
+    for level in (2, 3, 4, 5):
+        assert abs(t.eoc[level] - t.paper_eoc[level]) < 0.03, level
+
+
+def test_table_3_1_discretisation(table):
+    for row in table.itertuples():
+        nV, nF, nT, tau, N = PUBLISHED[row.level][:5]
+        assert (row.nV, row.nF, row.nT, row.N) == (nV, nF, nT, N)
+        assert row.tau == pytest.approx(tau)
+        assert 0.2 < row.t_min_barycentric <= 1 / 3
+
+
+@pytest.mark.parametrize("t_init", ["exact", "barycenter"])
+def test_second_order_for_every_t_initialisation(t_init):
+    errors = [sphere_run(level, t_init=t_init).l2_error for level in (1, 2, 3)]
+    orders = np.log2(np.array(errors[:-1]) / errors[1:])
+    assert np.all((orders > 1.75) & (orders < 2.2)), orders
+
+
+def test_tolerance_default_is_converged():
+    """Tightening rtol 1000x changes the level-3 error by < 0.01 %."""
+    default, tight = sphere_run(3), sphere_run(3, rtol=1e-12)
+    assert default.l2_error == pytest.approx(tight.l2_error, rel=1e-4)
+    assert tight.iterations > default.iterations
+
+
+def test_warm_start_previous_reproduces_published_iteration_counts():
+    """With x0 = X^{n-1} and rtol = 1e-8 the counts are within 25 % of the paper's."""
+    for level in (2, 3, 4):
+        run = sphere_run(level, warm_start="previous", rtol=1e-8)
+        assert run.iterations == pytest.approx(PUBLISHED[level][6], rel=0.25)
+
+
+def test_time_step_coupling():
+    assert [level_time_step(k) for k in (1, 2, 5)] == [0.04, 0.01, 0.04 / 256]
+    with pytest.raises(ValueError, match="not a multiple of tau"):
+        sphere_run(1, tau=0.03)

@@ -1,0 +1,67 @@
+import numpy as np
+import pytest
+
+from conftest import flat_lattice
+from ddfv.surfaces import icosphere
+from ddfv.topology import diamond_mesh
+
+
+@pytest.mark.parametrize("level", [0, 1, 2, 3])
+def test_icosphere_diamond_counts(level):
+    V, F = icosphere(level)
+    mesh = diamond_mesh(F, len(V))
+    assert (mesh.n_f, mesh.n_t) == (10 * 4**level + 2, 20 * 4**level)
+    assert len(mesh.diamonds) == 3 * mesh.n_t // 2          # n_dia = 3/2 n_T
+    assert mesh.n_f - len(mesh.diamonds) + mesh.n_t == 2     # Euler characteristic
+    assert not mesh.has_boundary
+
+
+def test_diamonds_and_halfedges_are_consistent():
+    V, F = icosphere(2)
+    mesh = diamond_mesh(F)
+    a, b, t1, t2 = mesh.diamonds.T
+    halfedges = {(f[k], f[(k + 1) % 3]): t for t, f in enumerate(F) for k in range(3)}
+    assert all(halfedges[(i, j)] == t for i, j, t in zip(a, b, t1))
+    assert all(halfedges[(j, i)] == t for i, j, t in zip(a, b, t2))
+    # the diamond of half-edge (t, k) is the edge faces[t, k] - faces[t, k+1]
+    d = mesh.diamonds[mesh.halfedges]
+    src, dst = F, F[:, [1, 2, 0]]
+    assert np.all(((d[..., 0] == src) & (d[..., 1] == dst))
+                  | ((d[..., 0] == dst) & (d[..., 1] == src)))
+
+
+def test_boundary_of_open_lattice():
+    m, k = 6, 5
+    V, F = flat_lattice(m, k)
+    mesh = diamond_mesh(F)
+    assert mesh.boundary.sum() == 2 * (m + k)
+    on_rim = (V[:, 0] % m == 0) | (V[:, 1] % k == 0)
+    assert np.array_equal(mesh.boundary_vertices, on_rim)
+    assert np.all(mesh.diamonds[mesh.boundary, 3] == -1)
+
+
+def test_one_ring_of_icosahedron_vertex():
+    V, F = icosphere(0)
+    mesh = diamond_mesh(F)
+    ring = mesh.one_ring(0)
+    assert len(ring) == 5
+    assert np.allclose(np.linalg.norm(V[ring] - V[0], axis=1),
+                       np.linalg.norm(V[1] - V[0]))
+
+
+def _tetrahedron():
+    return np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+
+
+@pytest.mark.parametrize("faces, n_vertices, message", [
+    (np.vstack([_tetrahedron(), [[0, 1, 4]]]), None, "non-manifold mesh"),
+    (np.vstack([_tetrahedron()[:3], [[1, 3, 2]]]), None, "inconsistent orientation"),
+    (_tetrahedron(), 5, r"unreferenced vertex\(es\): \[4\]"),
+    (np.vstack([_tetrahedron(), [[1, 1, 2]]]), None, "repeating a vertex"),
+    (_tetrahedron()[:3], None, "at least 4 triangles"),
+    (_tetrahedron(), 3, "face indices must lie in"),
+    (_tetrahedron().astype(float), None, "must be integers"),
+])
+def test_bad_topology_is_named(faces, n_vertices, message):
+    with pytest.raises(ValueError, match=message):
+        diamond_mesh(faces, n_vertices)
