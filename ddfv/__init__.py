@@ -11,6 +11,8 @@ sphere_run(level, ...) -> SphereRun
 icosphere(level), diamond_mesh(faces), read_mesh(path)
 SphereL2Error, eoc, sphere_radius
     The error (3.2), the order (3.1) and the exact solution.
+VARIANTS, variant_options(name)
+    Named variants of the scheme (paper, chord, eliminate).
 """
 
 from .memory import tune_malloc
@@ -23,9 +25,10 @@ from .sphere import SphereRun, sphere_run  # noqa: E402
 from .stepping import Flow, FlowBreakdown, Trajectory, simulate  # noqa: E402
 from .surfaces import icosphere  # noqa: E402
 from .topology import DiamondMesh, diamond_mesh  # noqa: E402
+from .variants import VARIANTS, variant_options  # noqa: E402
 
 __all__ = [
     "DiamondMesh", "Flow", "FlowBreakdown", "SphereL2Error", "SphereRun",
     "Trajectory", "diamond_mesh", "eoc", "icosphere", "read_mesh", "simulate",
-    "sphere_radius", "sphere_run",
+    "sphere_radius", "sphere_run", "VARIANTS", "variant_options",
 ]

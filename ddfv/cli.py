@@ -10,8 +10,9 @@ import numpy as np
 from .meshio import read_mesh
 from .provenance import provenance
 from .sphere import sphere_table
-from .stepping import DEFAULT_RTOL, TANGENTIAL, WARM_STARTS, simulate
+from .stepping import DEFAULT_RTOL, WARM_STARTS, simulate
 from .t_vertices import METHODS
+from .variants import VARIANTS, variant_options
 
 
 def _positive_float(text):
@@ -37,8 +38,8 @@ def _solver_options(parser):
                         help="BiCGStab initial guess (default: extrapolate)")
     parser.add_argument("--maxiter", type=_count, default=1000,
                         help="BiCGStab iterations allowed per step (default: 1000)")
-    parser.add_argument("--tangential", choices=TANGENTIAL, default="none",
-                        help="'eliminate': the tangential-velocity elimination (3.6)")
+    parser.add_argument("--variant", choices=list(VARIANTS), default="paper",
+                        help="scheme variant (default: paper; see ddfv/variants.py)")
 
 
 def build_parser():
@@ -80,18 +81,19 @@ def main(argv=None):
 
 def _options(args):
     return {"t_init": args.t_init, "rtol": args.rtol, "warm_start": args.warm_start,
-            "maxiter": args.maxiter, "tangential": args.tangential}
+            "maxiter": args.maxiter}
 
 
 def _sphere_table(args):
     if any(level < 0 for level in args.levels):
         raise ValueError(f"levels must be >= 0, got {args.levels}")
-    table = sphere_table(args.levels, **_options(args))
+    table = sphere_table(args.levels, variant=args.variant, **_options(args))
     print(format_table(table))
     if args.csv:
         args.csv.parent.mkdir(parents=True, exist_ok=True)
         table.to_csv(args.csv, index=False)
-        config = {"command": "sphere-table", "levels": args.levels, **_options(args)}
+        config = {"command": "sphere-table", "levels": args.levels,
+                  "variant": args.variant, **_options(args)}
         Path(f"{args.csv}.json").write_text(json.dumps(provenance(config), indent=2))
         print(f"wrote {args.csv}")
     return 0 if (table["status"] == "ok").all() else 1
@@ -124,14 +126,16 @@ def _int(x):
 def _run(args):
     V, F = read_mesh(args.mesh)
     traj = simulate(V, F, args.tau, args.steps, save_every=args.save_every,
-                    progress=True, **_options(args))
+                    progress=True, **variant_options(args.variant), **_options(args))
     config = {"command": "run", "mesh": str(args.mesh), "tau": args.tau,
-              "steps": args.steps, "save_every": args.save_every, **_options(args)}
+              "steps": args.steps, "save_every": args.save_every,
+              "variant": args.variant, **_options(args)}
     args.out.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(
         args.out, F=traj.F, T=traj.T, faces=traj.faces, t=traj.t, steps=traj.steps,
         iterations=traj.iterations, t_min_barycentric=traj.t_min_barycentric,
         status=traj.status, message=traj.message, failed_step=traj.failed_step,
+        variant=args.variant,
         provenance=json.dumps(provenance(config)))
     done = len(traj.iterations)
     print(f"wrote {args.out}: {len(traj.t)} frames, {done} steps, "

@@ -5,13 +5,14 @@ Level ``k`` is the icosphere refined ``k`` times with
 """
 
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
 from .errors import SphereL2Error
 from .stepping import simulate
 from .surfaces import icosphere
+from .variants import variant_options
 
 T_FINAL = 0.08
 TAU_LEVEL_1 = 0.04
@@ -40,6 +41,7 @@ class SphereRun:
     Attributes
     ----------
     level, nV, nF, nT, N : int
+    variant : str
     tau : float
     l2_error : float
         (3.2); NaN when the run did not finish.
@@ -54,9 +56,12 @@ class SphereRun:
     t_min_barycentric : float
         The T monitor: smallest barycentric coordinate over all time levels.
     message : str
+    t_monitor : list of float
+        The T monitor at every time level reached (``n = 0, 1, ...``).
     """
 
     level: int
+    variant: str
     nV: int
     nF: int
     nT: int
@@ -70,12 +75,18 @@ class SphereRun:
     t_failed: float
     t_min_barycentric: float
     message: str = ""
+    t_monitor: list = field(default_factory=list, repr=False)
 
-    def to_dict(self):
-        return asdict(self)
+    def to_dict(self, series=True):
+        """Fields as a dict; ``series=False`` leaves out ``t_monitor``."""
+        row = asdict(self)
+        if not series:
+            del row["t_monitor"]
+        return row
 
 
-def sphere_run(level, *, tau=None, t_final=T_FINAL, radius=1.0, **flow_options):
+def sphere_run(level, *, tau=None, t_final=T_FINAL, radius=1.0, variant="paper",
+               **flow_options):
     """Run the DDFV flow on the icosphere of ``level`` and measure (3.2).
 
     Parameters
@@ -86,6 +97,8 @@ def sphere_run(level, *, tau=None, t_final=T_FINAL, radius=1.0, **flow_options):
         Time step; default :func:`level_time_step`.
     t_final : float
     radius : float
+    variant : str
+        A name of :data:`ddfv.variants.VARIANTS`.
     **flow_options
         Passed to :class:`ddfv.Flow` (``t_init``, ``rtol``, ``warm_start``,
         ``maxiter``).
@@ -101,17 +114,18 @@ def sphere_run(level, *, tau=None, t_final=T_FINAL, radius=1.0, **flow_options):
     V, Fc = icosphere(level, radius)
     error = SphereL2Error(radius)
     cpu, wall = time.process_time(), time.perf_counter()
-    traj = simulate(V, Fc, tau, steps, save_every=0, observer=error, **flow_options)
+    options = {**variant_options(variant), **flow_options}
+    traj = simulate(V, Fc, tau, steps, save_every=0, observer=error, **options)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
     ok = traj.status == "ok"
     return SphereRun(
-        level=int(level), nV=len(V) + len(Fc), nF=len(V), nT=len(Fc),
+        level=int(level), variant=variant, nV=len(V) + len(Fc), nF=len(V), nT=len(Fc),
         tau=tau, N=steps, l2_error=error.value if ok else float("nan"),
         iterations=int(traj.iterations.sum()), cpu_seconds=cpu,
         wall_seconds=wall, status=traj.status,
         t_failed=float("nan") if ok else traj.failed_step * tau,
         t_min_barycentric=float(traj.t_min_barycentric.min()),
-        message=traj.message)
+        message=traj.message, t_monitor=traj.t_min_barycentric.tolist())
 
 
 def sphere_table(levels, **options):
@@ -136,7 +150,8 @@ def sphere_table(levels, **options):
     from .errors import eoc
 
     levels = [int(level) for level in levels]
-    table = pd.DataFrame([sphere_run(level, **options).to_dict() for level in levels])
+    table = pd.DataFrame([sphere_run(level, **options).to_dict(series=False)
+                          for level in levels])
     orders = eoc(table["l2_error"].to_numpy())
     consecutive = np.r_[False, np.diff(levels) == 1]
     table.insert(table.columns.get_loc("iterations") + 1, "eoc",

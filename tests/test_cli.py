@@ -44,7 +44,7 @@ def test_run_holds_the_boundary_of_open_meshes(tmp_path):
     igl.write_triangle_mesh(str(mesh), V, F)
     out = tmp_path / "run.npz"
     assert main(["run", str(mesh), "--tau", "0.002", "--steps", "3",
-                 "--tangential", "eliminate", "--out", str(out)]) == 0
+                 "--variant", "eliminate", "--out", str(out)]) == 0
     run = np.load(out)
     rim = np.abs(np.abs(V[:, 2]) - 0.5) < 1e-12
     np.testing.assert_allclose(run["F"][-1][rim], run["F"][0][rim])

@@ -58,3 +58,17 @@ def test_time_step_coupling():
     assert [level_time_step(k) for k in (1, 2, 5)] == [0.04, 0.01, 0.04 / 256]
     with pytest.raises(ValueError, match="not a multiple of tau"):
         sphere_run(1, tau=0.03)
+
+
+def test_variants_converge_at_second_order_and_are_recorded():
+    for variant in ("chord", "eliminate"):
+        runs = [sphere_run(level, variant=variant) for level in (1, 2, 3)]
+        assert all(r.variant == variant and r.status == "ok" for r in runs)
+        orders = np.log2(np.array([r.l2_error for r in runs[:-1]])
+                         / [r.l2_error for r in runs[1:]])
+        assert np.all((orders > 1.8) & (orders < 2.2)), (variant, orders)
+
+
+def test_unknown_variant_is_named():
+    with pytest.raises(ValueError, match="unknown variant 'fast'; choose one of paper"):
+        sphere_run(1, variant="fast")

@@ -1,0 +1,36 @@
+"""Named variants of the scheme, selectable by name in the API, CLI and pipeline.
+
+A variant is a set of options of :class:`ddfv.Flow`; adding one is one
+entry in :data:`VARIANTS` (and a line in ``ddfv/README.md``).
+
+``paper``
+    The scheme as published: broken-line ``|gamma|`` (2.5), no tangential
+    correction.
+``chord``
+    ``|gamma|`` replaced by the chord of the dual curve (``|v|``, ``|u|``).
+``eliminate``
+    The paper's scheme with the tangential-velocity elimination (3.6).
+
+The T-vertex initialisation is a separate setting (``t_init``).
+"""
+
+VARIANTS = {
+    "paper": {},
+    "chord": {"dual_length": "chord"},
+    "eliminate": {"tangential": "eliminate"},
+}
+
+
+def variant_options(name):
+    """Options of :class:`ddfv.Flow` that make up variant ``name``.
+
+    Raises
+    ------
+    ValueError
+        Unknown variant, naming the known ones.
+    """
+    try:
+        return dict(VARIANTS[name])
+    except KeyError:
+        raise ValueError(f"unknown variant {name!r}; choose one of "
+                         f"{', '.join(VARIANTS)}") from None
