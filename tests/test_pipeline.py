@@ -1,0 +1,178 @@
+"""The Snakemake pipeline, run for real on levels 1-2 in a temporary copy.
+
+The copy holds ``Snakefile``, ``workflow/`` and ``config/``; the packages
+come from this checkout through ``PYTHONPATH``. Checked: the numbers of
+``results/tables/convergence.csv`` against Table 3.1, every output, that a
+second run has nothing to do, that a bad run record stops the aggregation
+with a message naming the file, and that bad config values stop before any
+job.
+
+If the Slurm executor plugin is installed, Snakemake imports it at start-up
+and it asks ``scontrol show config``, which takes 10 s to give up when Slurm
+is installed but not running. These local runs do not use Slurm, so a
+``scontrol`` that fails at once is put first on ``PATH``.
+"""
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+# the study's own target (rule all also builds the figures of another rule
+# file); targets before --config, which takes every following word
+RUN = ["--cores", "2", "convergence", "--config", "levels=[1,2]"]
+TABLE = Path("results/tables/convergence.csv")
+OUTPUTS = [
+    "results/tables/convergence.csv", "results/tables/convergence.md",
+    "results/tables/convergence.tex", "results/tables/convergence.csv.json",
+    "results/figures/convergence.png", "results/figures/convergence.pdf",
+    *(f"results/runs/{s}/level{k}.json" for s in ("ddfv", "cotan") for k in (1, 2)),
+]
+IGNORE = shutil.ignore_patterns(".snakemake", "__pycache__", "*.pyc")
+TIMEOUT = 300
+
+
+def copy_workflow(dest):
+    dest.mkdir(parents=True)
+    shutil.copy2(REPO / "Snakefile", dest / "Snakefile")
+    for name in ("workflow", "config"):
+        shutil.copytree(REPO / name, dest / name, ignore=IGNORE)
+    return dest
+
+
+@pytest.fixture(scope="module")
+def env(tmp_path_factory):
+    stub = tmp_path_factory.mktemp("bin")
+    (stub / "scontrol").write_text("#!/bin/sh\nexit 1\n")
+    (stub / "scontrol").chmod(0o755)
+    env = {k: v for k, v in os.environ.items() if not k.startswith("SLURM_")}
+    env["PATH"] = os.pathsep.join([str(stub), env.get("PATH", "")])
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(REPO), env.get("PYTHONPATH")]))
+    return env
+
+
+def snakemake(workdir, env, *args):
+    """Run snakemake in workdir; return (exit code, stdout + stderr)."""
+    proc = subprocess.run([sys.executable, "-m", "snakemake", *args], cwd=workdir, env=env,
+                          capture_output=True, text=True, timeout=TIMEOUT)
+    return proc.returncode, proc.stdout + proc.stderr
+
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory, env):
+    work = copy_workflow(tmp_path_factory.mktemp("pipeline") / "work")
+    code, out = snakemake(work, env, *RUN)
+    assert code == 0, out[-5000:]
+    return work
+
+
+@pytest.fixture(scope="module")
+def table(workdir):
+    return pd.read_csv(workdir / TABLE)
+
+
+def test_all_outputs_exist(workdir):
+    missing = [p for p in OUTPUTS if not (workdir / p).is_file()]
+    assert not missing
+    assert not list((workdir / "results" / "runs").rglob("*.tmp"))
+
+
+def test_ddfv_errors_match_table_3_1(table):
+    ddfv = table[table["scheme"] == "ddfv"].set_index("level")
+    assert ddfv.loc[1, "l2_error"] == pytest.approx(1.34e-2, rel=0.03)
+    assert ddfv.loc[2, "l2_error"] == pytest.approx(3.26e-3, rel=0.01)
+    assert ddfv.loc[2, "paper_l2_error"] == 3.26e-3
+    np.testing.assert_allclose(ddfv["l2_ratio"], ddfv["l2_error"] / ddfv["paper_l2_error"])
+    assert ddfv["nV"].tolist() == [122, 482] and ddfv["N"].tolist() == [2, 8]
+    assert ddfv.loc[2, "eoc"] == pytest.approx(2.0, abs=0.1)
+
+
+def test_cotan_rows(table):
+    cotan = table[table["scheme"] == "cotan"].set_index("level")
+    assert cotan.index.tolist() == [1, 2]
+    assert (cotan["status"] == "ok").all()
+    assert np.isfinite(cotan["l2_error"]).all() and (cotan["l2_error"] > 0).all()
+    assert cotan["nV"].tolist() == [42, 162] and (cotan["nT"] == 0).all()
+    assert np.isnan(cotan.loc[1, "eoc"]) and cotan.loc[2, "eoc"] == pytest.approx(2.0, abs=0.15)
+    assert cotan["paper_l2_error"].isna().all()
+    np.testing.assert_allclose(cotan["wall_time_ratio"], 1.0)
+
+
+def test_table_layout(table):
+    assert table[["scheme", "level"]].values.tolist() == [
+        ["ddfv", 1], ["ddfv", 2], ["cotan", 1], ["cotan", 2]]
+    for column in ("scheme", "level", "nV", "tau", "N", "l2_error", "eoc", "iterations",
+                   "cpu_seconds", "wall_seconds", "status", "t_failed",
+                   "t_min_barycentric", "paper_l2_error", "paper_eoc",
+                   "paper_iterations", "paper_cpu_seconds", "l2_ratio"):
+        assert column in table.columns
+
+
+def test_provenance(workdir, table):
+    sidecar = json.loads((workdir / "results/tables/convergence.csv.json").read_text())
+    assert sidecar["config"]["levels"] == [1, 2] and sidecar["config_hash"]
+    assert len(sidecar["inputs"]) == 4
+    record = json.loads((workdir / "results/runs/cotan/level2.json").read_text())
+    assert record["provenance"]["blas_threads"] == dict.fromkeys(
+        ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"), "1")
+    assert record["provenance"]["blas_pinned_before_numpy"] is True
+    assert record["l2_error"] == table.set_index(["scheme", "level"]).loc[
+        ("cotan", 2), "l2_error"]
+
+
+def test_second_run_has_nothing_to_do(workdir, env):
+    code, out = snakemake(workdir, env, *RUN)
+    assert code == 0, out[-3000:]
+    assert "Nothing to be done" in out
+
+
+def test_bad_run_records_stop_the_aggregation(workdir, env, tmp_path):
+    work = tmp_path / "work"
+    shutil.copytree(workdir, work, symlinks=True)
+    runs = work / "results" / "runs"
+    (runs / "cotan" / "level2.json").write_text('{"scheme": "cotan", "level": 2,')
+    record = json.loads((runs / "ddfv" / "level1.json").read_text())
+    record["iterations"] = "8"
+    (runs / "ddfv" / "level1.json").write_text(json.dumps(record))
+    record = json.loads((runs / "ddfv" / "level2.json").read_text())
+    record["provenance"]["config_hash"] = "0123456789abcdef"
+    (runs / "ddfv" / "level2.json").write_text(json.dumps(record))
+    before = (work / TABLE).read_text()
+    code, out = snakemake(work, env, *RUN)
+    assert code != 0
+    assert "results/runs/cotan/level2.json: not valid JSON" in out
+    assert "results/runs/ddfv/level1.json: key 'iterations' should be int" in out
+    assert "results/runs/ddfv/level2.json: config hash '0123456789abcdef' does not match" in out
+    assert "3 invalid run record(s)" in out
+    assert "Error in rule convergence_table" in out
+    # the table of the good run is gone (Snakemake removes outputs of a failed job)
+    assert not (work / TABLE).exists() or (work / TABLE).read_text() == before
+
+
+BAD_CONFIGS = {  # --config value -> expected part of the message
+    "levels=[0]": "schema['properties']['levels']",
+    'levels=["a"]': "schema['properties']['levels']",
+    "schemes=[ddfv,fem]": "config key 'schemes': unknown scheme(s) ['fem']",
+    "tau_level_1=-0.04": "schema['properties']['tau_level_1']",
+    "tau_level_1=0.03": "config keys 't_final' and 'tau_level_1'",
+}
+
+
+def test_bad_config_stops_before_any_job(tmp_path, env):
+    work = copy_workflow(tmp_path / "work")
+    procs = {setting: subprocess.Popen(
+        [sys.executable, "-m", "snakemake", "-n", "convergence", "--config", setting],
+        cwd=work, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        for setting in BAD_CONFIGS}  # side by side: each is a Snakemake start-up
+    for setting, proc in procs.items():
+        out, _ = proc.communicate(timeout=TIMEOUT)
+        assert proc.returncode != 0, setting
+        assert BAD_CONFIGS[setting] in out, (setting, out[-2000:])
+    assert not (work / "results").exists()

@@ -1,0 +1,166 @@
+# Helpers shared by the rules: checks of the validated config that need more
+# than one key, the settings of one run, and the target lists.
+
+import functools
+import hashlib
+import importlib.machinery
+import math
+import os
+import re
+import sys
+from pathlib import Path
+
+
+class ConfigError(ValueError):
+    """A config value the schema cannot check; the message names the key."""
+
+
+# `--config levels=[1,2]` gives strings (checked by the schema): normalise
+LEVELS = sorted({int(level) for level in config["levels"]})
+config["levels"] = LEVELS
+SCHEMES = list(config["schemes"])
+# scheme -> (module, options of its sphere_run)
+SCHEME_MODULES = {
+    name: (entry, {}) if isinstance(entry, str) else (entry["module"], entry.get("options", {}))
+    for name, entry in config["scheme_modules"].items()
+}
+
+_unknown = [s for s in SCHEMES if s not in SCHEME_MODULES]
+if _unknown:
+    raise ConfigError(
+        f"config key 'schemes': unknown scheme(s) {_unknown}; known schemes are "
+        f"the keys of 'scheme_modules': {sorted(SCHEME_MODULES)}"
+    )
+
+
+def level_time_step(level):
+    """tau = tau_level_1 / 4**(level - 1), the coupling tau ~ h^2 of Table 3.1."""
+    return float(config["tau_level_1"]) / 4.0 ** (level - 1)
+
+
+def level_steps(level):
+    """Number of time steps N = t_final / tau of a level."""
+    return round(float(config["t_final"]) / level_time_step(level))
+
+
+for _level in LEVELS:
+    _steps = config["t_final"] / level_time_step(_level)
+    if _steps < 0.5 or not math.isclose(_steps, round(_steps), rel_tol=1e-9):
+        raise ConfigError(
+            f"config keys 't_final' and 'tau_level_1': t_final = {config['t_final']} "
+            f"is not a whole multiple of the level-{_level} time step "
+            f"tau = {level_time_step(_level):g} (t_final / tau = {_steps:g})"
+        )
+
+
+def _check_importable(scheme, module):
+    """Fail early unless the jobs can import `module`: its package lies next
+    to this Snakefile (a checkout; workflow/scripts/run_records.py puts that
+    first on sys.path) or is installed. The working directory does not count:
+    scripts do not run with it on sys.path."""
+    top = module.split(".")[0]
+    if (Path(workflow.basedir) / top / "__init__.py").is_file():
+        return
+    search = [p for p in sys.path if p not in ("", os.getcwd())]
+    if importlib.machinery.PathFinder.find_spec(top, search) is None:
+        raise ConfigError(
+            f"config key 'scheme_modules.{scheme}': package {top!r} of module "
+            f"{module!r} is not importable; install the project "
+            "(pip install -e . in the repository) or put it on PYTHONPATH"
+        )
+
+
+for _scheme in SCHEMES:
+    _check_importable(_scheme, SCHEME_MODULES[_scheme][0])
+
+
+def _package_dir(top):
+    """Folder of package `top` as the jobs will import it (see _check_importable)."""
+    search = [workflow.basedir] + [p for p in sys.path if p not in ("", os.getcwd())]
+    spec = importlib.machinery.PathFinder.find_spec(top, search)
+    return Path(spec.origin).parent
+
+
+@functools.cache
+def code_digest(top):
+    """SHA-256 of the Python files of package `top`: part of the run settings,
+    so that a run is redone when the code of its scheme changes (Snakemake
+    tracks only the rule's own script)."""
+    digest = hashlib.sha256()
+    root = _package_dir(top)
+    for path in sorted(root.rglob("*.py")):
+        digest.update(path.relative_to(root).as_posix().encode() + b"\0")
+        digest.update(path.read_bytes() + b"\0")
+    return digest.hexdigest()[:16]
+
+
+def run_settings(scheme, level):
+    """Everything that determines the run record of (scheme, level).
+
+    Passed to the run job and stored (with its hash) in the record's
+    provenance; the aggregation recomputes it to detect stale records.
+    """
+    level = int(level)
+    return {
+        "scheme": scheme,
+        "module": SCHEME_MODULES[scheme][0],
+        "options": SCHEME_MODULES[scheme][1],
+        "level": level,
+        "tau": level_time_step(level),
+        "t_final": float(config["t_final"]),
+        "radius": 1.0,
+        "rtol": float(config["rtol"]),
+        "code": {top: code_digest(top) for top in _packages(scheme)},
+    }
+
+
+def _packages(scheme):
+    """The packages a run imports: ddfv (SphereRun, solver) and the scheme's."""
+    return sorted({"ddfv", SCHEME_MODULES[scheme][0].split(".")[0]})
+
+
+def run_record(scheme, level):
+    return f"results/runs/{scheme}/level{level}.json"
+
+
+def run_records():
+    """Run records of every (scheme, level), schemes in config order."""
+    return [run_record(s, level) for s in SCHEMES for level in LEVELS]
+
+
+def expected_runs():
+    """{record path: settings} for the aggregation's checks."""
+    return {run_record(s, lv): run_settings(s, lv) for s in SCHEMES for lv in LEVELS}
+
+
+def run_seconds_estimate(level):
+    """Rough single-core wall time of one run (level 5: a few s; x16 per level)."""
+    return 10.0 * 16.0 ** (int(level) - 5)
+
+
+def run_runtime(wildcards):
+    """Slurm time limit in minutes: 4x the estimate, at least 5."""
+    return max(5, math.ceil(4 * run_seconds_estimate(wildcards.level) / 60))
+
+
+def run_mem_mb(wildcards):
+    """Peak memory with margin (measured: level 5 about 95 MB, x4 per level)."""
+    return 500 + 100 * 4 ** max(int(wildcards.level) - 5, 0)
+
+
+TABLES = [
+    "results/tables/convergence.csv",
+    "results/tables/convergence.md",
+    "results/tables/convergence.tex",
+    "results/tables/convergence.csv.json",
+]
+CONVERGENCE_FIGURES = [
+    "results/figures/convergence.png",
+    "results/figures/convergence.pdf",
+]
+CONVERGENCE_TARGETS = TABLES + CONVERGENCE_FIGURES
+
+
+wildcard_constraints:
+    scheme="|".join(re.escape(s) for s in SCHEMES),
+    level=r"[1-9][0-9]*",

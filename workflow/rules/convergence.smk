@@ -1,0 +1,91 @@
+# Convergence study: one job per (scheme, level), then Table 3.1 and the
+# convergence figure from the run records.
+#
+#   snakemake --cores 2 convergence    # only this study (rule all adds the figures)
+
+
+rule convergence:
+    """Target: Table 3.1 (CSV, Markdown, LaTeX, provenance) and the convergence figure."""
+    localrule: True
+    input:
+        CONVERGENCE_TARGETS,
+
+
+rule run_scheme:
+    """One scheme on one sphere level: results/runs/{scheme}/level{level}.json."""
+    output:
+        "results/runs/{scheme}/level{level}.json",
+    params:
+        # includes a digest of the schemes' code: changed code reruns the job
+        settings=lambda wildcards: run_settings(wildcards.scheme, wildcards.level),
+    log:
+        "results/logs/runs/{scheme}/level{level}.log",
+    threads: 1
+    resources:
+        mem_mb=run_mem_mb,
+        runtime=run_runtime,
+    # the long runs first, so that the short ones fill the other cores
+    priority: lambda wildcards: int(wildcards.level)
+    conda:
+        "../envs/ddfv.yaml"
+    script:
+        "../scripts/run_scheme.py"
+
+
+rule convergence_table:
+    """Table 3.1 with the paper's values and the baselines side by side."""
+    input:
+        records=run_records(),
+    output:
+        csv=report(
+            "results/tables/convergence.csv",
+            caption="../report/convergence_table.rst",
+            category="Convergence",
+            labels={"table": "Table 3.1 (CSV)"},
+        ),
+        md="results/tables/convergence.md",
+        tex="results/tables/convergence.tex",
+        provenance="results/tables/convergence.csv.json",
+    params:
+        expected=expected_runs(),
+        schemes=SCHEMES,
+        levels=LEVELS,
+        settings=config,
+    log:
+        "results/logs/convergence_table.log",
+    localrule: True
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    conda:
+        "../envs/ddfv.yaml"
+    script:
+        "../scripts/convergence_table.py"
+
+
+rule convergence_figure:
+    """Log-log L2 error against h for every scheme and the paper's points."""
+    input:
+        csv="results/tables/convergence.csv",
+    output:
+        png=report(
+            "results/figures/convergence.png",
+            caption="../report/convergence_figure.rst",
+            category="Convergence",
+            labels={"figure": "L2 error vs h"},
+        ),
+        pdf="results/figures/convergence.pdf",
+    params:
+        t_final=config["t_final"],
+    log:
+        "results/logs/convergence_figure.log",
+    localrule: True
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    conda:
+        "../envs/ddfv.yaml"
+    script:
+        "../scripts/plot_convergence.py"

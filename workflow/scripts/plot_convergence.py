@@ -1,0 +1,78 @@
+"""Convergence figure: space-time L2 error against the mesh size h (log-log).
+
+Called by rule ``convergence_figure`` (workflow/rules/convergence.smk) with
+``results/tables/convergence.csv``; one line per scheme, the published DDFV
+errors of Table 3.1 as open markers, and a slope-2 reference line.
+"""
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import FixedFormatter, FixedLocator, NullFormatter  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from run_records import setup_logging  # noqa: E402
+
+STYLE = {  # scheme -> label, colour, marker
+    "ddfv": ("DDFV (ours)", "tab:blue", "o"),
+    "cotan": ("cotangent, libigl (ours)", "tab:orange", "s"),
+}
+OTHER_COLOURS = ["tab:green", "tab:purple", "tab:brown", "tab:pink"]
+
+
+def plot(table, t_final):
+    """The figure of ``table`` (the convergence CSV as a DataFrame)."""
+    fig, ax = plt.subplots(figsize=(5.2, 4.0), layout="constrained")
+    ok = table[(table["status"] == "ok") & np.isfinite(table["l2_error"])]
+    others = iter(OTHER_COLOURS)
+    for scheme in table["scheme"].unique():
+        rows = ok[ok["scheme"] == scheme].sort_values("h")
+        label, colour, marker = STYLE.get(scheme, (scheme, next(others, "k"), "^"))
+        ax.plot(rows["h"], rows["l2_error"], marker=marker, color=colour, label=label,
+                markersize=5, linewidth=1.5)
+    paper = table[np.isfinite(table["paper_l2_error"])].sort_values("h")
+    if len(paper):
+        ax.plot(paper["h"], paper["paper_l2_error"], linestyle="none", marker="o",
+                markersize=10, markerfacecolor="none", markeredgecolor="black",
+                markeredgewidth=1.0, label="DDFV, Table 3.1 (paper)")
+    if len(ok):
+        h = np.array([ok["h"].min(), ok["h"].max()])
+        # through the smallest error at the finest mesh, shifted down by 2x
+        finest = ok[ok["h"] == ok["h"].min()]["l2_error"].min()
+        ax.plot(h, 0.5 * finest * (h / h[0]) ** 2, linestyle="--", color="0.5",
+                linewidth=1.0, label=r"slope 2 ($\propto h^2$)")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    levels = table.drop_duplicates("level").sort_values("h")
+    ax.xaxis.set_major_locator(FixedLocator(levels["h"]))
+    ax.xaxis.set_major_formatter(FixedFormatter([f"{h:.3g}" for h in levels["h"]]))
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    top = ax.secondary_xaxis("top")
+    top.set_xticks(levels["h"], labels=[str(level) for level in levels["level"]])
+    top.xaxis.set_minor_formatter(NullFormatter())
+    top.set_xlabel("refinement level", fontsize=9)
+    ax.set_xlabel(r"mesh size $h$ (mean edge length)")
+    ax.set_ylabel(r"space-time $L_2$ error")
+    ax.text(0.97, 0.04, "shrinking unit sphere\n" rf"$\tau \sim h^2$, $t_f = {t_final:g}$",
+            transform=ax.transAxes, ha="right", va="bottom", fontsize=8)
+    ax.grid(True, which="major", linewidth=0.5, alpha=0.5)
+    ax.grid(True, which="minor", axis="y", linewidth=0.3, alpha=0.25)
+    ax.legend(fontsize=8, loc="upper left", frameon=False)
+    return fig
+
+
+def main(csv, t_final, png, pdf, log_file):
+    log = setup_logging(log_file)
+    fig = plot(pd.read_csv(csv), t_final)
+    fig.savefig(png, dpi=200, metadata={"Software": None})
+    fig.savefig(pdf, metadata={"CreationDate": None, "Creator": None, "Producer": None})
+    plt.close(fig)
+    log.info("wrote %s, %s", png, pdf)
+
+
+if __name__ == "__main__":
+    sm = snakemake  # noqa: F821
+    main(sm.input.csv, sm.params.t_final, sm.output.png, sm.output.pdf, sm.log[0])
