@@ -1,0 +1,417 @@
+"""The experiments behind Figs. 3.1-3.8 of the paper, in one place.
+
+An :class:`Experiment` is one figure: the runs it needs (:class:`Run`:
+initial shape and its parameters, scheme, ``tau``, number of steps,
+tangential setting) and the panels to draw (:class:`Shot`: which run,
+which time level, zoom). ``EXPERIMENTS`` maps the figure name
+(``"fig_3_2"``) to it; ``workflow/scripts/figure.py`` runs one experiment
+with :func:`run_experiment` and draws it with :func:`draw_experiment`.
+
+Choices not stated in the paper (it gives only ``n_V``, ``tau`` for
+Figs. 3.2 and 3.5, and the time levels shown):
+
+* shapes and their parameters: see :mod:`ddfv.shapes` (bumpy sphere with
+  eight Gaussian bumps; cymling with flattening 0.4, 9 scallops of 10 %;
+  cylinder ``R = 1``, ``h = 0.55``, 24 x 8 twisted quads; hemisphere of
+  radius 1 with 10 rings);
+* ``tau = 0.0025`` everywhere (the paper's value for Figs. 3.2 and 3.5,
+  assumed for the others);
+* the cymling's flattening is chosen so that, as in the paper, ``n = 12``
+  is the last level before the contracted diamond cells go wrong (a
+  T-vertex leaves its triangle at ``n = 13``);
+* with these choices the cylinder without elimination loses a T-vertex
+  from its triangle between ``n = 580`` and ``n = 640`` (at ``n = 592``),
+  as in Fig. 3.6.
+"""
+
+import time
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from .diagnostics import MeshQuality, describe_violation, first_violation
+from .shapes import make_shape
+
+TAU = 0.0025
+SCHEMES = ("ddfv", "cotan")
+
+
+@dataclass(frozen=True)
+class Run:
+    """One simulation.
+
+    Attributes
+    ----------
+    key : str
+        Name of the run inside its experiment.
+    shape : str
+        A name of :data:`ddfv.shapes.SHAPES`.
+    params : dict
+        Parameters of the shape generator.
+    tau : float
+    steps : int
+    save_every : int
+        Frames kept (every panel's time level must be a multiple).
+    tangential : {"none", "eliminate"}
+        Passed to :func:`ddfv.simulate` (3.6).
+    scheme : {"ddfv", "cotan"}
+        ``"cotan"``: the cotangent baseline :mod:`baselines.cotan`.
+    t_init : str
+        T-vertex initialisation (Section 3).
+    label : str
+        Short description for legends.
+    """
+
+    key: str
+    shape: str
+    params: dict = field(default_factory=dict)
+    tau: float = TAU
+    steps: int = 0
+    save_every: int = 1
+    tangential: str = "none"
+    scheme: str = "ddfv"
+    t_init: str = "paper"
+    label: str = ""
+
+    def config(self):
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class Zoom:
+    """A square detail of half-width ``half`` (in length units of the surface).
+
+    ``at`` is a 3-D point, or ``"worst"``: the visible element worst by
+    the measure ``by`` (:func:`ddfv.render.worst_element`: the diamond
+    with the smallest angle, or the T-vertex with the smallest barycentric
+    coordinate) at time level ``step`` (by default the panel's own),
+    followed to the panel's time level.
+    """
+
+    half: float
+    at: object = "worst"
+    step: int | None = None
+    by: str = "angle"
+
+
+@dataclass(frozen=True)
+class Shot:
+    """One panel: run ``run`` at time level ``step``.
+
+    ``label`` is a template with ``{n}`` for the time level. ``zoom`` shows
+    a detail; ``box`` outlines, in a full view, the region of a detail
+    shown in another panel (the :class:`Zoom` of that panel).
+    """
+
+    run: str
+    step: int
+    label: str = "n = {n}"
+    zoom: Zoom | None = None
+    box: Zoom | None = None
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """A figure: runs, panels, view and caption."""
+
+    name: str
+    title: str
+    caption: str
+    runs: tuple
+    shots: tuple
+    view: tuple = (20.0, -60.0)
+    rows: int = 1
+    size: float = 2.6
+    aspect: float = 1.0
+
+    def run(self, key):
+        for r in self.runs:
+            if r.key == key:
+                return r
+        raise KeyError(f"experiment {self.name} has no run {key!r}")
+
+    def config(self):
+        return {"name": self.name, "runs": [r.config() for r in self.runs],
+                "shots": [asdict(s) for s in self.shots], "view": list(self.view)}
+
+    def describe(self):
+        """The runs as a reStructuredText bullet list (for report captions)."""
+        lines = []
+        for r in self.runs:
+            params = ", ".join(f"{k} = {v}" for k, v in r.params.items())
+            scheme = "DDFV" if r.scheme == "ddfv" else "cotangent"
+            what = f"{scheme} scheme, shape ``{r.shape}`` ({params}), tau = {r.tau:g}, " \
+                   f"{r.steps} steps"
+            if r.scheme == "ddfv":
+                what += f", tangential = ``{r.tangential}``, T-vertices ``{r.t_init}``"
+            lines.append(f"- ``{r.key}``: {what}")
+        steps = ", ".join(str(s.step) + (" (detail)" if s.zoom else "") for s in self.shots)
+        lines.append(f"- panels at n = {steps}; view elevation {self.view[0]:g}, "
+                     f"azimuth {self.view[1]:g} degrees")
+        return "\n".join(lines)
+
+
+def _shots(run, steps, **kw):
+    return tuple(Shot(run, n, **kw) for n in steps)
+
+
+_CYLINDER = dict(segments=24, bands=8, radius=1.0, half_height=0.55)
+_CYMLING = dict(level=3, flattening=0.4, lobes=9, wave=0.1)
+_BUMPY = dict(level=3, amplitude=0.25, width=0.2)
+_RIM_ZOOM = Zoom(0.12, "worst", 12)
+_CYL_ZOOM = Zoom(0.25, "worst", 640, by="barycentric")
+
+EXPERIMENTS = {e.name: e for e in [
+    Experiment(
+        "fig_3_1", "Sphere discretisations for the DDFV method",
+        "Discretisations of the unit sphere used by the DDFV method, from left to "
+        "right n_V = 122, 482, 1922 and 7682 (icosphere levels 1 to 4). Blue: the "
+        "primal triangles (F-edges); red: the diamond mesh joining every F-vertex to "
+        "the T-vertices of its triangles, initialised as in Section 3.",
+        runs=tuple(Run(f"level{k}", "sphere", {"level": k}, steps=0,
+                       label=f"icosphere level {k}") for k in (1, 2, 3, 4)),
+        shots=tuple(Shot(f"level{k}", 0, label=f"n_V = {30 * 4**k + 2}") for k in (1, 2, 3, 4)),
+        view=(20.0, -60.0), size=3.2),
+    Experiment(
+        "fig_3_2", "Bumpy sphere",
+        "Mean curvature flow of a bumpy sphere with n_V = 1922 and tau = 0.0025, "
+        "shown at time steps n = 0, 4, 12 and 32. The T-vertices follow the "
+        "F-vertices; none escapes from its triangle.",
+        runs=(Run("ddfv", "bumpy_sphere", _BUMPY, steps=32, save_every=4),),
+        shots=_shots("ddfv", (0, 4, 12, 32))),
+    Experiment(
+        "fig_3_3", "Cymling-like shape",
+        "Mean curvature flow of a cymling-like (pattypan squash) shape with "
+        "n_V = 1922 and tau = 0.0025, at time steps n = 0, 4, 8 and 12. The rim, "
+        "where the initial curvature is high, is where the diamond mesh deteriorates.",
+        runs=(Run("ddfv", "cymling", _CYMLING, steps=12, save_every=1),),
+        shots=_shots("ddfv", (0, 4, 8, 12)), view=(35.0, -60.0), aspect=0.7),
+    Experiment(
+        "fig_3_4", "Contraction of diamond cells (cymling, detail)",
+        "Detail of the cymling-like shape of Fig. 3.3 at its rim, the region of high "
+        "initial curvature: the same diamond cells at n = 0, 8 and 12 (tau = 0.0025). "
+        "The cells contract; one step later (n = 13) a T-vertex leaves its triangle.",
+        runs=(Run("ddfv", "cymling", _CYMLING, steps=13, save_every=1),),
+        shots=(Shot("ddfv", 12, box=_RIM_ZOOM),
+               Shot("ddfv", 0, "n = {n} (detail)", zoom=_RIM_ZOOM),
+               Shot("ddfv", 8, "n = {n} (detail)", zoom=_RIM_ZOOM),
+               Shot("ddfv", 12, "n = {n} (detail)", zoom=_RIM_ZOOM)),
+        view=(10.0, -75.0), aspect=0.8),
+    Experiment(
+        "fig_3_5", "Cylinder to catenoid",
+        "Mean curvature flow of an open cylinder (radius 1, height 1.1) with both "
+        "boundary circles fixed, n_V = 600, tau = 0.0025, diamond mesh shown, at time "
+        "steps n = 0, 40, 100 and 200: the surface approaches the catenoid.",
+        runs=(Run("ddfv", "cylinder", _CYLINDER, steps=200, save_every=20),),
+        shots=_shots("ddfv", (0, 40, 100, 200)), view=(12.0, -60.0), aspect=0.8),
+    Experiment(
+        "fig_3_6", "Degeneration of the diamond mesh (cylinder)",
+        "Continuation of the cylinder of Fig. 3.5 without tangential control. At "
+        "n = 580 the T-vertices in the second row of triangles from each boundary circle "
+        "have drifted towards the edges of their triangles; by n = 640 they "
+        "have left them and the diamond mesh folds over (dark cells near the rims). "
+        "Right: the folded region at n = 640 "
+        "in detail. The run record gives the first step at which a T-vertex left its "
+        "triangle.",
+        runs=(Run("ddfv", "cylinder", _CYLINDER, steps=640, save_every=20),),
+        shots=(Shot("ddfv", 580), Shot("ddfv", 640, box=_CYL_ZOOM),
+               Shot("ddfv", 640, "n = {n} (detail)", zoom=_CYL_ZOOM)),
+        view=(12.0, -60.0), aspect=0.8),
+    Experiment(
+        "fig_3_7", "Cylinder with tangential velocity eliminated",
+        "The cylinder of Fig. 3.5 computed with the tangential velocity eliminated "
+        "(3.6), at time steps n = 0, 100, 200 and 640: the T-vertices stay inside "
+        "their triangles and the diamond mesh does not degenerate.",
+        runs=(Run("ddfv", "cylinder", _CYLINDER, steps=640, save_every=20,
+                  tangential="eliminate"),),
+        shots=_shots("ddfv", (0, 100, 200, 640)), view=(12.0, -60.0), aspect=0.8),
+    Experiment(
+        "fig_3_8", "Hemisphere with fixed equator",
+        "Mean curvature flow of a hemisphere whose equator is held fixed, with the "
+        "tangential velocity eliminated (3.6), n_V = 931, tau = 0.0025, at time steps "
+        "n = 0, 40, 80 and 600: the surface flattens to the disk spanned by the equator.",
+        runs=(Run("ddfv", "hemisphere", {"rings": 10}, steps=600, save_every=40,
+                  tangential="eliminate"),),
+        shots=_shots("ddfv", (0, 40, 80, 600)), view=(25.0, -60.0), aspect=0.75),
+    Experiment(
+        "fig_3_6_cotan", "Cylinder: DDFV and the cotangent scheme",
+        "The cylinder of Figs. 3.5-3.6 (n_V = 600 for DDFV; the cotangent scheme has "
+        "the 216 F-vertices only) at n = 200, 580 and 640: top, DDFV without "
+        "tangential control; bottom, the cotangent scheme (baselines/cotan.py).",
+        runs=(Run("ddfv", "cylinder", _CYLINDER, steps=640, save_every=20, label="DDFV"),
+              Run("cotan", "cylinder", _CYLINDER, steps=640, save_every=20,
+                  scheme="cotan", label="cotangent")),
+        shots=(_shots("ddfv", (200, 580, 640), label="DDFV, n = {n}")
+               + _shots("cotan", (200, 580, 640), label="cotangent, n = {n}")),
+        rows=2, view=(12.0, -60.0), aspect=0.8),
+    Experiment(
+        "fig_3_4_cotan", "Cymling: DDFV and the cotangent scheme",
+        "The cymling-like shape of Fig. 3.3 (tau = 0.0025) at n = 0, 8 and 12: top, "
+        "DDFV; bottom, the cotangent scheme (baselines/cotan.py) on the same "
+        "F-vertices. The mesh contracts at the rim in both.",
+        runs=(Run("ddfv", "cymling", _CYMLING, steps=12, save_every=1, label="DDFV"),
+              Run("cotan", "cymling", _CYMLING, steps=12, save_every=1,
+                  scheme="cotan", label="cotangent")),
+        shots=(_shots("ddfv", (0, 8, 12), label="DDFV, n = {n}")
+               + _shots("cotan", (0, 8, 12), label="cotangent, n = {n}")),
+        rows=2, view=(35.0, -60.0), aspect=0.7),
+]}
+"""Figure name -> :class:`Experiment`."""
+
+PAPER_FIGURES = tuple(f"fig_3_{k}" for k in range(1, 9))
+
+
+def validate(experiment):
+    """Check that every panel's time level is computed and kept as a frame."""
+    for shot in experiment.shots:
+        run = experiment.run(shot.run)
+        for step in (shot.step, getattr(shot.zoom, "step", None), getattr(shot.box, "step", None)):
+            if step is None:
+                continue
+            if step > run.steps or (step % run.save_every and step != run.steps):
+                raise ValueError(f"{experiment.name}: time level {step} of run {run.key} "
+                                 f"is not kept (steps {run.steps}, save_every {run.save_every})")
+
+
+@dataclass
+class RunResult:
+    """Frames and record of one :class:`Run`."""
+
+    run: Run
+    F: np.ndarray           # (frames, n_f, 3)
+    T: np.ndarray | None    # (frames, n_t, 3); None for the cotangent scheme
+    steps: np.ndarray
+    faces: np.ndarray
+    iterations: np.ndarray
+    status: str
+    message: str
+    failed_step: int
+    wall_seconds: float
+    quality: object = None  # pandas.DataFrame of ddfv.diagnostics, DDFV runs only
+
+    def frame(self, step):
+        """Index of the last kept frame at or before ``step``."""
+        return int(np.searchsorted(self.steps, step, side="right") - 1)
+
+    def record(self):
+        """JSON-serialisable summary."""
+        violation = None if self.quality is None else first_violation(self.quality)
+        return {
+            "run": self.run.config(),
+            "status": self.status,
+            "message": self.message,
+            "failed_step": int(self.failed_step),
+            "last_step": int(self.steps[-1]),
+            "frames": [int(s) for s in self.steps],
+            "iterations": int(np.sum(self.iterations)),
+            "wall_seconds": round(self.wall_seconds, 3),
+            "first_violation": violation,
+            "violation": "" if self.quality is None else describe_violation(self.quality),
+        }
+
+
+def run_one(run):
+    """Simulate one :class:`Run`.
+
+    A breakdown of the flow ends the run with its status, keeping the
+    frames computed before. A scheme that refuses the surface (e.g. an open
+    surface for a closed-only scheme) gives ``status = "unsupported"`` with
+    the initial surface as the only frame.
+
+    Returns
+    -------
+    RunResult
+    """
+    if run.scheme not in SCHEMES:
+        raise ValueError(f"unknown scheme {run.scheme!r}; choose one of {', '.join(SCHEMES)}")
+    V, faces = make_shape(run.shape, **run.params)
+    start = time.perf_counter()
+    if run.scheme == "cotan":
+        from baselines import cotan
+
+        try:
+            traj = cotan.simulate(V, faces, run.tau, run.steps, save_every=run.save_every)
+        except ValueError as err:
+            return RunResult(run, V[None], None, np.array([0]), faces, np.array([], int),
+                             "unsupported", str(err), -1, time.perf_counter() - start)
+        return RunResult(run, traj.V, None, traj.steps, traj.faces, traj.iterations,
+                         traj.status, traj.message, traj.failed_step,
+                         time.perf_counter() - start)
+    from .stepping import simulate
+
+    quality = MeshQuality()
+    options = {"t_init": run.t_init}
+    if run.tangential != "none":
+        options["tangential"] = run.tangential
+    traj = simulate(V, faces, run.tau, run.steps, save_every=run.save_every,
+                    observer=quality, **options)
+    return RunResult(run, traj.F, traj.T, traj.steps, traj.faces, traj.iterations,
+                     traj.status, traj.message, traj.failed_step,
+                     time.perf_counter() - start, quality.frame())
+
+
+def run_experiment(experiment):
+    """:func:`run_one` for every run of the experiment: ``{key: RunResult}``."""
+    validate(experiment)
+    return {run.key: run_one(run) for run in experiment.runs}
+
+
+def experiment_status(results):
+    """Overall status: ``"ok"`` or the first run's non-ok status."""
+    for result in results.values():
+        if result.status != "ok":
+            return result.status
+    return "ok"
+
+
+def draw_experiment(experiment, results):
+    """The figure of an experiment from its runs' frames.
+
+    A panel whose time level was not reached shows the last frame of its
+    run, labelled with the level shown and a note.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from .render import Panel, element_centre, panel_row, worst_element
+
+    def zoom_of(spec, result, i):
+        """Centre and half-width of a zoom in frame ``i`` of ``result``."""
+        if spec is None:
+            return None
+        if not isinstance(spec.at, str):
+            return np.asarray(spec.at, dtype=float), spec.half
+        j = result.frame(spec.step) if spec.step is not None else i
+        T = None if result.T is None else result.T
+        k = worst_element(result.F[j], None if T is None else T[j], result.faces,
+                          experiment.view, spec.by)
+        centre = element_centre(result.F[i], None if T is None else T[i], result.faces, k,
+                                spec.by)
+        return centre, spec.half
+
+    panels = []
+    for shot in experiment.shots:
+        result = results[shot.run]
+        i = result.frame(shot.step)
+        reached = int(result.steps[i])
+        label = shot.label.format(n=reached)
+        note = ""
+        if result.status == "unsupported":
+            name = result.run.label or result.run.scheme
+            note = f"{name}: not computed\n{_short(result.message)}"
+        elif reached != shot.step:
+            note = f"n = {shot.step} not reached:\n{_short(result.message or result.status)}"
+        T = None if result.T is None else result.T[i]
+        panels.append(Panel(result.F[i], T, result.faces, label=label,
+                            zoom=zoom_of(shot.zoom, result, i),
+                            zoom_box=zoom_of(shot.box, result, i),
+                            note=note))
+    return panel_row(panels, view=experiment.view, rows=experiment.rows, size=experiment.size,
+                     aspect=experiment.aspect)
+
+
+def _short(text, width=34):
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, width)[:3])

@@ -1,0 +1,71 @@
+# Figures 3.1-3.8 of the paper (and two comparisons with the cotangent
+# baseline): one job per figure runs its experiment and draws it. What each
+# figure computes (shape, parameters, tau, steps, tangential setting, panels)
+# is defined in one place, ddfv/experiments.py (EXPERIMENTS); this file only
+# maps the registry to files.
+#
+#   snakemake --cores 2 results/figures/fig_3_6.png   # one figure
+#   python workflow/scripts/figure.py fig_3_6         # the same, by hand
+
+from ddfv.experiments import EXPERIMENTS
+
+FIGURES = list(EXPERIMENTS)
+
+
+# every file the job of one figure writes
+FIGURE_FILES = [
+    "results/figures/{figure}.png",
+    "results/figures/{figure}.pdf",
+    "results/runs/figures/{figure}.npz",
+    "results/runs/figures/{figure}.json",
+    "results/diagnostics/{figure}.csv",
+    "results/diagnostics/{figure}.png",
+]
+FIGURE_TARGETS = expand(FIGURE_FILES, figure=FIGURES)
+
+
+wildcard_constraints:
+    figure="|".join(FIGURES),
+
+
+rule figure:
+    """Run the experiment of one figure (ddfv/experiments.py) and draw it.
+
+    Writes the figure, the kept frames, per-step mesh-quality diagnostics
+    (CSV and plot) and a JSON record with the status of every run. A run
+    that breaks down keeps its frames and the job still succeeds; the
+    record and a note in the figure say what happened.
+    """
+    output:
+        png=report(
+            "results/figures/{figure}.png",
+            caption="../report/fig_caption.rst",
+            category="Figures 3.1-3.8",
+            labels={"figure": "{figure}", "type": "surfaces"},
+        ),
+        pdf="results/figures/{figure}.pdf",
+        frames="results/runs/figures/{figure}.npz",
+        record="results/runs/figures/{figure}.json",
+        csv="results/diagnostics/{figure}.csv",
+        plot=report(
+            "results/diagnostics/{figure}.png",
+            caption="../report/fig_diagnostics.rst",
+            category="Figures 3.1-3.8",
+            labels={"figure": "{figure}", "type": "mesh quality"},
+        ),
+    params:
+        title=lambda wildcards: EXPERIMENTS[wildcards.figure].title,
+        caption=lambda wildcards: EXPERIMENTS[wildcards.figure].caption,
+        settings=lambda wildcards: EXPERIMENTS[wildcards.figure].describe(),
+        # rerun when the experiment's definition changes
+        config=lambda wildcards: EXPERIMENTS[wildcards.figure].config(),
+    log:
+        "results/logs/figures/{figure}.log",
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    conda:
+        "../envs/ddfv.yaml"
+    script:
+        "../scripts/figure.py"
