@@ -3,7 +3,7 @@
 
 import functools
 import hashlib
-import importlib.machinery
+import importlib.util
 import math
 import os
 import re
@@ -53,16 +53,28 @@ for _level in LEVELS:
         )
 
 
+def _package_dir(top):
+    """Folder of package `top` as the jobs will import it: next to this
+    Snakefile (a checkout; workflow/scripts/run_records.py puts that first on
+    sys.path) or installed, editable installs included. The working
+    directory does not count: scripts do not run with it on sys.path.
+    None if not importable."""
+    local = Path(workflow.basedir) / top / "__init__.py"
+    if local.is_file():
+        return local.parent
+    saved = sys.path[:]
+    sys.path[:] = [p for p in sys.path if p not in ("", os.getcwd())]
+    try:
+        spec = importlib.util.find_spec(top)
+    finally:
+        sys.path[:] = saved
+    return Path(spec.origin).parent if spec is not None and spec.origin else None
+
+
 def _check_importable(scheme, module):
-    """Fail early unless the jobs can import `module`: its package lies next
-    to this Snakefile (a checkout; workflow/scripts/run_records.py puts that
-    first on sys.path) or is installed. The working directory does not count:
-    scripts do not run with it on sys.path."""
+    """Fail early unless the jobs can import `module` (see _package_dir)."""
     top = module.split(".")[0]
-    if (Path(workflow.basedir) / top / "__init__.py").is_file():
-        return
-    search = [p for p in sys.path if p not in ("", os.getcwd())]
-    if importlib.machinery.PathFinder.find_spec(top, search) is None:
+    if _package_dir(top) is None:
         raise ConfigError(
             f"config key 'scheme_modules.{scheme}': package {top!r} of module "
             f"{module!r} is not importable; install the project "
@@ -72,13 +84,6 @@ def _check_importable(scheme, module):
 
 for _scheme in SCHEMES:
     _check_importable(_scheme, SCHEME_MODULES[_scheme][0])
-
-
-def _package_dir(top):
-    """Folder of package `top` as the jobs will import it (see _check_importable)."""
-    search = [workflow.basedir] + [p for p in sys.path if p not in ("", os.getcwd())]
-    spec = importlib.machinery.PathFinder.find_spec(top, search)
-    return Path(spec.origin).parent
 
 
 @functools.cache
