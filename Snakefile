@@ -27,6 +27,8 @@ include: "workflow/rules/convergence.smk"
 # Hook for the figure rules maintained separately: figures.smk defines
 # FIGURE_TARGETS (the files `rule all` builds) and its rules.
 include: "workflow/rules/figures.smk"
+include: "workflow/rules/beyond.smk"
+include: "workflow/rules/report.smk"
 
 
 rule all:
@@ -35,3 +37,11 @@ rule all:
     input:
         CONVERGENCE_TARGETS,
         FIGURE_TARGETS,
+        REPORT_TARGETS,
+
+
+rule beyond:
+    """Target: level 6, the scheme variants and the stability study (slow)."""
+    localrule: True
+    input:
+        BEYOND_TARGETS,

@@ -1,0 +1,2 @@
+# The reproduction report (results/paper/), built from the result files.
+REPORT_TARGETS = []
