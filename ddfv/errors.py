@@ -34,8 +34,8 @@ class SphereL2Error:
         if flow.n == 0:
             return
         r = sphere_radius(flow.t, self.radius)
-        X = np.concatenate([flow.F, flow.T]) - self.centre
-        dist = np.linalg.norm(X, axis=1) - r
+        X = flow.X - self.centre[:, None]
+        dist = np.sqrt(X[0] ** 2 + X[1] ** 2 + X[2] ** 2) - r
         self.total += flow.tau * 0.5 * float(np.dot(dist**2, flow.covolumes))  # (3.2)
         self.levels += 1
 

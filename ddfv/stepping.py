@@ -154,6 +154,13 @@ class Flow:
             raise ValueError(f"initial surface is degenerate: {err}") from None
 
     @property
+    def X(self):
+        """(3, n_f + n_t) read-only view of ``[F^n; T^n]`` by components."""
+        view = self._X.view()
+        view.flags.writeable = False
+        return view
+
+    @property
     def F(self):
         """(n_f, 3) view of the F-vertices ``F^n``."""
         return self._X[:, :self.mesh.n_f].T

@@ -31,8 +31,9 @@ def test_l2_error_weights_are_half_the_covolumes():
 
     state = State()
     state.tau = tau
-    state.F, state.T = V * (1 + d), V[F].mean(axis=1)
-    state.T = state.T / np.linalg.norm(state.T, axis=1, keepdims=True) * (1 + d)
+    T = V[F].mean(axis=1)
+    T = T / np.linalg.norm(T, axis=1, keepdims=True) * (1 + d)
+    state.X = np.concatenate([V * (1 + d), T]).T
     state.covolumes = np.full(len(V) + len(F), 4 * np.pi / len(V))
     state.covolumes[len(V):] = 4 * np.pi / len(F)
     error(state)
