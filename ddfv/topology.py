@@ -11,6 +11,7 @@ from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
 
 @dataclass(frozen=True)
@@ -97,9 +98,10 @@ def diamond_mesh(faces, n_vertices=None):
     ValueError
         Fewer than 4 triangles, indices out of range, a triangle repeating
         a vertex, an unreferenced vertex, an edge shared by more than two
-        triangles (non-manifold), or two triangles that traverse their
-        common edge in the same direction (inconsistent orientation). The
-        message names the offending elements.
+        triangles or a vertex joining separate fans of triangles
+        (non-manifold), or two triangles that traverse their common edge in
+        the same direction (inconsistent orientation). The message names
+        the offending elements.
     """
     faces = np.asarray(faces)
     if faces.ndim != 2 or faces.shape[1] != 3:
@@ -147,6 +149,8 @@ def diamond_mesh(faces, n_vertices=None):
                          f"{pairs} traverse their common edge in the same "
                          "direction")
 
+    _check_vertex_fans(faces, n_f, tri[inner], tri[inner + 1], src[inner], dst[inner])
+
     t2 = np.full(len(starts), -1, dtype=np.int64)
     t2[counts == 2] = tri[inner + 1]
     # column-major: each column is contiguous for fast gathers
@@ -155,6 +159,30 @@ def diamond_mesh(faces, n_vertices=None):
     halfedges[order] = np.repeat(np.arange(len(starts)), counts)
     return DiamondMesh(n_f=n_f, faces=faces, diamonds=diamonds,
                        halfedges=halfedges.reshape(-1, 3))
+
+
+def _check_vertex_fans(faces, n_f, t1, t2, a, b):
+    """Refuse vertices whose triangles form more than one fan.
+
+    Corners ``(t, vertex)`` are joined across every inner edge ``(a, b)``
+    of triangles ``t1, t2`` at both of its vertices; a manifold vertex has
+    all its corners in one connected component.
+    """
+    n_t = len(faces)
+    corner = np.arange(3 * n_t).reshape(n_t, 3)
+
+    def corner_of(t, v):
+        return corner[t, np.argmax(faces[t] == v[:, None], axis=1)]
+
+    rows = np.r_[corner_of(t1, a), corner_of(t1, b)]
+    cols = np.r_[corner_of(t2, a), corner_of(t2, b)]
+    graph = sp.coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(3 * n_t, 3 * n_t))
+    _, label = connected_components(graph, directed=False)
+    fans = np.unique(np.column_stack([faces.ravel(), label]), axis=0)[:, 0]
+    bad = np.flatnonzero(np.bincount(fans, minlength=n_f) > 1)
+    if len(bad):
+        raise ValueError(f"non-manifold mesh: vertex(es) {_few(bad)} join separate "
+                         "fans of triangles")
 
 
 def _few(indices, limit=10):

@@ -56,6 +56,8 @@ def _tetrahedron():
 @pytest.mark.parametrize("faces, n_vertices, message", [
     (np.vstack([_tetrahedron(), [[0, 1, 4]]]), None, "non-manifold mesh"),
     (np.vstack([_tetrahedron()[:3], [[1, 3, 2]]]), None, "inconsistent orientation"),
+    (np.vstack([_tetrahedron(), _tetrahedron() + 3]), None,   # two tetrahedra at vertex 3
+     r"vertex\(es\) \[3\] join separate fans"),
     (_tetrahedron(), 5, r"unreferenced vertex\(es\): \[4\]"),
     (np.vstack([_tetrahedron(), [[1, 1, 2]]]), None, "repeating a vertex"),
     (_tetrahedron()[:3], None, "at least 4 triangles"),
