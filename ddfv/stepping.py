@@ -29,7 +29,7 @@ from tqdm import tqdm
 from .assembly import Assembler
 from .geometry import (covolume_areas, diamond_geometry, t_barycentric, triangle_areas,
                        vertex_normals)
-from .solver import bicgstab
+from .solver import apply_block, bicgstab
 from .t_vertices import initial_t_vertices
 from .topology import diamond_mesh
 
@@ -208,7 +208,7 @@ class Flow:
         A = self._assembler.system(geometry, covolumes, self.tau)
         rhs = self._X
         if self.tangential == "eliminate":
-            h = np.stack([x - A @ x for x in self._X]) / self.tau   # h^{n-1}
+            h = (self._X - apply_block(A, self._X)) / self.tau      # h^{n-1}
             N = vertex_normals(self.mesh, self.geometry)              # N^{n-1}
             rhs = self._X - self.tau * (h - (h * N).sum(axis=0) * N)  # (3.6)
         x0 = self._X
