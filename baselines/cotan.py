@@ -17,6 +17,11 @@ the lumped mass matrix of ``igl.massmatrix``: barycentric,
 Both are rebuilt from the current surface at every step: this is true mean
 curvature flow, with no re-centring, rescaling or frozen Laplacian.
 
+Open surfaces: boundary vertices are held fixed (Dirichlet boundary (1.2),
+as in the DDFV scheme): their rows of (C3) are replaced by rows of the
+identity, so that ``X_i^n = X_i^{n-1}``. Interior rows keep the cotangent
+weights of the boundary edges (one triangle each).
+
 To share the solver, stopping rule, warm start and iteration count with the
 DDFV scheme (:mod:`ddfv.stepping`), (C1) is solved in the row-scaled form
 
@@ -124,9 +129,12 @@ class Assembler:
     mesh : ddfv.topology.DiamondMesh
         Its diamonds are the edges ``(a, b)``; ``halfedges[t, k]`` is the
         edge ``faces[t, k] -> faces[t, k + 1]``.
+    fixed : (n,) bool array, optional
+        Dirichlet vertices: their rows of the system matrix (C3) are rows of
+        the identity. Default: the boundary vertices of ``mesh``.
     """
 
-    def __init__(self, mesh):
+    def __init__(self, mesh, fixed=None):
         n = mesh.n_f
         a, b = mesh.diamonds[:, 0], mesh.diamonds[:, 1]
         diag = np.arange(n)
@@ -148,6 +156,11 @@ class Assembler:
         self._indices = cols[perm].astype(np.int32)
         self._indptr = np.searchsorted(self._rows, np.arange(n + 1)).astype(np.int32)
         self._diag = inverse[-n:]
+        fixed = mesh.boundary_vertices if fixed is None else np.asarray(fixed, dtype=bool)
+        # CSR slots of the Dirichlet rows and their identity values
+        self._fixed_slots = np.flatnonzero(fixed[self._rows])
+        self._fixed_values = (self._indices[self._fixed_slots]
+                              == self._rows[self._fixed_slots]).astype(float)
 
     def edge_weights(self, vertices):
         """``w_ab = 1/2 (cot alpha_ab + cot beta_ab)`` for every edge, (C2)."""
@@ -171,7 +184,7 @@ class Assembler:
                            minlength=self.shape[0])
 
     def system(self, vertices, mass, tau):
-        """``I + tau diag(1/M) L`` of (C3) as CSR.
+        """``I + tau diag(1/M) L`` of (C3) as CSR, Dirichlet rows = identity.
 
         Parameters
         ----------
@@ -183,18 +196,39 @@ class Assembler:
         """
         data = self._data(vertices) * (tau / mass).take(self._rows)
         data[self._diag] += 1.0
+        data[self._fixed_slots] = self._fixed_values
         return sp.csr_matrix((data, self._indices, self._indptr), shape=self.shape)
 
 
+def dirichlet_rows(A, fixed):
+    """Replace the rows ``fixed`` of a CSR matrix by rows of the identity, in place.
+
+    Parameters
+    ----------
+    A : (n, n) scipy.sparse.csr_matrix
+        Must store its diagonal entries.
+    fixed : (n,) bool array
+
+    Returns
+    -------
+    A
+    """
+    rows = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))
+    slots = np.flatnonzero(fixed[rows])
+    A.data[slots] = (A.indices[slots] == rows[slots]).astype(A.dtype)
+    return A
+
+
 class Flow:
-    """Cotangent mean curvature flow of one closed triangulated surface.
+    """Cotangent mean curvature flow of one triangulated surface.
 
     Parameters
     ----------
     vertices : (n, 3) float array
         Initial surface ``X^0``.
     faces : (m, 3) int array
-        Consistently oriented triangles of a closed manifold surface.
+        Consistently oriented triangles of a manifold surface, closed or
+        with boundary; boundary vertices keep their position (Dirichlet).
     tau : float
         Time step.
     mass : {"barycentric", "voronoi"}
@@ -212,6 +246,8 @@ class Flow:
         Current state ``X^n``.
     n : int
         Current time level.
+    fixed : (n,) bool array
+        The boundary (Dirichlet) vertices.
     """
 
     def __init__(self, vertices, faces, tau, *, mass="barycentric",
@@ -228,10 +264,7 @@ class Flow:
         self.mass_type = _mass_type(mass)
         self.mesh = diamond_mesh(faces, len(vertices))
         V = validate_vertices(vertices, self.mesh.faces)
-        if self.mesh.has_boundary:
-            raise ValueError("the mesh has a boundary "
-                             f"({int(self.mesh.boundary.sum())} boundary edges); "
-                             "the cotangent baseline needs a closed surface")
+        self.fixed = self.mesh.boundary_vertices
         self.tau, self.rtol, self.maxiter = float(tau), float(rtol), int(maxiter)
         self.assembly = assembly
         self.faces = np.ascontiguousarray(self.mesh.faces, dtype=np.int64)
@@ -276,12 +309,13 @@ class Flow:
         return cotangent_laplacian(self._vertices, self.faces)
 
     def system(self):
-        """``I + tau diag(1/M^n) L^n`` (C3), CSR."""
+        """``I + tau diag(1/M^n) L^n`` (C3), CSR; rows of boundary vertices = identity."""
         if self._assembler is not None:
             return self._assembler.system(self._vertices, self.mass, self.tau)
         L = self.laplacian()
         L.data *= np.repeat(self.tau / self.mass, np.diff(L.indptr))
-        return L + sp.identity(L.shape[0], format="csr")
+        A = (L + sp.identity(L.shape[0], format="csr")).tocsr()
+        return dirichlet_rows(A, self.fixed) if self.mesh.has_boundary else A
 
     def step(self):
         """Advance one time step, (C3).
@@ -368,7 +402,8 @@ def simulate(vertices, faces, tau, steps, *, save_every=1, mass="barycentric",
     ----------
     vertices : (n, 3) float array
     faces : (m, 3) int array
-        Closed, consistently oriented manifold surface.
+        Consistently oriented manifold surface; boundary vertices, if any,
+        stay fixed.
     tau : float
     steps : int
     save_every : int
@@ -388,7 +423,7 @@ def simulate(vertices, faces, tau, steps, *, save_every=1, mass="barycentric",
     Raises
     ------
     ValueError
-        Bad parameters or input mesh (open, non-manifold, degenerate, ...).
+        Bad parameters or input mesh (non-manifold, degenerate, ...).
 
     Examples
     --------

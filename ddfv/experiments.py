@@ -237,7 +237,9 @@ EXPERIMENTS = {e.name: e for e in [
         "fig_3_6_cotan", "Cylinder: DDFV and the cotangent scheme",
         "The cylinder of Figs. 3.5-3.6 (n_V = 600 for DDFV; the cotangent scheme has "
         "the 216 F-vertices only) at n = 200, 580 and 640: top, DDFV without "
-        "tangential control; bottom, the cotangent scheme (baselines/cotan.py).",
+        "tangential control; bottom, the cotangent scheme (baselines/cotan.py) with "
+        "the same fixed boundary circles. Both approach the catenoid; the cotangent "
+        "mesh has no T-vertices to drift and stays regular.",
         runs=(Run("ddfv", "cylinder", _CYLINDER, steps=640, save_every=20, label="DDFV"),
               Run("cotan", "cylinder", _CYLINDER, steps=640, save_every=20,
                   scheme="cotan", label="cotangent")),
@@ -314,8 +316,8 @@ def run_one(run):
     """Simulate one :class:`Run`.
 
     A breakdown of the flow ends the run with its status, keeping the
-    frames computed before. A scheme that refuses the surface (e.g. an open
-    surface for a closed-only scheme) gives ``status = "unsupported"`` with
+    frames computed before. A scheme that refuses the surface (its
+    ``simulate`` raises ``ValueError``) gives ``status = "unsupported"`` with
     the initial surface as the only frame.
 
     Returns

@@ -8,6 +8,7 @@ from baselines import cotan
 from baselines.cotan import (Assembler, Flow, VertexL2Error, cotangent_laplacian,
                              lumped_mass, simulate, sphere_run)
 from ddfv.errors import eoc, sphere_radius
+from ddfv.shapes import catenoid_waist, cylinder
 from ddfv.solver import SolveInfo
 from ddfv.surfaces import icosphere
 from ddfv.topology import diamond_mesh
@@ -195,8 +196,6 @@ def test_bad_parameters(change, message):
 
 def test_bad_meshes():
     V, F = icosphere(1)
-    with pytest.raises(ValueError, match="boundary"):
-        simulate(V, F[1:], 0.01, 1)
     with pytest.raises(ValueError, match="NaN or inf"):
         simulate(np.where(np.arange(len(V))[:, None] == 3, np.nan, V), F, 0.01, 1)
     with pytest.raises(ValueError, match="shape"):
@@ -211,3 +210,53 @@ def test_bad_meshes():
         simulate(V, np.r_[F[:1, ::-1], F[1:]], 0.01, 1)
     with pytest.raises(ValueError, match="not a multiple"):
         sphere_run(1, tau=0.03)
+
+
+def test_open_cylinder_keeps_its_boundary_and_approaches_the_catenoid():
+    # the cylinder of Figs. 3.5-3.6 (R = 1, h = 0.55, 24 x 8 twisted quads,
+    # 216 vertices). Steady state: r(z) = a cosh(z/a), a cosh(h/a) = R,
+    # a = 0.8046. Measured waist radius 0.8511 (n = 100), 0.8141 (200),
+    # 0.8001 (400); at n = 400 max |r - a cosh(z/a)| = 0.0059 (the
+    # discretisation error of 24 segments). Tolerances: 1 % and 0.01.
+    V, F = cylinder()
+    fixed = diamond_mesh(F, len(V)).boundary_vertices
+    assert fixed.sum() == 48
+    traj = simulate(V, F, 0.0025, 400, save_every=100)
+    assert traj.status == "ok", traj.message
+    for X in traj.V:
+        np.testing.assert_array_equal(X[fixed], V[fixed])
+    r, z = np.hypot(traj.V[..., 0], traj.V[..., 1]), traj.V[..., 2]
+    waist = np.where(np.abs(z) < 1e-9, r, np.nan)
+    neck = np.nanmean(waist, axis=1)
+    assert np.all(np.diff(neck) < 0), neck  # shrinks towards the catenoid
+    a = catenoid_waist(1.0, 0.55)
+    assert neck[-1] == pytest.approx(a, rel=0.01)
+    np.testing.assert_allclose(r[-1], a * np.cosh(z[-1] / a), atol=0.01)
+
+
+def test_dirichlet_rows_are_identity_in_both_assemblies():
+    V, F = cylinder(12, 4)
+    flow = {a: Flow(V, F, 0.01, assembly=a) for a in cotan.ASSEMBLIES}
+    fixed = flow["cached"].fixed
+    A = flow["cached"].system().toarray()
+    np.testing.assert_array_equal(A[fixed], np.eye(len(V))[fixed])
+    np.testing.assert_allclose(flow["igl"].system().toarray(), A, rtol=0, atol=1e-13)
+    free = ~fixed
+    expected = np.eye(len(V)) + 0.01 * cotangent_laplacian(V, F).toarray() / \
+        lumped_mass(V, F)[:, None]
+    np.testing.assert_allclose(A[free], expected[free], rtol=0, atol=1e-13)
+    a = simulate(V, F, 0.01, 10, assembly="cached")
+    b = simulate(V, F, 0.01, 10, assembly="igl")
+    np.testing.assert_allclose(a.V, b.V, rtol=0, atol=1e-12)
+
+
+def test_sphere_with_a_hole_keeps_the_hole_fixed():
+    V, F = icosphere(2)
+    traj = simulate(V, F[1:], 0.01, 5)
+    assert traj.status == "ok"
+    np.testing.assert_array_equal(traj.V[:, F[0]], np.broadcast_to(V[F[0]], (6, 3, 3)))
+    free = np.ones(len(V), bool)
+    free[F[0]] = False
+    # the other vertices shrink (measured radii 0.894-0.927 at t = 0.05; the
+    # closed sphere: 0.894)
+    assert np.linalg.norm(traj.V[-1, free], axis=1).max() < 0.95
