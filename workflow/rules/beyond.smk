@@ -1,3 +1,201 @@
-# Beyond Table 3.1 (level 6, scheme variants, T-vertex stability study).
-# Not part of `rule all`: run with `snakemake --cores 2 beyond`.
-BEYOND_TARGETS = []
+# Beyond Table 3.1: level 6, the scheme variants and the T-vertex stability
+# study (issue #5). Not part of `rule all`:
+#
+#   snakemake --cores 2 beyond      # about 5 minutes on 2 cores
+#
+# Settings: the config key `beyond` (config/README.md), checked by
+# workflow/scripts/beyond_config.py. Four studies, all under results/beyond/
+# (results/README.md):
+#
+# - levels: every scheme on every level with tau ~ h^2 as in Table 3.1; the
+#   ordinary run records results/runs/{scheme}/level{k}.json of rule
+#   run_scheme (shared with the convergence study);
+# - long_time: one level continued past t_final (onset of the breakdown);
+# - space: refined meshes with one tiny time step (order 2 in space);
+# - time: one mesh, tau halved repeatedly (order 1 in time; DDFV only).
+#
+# Runs that break down are records like any other (status, t_failed, the T
+# monitor of every time level reached); the tables show them as such.
+# Settings, record paths and resources of the jobs: workflow/rules/common.smk
+# (BEYOND, beyond_run_settings, time_settings, BEYOND_*_RUNS).
+
+BEYOND_TABLE_NAMES = ["levels", "stability", "time_convergence", "space_convergence"]
+BEYOND_TABLES = {
+    f"{name}_{ext}": f"results/beyond/tables/{name}.{ext}"
+    for name in BEYOND_TABLE_NAMES
+    for ext in ("csv", "md", "tex")
+}
+BEYOND_FIGURE_NAMES = ["levels", "t_monitor", "time_convergence", "space_convergence"]
+BEYOND_FIGURES = {
+    f"{name}_{ext}": f"results/beyond/figures/{name}.{ext}"
+    for name in BEYOND_FIGURE_NAMES
+    for ext in ("png", "pdf")
+}
+BEYOND_TARGETS = [
+    *BEYOND_TABLES.values(),
+    "results/beyond/tables/t_monitor.csv",
+    "results/beyond/tables/beyond.json",
+    *BEYOND_FIGURES.values(),
+    "results/beyond/findings.md",
+]
+
+
+wildcard_constraints:
+    study="long_time|space",
+
+
+rule beyond_run:
+    """One scheme on one sphere level with the settings of a beyond study."""
+    output:
+        "results/beyond/runs/{study}/{scheme}/level{level}.json",
+    params:
+        settings=lambda wildcards: beyond_run_settings(
+            wildcards.study, wildcards.scheme, wildcards.level
+        ),
+    log:
+        "results/logs/beyond/{study}/{scheme}/level{level}.log",
+    threads: 1
+    resources:
+        mem_mb=run_mem_mb,
+        runtime=beyond_run_runtime,
+    priority: lambda wildcards: int(wildcards.level)
+    conda:
+        "../envs/ddfv.yaml"
+    script:
+        "../scripts/run_scheme.py"
+
+
+rule beyond_time:
+    """Time convergence of one DDFV scheme on one mesh (ddfv.convergence)."""
+    output:
+        "results/beyond/runs/time/{scheme}.json",
+    params:
+        settings=lambda wildcards: time_settings(wildcards.scheme),
+    log:
+        "results/logs/beyond/time/{scheme}.log",
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=time_runtime,
+    priority: 3
+    conda:
+        "../envs/ddfv.yaml"
+    script:
+        "../scripts/beyond_time.py"
+
+
+rule beyond_tables:
+    """The tables of the beyond study and the T monitor series."""
+    input:
+        levels=list(BEYOND_LEVEL_RUNS),
+        long_time=list(BEYOND_LONG_RUNS),
+        space=list(BEYOND_SPACE_RUNS),
+        time=list(BEYOND_TIME_RUNS),
+    output:
+        **{
+            key: (
+                report(
+                    path,
+                    caption=f"../report/beyond_{key[:-4]}.rst",
+                    category="Beyond Table 3.1",
+                    labels={"table": key[:-4]},
+                )
+                if key.endswith("_csv")
+                else path
+            )
+            for key, path in BEYOND_TABLES.items()
+        },
+        t_monitor="results/beyond/tables/t_monitor.csv",
+        provenance="results/beyond/tables/beyond.json",
+    params:
+        expected={
+            **BEYOND_LEVEL_RUNS,
+            **BEYOND_LONG_RUNS,
+            **BEYOND_SPACE_RUNS,
+            **BEYOND_TIME_RUNS,
+        },
+        beyond=BEYOND,
+        paper_schemes=BEYOND_PAPER_SCHEMES,
+        settings={
+            k: config[k] for k in ("tau_level_1", "t_final", "rtol")
+        },
+    log:
+        "results/logs/beyond/tables.log",
+    localrule: True
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    conda:
+        "../envs/ddfv.yaml"
+    script:
+        "../scripts/beyond_tables.py"
+
+
+rule beyond_figures:
+    """L2 per level, the T monitor against time, time and space convergence."""
+    input:
+        levels=BEYOND_TABLES["levels_csv"],
+        stability=BEYOND_TABLES["stability_csv"],
+        time=BEYOND_TABLES["time_convergence_csv"],
+        space=BEYOND_TABLES["space_convergence_csv"],
+        t_monitor="results/beyond/tables/t_monitor.csv",
+    output:
+        **{
+            key: (
+                report(
+                    path,
+                    caption=f"../report/beyond_figure_{key[:-4]}.rst",
+                    category="Beyond Table 3.1",
+                    labels={"figure": key[:-4]},
+                )
+                if key.endswith("_png")
+                else path
+            )
+            for key, path in BEYOND_FIGURES.items()
+        },
+    params:
+        beyond=BEYOND,
+        t_final=config["t_final"],
+    log:
+        "results/logs/beyond/figures.log",
+    localrule: True
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    conda:
+        "../envs/ddfv.yaml"
+    script:
+        "../scripts/beyond_plots.py"
+
+
+rule beyond_findings:
+    """The written findings, generated from the tables (no hand-typed numbers)."""
+    input:
+        levels=BEYOND_TABLES["levels_csv"],
+        stability=BEYOND_TABLES["stability_csv"],
+        time=BEYOND_TABLES["time_convergence_csv"],
+        space=BEYOND_TABLES["space_convergence_csv"],
+    output:
+        report(
+            "results/beyond/findings.md",
+            caption="../report/beyond_findings.rst",
+            category="Beyond Table 3.1",
+            labels={"table": "findings"},
+        ),
+    params:
+        beyond=BEYOND,
+        paper_schemes=BEYOND_PAPER_SCHEMES,
+        t_final=config["t_final"],
+    log:
+        "results/logs/beyond/findings.log",
+    localrule: True
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    conda:
+        "../envs/ddfv.yaml"
+    script:
+        "../scripts/beyond_findings.py"

@@ -99,24 +99,30 @@ def code_digest(top):
     return digest.hexdigest()[:16]
 
 
-def run_settings(scheme, level):
+def run_settings(scheme, level, *, study=None, tau=None, t_final=None):
     """Everything that determines the run record of (scheme, level).
 
     Passed to the run job and stored (with its hash) in the record's
     provenance; the aggregation recomputes it to detect stale records.
+    ``study``, ``tau`` and ``t_final`` override the convergence study's
+    settings (the studies of workflow/rules/beyond.smk); without them the
+    settings, and so the hash, are those of Table 3.1.
     """
     level = int(level)
-    return {
+    settings = {
         "scheme": scheme,
         "module": SCHEME_MODULES[scheme][0],
         "options": SCHEME_MODULES[scheme][1],
         "level": level,
-        "tau": level_time_step(level),
-        "t_final": float(config["t_final"]),
+        "tau": level_time_step(level) if tau is None else float(tau),
+        "t_final": float(config["t_final"] if t_final is None else t_final),
         "radius": 1.0,
         "rtol": float(config["rtol"]),
         "code": {top: code_digest(top) for top in _packages(scheme)},
     }
+    if study is not None:
+        settings = {"study": study, **settings}
+    return settings
 
 
 def _packages(scheme):
@@ -153,6 +159,112 @@ def run_mem_mb(wildcards):
     return 500 + 100 * 4 ** max(int(wildcards.level) - 5, 0)
 
 
+def convergence_settings():
+    """The config as far as Table 3.1 depends on it: without the beyond study
+    and with the modules of the schemes run, so that changing those leaves
+    the tables of the convergence study alone."""
+    settings = {k: v for k, v in config.items() if k != "beyond"}
+    settings["scheme_modules"] = {s: config["scheme_modules"][s] for s in SCHEMES}
+    return settings
+
+
+# -- the study beyond Table 3.1 (workflow/rules/beyond.smk) --------------------
+
+
+def _load_script(name):
+    """A module of workflow/scripts by file (leaves sys.path alone)."""
+    path = Path(workflow.basedir) / "workflow" / "scripts" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(f"_workflow_{name}", path)
+    loaded = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(loaded)
+    return loaded
+
+
+_beyond_config = _load_script("beyond_config")
+# the config key `beyond`, checked across keys and normalised
+BEYOND = _beyond_config.beyond_settings(config, SCHEME_MODULES)
+for _scheme in _beyond_config.used_schemes(BEYOND):
+    _check_importable(_scheme, SCHEME_MODULES[_scheme][0])
+# schemes compared with the published Table 3.1: the DDFV variants
+BEYOND_PAPER_SCHEMES = [
+    s for s in BEYOND["schemes"] if SCHEME_MODULES[s][0] == _beyond_config.DDFV_MODULE
+]
+
+
+def beyond_record(study, scheme, level):
+    return f"results/beyond/runs/{study}/{scheme}/level{level}.json"
+
+
+def time_record(scheme):
+    return f"results/beyond/runs/time/{scheme}.json"
+
+
+def beyond_run_settings(study, scheme, level):
+    """Run settings of one run of the long-time or the space study."""
+    if study == "long_time":
+        return run_settings(scheme, level, study=study, t_final=BEYOND["long_time"]["t_final"])
+    space = BEYOND["space_study"]
+    return run_settings(scheme, level, study=study, tau=space["tau"], t_final=space["t_final"])
+
+
+def time_settings(scheme):
+    """Settings of the time study of one (DDFV) scheme."""
+    study = BEYOND["time_study"]
+    return {
+        "study": "time",
+        "scheme": scheme,
+        "module": SCHEME_MODULES[scheme][0],
+        "options": SCHEME_MODULES[scheme][1],
+        "level": study["level"],
+        "taus": study["taus"],
+        "reference_factor": study["reference_factor"],
+        "t_final": study["t_final"],
+        "radius": 1.0,
+        "rtol": float(config["rtol"]),
+        "code": {top: code_digest(top) for top in _packages(scheme)},
+    }
+
+
+# {record path: settings} of every input of the beyond aggregation
+BEYOND_LEVEL_RUNS = {
+    run_record(s, lv): run_settings(s, lv) for s in BEYOND["schemes"] for lv in BEYOND["levels"]
+}
+BEYOND_LONG_RUNS = {
+    beyond_record("long_time", s, BEYOND["long_time"]["level"]): beyond_run_settings(
+        "long_time", s, BEYOND["long_time"]["level"]
+    )
+    for s in BEYOND["long_time"]["schemes"]
+}
+BEYOND_SPACE_RUNS = {
+    beyond_record("space", s, lv): beyond_run_settings("space", s, lv)
+    for s in BEYOND["space_study"]["schemes"]
+    for lv in BEYOND["space_study"]["levels"]
+}
+BEYOND_TIME_RUNS = {time_record(s): time_settings(s) for s in BEYOND["time_study"]["schemes"]}
+
+
+def beyond_seconds(level, steps):
+    """Rough single-core wall time of a DDFV run of `steps` steps on `level`, with
+    margin (measured alone: 10-13 ms a step on level 5, x4 per level, plus about
+    0.6 ms a step of fixed cost; up to 1.5x that with other jobs running)."""
+    return steps * (0.02 * 4.0 ** (int(level) - 5) + 0.001)
+
+
+def beyond_run_runtime(wildcards):
+    """Slurm time limit in minutes: 4x the estimate, at least 5."""
+    settings = beyond_run_settings(wildcards.study, wildcards.scheme, wildcards.level)
+    steps = round(settings["t_final"] / settings["tau"])
+    return max(5, math.ceil(4 * beyond_seconds(wildcards.level, steps) / 60))
+
+
+def time_runtime(wildcards):
+    """Slurm time limit of a time study (all its runs and the reference), minutes."""
+    study = BEYOND["time_study"]
+    steps = sum(round(study["t_final"] / tau) for tau in study["taus"])
+    steps += round(study["t_final"] * study["reference_factor"] / study["taus"][-1])
+    return max(5, math.ceil(4 * beyond_seconds(study["level"], steps) / 60))
+
+
 TABLES = [
     "results/tables/convergence.csv",
     "results/tables/convergence.md",
@@ -166,6 +278,8 @@ CONVERGENCE_FIGURES = [
 CONVERGENCE_TARGETS = TABLES + CONVERGENCE_FIGURES
 
 
+# every scheme of scheme_modules has run records on request (the beyond study
+# runs schemes that `schemes` does not list); longest names first
 wildcard_constraints:
-    scheme="|".join(re.escape(s) for s in SCHEMES),
+    scheme="|".join(re.escape(s) for s in sorted(SCHEME_MODULES, key=len, reverse=True)),
     level=r"[1-9][0-9]*",

@@ -50,7 +50,7 @@ rule convergence_table:
         expected=expected_runs(),
         schemes=SCHEMES,
         levels=LEVELS,
-        settings=config,
+        settings=convergence_settings(),
     log:
         "results/logs/convergence_table.log",
     localrule: True

@@ -43,7 +43,37 @@ def mesh_size(level):
     return float(np.linalg.norm(V[a] - V[b], axis=1).mean())
 
 
-def build_table(records, schemes, levels):
+def eoc_column(levels, l2_error, status):
+    """EOC (3.1) of each row against the previous one, where it means something.
+
+    Parameters
+    ----------
+    levels : (k,) int array_like
+        Refinement levels of the rows, ascending.
+    l2_error : (k,) float array_like
+    status : (k,) str array_like
+
+    Returns
+    -------
+    (k,) float array
+        ``log2(e_{j-1} / e_j)`` where row ``j - 1`` is one level coarser and
+        both runs finished (``status == "ok"``, finite error); NaN elsewhere,
+        so that no order is ever taken against a run that broke down.
+
+    Examples
+    --------
+    >>> eoc_column([1, 2, 3, 4], [1e-2, 2.5e-3, float("nan"), 4e-4],
+    ...            ["ok", "ok", "solver_failed", "ok"]).round(3).tolist()
+    [nan, 2.0, nan, nan]
+    """
+    levels = np.asarray(levels)
+    ok = (np.asarray(status) == "ok") & np.isfinite(np.asarray(l2_error, dtype=float))
+    errors = np.where(ok, np.asarray(l2_error, dtype=float), np.nan)
+    valid = np.r_[False, (np.diff(levels) == 1) & ok[1:] & ok[:-1]]
+    return np.where(valid, eoc(errors), np.nan)
+
+
+def build_table(records, schemes, levels, paper_schemes=(PAPER_SCHEME,)):
     """One row per (scheme, level) with EOC (3.1), paper values and ratios.
 
     Parameters
@@ -52,26 +82,29 @@ def build_table(records, schemes, levels):
         ``(scheme, level) -> record`` (see run_records.py).
     schemes, levels : list
         Row order.
+    paper_schemes : collection of str
+        Schemes compared with the published Table 3.1 (default: the paper's
+        scheme only; the beyond study adds the DDFV variants).
 
     Returns
     -------
     pandas.DataFrame
         Columns :data:`COLUMNS`. ``eoc`` is taken against the previous
-        level when that is one coarser; the ``paper_*`` columns and
+        level when that is one coarser and both runs finished
+        (:func:`eoc_column`); the ``paper_*`` columns and
         ``l2_ratio = l2_error / paper_l2_error`` are filled for
-        :data:`PAPER_SCHEME` only; ``wall_time_ratio`` is the wall time over
+        ``paper_schemes`` only; ``wall_time_ratio`` is the wall time over
         that of :data:`BASELINE` on the same level.
     """
     h = {level: mesh_size(level) for level in levels}
     published = pd.DataFrame.from_dict(PUBLISHED, orient="index", columns=PUBLISHED_COLUMNS)
-    consecutive = np.r_[False, np.diff(levels) == 1]
     parts = []
     for scheme in schemes:
         part = pd.DataFrame([records[scheme, level] for level in levels])
         part["h"] = part["level"].map(h)
-        part["eoc"] = np.where(consecutive, eoc(part["l2_error"].to_numpy()), np.nan)
+        part["eoc"] = eoc_column(part["level"], part["l2_error"], part["status"])
         for column in ("l2_error", "eoc", "iterations", "cpu_seconds"):
-            values = part["level"].map(published[column]) if scheme == PAPER_SCHEME else np.nan
+            values = part["level"].map(published[column]) if scheme in paper_schemes else np.nan
             part[f"paper_{column}"] = np.asarray(values, dtype=float)
         part["paper_iterations"] = part["paper_iterations"].astype("Int64")
         part["l2_ratio"] = part["l2_error"] / part["paper_l2_error"]
@@ -136,7 +169,7 @@ def paper_rows(table):
     rows = []
     for r in table[table["scheme"] == PAPER_SCHEME].itertuples():
         rows.append([str(r.level), str(r.nV), str(r.nF), str(r.nT), f"{r.tau:g}", str(r.N),
-                     _sci(r.paper_l2_error, 2), _sci(r.l2_error, 3), _fix(r.l2_ratio, 3),
+                     _sci(r.paper_l2_error, 2), l2_cell(r), _fix(r.l2_ratio, 3),
                      _fix(r.paper_eoc, 2), _fix(r.eoc, 3), _int(r.paper_iterations),
                      str(r.iterations), _fix(r.paper_cpu_seconds, 2),
                      _sig(r.cpu_seconds, 3), r.status])
@@ -159,11 +192,18 @@ def comparison_rows(table, schemes):
         row = [str(level), f"{first.h:.4f}", f"{first.tau:g}", str(first.N)]
         for s in schemes:
             r = by.loc[(s, level)]
-            row += [str(r.nV), _sci(r.l2_error, 3), _fix(r.eoc, 3), str(r.iterations),
+            row += [str(r.nV), l2_cell(r), _fix(r.eoc, 3), str(r.iterations),
                     _sig(r.wall_seconds, 3)]
         row += [_fix(by.loc[(s, level)].wall_time_ratio, 2) for s in others]
         rows.append(row)
     return header, rows
+
+
+def l2_cell(row, digits=3):
+    """The L2 error of a row, or where the run broke down."""
+    if row.status != "ok":
+        return f"failed (t = {row.t_failed:.4g})"
+    return _sci(row.l2_error, digits)
 
 
 def failure_notes(table):

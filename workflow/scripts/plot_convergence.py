@@ -2,7 +2,10 @@
 
 Called by rule ``convergence_figure`` (workflow/rules/convergence.smk) with
 ``results/tables/convergence.csv``; one line per scheme, the published DDFV
-errors of Table 3.1 as open markers, and a slope-2 reference line.
+errors of Table 3.1 as open markers, and a slope-2 reference line. A run
+that broke down has no error: it is marked by a cross at the bottom of the
+axes, at its mesh size, in the colour of its scheme. :func:`draw` draws
+into a given axes (used by workflow/scripts/beyond_plots.py).
 """
 
 import matplotlib
@@ -18,21 +21,46 @@ from run_records import setup_logging  # noqa: E402
 
 STYLE = {  # scheme -> label, colour, marker
     "ddfv": ("DDFV (ours)", "tab:blue", "o"),
+    "ddfv-chord": (r"DDFV, chord $|\gamma|$ (ours)", "tab:green", "D"),
+    "ddfv-eliminate": ("DDFV, elimination (3.6) (ours)", "tab:purple", "v"),
     "cotan": ("cotangent, libigl (ours)", "tab:orange", "s"),
 }
-OTHER_COLOURS = ["tab:green", "tab:purple", "tab:brown", "tab:pink"]
+OTHER_COLOURS = ["tab:red", "tab:brown", "tab:pink", "tab:olive"]
+
+
+def styles(schemes):
+    """``scheme -> (label, colour, marker)``: :data:`STYLE`, others in turn."""
+    others = iter(OTHER_COLOURS)
+    return {s: STYLE.get(s, (s, next(others, "k"), "^")) for s in schemes}
 
 
 def plot(table, t_final):
     """The figure of ``table`` (the convergence CSV as a DataFrame)."""
     fig, ax = plt.subplots(figsize=(5.2, 4.0), layout="constrained")
+    draw(ax, table, t_final)
+    return fig
+
+
+def draw(ax, table, t_final, style=None, note=None):
+    """Draw the convergence plot of ``table`` into ``ax``.
+
+    ``style`` maps schemes to ``(label, colour, marker)`` (default
+    :func:`styles`); ``note`` replaces the text in the lower right corner
+    (the experiment: shrinking sphere, ``tau ~ h^2``, ``t_f``).
+    """
+    style = style or styles(table["scheme"].unique())
     ok = table[(table["status"] == "ok") & np.isfinite(table["l2_error"])]
-    others = iter(OTHER_COLOURS)
     for scheme in table["scheme"].unique():
         rows = ok[ok["scheme"] == scheme].sort_values("h")
-        label, colour, marker = STYLE.get(scheme, (scheme, next(others, "k"), "^"))
+        label, colour, marker = style[scheme]
         ax.plot(rows["h"], rows["l2_error"], marker=marker, color=colour, label=label,
                 markersize=5, linewidth=1.5)
+    failed = table[table["status"] != "ok"]
+    for i, r in enumerate(failed.itertuples()):
+        ax.plot([r.h], [0.03 + 0.05 * (i % 3)], linestyle="none", marker="x",
+                markersize=8, markeredgewidth=2, color=style[r.scheme][1],
+                transform=ax.get_xaxis_transform(), clip_on=False,
+                label="broke down (no error)" if i == 0 else None)
     paper = table[np.isfinite(table["paper_l2_error"])].sort_values("h")
     if len(paper):
         ax.plot(paper["h"], paper["paper_l2_error"], linestyle="none", marker="o",
@@ -56,12 +84,12 @@ def plot(table, t_final):
     top.set_xlabel("refinement level", fontsize=9)
     ax.set_xlabel(r"mesh size $h$ (mean edge length)")
     ax.set_ylabel(r"space-time $L_2$ error")
-    ax.text(0.97, 0.04, "shrinking unit sphere\n" rf"$\tau \sim h^2$, $t_f = {t_final:g}$",
-            transform=ax.transAxes, ha="right", va="bottom", fontsize=8)
+    if note is None:
+        note = "shrinking unit sphere\n" rf"$\tau \sim h^2$, $t_f = {t_final:g}$"
+    ax.text(0.97, 0.04, note, transform=ax.transAxes, ha="right", va="bottom", fontsize=8)
     ax.grid(True, which="major", linewidth=0.5, alpha=0.5)
     ax.grid(True, which="minor", axis="y", linewidth=0.3, alpha=0.25)
     ax.legend(fontsize=8, loc="upper left", frameon=False)
-    return fig
 
 
 def main(csv, t_final, png, pdf, log_file):
