@@ -53,7 +53,8 @@ import scipy.sparse as sp
 from ddfv.errors import sphere_radius
 from ddfv.solver import bicgstab
 from ddfv.sphere import T_FINAL, SphereRun, level_time_step
-from ddfv.stepping import DEFAULT_RTOL, FlowBreakdown, validate_vertices
+from ddfv.stepping import (DEFAULT_RTOL, FlowBreakdown, collapsed_cells, run_steps,
+                           validate_vertices)
 from ddfv.surfaces import icosphere
 from ddfv.topology import diamond_mesh
 
@@ -334,12 +335,7 @@ class Flow:
         x0 = 2.0 * self._X - self._X_prev
         X, info = bicgstab(A, self._X, x0, rtol=self.rtol, maxiter=self.maxiter)
         if not info.converged:
-            n = self.n + 1
-            raise FlowBreakdown(
-                "solver_failed", n, n * self.tau,
-                f"BiCGStab did not converge at step {n} (t = {n * self.tau:.6g}): "
-                f"relative residual {info.residual:.3e} > rtol {self.rtol:.1e} "
-                f"after {info.iterations} iterations")
+            raise FlowBreakdown.solver_failed(self.n + 1, self.tau, info, self.rtol)
         self._X_prev, self._X = self._X, X
         self.n += 1
         for name in ("_vertices", "double_areas", "mass"):
@@ -349,16 +345,11 @@ class Flow:
 
     def _check_geometry(self):
         if not np.isfinite(self._X).all():
-            raise FlowBreakdown("degenerated", self.n, self.t,
-                                f"mesh degenerated at step {self.n} (t = {self.t:.6g}): "
-                                "non-finite coordinates")
+            raise FlowBreakdown.degenerated(self.n, self.tau, "non-finite coordinates")
         area = self.double_areas
-        collapsed = np.flatnonzero(~(area > _COLLAPSED * area.mean()))
-        if len(collapsed):
-            raise FlowBreakdown("degenerated", self.n, self.t,
-                                f"mesh degenerated at step {self.n} (t = {self.t:.6g}): "
-                                f"{len(collapsed)} triangle(s) collapsed, "
-                                f"e.g. triangle {int(collapsed[0])}")
+        what = collapsed_cells(area, _COLLAPSED * area.mean(), "triangle")
+        if what:
+            raise FlowBreakdown.degenerated(self.n, self.tau, what)
 
 
 @dataclass
@@ -432,37 +423,14 @@ def simulate(vertices, faces, tau, steps, *, save_every=1, mass="barycentric",
     >>> traj.status, traj.steps.tolist()
     ('ok', [0, 2, 4])
     """
-    if int(steps) != steps or steps < 0:
-        raise ValueError(f"steps must be a whole number >= 0, got {steps!r}")
-    if int(save_every) != save_every or save_every < 0:
-        raise ValueError(f"save_every must be a whole number >= 0, got {save_every!r}")
     flow = Flow(vertices, faces, tau, mass=mass, rtol=rtol, maxiter=maxiter,
                 assembly=assembly)
-    frames, iterations = [], []
-    status, message, failed = "ok", "", -1
-
-    def save():
-        frames.append((flow.n, flow.V.copy()))
-
-    if observer is not None:
-        observer(flow)
-    save()
-    for _ in range(int(steps)):
-        try:
-            iterations.append(flow.step().iterations)
-        except FlowBreakdown as err:
-            status, message, failed = err.status, str(err), err.step
-            break
-        if observer is not None:
-            observer(flow)
-        if save_every and flow.n % save_every == 0:
-            save()
-    if frames[-1][0] != flow.n:
-        save()
-    n, V = zip(*frames)
-    return Trajectory(V=np.array(V), t=np.array(n) * flow.tau, steps=np.array(n),
-                      iterations=np.array(iterations, dtype=int), faces=flow.faces,
-                      status=status, message=message, failed_step=failed)
+    run = run_steps(flow, steps, save_every=save_every, observer=observer,
+                    state=lambda f: (f.V.copy(),))
+    (V,) = run.frames
+    return Trajectory(V=V, t=run.steps * flow.tau, steps=run.steps,
+                      iterations=run.iterations, faces=flow.faces, status=run.status,
+                      message=run.message, failed_step=run.failed_step)
 
 
 class VertexL2Error:

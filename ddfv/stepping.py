@@ -55,6 +55,38 @@ class FlowBreakdown(RuntimeError):
         super().__init__(message)
         self.status, self.step, self.time = status, step, time
 
+    @classmethod
+    def solver_failed(cls, step, tau, info, rtol):
+        """BiCGStab (``info``: :class:`~ddfv.solver.SolveInfo`) missed ``rtol``."""
+        t = step * tau
+        return cls("solver_failed", step, t,
+                   f"BiCGStab did not converge at step {step} (t = {t:.6g}): "
+                   f"relative residual {info.residual:.3e} > rtol {rtol:.1e} "
+                   f"after {info.iterations} iterations")
+
+    @classmethod
+    def degenerated(cls, step, tau, what):
+        """The state of time level ``step`` is degenerate: ``what`` says how."""
+        t = step * tau
+        return cls("degenerated", step, t, f"mesh degenerated at step {step} (t = {t:.6g}): {what}")
+
+
+def collapsed_cells(measure, threshold, cell):
+    """Describe the cells whose ``measure`` is not above ``threshold``, or None.
+
+    Parameters
+    ----------
+    measure : (m,) float array
+        Areas of the cells (NaN counts as collapsed).
+    threshold : float
+    cell : str
+        Name of a cell in the message, e.g. ``"diamond cell"``.
+    """
+    collapsed = np.flatnonzero(~(measure > threshold))
+    if len(collapsed) == 0:
+        return None
+    return f"{len(collapsed)} {cell}(s) collapsed, e.g. {cell} {int(collapsed[0])}"
+
 
 def validate_vertices(vertices, faces):
     """Check coordinates and triangle areas of an input surface.
@@ -218,12 +250,7 @@ class Flow:
         X, info = bicgstab(A, rhs, x0, rtol=self.rtol, maxiter=self.maxiter)
         clock = self._tick("solve", clock)
         if not info.converged:
-            n = self.n + 1
-            raise FlowBreakdown(
-                "solver_failed", n, n * self.tau,
-                f"BiCGStab did not converge at step {n} (t = {n * self.tau:.6g}): "
-                f"relative residual {info.residual:.3e} > rtol {self.rtol:.1e} "
-                f"after {info.iterations} iterations")
+            raise FlowBreakdown.solver_failed(self.n + 1, self.tau, info, self.rtol)
         self._X_prev, self._X = self._X, X
         self.n += 1
         for name in ("geometry", "covolumes"):
@@ -238,22 +265,16 @@ class Flow:
         return now
 
     def _check_geometry(self):
-        g = self.geometry
         if not np.isfinite(self._X).all():
-            raise FlowBreakdown("degenerated", self.n, self.t,
-                                f"mesh degenerated at step {self.n} (t = {self.t:.6g}): "
-                                "non-finite coordinates")
-        J = g.J
+            raise FlowBreakdown.degenerated(self.n, self.tau, "non-finite coordinates")
+        J = self.geometry.J
         if self.n == 0:
             self._J0 = J.mean()
         # collapsed against the mesh now (a local collapse) or at n = 0 (the
         # surface shrinking to a point)
-        collapsed = np.flatnonzero(~(J > max(1e-10 * J.mean(), 1e-12 * self._J0)))
-        if len(collapsed):
-            raise FlowBreakdown("degenerated", self.n, self.t,
-                                f"mesh degenerated at step {self.n} (t = {self.t:.6g}): "
-                                f"{len(collapsed)} diamond cell(s) collapsed, "
-                                f"e.g. diamond {int(collapsed[0])}")
+        what = collapsed_cells(J, max(1e-10 * J.mean(), 1e-12 * self._J0), "diamond cell")
+        if what:
+            raise FlowBreakdown.degenerated(self.n, self.tau, what)
 
 
 @dataclass
@@ -324,23 +345,85 @@ def simulate(vertices, faces, tau, steps, *, save_every=1, observer=None,
         On a breakdown, ``status`` and ``message`` say what happened and
         everything computed before is kept.
     """
-    if int(steps) != steps or steps < 0:
-        raise ValueError(f"steps must be a whole number >= 0, got {steps!r}")
-    if int(save_every) != save_every or save_every < 0:
-        raise ValueError(f"save_every must be a whole number >= 0, got {save_every!r}")
     flow = Flow(vertices, faces, tau, **flow_options)
-    frames, iterations, monitor = [], [], []
-    status, message, failed = "ok", "", -1
+    monitor = []
 
-    def record():
+    def record(flow):
         monitor.append(flow.t_min_barycentric())
         if observer is not None:
             observer(flow)
 
-    def save():
-        frames.append((flow.n, flow.F.copy(), flow.T.copy()))
+    run = run_steps(flow, steps, save_every=save_every, observer=record,
+                    progress=progress, state=lambda f: (f.F.copy(), f.T.copy()))
+    F, T = run.frames
+    return Trajectory(
+        F=F, T=T, t=run.steps * flow.tau, steps=run.steps, iterations=run.iterations,
+        t_min_barycentric=np.array(monitor), faces=flow.mesh.faces,
+        status=run.status, message=run.message, failed_step=run.failed_step,
+        timings=dict(flow.timings))
 
-    record()
+
+@dataclass
+class Steps:
+    """What :func:`run_steps` collected.
+
+    Attributes
+    ----------
+    steps : (frames,) int array
+        Time level of each frame.
+    frames : tuple of (frames, ...) arrays
+        One stacked array per entry of the ``state`` of each frame.
+    iterations : (n_steps,) int array
+    status, message : str
+    failed_step : int
+    """
+
+    steps: np.ndarray
+    frames: tuple
+    iterations: np.ndarray
+    status: str
+    message: str
+    failed_step: int
+
+
+def run_steps(flow, steps, *, save_every, state, observer=None, progress=False):
+    """Step a flow and keep frames: the driver of every scheme's ``simulate``.
+
+    Parameters
+    ----------
+    flow : object
+        With ``step() -> SolveInfo`` (raising :class:`FlowBreakdown`) and
+        the current time level ``n``.
+    steps : int
+    save_every : int
+        Keep every ``save_every``-th time level (the first and the last are
+        always kept); ``0`` keeps only those two.
+    state : callable
+        ``state(flow)`` -> tuple of arrays, copied, that make a frame.
+    observer : callable, optional
+        ``observer(flow)`` at every time level reached, ``n = 0`` included.
+    progress : bool
+        A progress bar for runs longer than two seconds.
+
+    Returns
+    -------
+    Steps
+        On a breakdown ``status``, ``message`` and ``failed_step`` say what
+        happened; the frames and counts of the levels before are kept (and
+        the state after a degenerate step as the last frame).
+    """
+    if int(steps) != steps or steps < 0:
+        raise ValueError(f"steps must be a whole number >= 0, got {steps!r}")
+    if int(save_every) != save_every or save_every < 0:
+        raise ValueError(f"save_every must be a whole number >= 0, got {save_every!r}")
+    frames, iterations = [], []
+    status, message, failed = "ok", "", -1
+
+    def save():
+        frames.append((flow.n, *state(flow)))
+
+    if observer is not None:
+        observer(flow)
     save()
     with tqdm(total=int(steps), delay=2.0, disable=not progress, unit="step") as bar:
         for _ in range(int(steps)):
@@ -351,14 +434,13 @@ def simulate(vertices, faces, tau, steps, *, save_every=1, observer=None,
                 break
             finally:
                 bar.update()
-            record()
+            if observer is not None:
+                observer(flow)
             if save_every and flow.n % save_every == 0:
                 save()
     if frames[-1][0] != flow.n:
         save()
-    n, F, T = zip(*frames)
-    return Trajectory(
-        F=np.array(F), T=np.array(T), t=np.array(n) * flow.tau,
-        steps=np.array(n), iterations=np.array(iterations, dtype=int),
-        t_min_barycentric=np.array(monitor), faces=flow.mesh.faces,
-        status=status, message=message, failed_step=failed, timings=dict(flow.timings))
+    n, *arrays = zip(*frames)
+    return Steps(steps=np.array(n), frames=tuple(np.array(a) for a in arrays),
+                 iterations=np.array(iterations, dtype=int), status=status,
+                 message=message, failed_step=failed)
