@@ -16,7 +16,7 @@ import pandas as pd
 
 from .errors import SphereL2Error, eoc
 from .geometry import covolume_areas, diamond_geometry
-from .sphere import T_FINAL, sphere_run
+from .sphere import T_FINAL, sphere_run, time_steps
 from .stepping import simulate
 from .surfaces import icosphere
 from .topology import diamond_mesh
@@ -54,7 +54,7 @@ def time_convergence(level, taus, *, reference_factor=8, t_final=T_FINAL,
 
     def final_state(tau):
         error = SphereL2Error()
-        traj = simulate(V, F, tau, _steps(t_final, tau), save_every=0, observer=error,
+        traj = simulate(V, F, tau, time_steps(t_final, tau), save_every=0, observer=error,
                         **options)
         l2 = error.value if traj.status == "ok" else np.nan
         return traj, np.concatenate([traj.F[-1], traj.T[-1]]), l2
@@ -70,7 +70,7 @@ def time_convergence(level, taus, *, reference_factor=8, t_final=T_FINAL,
         traj, X, l2 = final_state(tau)
         ok = traj.status == "ok"
         rows.append({
-            "tau": tau, "N": _steps(t_final, tau),
+            "tau": tau, "N": time_steps(t_final, tau),
             "error": float(np.sqrt(0.5 * chi @ np.sum((X - ref) ** 2, axis=1))) if ok else np.nan,
             "l2_error": l2, "status": traj.status})
     table = pd.DataFrame(rows)
@@ -95,9 +95,3 @@ def space_convergence(levels, tau, *, t_final=T_FINAL, variant="paper", **flow_o
     table.insert(5, "eoc", eoc(table["l2_error"].to_numpy()))
     return table
 
-
-def _steps(t_final, tau):
-    steps = int(round(t_final / tau))
-    if not np.isclose(steps * tau, t_final, rtol=1e-12, atol=0):
-        raise ValueError(f"t_final = {t_final} is not a multiple of tau = {tau}")
-    return steps

@@ -34,6 +34,14 @@ def level_time_step(level, tau_level_1=TAU_LEVEL_1):
     return tau_level_1 / 4.0 ** (level - 1)
 
 
+def time_steps(t_final, tau):
+    """Number of steps ``N = t_final / tau``; ``t_final`` must be a multiple of ``tau``."""
+    steps = int(round(t_final / tau))
+    if not np.isclose(steps * tau, t_final, rtol=1e-12, atol=0):
+        raise ValueError(f"t_final = {t_final} is not a multiple of tau = {tau}")
+    return steps
+
+
 @dataclass
 class SphereRun:
     """One row of Table 3.1.
@@ -108,9 +116,7 @@ def sphere_run(level, *, tau=None, t_final=T_FINAL, radius=1.0, variant="paper",
     SphereRun
     """
     tau = level_time_step(level) if tau is None else float(tau)
-    steps = int(round(t_final / tau))
-    if not np.isclose(steps * tau, t_final, rtol=1e-12, atol=0):
-        raise ValueError(f"t_final = {t_final} is not a multiple of tau = {tau}")
+    steps = time_steps(t_final, tau)
     V, Fc = icosphere(level, radius)
     error = SphereL2Error(radius)
     cpu, wall = time.process_time(), time.perf_counter()
