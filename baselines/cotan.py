@@ -50,9 +50,9 @@ import igl
 import numpy as np
 import scipy.sparse as sp
 
-from ddfv.errors import sphere_radius
+from ddfv.errors import SphereL2Error
 from ddfv.solver import bicgstab
-from ddfv.sphere import T_FINAL, SphereRun, level_time_step
+from ddfv.sphere import T_FINAL, SphereRun, level_time_step, time_steps
 from ddfv.stepping import (DEFAULT_RTOL, FlowBreakdown, collapsed_cells, run_steps,
                            validate_vertices)
 from ddfv.surfaces import icosphere
@@ -284,6 +284,19 @@ class Flow:
         return self._X.T
 
     @property
+    def X(self):
+        """(3, n) read-only view of ``X^n`` by components."""
+        view = self._X.view()
+        view.flags.writeable = False
+        return view
+
+    @property
+    def l2_weights(self):
+        """Quadrature weights of the L2 error over the vertices: the lumped
+        mass ``M^n_ii`` (the vertex areas tile the surface once)."""
+        return self.mass
+
+    @property
     def t(self):
         return self.n * self.tau
 
@@ -433,49 +446,13 @@ def simulate(vertices, faces, tau, steps, *, save_every=1, mass="barycentric",
                       message=run.message, failed_step=run.failed_step)
 
 
-class VertexL2Error:
-    """Space-time L2 error of a flow started from a sphere, over vertices.
-
-    The vertex analogue of (3.2)::
-
-        sqrt( sum_{n=1}^{N} tau sum_i (|X_i^n - c| - r(t^n))^2 M_ii^n )
-
-    with the lumped mass ``M^n`` of time level ``n`` as ``chi(V_i)`` (no
-    1/2: the vertex areas tile the surface once). Use as the ``observer``
-    of :func:`simulate`.
-
-    Parameters
-    ----------
-    radius : float
-        Initial radius ``R``; ``r(t) = sqrt(R^2 - 4 t)``.
-    centre : (3,) float array
-    """
-
-    def __init__(self, radius=1.0, centre=(0.0, 0.0, 0.0)):
-        self.radius = float(radius)
-        self.centre = np.asarray(centre, dtype=float)
-        self.total = 0.0
-        self.levels = 0
-
-    def __call__(self, flow):
-        if flow.n == 0:
-            return
-        dist = np.linalg.norm(flow.V - self.centre, axis=1) - sphere_radius(flow.t, self.radius)
-        self.total += flow.tau * float(np.dot(dist**2, flow.mass))
-        self.levels += 1
-
-    @property
-    def value(self):
-        """The L2 error of the time levels observed so far."""
-        return float(np.sqrt(self.total))
-
-
 def sphere_run(level, *, tau=None, t_final=T_FINAL, radius=1.0, **options):
     """Run the cotangent flow on the icosphere of ``level``: one baseline row.
 
     Same experiment as :func:`ddfv.sphere.sphere_run` (Section 3.1): the
     icosphere refined ``level`` times, ``tau = 0.04 / 4**(level - 1)`` by
-    default, error :class:`VertexL2Error`.
+    default, error :class:`ddfv.errors.SphereL2Error` over the vertices
+    weighted by the lumped mass.
 
     Parameters
     ----------
@@ -496,11 +473,9 @@ def sphere_run(level, *, tau=None, t_final=T_FINAL, radius=1.0, **options):
         and the error.
     """
     tau = level_time_step(level) if tau is None else float(tau)
-    steps = int(round(t_final / tau))
-    if not np.isclose(steps * tau, t_final, rtol=1e-12, atol=0):
-        raise ValueError(f"t_final = {t_final} is not a multiple of tau = {tau}")
+    steps = time_steps(t_final, tau)
     V, F = icosphere(level, radius)
-    error = VertexL2Error(radius)
+    error = SphereL2Error(radius)
     cpu, wall = time.process_time(), time.perf_counter()
     traj = simulate(V, F, tau, steps, save_every=0, observer=error, **options)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall

@@ -12,9 +12,10 @@ class SphereL2Error:
     """Space-time L2 error (3.2) of a flow started from a sphere.
 
     Use as the ``observer`` of :func:`ddfv.simulate`; the sum runs over the
-    time levels ``n = 1 ... N``, with the covolume areas ``chi^n`` of level
-    ``n``, F- and T-covolumes each weighted by 1/2 since each family tiles
-    the surface once.
+    time levels ``n = 1 ... N`` and the points of ``flow.X`` with the
+    weights ``flow.l2_weights`` of level ``n``: for DDFV the covolume
+    areas ``chi^n / 2`` of F- and T-vertices (each family tiles the surface
+    once), for the cotangent baseline the lumped mass of the vertices.
 
     Parameters
     ----------
@@ -36,7 +37,7 @@ class SphereL2Error:
         r = sphere_radius(flow.t, self.radius)
         X = flow.X - self.centre[:, None]
         dist = np.sqrt(X[0] ** 2 + X[1] ** 2 + X[2] ** 2) - r
-        self.total += flow.tau * 0.5 * float(np.dot(dist**2, flow.covolumes))  # (3.2)
+        self.total += flow.tau * float(np.dot(dist**2, flow.l2_weights))  # (3.2)
         self.levels += 1
 
     @property

@@ -216,6 +216,12 @@ class Flow:
         """(n_f + n_t,) covolume areas ``chi^n``, F-vertices first."""
         return np.concatenate(covolume_areas(self.mesh, self.geometry))
 
+    @property
+    def l2_weights(self):
+        """Quadrature weights of the L2 error (3.2): ``chi^n / 2`` (the F- and
+        the T-covolumes each tile the surface once)."""
+        return 0.5 * self.covolumes
+
     def t_min_barycentric(self):
         """Smallest barycentric coordinate of any T-vertex in its triangle."""
         return float(t_barycentric(self.F, self.T, self.mesh.faces).min())

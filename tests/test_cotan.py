@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from baselines import cotan
-from baselines.cotan import (Assembler, Flow, VertexL2Error, cotangent_laplacian,
+from baselines.cotan import (Assembler, Flow, cotangent_laplacian,
                              lumped_mass, simulate, sphere_run)
-from ddfv.errors import eoc, sphere_radius
+from ddfv.errors import SphereL2Error, eoc, sphere_radius
 from ddfv.shapes import catenoid_waist, cylinder
 from ddfv.solver import SolveInfo
 from ddfv.surfaces import icosphere
@@ -103,7 +103,7 @@ def test_sphere_run_fields():
 def test_l2_error_definition():
     # one step by hand: sqrt(tau sum_i (|X_i^1| - r(t^1))^2 M_ii^1)
     V, F = icosphere(1)
-    error = VertexL2Error()
+    error = SphereL2Error()
     flow = Flow(V, F, 0.04)
     flow.step()
     error(flow)

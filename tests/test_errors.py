@@ -34,8 +34,8 @@ def test_l2_error_weights_are_half_the_covolumes():
     T = V[F].mean(axis=1)
     T = T / np.linalg.norm(T, axis=1, keepdims=True) * (1 + d)
     state.X = np.concatenate([V * (1 + d), T]).T
-    state.covolumes = np.full(len(V) + len(F), 4 * np.pi / len(V))
-    state.covolumes[len(V):] = 4 * np.pi / len(F)
+    state.l2_weights = np.full(len(V) + len(F), 0.5 * 4 * np.pi / len(V))
+    state.l2_weights[len(V):] = 0.5 * 4 * np.pi / len(F)
     error(state)
     assert error.value == pytest.approx(np.sqrt(tau * d**2 * 4 * np.pi), rel=1e-10)
 
