@@ -26,18 +26,18 @@ L2 error, and no EOC against them (:func:`convergence_table.eoc_column`).
 """
 
 import hashlib
-import json
 import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from run_records import (RecordError, read_record, setup_logging,  # first: sys.path
-                         write_json_atomic, write_text_atomic)
+from run_records import (RECOMPUTE, RecordError, check_config_hash,  # first: sys.path
+                         load_record, read_record, setup_logging, write_json_atomic,
+                         write_text_atomic)
 
 from convergence_table import (COLUMNS, _fix, _int, _md_table, _sci, _sig,  # noqa: E402
                                _tex_table, build_table, eoc_column, l2_cell, mesh_size)
-from ddfv.provenance import config_hash, provenance  # noqa: E402
+from ddfv.provenance import provenance  # noqa: E402
 
 FLOAT_FORMAT = None  # shortest round-trip repr, as convergence_table.py
 MONITOR_COLUMNS = ["t_reached", "t_monitor_start", "t_monitor_end", "t_exit"]
@@ -66,26 +66,10 @@ def read_time_record(path, expected):
     RecordError
         Unreadable, a missing key, or settings other than ``expected``.
     """
-    hint = "delete it and run snakemake again to recompute it"
-    try:
-        record = json.loads(Path(path).read_text())
-    except OSError as err:
-        raise RecordError(f"{path}: cannot read time record: {err}") from None
-    except json.JSONDecodeError as err:
-        raise RecordError(f"{path}: not valid JSON ({err}); {hint}") from None
-    if not isinstance(record, dict):
-        raise RecordError(f"{path}: expected a JSON object; {hint}")
-    missing = [k for k in TIME_FIELDS if k not in record]
-    if missing:
-        raise RecordError(f"{path}: missing key(s) {missing}; {hint}")
+    record = load_record(path, TIME_FIELDS, "time record")
     if not isinstance(record["rows"], list):
-        raise RecordError(f"{path}: key 'rows' should be a list; {hint}")
-    stored = record["provenance"].get("config_hash") if isinstance(
-        record["provenance"], dict) else None
-    if stored != config_hash(expected):
-        raise RecordError(f"{path}: config hash {stored!r} does not match the current "
-                          f"settings (hash {config_hash(expected)!r}): the record is stale "
-                          f"or was edited; {hint}")
+        raise RecordError(f"{path}: key 'rows' should be a list; {RECOMPUTE}")
+    check_config_hash(path, record, expected)
     return record
 
 

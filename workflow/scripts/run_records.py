@@ -33,6 +33,9 @@ FIELDS.update({"scheme": str, "module": str, "options": dict, "t_final": float,
                "rtol": float, "provenance": dict})
 
 
+RECOMPUTE = "delete it and run snakemake again to recompute it"
+
+
 class RecordError(ValueError):
     """A run record that cannot be used; the message names the file."""
 
@@ -101,20 +104,7 @@ def read_record(path, expected):
         an unknown status, or settings other than ``expected`` (a stale
         record: its provenance config hash differs).
     """
-    hint = "delete it and run snakemake again to recompute it"
-    try:
-        text = Path(path).read_text()
-    except OSError as err:
-        raise RecordError(f"{path}: cannot read run record: {err}") from None
-    try:
-        record = json.loads(text)
-    except json.JSONDecodeError as err:
-        raise RecordError(f"{path}: not valid JSON ({err}); {hint}") from None
-    if not isinstance(record, dict):
-        raise RecordError(f"{path}: expected a JSON object, got {type(record).__name__}; {hint}")
-    missing = [k for k in FIELDS if k not in record]
-    if missing:
-        raise RecordError(f"{path}: missing key(s) {missing}; {hint}")
+    record = load_record(path, FIELDS, "run record")
     for key, kind in FIELDS.items():
         value = record[key]
         if kind is float:
@@ -126,19 +116,51 @@ def read_record(path, expected):
         if not ok:
             raise RecordError(f"{path}: key {key!r} should be {kind.__name__}"
                               f"{' or null' if kind is float else ''}, "
-                              f"got {value!r}; {hint}")
+                              f"got {value!r}; {RECOMPUTE}")
         if kind is float:
             record[key] = float("nan") if value is None else float(value)
     if record["status"] not in STATUSES:
         raise RecordError(f"{path}: unknown status {record['status']!r} "
-                          f"(expected one of {', '.join(STATUSES)}); {hint}")
+                          f"(expected one of {', '.join(STATUSES)}); {RECOMPUTE}")
     for key in ("scheme", "level"):
         if record[key] != expected[key]:
             raise RecordError(f"{path}: {key} is {record[key]!r}, expected "
-                              f"{expected[key]!r}; {hint}")
-    stored = record["provenance"].get("config_hash")
+                              f"{expected[key]!r}; {RECOMPUTE}")
+    check_config_hash(path, record, expected)
+    return record
+
+
+def load_record(path, required, what):
+    """Read a JSON record that must be an object with the keys ``required``.
+
+    Raises
+    ------
+    RecordError
+        Unreadable file, invalid JSON, not an object, or a missing key; the
+        message names the file and says how to recompute it.
+    """
+    try:
+        text = Path(path).read_text()
+    except OSError as err:
+        raise RecordError(f"{path}: cannot read {what}: {err}") from None
+    try:
+        record = json.loads(text)
+    except json.JSONDecodeError as err:
+        raise RecordError(f"{path}: not valid JSON ({err}); {RECOMPUTE}") from None
+    if not isinstance(record, dict):
+        raise RecordError(f"{path}: expected a JSON object, got {type(record).__name__}; "
+                          f"{RECOMPUTE}")
+    missing = [k for k in required if k not in record]
+    if missing:
+        raise RecordError(f"{path}: missing key(s) {missing}; {RECOMPUTE}")
+    return record
+
+
+def check_config_hash(path, record, expected):
+    """Refuse a record whose provenance hash is not that of ``expected`` (stale)."""
+    provenance = record["provenance"]
+    stored = provenance.get("config_hash") if isinstance(provenance, dict) else None
     if stored != config_hash(expected):
         raise RecordError(f"{path}: config hash {stored!r} does not match the current "
                           f"settings {expected} (hash {config_hash(expected)!r}): the record "
-                          f"is stale or was edited; {hint}")
-    return record
+                          f"is stale or was edited; {RECOMPUTE}")
