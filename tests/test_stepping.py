@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from conftest import bumpy_sphere, cylinder
+from conftest import cylinder
 from ddfv import Flow, simulate
 from ddfv.surfaces import icosphere
 from ddfv.topology import diamond_mesh

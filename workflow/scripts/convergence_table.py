@@ -13,7 +13,6 @@ and ``wall_time_ratio``.
 import hashlib
 import re
 import sys
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
