@@ -57,45 +57,53 @@ def bicgstab(A, b, x0, rtol=1e-10, maxiter=1000):
         return np.zeros_like(b), SolveInfo(0, 0.0, True)
     tol = rtol * bnorm
     x = np.array(x0, dtype=float, copy=True)
-    r = b - apply_block(A, x)
+    r = apply_block(A, x)
+    np.subtract(b, r, out=r)
     rnorm = _norm(r)
     if rnorm <= tol:
         return x, SolveInfo(0, rnorm / bnorm, True)
-    r_hat = r.copy()
-    p = np.zeros_like(r)
-    v = np.zeros_like(r)
-    rho = alpha = omega = 1.0
+    # every vector lives in one buffer, updated in place
+    r_hat, p, v, s, t, work = (np.empty_like(r) for _ in range(6))
+    r_hat[...] = p[...] = r
+    rho = _dot(r_hat, r)
     for it in range(1, maxiter + 1):
-        rho_new = _dot(r_hat, r)
-        if rho_new == 0.0 or omega == 0.0:
-            return x, SolveInfo(it - 1, rnorm / bnorm, False)
-        beta = (rho_new / rho) * (alpha / omega)
-        p = r + beta * (p - omega * v)
-        v = apply_block(A, p)
-        alpha = rho_new / _dot(r_hat, v)
-        s = r - alpha * v
+        if it > 1:
+            rho_new = _dot(r_hat, r)
+            if rho_new == 0.0:
+                return x, SolveInfo(it - 1, rnorm / bnorm, False)
+            beta = (rho_new / rho) * (alpha / omega)
+            rho = rho_new
+            p -= np.multiply(v, omega, out=work)        # p = r + beta (p - omega v)
+            p *= beta
+            p += r
+        apply_block(A, p, out=v)
+        alpha = rho / _dot(r_hat, v)
+        np.subtract(r, np.multiply(v, alpha, out=work), out=s)   # s = r - alpha v
+        x += np.multiply(p, alpha, out=work)
         snorm = _norm(s)
         if snorm <= tol:  # half-step exit: still one iteration
-            x += alpha * p
             return x, SolveInfo(it, snorm / bnorm, True)
-        t = apply_block(A, s)
-        omega = _dot(t, s) / _dot(t, t)
-        x += alpha * p + omega * s
-        r = s - omega * t
+        apply_block(A, s, out=t)
+        tt = _dot(t, t)
+        omega = _dot(t, s) / tt if tt > 0.0 else 0.0
+        if omega == 0.0:
+            return x, SolveInfo(it, snorm / bnorm, False)
+        x += np.multiply(s, omega, out=work)
+        np.subtract(s, np.multiply(t, omega, out=work), out=r)   # r = s - omega t
         rnorm = _norm(r)
         if rnorm <= tol:
             return x, SolveInfo(it, rnorm / bnorm, True)
-        rho = rho_new
     return x, SolveInfo(maxiter, rnorm / bnorm, False)
 
 
-def apply_block(A, X):
-    """``A`` applied to every row of a (k, n) block ``X``.
+def apply_block(A, X, out=None):
+    """``A`` applied to every row of a (k, n) block ``X`` (into ``out`` if given).
 
     In scipy, k products with vectors are faster than one product with an
     (n, k) block (measured: 0.9 ms against 1.3 ms at level 5).
     """
-    out = np.empty_like(X)
+    if out is None:
+        out = np.empty_like(X)
     for k, x in enumerate(X):
         out[k] = A @ x
     return out
