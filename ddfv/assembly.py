@@ -95,10 +95,8 @@ class Assembler:
         inverse[perm] = np.arange(len(perm))
         self.shape = (n, n)
         self._perm = perm
-        self._rows = rows[perm]
         self._indices = cols[perm].astype(np.int32)
-        self._indptr = np.searchsorted(self._rows, np.arange(n + 1)).astype(np.int32)
-        self._diag = inverse[-n:]
+        self._indptr = np.searchsorted(rows[perm], np.arange(n + 1)).astype(np.int32)
         self._he_out = np.ascontiguousarray(mesh.halfedges.T)
         self._he_in = np.ascontiguousarray(mesh.halfedges[:, [2, 0, 1]].T)
         self._mesh = mesh
@@ -107,6 +105,10 @@ class Assembler:
         if self._has_boundary:
             self._bnd_out = mesh.boundary[self._he_out]
             self._bnd_in = mesh.boundary[self._he_in]
+        # rows of the F-F, F-T and T-T blocks, for the row scaling
+        self._rows_ff = (a, b)
+        self._rows_ft = np.ascontiguousarray(mesh.faces.T)
+        self._rows_tt = (t1[inner], t2[inner])
         # Rows of boundary F-vertices are Dirichlet rows (Section 2.2.4).
         self._dirichlet = np.r_[mesh.boundary_vertices, np.zeros(n_t, bool)]
         # block boundaries within the entry buffer
@@ -118,17 +120,24 @@ class Assembler:
     def nnz(self):
         return len(self._indices)
 
-    def _entries(self, geom):
-        """Values of ``K`` in CSR order (Dirichlet rows not yet removed)."""
+    def _entries(self, geom, scale, shift):
+        """Values of ``diag(scale) K + shift I`` in CSR order.
+
+        Each block of entries is scaled by the ``scale`` of its rows before
+        the one permutation to CSR order.
+        """
         mesh = self._mesh
         alpha, beta, alpha_hat, beta_hat = flux_coefficients(geom)
+        s_f, s_t = scale[:mesh.n_f], scale[mesh.n_f:]
         ff_ab, ff_ba, ft, tf, tt_12, tt_21, d_f, d_t = (
             self._vals[i:j] for i, j in zip(self._cuts[:-1], self._cuts[1:]))
-        np.negative(alpha, out=ff_ab)
-        np.negative(alpha, out=ff_ba)
         ft = ft.reshape(3, -1)
         tf = tf.reshape(3, -1)
+        # off-diagonal entries -flux coefficient (module docstring)
+        np.multiply(alpha, s_f.take(self._rows_ff[0]), out=ff_ab)
+        np.multiply(alpha, s_f.take(self._rows_ff[1]), out=ff_ba)
         np.subtract(beta.take(self._he_in), beta.take(self._he_out), out=ft)
+        ft *= s_f.take(self._rows_ft)
         np.subtract(beta_hat.take(self._he_in), beta_hat.take(self._he_out), out=tf)
         ah = alpha_hat.take(self._he_out)
         np.add(ah[0], ah[1], out=d_t)
@@ -139,11 +148,20 @@ class Assembler:
             tf -= ah_b + alpha_hat.take(self._he_in) * self._bnd_in
             d_t += ah_b[0] + ah_b[1] + ah_b[2]
             alpha_hat = alpha_hat[self._inner]
-        np.negative(alpha_hat, out=tt_12)
-        np.negative(alpha_hat, out=tt_21)
-        a, b = mesh.diamonds[:, 0], mesh.diamonds[:, 1]
+        tf *= s_t
+        np.multiply(alpha_hat, s_t.take(self._rows_tt[0]), out=tt_12)
+        np.multiply(alpha_hat, s_t.take(self._rows_tt[1]), out=tt_21)
+        for block in (ff_ab, ff_ba, tt_12, tt_21):
+            np.negative(block, out=block)
+        # diagonal K_ii = sum of alpha (F rows) or alpha_hat (T rows): zero row sums
+        a, b = self._rows_ff
         np.add(np.bincount(a, alpha, minlength=mesh.n_f),
                np.bincount(b, alpha, minlength=mesh.n_f), out=d_f)
+        d_f *= s_f
+        d_t *= s_t
+        if shift:
+            d_f += shift
+            d_t += shift
         return self._vals.take(self._perm)
 
     def _csr(self, data):
@@ -163,9 +181,7 @@ class Assembler:
             Zero row sums; ``-(K X)_i`` approximates the integral of the
             Laplace-Beltrami operator of ``X`` over covolume ``i`` (2.9).
         """
-        data = self._entries(geom)
-        if self._has_boundary:
-            data *= ~self._dirichlet.take(self._rows)
+        data = self._entries(geom, (~self._dirichlet).astype(float), 0.0)
         return self._csr(data)
 
     def system(self, geom, chi, tau):
@@ -189,6 +205,4 @@ class Assembler:
         scale = tau / chi
         if self._has_boundary:
             scale[self._dirichlet] = 0.0
-        data = self._entries(geom) * scale.take(self._rows)
-        data[self._diag] += 1.0
-        return self._csr(data)
+        return self._csr(self._entries(geom, scale, 1.0))
