@@ -198,7 +198,7 @@ def vertex_normals(mesh, geom):
 
 def triangle_areas(F, faces):
     """(n_t,) areas of the triangles of the primal mesh."""
-    p0, p1, p2 = (np.take(F.T, faces[:, k], axis=1) for k in range(3))
+    p0, p1, p2 = np.take(F.T, faces.T, axis=1).swapaxes(0, 1)
     return 0.5 * _norm(_cross(p1 - p0, p2 - p0))
 
 
@@ -218,7 +218,7 @@ def t_barycentric(F, T, faces):
     -------
     (n_t, 3) float array
     """
-    p0, p1, p2 = (np.take(F.T, faces[:, k], axis=1) for k in range(3))
+    p0, p1, p2 = np.take(F.T, faces.T, axis=1).swapaxes(0, 1)
     e1, e2, d = p1 - p0, p2 - p0, T.T - p0
     # normal equations of the projection onto the plane of the triangle
     g11, g12, g22 = _dot(e1, e1), _dot(e1, e2), _dot(e2, e2)
@@ -237,7 +237,8 @@ def _cross(x, y):
 
 
 def _dot(x, y):
-    return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]
+    """Dot products of the columns of (3, m) component arrays."""
+    return np.einsum("ij,ij->j", x, y)
 
 
 def _norm(x):
