@@ -91,8 +91,6 @@ class Assembler:
         cols = np.concatenate([b, a, corner_t, corner_f,
                                n_f + t2[inner], n_f + t1[inner], diag])
         perm = np.lexsort((cols, rows))
-        inverse = np.empty_like(perm)
-        inverse[perm] = np.arange(len(perm))
         self.shape = (n, n)
         self._perm = perm
         self._indices = cols[perm].astype(np.int32)
