@@ -67,15 +67,6 @@ def bicgstab(A, b, x0, rtol=1e-10, maxiter=1000):
     r_hat[...] = p[...] = r
     rho = _dot(r_hat, r)
     for it in range(1, maxiter + 1):
-        if it > 1:
-            rho_new = _dot(r_hat, r)
-            if rho_new == 0.0:
-                return x, SolveInfo(it - 1, rnorm / bnorm, False)
-            beta = (rho_new / rho) * (alpha / omega)
-            rho = rho_new
-            p -= np.multiply(v, omega, out=work)        # p = r + beta (p - omega v)
-            p *= beta
-            p += r
         apply_block(A, p, out=v)
         alpha = rho / _dot(r_hat, v)
         np.subtract(r, np.multiply(v, alpha, out=work), out=s)   # s = r - alpha v
@@ -93,6 +84,14 @@ def bicgstab(A, b, x0, rtol=1e-10, maxiter=1000):
         rnorm = _norm(r)
         if rnorm <= tol:
             return x, SolveInfo(it, rnorm / bnorm, True)
+        rho_new = _dot(r_hat, r)
+        if rho_new == 0.0:
+            return x, SolveInfo(it, rnorm / bnorm, False)
+        beta = (rho_new / rho) * (alpha / omega)
+        rho = rho_new
+        p -= np.multiply(v, omega, out=work)     # p = r + beta (p - omega v)
+        p *= beta
+        p += r
     return x, SolveInfo(maxiter, rnorm / bnorm, False)
 
 
