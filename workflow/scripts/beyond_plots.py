@@ -29,7 +29,7 @@ import pandas as pd  # noqa: E402
 from matplotlib.ticker import FixedLocator, NullFormatter  # noqa: E402
 
 from run_records import setup_logging  # noqa: E402  (first: sys.path)
-from plot_convergence import draw, styles  # noqa: E402
+from plot_convergence import draw, scheme_lines, slope_guide, styles  # noqa: E402
 
 EDGE = 1.0 / 3.0   # 1/3 - monitor at which a T-vertex reaches an edge of its triangle
 SAVE = {"png": {"dpi": 200, "metadata": {"Software": None}},
@@ -148,18 +148,8 @@ def plot_t_monitor(series, stability, schemes, long_level):
 def plot_time(table):
     """Error at t_f against tau on a fixed mesh, one line per scheme, slope 1."""
     fig, ax = plt.subplots(figsize=(5.2, 4.0), layout="constrained")
-    style = legend_style(table)
-    ok = table[(table["status"] == "ok") & np.isfinite(table["error"])]
-    for scheme in table["scheme"].unique():
-        rows = ok[ok["scheme"] == scheme].sort_values("tau")
-        label, colour, marker = style[scheme]
-        ax.plot(rows["tau"], rows["error"], marker=marker, color=colour, label=label,
-                markersize=5, linewidth=1.5)
-    if len(ok):
-        tau = np.array([ok["tau"].min(), ok["tau"].max()])
-        smallest = ok[ok["tau"] == ok["tau"].min()]["error"].min()
-        ax.plot(tau, 0.5 * smallest * tau / tau[0], linestyle="--", color="0.5", linewidth=1.0,
-                label=r"slope 1 ($\propto \tau$)")
+    ok = scheme_lines(ax, table, "tau", "error", legend_style(table))
+    slope_guide(ax, ok, "tau", "error", 1, r"slope 1 ($\propto \tau$)")
     ax.set_xscale("log")
     ax.set_yscale("log")
     taus = np.sort(table["tau"].dropna().unique())

@@ -49,12 +49,7 @@ def draw(ax, table, t_final, style=None, note=None):
     (the experiment: shrinking sphere, ``tau ~ h^2``, ``t_f``).
     """
     style = style or styles(table["scheme"].unique())
-    ok = table[(table["status"] == "ok") & np.isfinite(table["l2_error"])]
-    for scheme in table["scheme"].unique():
-        rows = ok[ok["scheme"] == scheme].sort_values("h")
-        label, colour, marker = style[scheme]
-        ax.plot(rows["h"], rows["l2_error"], marker=marker, color=colour, label=label,
-                markersize=5, linewidth=1.5)
+    ok = scheme_lines(ax, table, "h", "l2_error", style)
     failed = table[table["status"] != "ok"]
     for i, r in enumerate(failed.itertuples()):
         ax.plot([r.h], [0.03 + 0.05 * (i % 3)], linestyle="none", marker="x",
@@ -66,12 +61,7 @@ def draw(ax, table, t_final, style=None, note=None):
         ax.plot(paper["h"], paper["paper_l2_error"], linestyle="none", marker="o",
                 markersize=10, markerfacecolor="none", markeredgecolor="black",
                 markeredgewidth=1.0, label="DDFV, Table 3.1 (paper)")
-    if len(ok):
-        h = np.array([ok["h"].min(), ok["h"].max()])
-        # through the smallest error at the finest mesh, shifted down by 2x
-        finest = ok[ok["h"] == ok["h"].min()]["l2_error"].min()
-        ax.plot(h, 0.5 * finest * (h / h[0]) ** 2, linestyle="--", color="0.5",
-                linewidth=1.0, label=r"slope 2 ($\propto h^2$)")
+    slope_guide(ax, ok, "h", "l2_error", 2, r"slope 2 ($\propto h^2$)")
     ax.set_xscale("log")
     ax.set_yscale("log")
     levels = table.drop_duplicates("level").sort_values("h")
@@ -90,6 +80,29 @@ def draw(ax, table, t_final, style=None, note=None):
     ax.grid(True, which="major", linewidth=0.5, alpha=0.5)
     ax.grid(True, which="minor", axis="y", linewidth=0.3, alpha=0.25)
     ax.legend(fontsize=8, loc="upper left", frameon=False)
+
+
+def scheme_lines(ax, table, x, y, style):
+    """One line ``y`` against ``x`` per scheme, through its finished rows.
+
+    Returns the finished rows (status ``ok``, finite ``y``).
+    """
+    ok = table[(table["status"] == "ok") & np.isfinite(table[y])]
+    for scheme in table["scheme"].unique():
+        rows = ok[ok["scheme"] == scheme].sort_values(x)
+        label, colour, marker = style[scheme]
+        ax.plot(rows[x], rows[y], marker=marker, color=colour, label=label,
+                markersize=5, linewidth=1.5)
+    return ok
+
+
+def slope_guide(ax, ok, x, y, order, label):
+    """A dashed ``x**order`` guide through half the smallest ``y`` at the smallest ``x``."""
+    if len(ok):
+        xs = np.array([ok[x].min(), ok[x].max()])
+        smallest = ok[ok[x] == ok[x].min()][y].min()
+        ax.plot(xs, 0.5 * smallest * (xs / xs[0]) ** order, linestyle="--", color="0.5",
+                linewidth=1.0, label=label)
 
 
 def main(csv, t_final, png, pdf, log_file):
