@@ -1,34 +1,28 @@
 """Discrete duality finite volume (DDFV) scheme for mean curvature flow of surfaces.
 
+The scheme of the paper, read in its order: :mod:`ddfv.topology` (the
+diamond mesh, 2.2.2) -> :mod:`ddfv.geometry` (per-diamond quantities,
+2.2.3-2.2.5) -> :mod:`ddfv.t_vertices` (initial T-vertices, Section 3) ->
+:mod:`ddfv.assembly` (the system (2.10)-(2.15)) -> :mod:`ddfv.flow`
+(semi-implicit steps (2.1), Dirichlet boundary (1.2), elimination (3.6))
+with its named :mod:`ddfv.variants`.
+
+This package is the scheme only: it imports nothing from the harness
+(``mcfbench``, which runs it: solver, driver, problems, studies) or from
+``baselines``.
+
 Public API
 ----------
-simulate(vertices, faces, tau, steps, ...) -> Trajectory
-    Run the flow (Sections 2-3 of the paper).
-Flow
-    One flow, stepped by hand.
-sphere_run(level, ...) -> SphereRun
-    One row of Table 3.1.
-icosphere(level), diamond_mesh(faces), read_mesh(path)
-SphereL2Error, eoc, sphere_radius
-    The error (3.2), the order (3.1) and the exact solution.
+Flow(vertices, faces, tau, **options)
+    One DDFV flow; ``flow.step(solve)`` advances one time step.
 VARIANTS, variant_options(name)
-    Named variants of the scheme (paper, chord, eliminate).
+    Named variants of the scheme (paper, chord, eliminate, chord-eliminate).
+DiamondMesh, diamond_mesh(faces)
+    The diamond mesh (Section 2.2.2).
 """
 
-from .memory import tune_malloc
+from .flow import Flow
+from .topology import DiamondMesh, diamond_mesh
+from .variants import VARIANTS, variant_options
 
-tune_malloc()
-
-from .errors import SphereL2Error, eoc, sphere_radius  # noqa: E402
-from .meshio import read_mesh  # noqa: E402
-from .sphere import SphereRun, sphere_run  # noqa: E402
-from .stepping import Flow, FlowBreakdown, Trajectory, simulate  # noqa: E402
-from .surfaces import icosphere  # noqa: E402
-from .topology import DiamondMesh, diamond_mesh  # noqa: E402
-from .variants import VARIANTS, variant_options  # noqa: E402
-
-__all__ = [
-    "DiamondMesh", "Flow", "FlowBreakdown", "SphereL2Error", "SphereRun",
-    "Trajectory", "diamond_mesh", "eoc", "icosphere", "read_mesh", "simulate",
-    "sphere_radius", "sphere_run", "VARIANTS", "variant_options",
-]
+__all__ = ["DiamondMesh", "Flow", "VARIANTS", "diamond_mesh", "variant_options"]

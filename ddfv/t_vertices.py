@@ -12,7 +12,13 @@
     exists and ``R = rho`` is used. On open surfaces the cotangent formula
     does not give the curvature at boundary vertices: ``h`` is averaged
     over the triangle's interior vertices only, and a triangle with all
-    three vertices on the boundary keeps its barycentre.
+    three vertices on the boundary keeps its barycentre. Safe on real
+    meshes: where the projected point's projection onto the triangle's plane
+    would lie outside the triangle (the osculating sphere of a coarse or
+    sharp-featured mesh is far from the surface; Section 2.2.2 requires the
+    projection to lie in the triangle), or is not finite, the barycentre is
+    kept instead (see ``ddfv/README.md``; on the icosphere no triangle falls
+    back, so Table 3.1 is unchanged).
 ``barycenter``
     The barycentre of the triangle.
 ``exact``
@@ -23,6 +29,8 @@
 import igl
 import numpy as np
 import scipy.sparse as sp
+
+from .geometry import t_barycentric
 
 METHODS = ("paper", "barycenter", "exact")
 
@@ -73,7 +81,9 @@ def initial_t_vertices(F, mesh, method="paper"):
     centre = cc + side * np.sqrt(R**2 - rho**2)[:, None] * n / np.sqrt(nn)[:, None]
     d = g - centre
     projected = centre + R[:, None] * d / np.linalg.norm(d, axis=1, keepdims=True)
-    return np.where(curved[:, None], projected, g)
+    inside = (t_barycentric(F, projected, faces).min(axis=1) >= 0.0) \
+        & np.isfinite(projected).all(axis=1)
+    return np.where((curved & inside)[:, None], projected, g)
 
 
 def cotangent_mean_curvature_vector(F, faces):

@@ -1,7 +1,8 @@
 """Named variants of the scheme, selectable by name in the API, CLI and pipeline.
 
 A variant is a set of options of :class:`ddfv.Flow`; adding one is one
-entry in :data:`VARIANTS` (and a line in ``ddfv/README.md``).
+entry in :data:`VARIANTS` (and a line in ``ddfv/README.md``); the harness's
+scheme registry (``mcfbench/schemes.py``) names each one ``ddfv-<variant>``.
 
 ``paper``
     The scheme as published: broken-line ``|gamma|`` (2.5), no tangential
@@ -10,6 +11,8 @@ entry in :data:`VARIANTS` (and a line in ``ddfv/README.md``).
     ``|gamma|`` replaced by the chord of the dual curve (``|v|``, ``|u|``).
 ``eliminate``
     The paper's scheme with the tangential-velocity elimination (3.6).
+``chord-eliminate``
+    Both: chord-length ``|gamma|`` and the elimination (3.6).
 
 The T-vertex initialisation is a separate setting (``t_init``).
 """
@@ -18,6 +21,7 @@ VARIANTS = {
     "paper": {},
     "chord": {"dual_length": "chord"},
     "eliminate": {"tangential": "eliminate"},
+    "chord-eliminate": {"dual_length": "chord", "tangential": "eliminate"},
 }
 
 

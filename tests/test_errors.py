@@ -1,8 +1,10 @@
 import numpy as np
 import pytest
 
-from ddfv import SphereL2Error, eoc, simulate, sphere_radius
-from ddfv.surfaces import icosphere
+from ddfv import Flow
+from mcfbench.driver import simulate
+from mcfbench.errors import SphereL2Error, eoc, sphere_radius
+from mcfbench.surfaces import icosphere
 
 
 def test_l2_error_vanishes_on_the_exact_solution():
@@ -11,12 +13,12 @@ def test_l2_error_vanishes_on_the_exact_solution():
     error = SphereL2Error()
 
     def exact(flow):
-        r = sphere_radius(flow.t)
+        r = sphere_radius(flow.n * flow.tau)
         flow._X /= np.linalg.norm(flow._X, axis=0) / r   # project onto the sphere
         flow.__dict__.pop("covolumes", None)
         error(flow)
 
-    simulate(V, F, 0.01, 3, observer=exact, t_init="exact")
+    simulate(Flow(V, F, 0.01, t_init="exact"), 3, observers=[exact])
     assert error.levels == 3 and error.value < 1e-14
 
 
@@ -32,8 +34,9 @@ def test_l2_error_weights_are_half_the_covolumes():
     state = State()
     state.tau = tau
     T = V[F].mean(axis=1)
-    T = T / np.linalg.norm(T, axis=1, keepdims=True) * (1 + d)
-    state.X = np.concatenate([V * (1 + d), T]).T
+    r = sphere_radius(tau)                       # the exact radius at t^1 = tau
+    T = T / np.linalg.norm(T, axis=1, keepdims=True) * (r + d)
+    state.X = np.concatenate([V * (r + d), T]).T
     state.l2_weights = np.full(len(V) + len(F), 0.5 * 4 * np.pi / len(V))
     state.l2_weights[len(V):] = 0.5 * 4 * np.pi / len(F)
     error(state)

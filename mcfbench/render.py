@@ -34,7 +34,7 @@ from matplotlib.collections import PolyCollection  # noqa: E402
 from matplotlib.colors import to_rgba  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 
-from .topology import diamond_mesh  # noqa: E402
+from ddfv.topology import diamond_mesh  # noqa: E402
 
 PRIMAL_COLOR = "#1f4fd8"     # F-edges (blue, as in Fig. 2.2)
 DIAMOND_COLOR = "#d62020"    # F-T edges and boundary edges (red)
@@ -260,7 +260,7 @@ def worst_element(F, T, faces, view=None, by="angle", max_tilt=60.0):
         Diamond index (``"angle"``) or triangle index (``"barycentric"``);
         see :func:`element_centre`.
     """
-    from .diagnostics import diamond_min_angles
+    from .quality import diamond_min_angles
     from .geometry import t_barycentric
 
     if by not in WORST_MEASURES:

@@ -34,7 +34,7 @@ class SphereL2Error:
     def __call__(self, flow):
         if flow.n == 0:
             return
-        r = sphere_radius(flow.t, self.radius)
+        r = sphere_radius(flow.n * flow.tau, self.radius)
         X = flow.X - self.centre[:, None]
         dist = np.sqrt(X[0] ** 2 + X[1] ** 2 + X[2] ** 2) - r
         self.total += flow.tau * float(np.dot(dist**2, flow.l2_weights))  # (3.2)

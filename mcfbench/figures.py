@@ -29,11 +29,13 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from .diagnostics import MeshQuality, describe_violation, first_violation
-from .shapes import make_shape
+from .driver import simulate
+from .mesh import validate_mesh
+from .quality import MeshQuality, describe_violation, first_violation
+from .schemes import get_scheme
+from .surfaces import make_surface
 
 TAU = 0.0025
-SCHEMES = ("ddfv", "cotan")
 
 
 @dataclass(frozen=True)
@@ -52,12 +54,11 @@ class Run:
     steps : int
     save_every : int
         Frames kept (every panel's time level must be a multiple).
-    tangential : {"none", "eliminate"}
-        Passed to :func:`ddfv.simulate` (3.6).
-    scheme : {"ddfv", "cotan"}
-        ``"cotan"``: the cotangent baseline :mod:`baselines.cotan`.
+    scheme : str
+        A name of :data:`mcfbench.schemes.SCHEMES` (``ddfv-eliminate``: the
+        elimination (3.6)).
     t_init : str
-        T-vertex initialisation (Section 3).
+        T-vertex initialisation (Section 3), DDFV schemes only.
     label : str
         Short description for legends.
     """
@@ -68,7 +69,6 @@ class Run:
     tau: float = TAU
     steps: int = 0
     save_every: int = 1
-    tangential: str = "none"
     scheme: str = "ddfv"
     t_init: str = "paper"
     label: str = ""
@@ -139,11 +139,11 @@ class Experiment:
         lines = []
         for r in self.runs:
             params = ", ".join(f"{k} = {v}" for k, v in r.params.items())
-            scheme = "DDFV" if r.scheme == "ddfv" else "cotangent"
-            what = f"{scheme} scheme, shape ``{r.shape}`` ({params}), tau = {r.tau:g}, " \
-                   f"{r.steps} steps"
-            if r.scheme == "ddfv":
-                what += f", tangential = ``{r.tangential}``, T-vertices ``{r.t_init}``"
+            scheme = get_scheme(r.scheme)
+            what = f"{scheme.label} (``{scheme.name}``), shape ``{r.shape}`` ({params}), " \
+                   f"tau = {r.tau:g}, {r.steps} steps"
+            if scheme.family == "ddfv":
+                what += f", T-vertices ``{r.t_init}``"
             lines.append(f"- ``{r.key}``: {what}")
         steps = ", ".join(str(s.step) + (" (detail)" if s.zoom else "") for s in self.shots)
         lines.append(f"- panels at n = {steps}; view elevation {self.view[0]:g}, "
@@ -155,7 +155,7 @@ def _shots(run, steps, **kw):
     return tuple(Shot(run, n, **kw) for n in steps)
 
 
-_CYLINDER = dict(segments=24, bands=8, radius=1.0, half_height=0.55)
+_CYLINDER = dict(around=24, along=8, radius=1.0, half_height=0.55, diagonals="twisted")
 _CYMLING = dict(level=3, flattening=0.4, lobes=9, wave=0.1)
 _BUMPY = dict(level=3, amplitude=0.25, width=0.2)
 _RIM_ZOOM = Zoom(0.12, "worst", 12)
@@ -223,7 +223,7 @@ EXPERIMENTS = {e.name: e for e in [
         "(3.6), at time steps n = 0, 100, 200 and 640: the T-vertices stay inside "
         "their triangles and the diamond mesh does not degenerate.",
         runs=(Run("ddfv", "cylinder", _CYLINDER, steps=640, save_every=20,
-                  tangential="eliminate"),),
+                  scheme="ddfv-eliminate"),),
         shots=_shots("ddfv", (0, 100, 200, 640)), view=(12.0, -60.0), aspect=0.8),
     Experiment(
         "fig_3_8", "Hemisphere with fixed equator",
@@ -231,7 +231,7 @@ EXPERIMENTS = {e.name: e for e in [
         "tangential velocity eliminated (3.6), n_V = 931, tau = 0.0025, at time steps "
         "n = 0, 40, 80 and 600: the surface flattens to the disk spanned by the equator.",
         runs=(Run("ddfv", "hemisphere", {"rings": 10}, steps=600, save_every=40,
-                  tangential="eliminate"),),
+                  scheme="ddfv-eliminate"),),
         shots=_shots("ddfv", (0, 40, 80, 600)), view=(25.0, -60.0), aspect=0.75),
     Experiment(
         "fig_3_6_cotan", "Cylinder: DDFV and the cotangent scheme",
@@ -281,7 +281,7 @@ class RunResult:
 
     run: Run
     F: np.ndarray           # (frames, n_f, 3)
-    T: np.ndarray | None    # (frames, n_t, 3); None for the cotangent scheme
+    T: np.ndarray | None    # (frames, n_t, 3); None for the vertex schemes
     steps: np.ndarray
     faces: np.ndarray
     iterations: np.ndarray
@@ -289,7 +289,7 @@ class RunResult:
     message: str
     failed_step: int
     wall_seconds: float
-    quality: object = None  # pandas.DataFrame of ddfv.diagnostics, DDFV runs only
+    quality: object = None  # pandas.DataFrame of mcfbench.quality, DDFV runs only
 
     def frame(self, step):
         """Index of the last kept frame at or before ``step``."""
@@ -315,41 +315,33 @@ class RunResult:
 def run_one(run):
     """Simulate one :class:`Run`.
 
-    A breakdown of the flow ends the run with its status, keeping the
-    frames computed before. A scheme that refuses the surface (its
-    ``simulate`` raises ``ValueError``) gives ``status = "unsupported"`` with
-    the initial surface as the only frame.
+    The run goes on past an invalid state (``on_defect="record"``: the
+    figures show what happens after a T-vertex leaves its triangle), and
+    its status says what went wrong first; a breakdown of the solver ends
+    it, keeping the frames computed before. A scheme that refuses the
+    surface (ValueError) gives ``status = "unsupported"`` with the initial
+    surface as the only frame.
 
     Returns
     -------
     RunResult
     """
-    if run.scheme not in SCHEMES:
-        raise ValueError(f"unknown scheme {run.scheme!r}; choose one of {', '.join(SCHEMES)}")
-    V, faces = make_shape(run.shape, **run.params)
+    scheme = get_scheme(run.scheme)
+    V, faces = validate_mesh(*make_surface(run.shape, **run.params))
     start = time.perf_counter()
-    if run.scheme == "cotan":
-        from baselines import cotan
-
-        try:
-            traj = cotan.simulate(V, faces, run.tau, run.steps, save_every=run.save_every)
-        except ValueError as err:
-            return RunResult(run, V[None], None, np.array([0]), faces, np.array([], int),
-                             "unsupported", str(err), -1, time.perf_counter() - start)
-        return RunResult(run, traj.V, None, traj.steps, traj.faces, traj.iterations,
-                         traj.status, traj.message, traj.failed_step,
-                         time.perf_counter() - start)
-    from .stepping import simulate
-
-    quality = MeshQuality()
-    options = {"t_init": run.t_init}
-    if run.tangential != "none":
-        options["tangential"] = run.tangential
-    traj = simulate(V, faces, run.tau, run.steps, save_every=run.save_every,
-                    observer=quality, **options)
-    return RunResult(run, traj.F, traj.T, traj.steps, traj.faces, traj.iterations,
-                     traj.status, traj.message, traj.failed_step,
-                     time.perf_counter() - start, quality.frame())
+    options = {"t_init": run.t_init} if scheme.family == "ddfv" else {}
+    try:
+        flow = scheme.make(V, faces, run.tau, **options)
+    except ValueError as err:
+        return RunResult(run, V[None], None, np.array([0]), faces, np.array([], int),
+                         "unsupported", str(err), -1, time.perf_counter() - start)
+    quality = MeshQuality() if scheme.family == "ddfv" else None
+    traj = simulate(flow, run.steps, save_every=run.save_every, on_defect="record",
+                    observers=[quality] if quality else [])
+    frames = traj.frames
+    return RunResult(run, frames.get("F", frames.get("V")), frames.get("T"), traj.steps,
+                     traj.faces, traj.iterations, traj.status, traj.message, traj.failed_step,
+                     time.perf_counter() - start, quality.frame() if quality else None)
 
 
 def run_experiment(experiment):

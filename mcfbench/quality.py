@@ -35,7 +35,7 @@ then :meth:`MeshQuality.frame` and :func:`first_violation`.
 import numpy as np
 import pandas as pd
 
-from .geometry import diamond_corners, diamond_geometry, t_barycentric
+from ddfv.geometry import diamond_corners, diamond_geometry, t_barycentric
 
 #: relative diamond area below which a diamond cell counts as collapsed
 COLLAPSE_AREA = 1e-8
@@ -108,7 +108,7 @@ class MeshQuality:
         self.rows = []
 
     def __call__(self, flow):
-        row = {"n": int(flow.n), "t": float(flow.t)}
+        row = {"n": int(flow.n), "t": float(flow.n * flow.tau)}
         row.update(mesh_quality(flow.mesh, flow.F, flow.T, flow.geometry))
         self.rows.append(row)
 

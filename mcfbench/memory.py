@@ -5,8 +5,10 @@ such blocks are mapped fresh and trimmed again at every free, so each step
 pays for hundreds of page faults (transparent huge pages make each one
 expensive): on the level-5 sphere this doubled the wall time, 44 % of it in
 the kernel. Raising glibc's mmap and trim thresholds lets the heap recycle
-the blocks. Process-wide and harmless; a no-op elsewhere than glibc; set
-``DDFV_MALLOC_TUNING=0`` to leave the allocator alone.
+the blocks. Process-wide, so never done on import: the entry points (the
+command line, the pipeline's jobs, the benchmarks) call :func:`tune_malloc`.
+A no-op elsewhere than glibc; ``DDFV_MALLOC_TUNING=0`` leaves the allocator
+alone.
 """
 
 import ctypes

@@ -1,0 +1,253 @@
+"""Semi-implicit time stepping (2.1) of the DDFV scheme: one flow, one step at a time.
+
+One step solves ``(I + tau diag(1/chi^{n-1}) K^{n-1}) X^n = X^{n-1}``
+((2.10), (2.13)) for the stacked ``X = [F; T]`` (stored by components,
+shape (3, n_F + n_T)) as one block system; the linear solver is passed in
+by the caller (the paper uses BiCGStab, Section 3).
+
+Open surfaces: boundary F-vertices keep their position (1.2); see
+:mod:`ddfv.assembly`. With ``tangential="eliminate"`` the right-hand side
+becomes ``X^{n-1} - tau (h - (h.N) N)`` (3.6), where
+``h = -diag(1/chi) K X^{n-1} = (X^{n-1} - A X^{n-1}) / tau`` is the
+scheme's own discrete Laplacian of the previous state (zero at Dirichlet
+vertices) and ``N`` the vertex normals of
+:func:`ddfv.geometry.vertex_normals`.
+
+Warm start: ``X^n`` is predicted by linear extrapolation
+``2 X^{n-1} - X^{n-2}`` (``X^0`` at the first step), whose residual is
+O(tau^2) instead of the O(tau) of ``X^{n-1}``; ``warm_start="previous"``
+starts from ``X^{n-1}`` (see ``ddfv/README.md``).
+
+Invalid states (:meth:`Flow.defects`): non-finite coordinates or collapsed
+diamond cells (``"degenerated"``), and a T-vertex whose projection left its
+triangle (``"t_escaped"``, Section 2.2.2: "the point T_i^n does not need to
+lie in the triangle, only its projection does").
+"""
+
+import time
+from functools import cached_property
+
+import numpy as np
+
+from .assembly import Assembler
+from .geometry import covolume_areas, diamond_geometry, t_barycentric, vertex_normals
+from .t_vertices import initial_t_vertices
+from .topology import diamond_mesh
+
+WARM_STARTS = ("extrapolate", "previous")
+TANGENTIAL = ("none", "eliminate")
+
+
+def collapsed_cells(measure, threshold, cell):
+    """Describe the cells whose ``measure`` is not above ``threshold``, or None.
+
+    Parameters
+    ----------
+    measure : (m,) float array
+        Areas of the cells (NaN counts as collapsed).
+    threshold : float
+    cell : str
+        Name of a cell in the message, e.g. ``"diamond cell"``.
+    """
+    collapsed = np.flatnonzero(~(measure > threshold))
+    if len(collapsed) == 0:
+        return None
+    return f"{len(collapsed)} {cell}(s) collapsed, e.g. {cell} {int(collapsed[0])}"
+
+
+class Flow:
+    """DDFV mean curvature flow of one triangulated surface.
+
+    Parameters
+    ----------
+    vertices : (n_f, 3) float array
+        Initial F-vertices ``F^0``.
+    faces : (n_t, 3) int array
+        Consistently oriented triangles.
+    tau : float
+        Time step.
+    T0 : (n_t, 3) float array, optional
+        Initial T-vertices; by default from ``t_init``.
+    t_init : {"paper", "barycenter", "exact"}
+        T-vertex initialisation (see :mod:`ddfv.t_vertices`).
+    warm_start : {"extrapolate", "previous"}
+        Initial guess of BiCGStab (see module docstring).
+    tangential : {"none", "eliminate"}
+        ``"eliminate"`` removes the tangential part of the discrete mean
+        curvature vector from the velocity (3.6).
+    dual_length : {"broken", "chord"}
+        Length of the dual curves ``|gamma|``: the paper's broken line (2.5)
+        or the chord (see :func:`ddfv.geometry.diamond_geometry`).
+
+    Attributes
+    ----------
+    F, T : float arrays
+        Current state ``F^n``, ``T^n``.
+    n : int
+        Current time level.
+    timings : dict
+        Seconds spent so far in ``"geometry"`` (including the covolumes and
+        the checks of each new state), ``"assembly"`` and ``"solve"``.
+    """
+
+    def __init__(self, vertices, faces, tau, *, T0=None, t_init="paper",
+                 warm_start="extrapolate", tangential="none", dual_length="broken"):
+        if not (np.isfinite(tau) and tau > 0):
+            raise ValueError(f"tau must be a positive number, got {tau!r}")
+        if warm_start not in WARM_STARTS:
+            raise ValueError(f"unknown warm_start {warm_start!r}; choose one of "
+                             f"{', '.join(WARM_STARTS)}")
+        if tangential not in TANGENTIAL:
+            raise ValueError(f"unknown tangential {tangential!r}; choose one of "
+                             f"{', '.join(TANGENTIAL)}")
+        self.mesh = diamond_mesh(faces, len(vertices))
+        F = np.asarray(vertices, dtype=float)
+        T = initial_t_vertices(F, self.mesh, t_init) if T0 is None \
+            else np.asarray(T0, dtype=float)
+        if T.shape != (self.mesh.n_t, 3):
+            raise ValueError(f"T0 must have shape {(self.mesh.n_t, 3)}, got {T.shape}")
+        self.tau = float(tau)
+        self.warm_start, self.tangential = warm_start, tangential
+        self.dual_length = dual_length
+        self.n = 0
+        self._X = np.ascontiguousarray(np.concatenate([F, T]).T)
+        self._X_prev = self._X
+        self._assembler = Assembler(self.mesh)
+        self.timings = {"geometry": 0.0, "assembly": 0.0, "solve": 0.0}
+        self._J0 = self.geometry.J.mean()
+
+    @property
+    def X(self):
+        """(3, n_f + n_t) read-only view of ``[F^n; T^n]`` by components."""
+        view = self._X.view()
+        view.flags.writeable = False
+        return view
+
+    @property
+    def F(self):
+        """(n_f, 3) view of the F-vertices ``F^n``."""
+        return self._X[:, :self.mesh.n_f].T
+
+    @property
+    def T(self):
+        """(n_t, 3) view of the T-vertices ``T^n``."""
+        return self._X[:, self.mesh.n_f:].T
+
+    @property
+    def t(self):
+        return self.n * self.tau
+
+    @property
+    def vertices(self):
+        """(n_f, 3) the F-vertices (the mesh vertices)."""
+        return self.F
+
+    @property
+    def faces(self):
+        """(n_t, 3) the triangles."""
+        return self.mesh.faces
+
+    @property
+    def fixed(self):
+        """(n_f,) bool: the Dirichlet (boundary) F-vertices (1.2)."""
+        return self.mesh.boundary_vertices
+
+    @cached_property
+    def geometry(self):
+        """:class:`~ddfv.geometry.DiamondGeometry` of the current state."""
+        return diamond_geometry(self.mesh, self.F, self.T, self.dual_length)
+
+    @cached_property
+    def covolumes(self):
+        """(n_f + n_t,) covolume areas ``chi^n``, F-vertices first."""
+        return np.concatenate(covolume_areas(self.mesh, self.geometry))
+
+    @property
+    def l2_weights(self):
+        """Quadrature weights of the L2 error (3.2): ``chi^n / 2`` (the F- and
+        the T-covolumes each tile the surface once)."""
+        return 0.5 * self.covolumes
+
+    @cached_property
+    def barycentric(self):
+        """(n_t, 3) barycentric coordinates of each T-vertex projected into
+        its triangle (the T monitor; Section 3.2)."""
+        return t_barycentric(self.F, self.T, self.mesh.faces)
+
+    def t_min_barycentric(self):
+        """Smallest barycentric coordinate of any T-vertex in its triangle."""
+        return float(self.barycentric.min())
+
+    def frame(self):
+        """``{"F": (n_f, 3), "T": (n_t, 3)}`` copies of the current state."""
+        return {"F": self.F.copy(), "T": self.T.copy()}
+
+    def step(self, solve):
+        """Advance one time step.
+
+        Parameters
+        ----------
+        solve : callable
+            ``solve(A, b, x0) -> (x, info)`` for (3, n) blocks sharing the
+            (n, n) matrix ``A``; raises when it fails, which leaves the
+            state at ``n - 1``.
+
+        Returns
+        -------
+        info
+            What ``solve`` returned.
+        """
+        clock = time.perf_counter()
+        geometry, covolumes = self.geometry, self.covolumes
+        self._tick("geometry", clock)
+        clock = time.perf_counter()
+        A = self._assembler.system(geometry, covolumes, self.tau)
+        rhs = self._X
+        if self.tangential == "eliminate":
+            h = (self._X - (A @ self._X.T).T) / self.tau            # h^{n-1}
+            N = vertex_normals(self.mesh, self.geometry)              # N^{n-1}
+            rhs = self._X - self.tau * (h - (h * N).sum(axis=0) * N)  # (3.6)
+        x0 = self._X
+        if self.warm_start == "extrapolate":
+            x0 = 2.0 * self._X - self._X_prev
+        clock = self._tick("assembly", clock)
+        X, info = solve(A, rhs, x0)
+        self._tick("solve", clock)
+        self._X_prev, self._X = self._X, np.ascontiguousarray(X)
+        self.n += 1
+        for name in ("geometry", "covolumes", "barycentric"):
+            self.__dict__.pop(name, None)
+        return info
+
+    def _tick(self, phase, since):
+        now = time.perf_counter()
+        self.timings[phase] += now - since
+        return now
+
+    def defects(self):
+        """What is wrong with the current state: ``[(status, description)]``.
+
+        ``"degenerated"``: non-finite coordinates, or diamond cells whose
+        area ``J`` fell below ``1e-10`` x the mean (a local collapse) or
+        ``1e-12`` x the initial mean (the surface shrinking to a point).
+        ``"t_escaped"``: the projection of a T-vertex left its triangle (a
+        negative barycentric coordinate, Section 2.2.2).
+        """
+        clock = time.perf_counter()
+        try:
+            if not np.isfinite(self._X).all():
+                return [("degenerated", "non-finite coordinates")]
+            J = self.geometry.J
+            what = collapsed_cells(J, max(1e-10 * J.mean(), 1e-12 * self._J0), "diamond cell")
+            if what:
+                return [("degenerated", what)]
+            bary = self.barycentric
+            worst = int(np.argmin(bary.min(axis=1)))
+            value = float(bary[worst].min())
+            if not value >= 0.0:
+                count = int(np.count_nonzero(~(bary.min(axis=1) >= 0.0)))
+                return [("t_escaped", f"the T-vertex of triangle {worst} left its triangle "
+                         f"(barycentric coordinate {value:.3g}; {count} T-vertex(es) outside)")]
+            return []
+        finally:
+            self._tick("geometry", clock)

@@ -1,0 +1,275 @@
+"""Command line: ``python -m mcfbench`` (alias ``python -m ddfv``).
+
+``sphere-table``
+    Table 3.1 for any scheme, next to the published values.
+``study PROBLEM``
+    Any scheme on any problem over its refinement series, with EOC.
+``run MESH``
+    Any scheme on a user's mesh, frames into an ``.npz``.
+``schemes``, ``problems``
+    The registries.
+"""
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .atomic import check_writable, save_npz, write_json
+from .memory import tune_malloc
+from .mesh import summarize
+from .meshio import read_mesh
+from .problems import PROBLEMS, get_problem
+from .provenance import provenance
+from .schemes import SCHEMES, get_scheme
+from .solver import METHODS, Solver
+from .studies import level_sweep, run
+from .tables import sphere_table
+
+
+def _positive_float(text):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a positive number, got {text!r}") from None
+    if not (np.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"must be a positive number, got {text}")
+    return value
+
+
+def _count(text, least=0):
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
+    if value < least:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= {least}, got {text}")
+    return value
+
+
+def _level(text):
+    return _count(text, least=1)
+
+
+def _common(parser, default_solver):
+    parser.add_argument("--scheme", default="ddfv", choices=list(SCHEMES),
+                        help="scheme (default: ddfv; see `schemes`)")
+    parser.add_argument("--variant", help="DDFV variant: same as --scheme ddfv-VARIANT "
+                        "(paper, chord, eliminate, chord-eliminate)")
+    parser.add_argument("--solver", choices=METHODS, default=default_solver,
+                        help=f"linear solver (default: {default_solver})")
+    parser.add_argument("--rtol", type=_positive_float, default=1e-9,
+                        help="relative tolerance of the iterative solvers (default: 1e-9)")
+    parser.add_argument("--maxiter", type=_level, default=1000,
+                        help="iterations allowed per step (default: 1000)")
+    parser.add_argument("--t-init", choices=("paper", "barycenter", "exact"),
+                        help="DDFV: T-vertex initialisation (default: paper)")
+    parser.add_argument("--warm-start", choices=("extrapolate", "previous"),
+                        help="DDFV: initial guess of the solver (default: extrapolate)")
+    parser.add_argument("--on-defect", choices=("stop", "record"), default="stop",
+                        help="an invalid state (T-vertex escaped, triangle inverted, mesh "
+                             "degenerated) ends the run (stop, default) or is recorded")
+
+
+def build_parser():
+    parser = argparse.ArgumentParser(
+        prog="python -m mcfbench",
+        description="Benchmark of mean curvature flow schemes (DDFV and baselines).")
+    commands = parser.add_subparsers(dest="command", required=True)
+
+    table = commands.add_parser("sphere-table", help="Table 3.1 (shrinking unit sphere)")
+    table.add_argument("--levels", type=_level, nargs="+", default=[1, 2, 3, 4, 5],
+                       help="icosphere refinement levels >= 1 (default: 1 2 3 4 5)")
+    table.add_argument("--csv", type=Path, help="also write the table as CSV "
+                       "(and its provenance as CSV.json)")
+    _common(table, "bicgstab")
+
+    study = commands.add_parser("study", help="a scheme on a problem's refinement series")
+    study.add_argument("problem", choices=list(PROBLEMS))
+    study.add_argument("--levels", type=_level, nargs="+", help="default: the problem's")
+    study.add_argument("--csv", type=Path, help="also write the table as CSV")
+    _common(study, "bicgstab")
+
+    flow = commands.add_parser("run", help="run a scheme on a triangle mesh file "
+                               "(boundary vertices are held fixed)")
+    flow.add_argument("mesh", type=Path, help="OBJ, OFF, PLY or STL file")
+    step = flow.add_mutually_exclusive_group(required=True)
+    step.add_argument("--tau", type=_positive_float, help="time step")
+    step.add_argument("--tau-edge", type=_positive_float, metavar="C",
+                      help="time step C * (mean edge length)^2")
+    flow.add_argument("--steps", type=_level, required=True, help="number of time steps")
+    flow.add_argument("--save-every", type=_count, default=1,
+                      help="keep every K-th step as a frame (0: first and last only)")
+    flow.add_argument("--out", type=Path, required=True, help="output file (.npz)")
+    _common(flow, "direct")
+
+    commands.add_parser("schemes", help="list the schemes")
+    commands.add_parser("problems", help="list the problems")
+    return parser
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
+    tune_malloc()
+    try:
+        return COMMANDS[args.command](args)
+    except (ValueError, FileNotFoundError) as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+
+
+def _scheme(args):
+    if args.variant is not None:
+        name = "ddfv" if args.variant == "paper" else f"ddfv-{args.variant}"
+        return get_scheme(name)
+    return get_scheme(args.scheme)
+
+
+def _options(args, scheme):
+    """Run options: the solver and the DDFV-only settings that were given."""
+    options = {"solver": Solver(args.solver, args.rtol, args.maxiter),
+               "on_defect": args.on_defect}
+    ddfv_only = {"t_init": args.t_init, "warm_start": args.warm_start}
+    given = {k: v for k, v in ddfv_only.items() if v is not None}
+    if given and scheme.family != "ddfv":
+        raise ValueError(f"--{next(iter(given)).replace('_', '-')} applies to the DDFV "
+                         f"schemes only, not to {scheme.name}")
+    return {**options, **given}
+
+
+def _settings(args, scheme):
+    return {"command": args.command, "scheme": scheme.name, "solver": args.solver,
+            "rtol": args.rtol, "maxiter": args.maxiter, "t_init": args.t_init,
+            "warm_start": args.warm_start, "on_defect": args.on_defect}
+
+
+def _sphere_table(args):
+    scheme = _scheme(args)
+    if args.csv:
+        check_writable(args.csv)
+    table = sphere_table(args.levels, scheme.name, **_options(args, scheme))
+    print(format_table(table))
+    if args.csv:
+        _write_csv(args.csv, table, {**_settings(args, scheme), "levels": args.levels})
+    _print_failures(table)
+    return 0 if (table["status"] == "ok").all() else 1
+
+
+def _study(args):
+    scheme, problem = _scheme(args), get_problem(args.problem)
+    if args.csv:
+        check_writable(args.csv)
+    table = level_sweep(scheme.name, problem, args.levels, **_options(args, scheme))
+    columns = ["level", "nV", "h", "tau", "N", "steps_done", "status",
+               *[c for c in table.columns if c.startswith("eoc_")],
+               *[c for c in table.columns if c not in _NOT_METRICS and
+                 not c.startswith("eoc_")], "iterations", "min_angle", "cpu_seconds"]
+    print(f"{scheme.label} on {problem.label} ({problem.exact})")
+    print(table[list(dict.fromkeys(columns))].to_string(index=False, float_format="%.4g"))
+    if args.csv:
+        _write_csv(args.csv, table, {**_settings(args, scheme), "problem": problem.name,
+                                     "levels": args.levels})
+    _print_failures(table)
+    return 0 if (table["status"] == "ok").all() else 1
+
+
+_NOT_METRICS = {"scheme", "problem", "level", "nV", "nF", "nT", "h", "tau", "N", "steps_done",
+                "status", "message", "t_failed", "t_end", "steady", "iterations", "solver",
+                "cpu_seconds", "wall_seconds", "t_min_barycentric", "min_angle", "max_aspect",
+                "max_flipped"}
+
+
+def _write_csv(path, table, config):
+    from .atomic import atomic_path
+
+    with atomic_path(path) as tmp:
+        table.to_csv(tmp, index=False)
+    write_json(f"{path}.json", provenance(config))
+    print(f"wrote {path}")
+
+
+def _print_failures(table):
+    for row in table.itertuples():
+        if row.status != "ok":
+            print(f"error: level {row.level}: {row.message}", file=sys.stderr)
+
+
+def format_table(table):
+    """Table 3.1, ours next to the paper's, as text."""
+    head = (f"{'nV':>6} {'nF':>6} {'nT':>6} {'tau':>10} {'N':>4} | "
+            f"{'L2 error':>10} {'paper':>9} {'ratio':>6} | {'iter':>5} {'paper':>5} | "
+            f"{'EOC':>5} {'paper':>5} | {'CPU s':>7} {'paper':>7} | status")
+    lines = [head, "-" * len(head)]
+    for r in table.itertuples():
+        lines.append(
+            f"{r.nV:6d} {r.nF:6d} {r.nT:6d} {r.tau:10.8f} {r.N:4d} | "
+            f"{r.l2_error:10.4e} {r.paper_l2_error:9.2e} {r.l2_ratio:6.3f} | "
+            f"{r.iterations:5d} {_int(r.paper_iterations):>5} | "
+            f"{_num(r.eoc, 3):>5} {_num(r.paper_eoc, 2):>5} | "
+            f"{r.cpu_seconds:7.2f} {_num(r.paper_cpu_seconds, 2):>7} | {r.status}")
+    return "\n".join(lines)
+
+
+def _num(x, digits):
+    return "" if x is None or np.isnan(x) else f"{x:.{digits}f}"
+
+
+def _int(x):
+    return "" if x is None or np.isnan(x) else f"{int(x)}"
+
+
+def _run(args):
+    scheme = _scheme(args)
+    options = _options(args, scheme)
+    check_writable(args.out)
+    if args.out.suffix != ".npz":
+        raise ValueError(f"--out {args.out}: the output is an .npz archive; name it *.npz")
+    V, F, intake = read_mesh(args.mesh)
+    for note in intake.notes():
+        print(f"note: {note}")
+    print(f"mesh: {summarize(V, F)}")
+    problem = get_problem("sphere").with_settings(
+        name="user", label=args.mesh.name, metrics=(), tau_rule="mesh",
+        tau_1=args.tau_edge or 1.0, steps=args.steps)
+    tau = args.tau
+    print(f"scheme {scheme.name}, solver {args.solver}"
+          f"{'' if args.solver == 'direct' else f' (rtol {args.rtol:g})'}, "
+          f"tau {tau if tau else problem.tau(0, (V, F)):.4g}, {args.steps} steps")
+    result, traj = run(scheme, problem, 0, tau=tau, mesh=(V, F), save_every=args.save_every,
+                       **options)
+    config = {**_settings(args, scheme), "mesh": str(args.mesh), "tau": result.tau,
+              "steps": args.steps, "save_every": args.save_every}
+    save_npz(args.out, **{k: v for k, v in traj.frames.items()}, faces=traj.faces,
+             vertex_map=intake.kept, t=traj.t, steps=traj.steps, iterations=traj.iterations,
+             t_min_barycentric=np.array(result.series["t_min_barycentric"]),
+             status=traj.status, message=traj.message, failed_step=traj.failed_step,
+             scheme=scheme.name, defects=json.dumps(traj.defects),
+             provenance=json.dumps(provenance(config)))
+    print(f"wrote {args.out}: {len(traj.t)} frames, {traj.steps_done} steps, "
+          f"{int(traj.iterations.sum())} solver iterations, smallest angle "
+          f"{result.min_angle:.3g} deg"
+          + (f", min T barycentric {result.t_min_barycentric:.3f}"
+             if scheme.family == "ddfv" else ""))
+    if traj.status != "ok":
+        print(f"error: {traj.message} (frames up to step {traj.steps[-1]} kept)",
+              file=sys.stderr)
+        return 1
+    return 0
+
+
+def _schemes(args):
+    for scheme in SCHEMES.values():
+        print(f"{scheme.name:22s} {scheme.description}")
+    return 0
+
+
+def _problems(args):
+    for problem in PROBLEMS.values():
+        print(f"{problem.name:12s} {problem.label}: {problem.exact}")
+    return 0
+
+
+COMMANDS = {"sphere-table": _sphere_table, "study": _study, "run": _run,
+            "schemes": _schemes, "problems": _problems}

@@ -1,0 +1,187 @@
+"""The time-stepping driver shared by every scheme.
+
+:func:`simulate` steps a :class:`~mcfbench.flow.Flow` with the shared
+linear solver, checks every state it reaches (the initial one included)
+through :meth:`Flow.defects`, calls observers at every time level and keeps
+frames. Every way a run can end is one :class:`~mcfbench.flow.FlowBreakdown`
+with one message format, ``"{status} at step {n} (t = {t}): {detail}"``.
+"""
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from tqdm import tqdm
+
+from .flow import FlowBreakdown
+from .solver import Solver, SolverFailure
+
+ON_DEFECT = ("stop", "record")
+
+
+@dataclass
+class Trajectory:
+    """What :func:`simulate` computed.
+
+    Attributes
+    ----------
+    frames : dict of str -> (frames, ...) float arrays
+        The arrays of :meth:`Flow.frame` stacked over the kept frames
+        (DDFV: ``"F"``, ``"T"``; the others: ``"V"``). Frame 0 is the
+        initial state, the last frame the last state computed.
+    steps : (frames,) int array
+        Time level of each frame.
+    t : (frames,) float array
+    faces : (m, 3) int array
+    iterations : (n_steps,) int array
+        Solver iterations of each completed step.
+    status : str
+        ``"ok"`` or the status of the first breakdown or defect
+        (:data:`mcfbench.flow.STATUSES`).
+    message : str
+        Empty when ``status == "ok"``.
+    failed_step : int
+        Time level of the breakdown or first defect, ``-1`` when ``ok``.
+    steps_done : int
+        Time steps completed (in ``"record"`` mode possibly all of them
+        although ``status`` is not ``ok``).
+    defects : list of dict
+        Every defect seen (``"record"`` mode: one per status, its first
+        occurrence): ``status``, ``step``, ``time``, ``detail``.
+    wall_seconds, cpu_seconds : float
+        Time of the stepping, observers included.
+    """
+
+    frames: dict
+    steps: np.ndarray
+    t: np.ndarray
+    faces: np.ndarray
+    iterations: np.ndarray
+    status: str = "ok"
+    message: str = ""
+    failed_step: int = -1
+    steps_done: int = 0
+    defects: list = field(default_factory=list)
+    wall_seconds: float = 0.0
+    cpu_seconds: float = 0.0
+
+    @property
+    def ok(self):
+        return self.status == "ok"
+
+    @property
+    def t_failed(self):
+        """Time of the breakdown or first defect, NaN when ``ok``."""
+        return float("nan") if self.ok else float(self.defects[0]["time"]) \
+            if self.defects else float("nan")
+
+
+def simulate(flow, steps, *, solver=None, save_every=1, observers=(), on_defect="stop",
+             until=None, progress=False):
+    """Step ``flow`` ``steps`` times.
+
+    Parameters
+    ----------
+    flow : mcfbench.flow.Flow
+    steps : int
+    solver : mcfbench.solver.Solver, optional
+        Default ``Solver()`` (BiCGStab, rtol 1e-9).
+    save_every : int
+        Keep every ``save_every``-th time level as a frame (the first and
+        the last are always kept); ``0`` keeps only those two.
+    observers : sequence of callables
+        ``observer(flow)`` at every time level reached, ``n = 0`` included,
+        in order.
+    on_defect : {"stop", "record"}
+        What an invalid state (:meth:`Flow.defects`) does: end the run
+        (default; the invalid state is kept as the last frame) or be
+        recorded (its first occurrence per status) while the run goes on.
+        Solver failures always end the run (the state stays at the last
+        valid level).
+    until : callable, optional
+        ``until(flow) -> bool`` after the observers of every level
+        ``n >= 1``: True ends the run there (e.g. a steady state), status
+        ``ok``.
+    progress : bool
+        A progress bar for runs longer than two seconds.
+
+    Returns
+    -------
+    Trajectory
+        Everything computed before a breakdown is kept.
+    """
+    if int(steps) != steps or steps < 0:
+        raise ValueError(f"steps must be a whole number >= 0, got {steps!r}")
+    if int(save_every) != save_every or save_every < 0:
+        raise ValueError(f"save_every must be a whole number >= 0, got {save_every!r}")
+    if on_defect not in ON_DEFECT:
+        raise ValueError(f"unknown on_defect {on_defect!r}; choose one of {', '.join(ON_DEFECT)}")
+    solver = Solver() if solver is None else solver
+    frames, steps_kept, iterations, defects = [], [], [], []
+    seen = set()
+
+    def save():
+        steps_kept.append(flow.n)
+        frames.append(flow.frame())
+
+    def check():
+        """Record the defects of the current state; raise in stop mode."""
+        for status, detail in flow.defects():
+            if status in seen:
+                continue
+            seen.add(status)
+            defects.append({"status": status, "step": flow.n, "time": flow.n * flow.tau,
+                            "detail": detail})
+            if on_defect == "stop":
+                raise FlowBreakdown(status, flow.n, flow.n * flow.tau, detail)
+
+    def observe():
+        for observer in observers:
+            observer(flow)
+
+    wall, cpu = time.perf_counter(), time.process_time()
+    broken = None
+    try:
+        check()
+        observe()
+    except FlowBreakdown as err:
+        broken = err
+    save()
+    with tqdm(total=int(steps), delay=2.0, disable=not progress or broken is not None,
+              unit="step") as bar:
+        for _ in range(int(steps) if broken is None else 0):
+            try:
+                try:
+                    info = flow.step(solver)
+                except SolverFailure as err:
+                    step = flow.n + 1
+                    defects.append({"status": err.status, "step": step,
+                                    "time": step * flow.tau, "detail": str(err)})
+                    raise FlowBreakdown(err.status, step, step * flow.tau, str(err)) from None
+                iterations.append(info.iterations)
+                check()
+            except FlowBreakdown as err:
+                broken = err
+                break
+            finally:
+                bar.update()
+            observe()
+            if save_every and flow.n % save_every == 0:
+                save()
+            if until is not None and until(flow):
+                break
+    if steps_kept[-1] != flow.n:
+        save()
+    status, message, failed = "ok", "", -1
+    if defects:
+        first = defects[0]
+        status, failed = first["status"], first["step"]
+        message = str(broken) if broken is not None else str(
+            FlowBreakdown(first["status"], first["step"], first["time"], first["detail"]))
+    stacked = {key: np.stack([frame[key] for frame in frames]) for key in frames[0]}
+    return Trajectory(
+        frames=stacked, steps=np.array(steps_kept), t=np.array(steps_kept) * flow.tau,
+        faces=np.asarray(flow.faces), iterations=np.array(iterations, dtype=int),
+        status=status, message=message, failed_step=failed, steps_done=len(iterations),
+        defects=defects, wall_seconds=time.perf_counter() - wall,
+        cpu_seconds=time.process_time() - cpu)

@@ -1,0 +1,328 @@
+"""Studies for ANY scheme on ANY problem: one run, level sweeps, time and space convergence.
+
+:func:`run` is the single place where a scheme meets a problem: it builds
+the problem's mesh, validates it, builds the scheme's flow, steps it with
+the shared solver and driver, and measures the problem's metrics, the mesh
+quality over time, iterations and time. Table 3.1 is
+``[run("ddfv", "sphere", k) for k in 1..5]`` (:func:`level_sweep`).
+
+Convergence in time and in space separately (beyond Table 3.1):
+:func:`time_convergence` (fixed mesh, tau halved, against a fine-tau
+reference of the same scheme: order 1 expected, (2.1)) and
+:func:`space_convergence` (one tiny tau, refined meshes, against the exact
+solution: order 2 expected).
+"""
+
+import time
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from . import metrics
+from .driver import simulate
+from .errors import eoc
+from .mesh import validate_mesh
+from .problems import get_problem
+from .schemes import get_scheme
+from .solver import Solver
+
+
+@dataclass
+class RunResult:
+    """One scheme on one problem at one level.
+
+    Attributes
+    ----------
+    scheme, problem : str
+    level : int
+    nV : int
+        Points of the state (DDFV: F- plus T-vertices).
+    nF, nT : int
+        Mesh vertices and triangles.
+    h : float
+        Mean edge length of the initial mesh.
+    tau : float
+    N : int
+        Steps asked for.
+    steps_done : int
+        Steps completed.
+    status, message : str
+        ``"ok"`` or the breakdown (:data:`mcfbench.flow.STATUSES`).
+    t_failed : float
+        Time of the breakdown or first defect, NaN when ``ok``.
+    t_end : float
+        Time of the last state reached (earlier than ``N tau`` at a
+        breakdown or when the steady state was reached).
+    steady : bool
+        The run stopped at the problem's steady state.
+    iterations : int
+        Total solver iterations.
+    solver : str
+        The solver's method.
+    cpu_seconds, wall_seconds : float
+        Flow construction (T-vertex initialisation included), stepping and
+        metrics.
+    t_min_barycentric : float
+        DDFV: the T monitor, smallest barycentric coordinate of a T-vertex
+        over all time levels reached (NaN for the other schemes).
+    min_angle, max_aspect, max_flipped : float
+        Worst mesh quality over the sampled time levels
+        (:func:`mcfbench.metrics.quality`).
+    metrics : dict
+        The problem's metrics (e.g. ``l2_error``); NaN when the run did not
+        finish.
+    series : dict of lists
+        ``t``, ``t_min_barycentric`` (every level), ``quality_t``,
+        ``min_angle``, ``max_aspect``, ``flipped`` (sampled levels).
+    """
+
+    scheme: str
+    problem: str
+    level: int
+    nV: int
+    nF: int
+    nT: int
+    h: float
+    tau: float
+    N: int
+    steps_done: int
+    status: str
+    message: str
+    t_failed: float
+    t_end: float
+    steady: bool
+    iterations: int
+    solver: str
+    cpu_seconds: float
+    wall_seconds: float
+    t_min_barycentric: float
+    min_angle: float
+    max_aspect: float
+    max_flipped: float
+    metrics: dict = field(default_factory=dict)
+    series: dict = field(default_factory=dict, repr=False)
+
+    def to_dict(self, series=True):
+        """Fields as a flat dict: the metrics as top-level keys; ``series=False``
+        leaves out the time series."""
+        row = asdict(self)
+        row.update(row.pop("metrics"))
+        if not series:
+            del row["series"]
+        return row
+
+
+class _Monitor:
+    """Observer: the T monitor at every level, mesh quality every ``every`` levels."""
+
+    def __init__(self, every):
+        self.every = max(1, int(every))
+        self.t, self.t_monitor = [], []
+        self.quality = {"quality_t": [], "min_angle": [], "max_aspect": [], "flipped": []}
+
+    def __call__(self, flow):
+        t = flow.n * flow.tau
+        self.t.append(t)
+        monitor = getattr(flow, "t_min_barycentric", None)
+        self.t_monitor.append(monitor() if monitor is not None else float("nan"))
+        if flow.n % self.every == 0:
+            self.sample(flow)
+
+    def final(self, flow):
+        """Include the last state reached (an invalid one too, when finite)."""
+        if not np.isfinite(flow.X).all():
+            return
+        if not self.t or self.t[-1] != flow.n * flow.tau:
+            self(flow)
+        self.sample(flow)
+
+    def sample(self, flow):
+        if self.quality["quality_t"] and self.quality["quality_t"][-1] == flow.n * flow.tau:
+            return
+        q = metrics.quality(flow.vertices, flow.faces)
+        self.quality["quality_t"].append(flow.n * flow.tau)
+        self.quality["min_angle"].append(q["min_angle"])
+        self.quality["max_aspect"].append(q["max_aspect_ratio"])
+        self.quality["flipped"].append(q["flipped_triangles"])
+
+
+class _Steady:
+    """``until`` of the driver: the largest vertex speed fell below ``speed``."""
+
+    def __init__(self, speed):
+        self.speed, self.previous, self.reached = speed, None, False
+
+    def __call__(self, flow):
+        V = flow.vertices.copy()
+        done = self.previous is not None and \
+            metrics.max_speed(self.previous, V, flow.tau) < self.speed
+        self.previous = V
+        self.reached = bool(done)
+        return self.reached
+
+
+def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defect="stop",
+        save_every=0, samples=50, mesh=None, **options):
+    """Run ``scheme`` on ``problem`` at refinement ``level``.
+
+    Parameters
+    ----------
+    scheme : str or mcfbench.schemes.Scheme
+    problem : str or mcfbench.problems.Problem
+    level : int
+    tau, t_final : float, optional
+        Override the problem's time rule.
+    solver : mcfbench.solver.Solver, optional
+        Default: BiCGStab, rtol 1e-9 (the paper's).
+    on_defect : {"stop", "record"}
+        See :func:`mcfbench.driver.simulate`.
+    save_every : int
+        Frames kept in the returned trajectory (``0``: first and last).
+    samples : int
+        About how many time levels the mesh quality is sampled at.
+    mesh : (vertices, faces), optional
+        Instead of the problem's generator (a user's mesh).
+    **options
+        Options of the scheme's flow class (override the registry's).
+
+    Returns
+    -------
+    result : RunResult
+    trajectory : mcfbench.driver.Trajectory
+    """
+    scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
+    problem = get_problem(problem) if isinstance(problem, str) else problem
+    V, F = validate_mesh(*(problem.mesh(level) if mesh is None else mesh))
+    tau = problem.tau(level, (V, F)) if tau is None else float(tau)
+    steps = problem.time_steps(tau, t_final)
+    solver = Solver() if solver is None else solver
+    monitor = _Monitor(max(1, steps // max(1, samples)))
+    observers = problem.observers()
+    until = _Steady(problem.steady_speed) if problem.steady_speed else None
+    cpu, wall = time.process_time(), time.perf_counter()
+    flow = scheme.make(V, F, tau, **options)
+    traj = simulate(flow, steps, solver=solver, save_every=save_every,
+                    observers=[monitor, *observers], on_defect=on_defect, until=until)
+    monitor.final(flow)
+    cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
+    values = {}
+    for observer in observers:
+        values.update(observer.result())
+    if not traj.ok:
+        values = {k: float("nan") for k in values}
+    X = flow.X
+    q = monitor.quality
+    result = RunResult(
+        scheme=scheme.name, problem=problem.name, level=int(level), nV=X.shape[1],
+        nF=len(V), nT=len(F) if scheme.family == "ddfv" else 0,
+        h=metrics.mean_edge_length(V, F), tau=tau, N=steps, steps_done=traj.steps_done,
+        status=traj.status, message=traj.message, t_failed=traj.t_failed,
+        t_end=flow.n * tau, steady=bool(until is not None and until.reached),
+        iterations=int(traj.iterations.sum()), solver=solver.method, cpu_seconds=cpu,
+        wall_seconds=wall, t_min_barycentric=_worst(np.min, monitor.t_monitor),
+        min_angle=_worst(np.min, q["min_angle"]), max_aspect=_worst(np.max, q["max_aspect"]),
+        max_flipped=_worst(np.max, q["flipped"]), metrics=values,
+        series={"t": monitor.t, "t_min_barycentric": monitor.t_monitor, **q})
+    return result, traj
+
+
+def _worst(reduce, values):
+    """``reduce`` of a series, NaN for an empty one."""
+    return float(reduce(values)) if len(values) else float("nan")
+
+
+def level_sweep(scheme, problem, levels=None, **options):
+    """:func:`run` on each level and the EOC (3.1) of every metric.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per level: :meth:`RunResult.to_dict` without series, and
+        ``eoc_<metric>`` against the previous level when that is one coarser.
+    """
+    problem = get_problem(problem) if isinstance(problem, str) else problem
+    levels = [int(level) for level in (problem.levels if levels is None else levels)]
+    results = [run(scheme, problem, level, **options)[0] for level in levels]
+    table = pd.DataFrame([r.to_dict(series=False) for r in results])
+    consecutive = np.r_[False, np.diff(levels) == 1]
+    for name in results[0].metrics:
+        table[f"eoc_{name}"] = np.where(consecutive, eoc(np.abs(table[name].to_numpy())),
+                                        np.nan)
+    return table
+
+
+def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_final=None,
+                     **options):
+    """Error at ``t_final`` against a fine-``tau`` reference of the same scheme on one mesh.
+
+    Parameters
+    ----------
+    scheme, problem : str
+    level : int
+        Fixed mesh.
+    taus : sequence of float
+        Time steps, each dividing ``t_final``; usually halved repeatedly.
+    reference_factor : int
+        The reference uses ``min(taus) / reference_factor``.
+    t_final : float, optional
+        Default: the problem's.
+    **options
+        Passed to :func:`run`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``tau, N, error, eoc, <metrics>, status``: ``error`` is
+        ``sqrt(sum_i w_i |X_i - X_i^ref|^2)`` at ``t_final`` over every point
+        of the state, ``w`` the scheme's quadrature weights of the
+        reference (DDFV: the covolumes chi / 2), ``eoc`` its order (3.1)
+        between successive rows.
+
+    Raises
+    ------
+    RuntimeError
+        The reference run broke down (its message).
+    """
+    def final(tau):
+        result, traj = run(scheme, problem, level, tau=tau, t_final=t_final, **options)
+        X = np.concatenate([traj.frames[k][-1] for k in traj.frames]).T
+        return result, X
+
+    ref_result, ref = final(min(taus) / reference_factor)
+    if ref_result.status != "ok":
+        raise RuntimeError(f"reference run failed: {ref_result.message}")
+    weights = _final_weights(scheme, problem, level, ref, t_final, options)
+    rows = []
+    for tau in taus:
+        result, X = final(tau)
+        ok = result.status == "ok"
+        rows.append({"tau": tau, "N": result.N,
+                     "error": float(np.sqrt(weights @ np.sum((X - ref) ** 2, axis=0)))
+                     if ok else np.nan,
+                     **result.metrics, "status": result.status})
+    table = pd.DataFrame(rows)
+    table.insert(3, "eoc", eoc(table["error"].to_numpy()))
+    return table
+
+
+def _final_weights(scheme, problem, level, X, t_final, options):
+    """Quadrature weights of the state ``X`` (3, n_points) of the scheme's flow."""
+    scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
+    problem = get_problem(problem) if isinstance(problem, str) else problem
+    V, F = validate_mesh(*problem.mesh(level))
+    n = len(V)
+    extra = {"T0": X[:, n:].T} if scheme.family == "ddfv" else {}
+    flow = scheme.make(X[:, :n].T, F, 1.0, **{**options, **extra})
+    return np.asarray(flow.l2_weights)
+
+
+def space_convergence(scheme, problem, levels, tau, *, t_final=None, **options):
+    """The problem's metrics on refined meshes with one small ``tau``, with EOC.
+
+    Returns
+    -------
+    pandas.DataFrame
+        As :func:`level_sweep`.
+    """
+    return level_sweep(scheme, problem, levels, tau=tau, t_final=t_final, **options)

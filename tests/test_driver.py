@@ -1,0 +1,125 @@
+"""The shared driver (mcfbench/driver.py) on a flow whose answer is known exactly.
+
+``Decay`` is implicit Euler for ``x' = -x`` on n points: each step solves
+``(1 + tau) x^n = x^{n-1}``, so ``x^n = x^0 / (1 + tau)^n``.
+"""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from mcfbench.driver import simulate
+from mcfbench.flow import Flow
+from mcfbench.solver import Solver
+
+
+class Decay:
+    """A minimal :class:`mcfbench.flow.Flow`: implicit Euler for x' = -x."""
+
+    def __init__(self, vertices, faces, tau, *, defect_at=None, status="t_escaped"):
+        self.tau, self.n = float(tau), 0
+        self._X = np.ascontiguousarray(np.asarray(vertices, float).T)
+        self._faces = np.asarray(faces)
+        self.defect_at, self.status = defect_at, status
+
+    X = property(lambda self: self._X)
+    vertices = property(lambda self: self._X.T)
+    faces = property(lambda self: self._faces)
+    l2_weights = property(lambda self: np.ones(self._X.shape[1]))
+
+    def step(self, solve):
+        A = sp.identity(self._X.shape[1], format="csr") * (1.0 + self.tau)
+        X, info = solve(A, self._X, self._X)
+        self._X, self.n = X, self.n + 1
+        return info
+
+    def defects(self):
+        if self.defect_at is not None and self.n >= self.defect_at:
+            return [(self.status, f"point 0 at {self._X[0, 0]:.3f}")]
+        return []
+
+    def frame(self):
+        return {"V": self._X.T.copy()}
+
+
+V0 = np.arange(12.0).reshape(4, 3) + 1.0
+FACES = np.array([[0, 1, 2], [0, 2, 3]])
+
+
+def test_decay_follows_the_contract():
+    assert isinstance(Decay(V0, FACES, 0.1), Flow)
+
+
+def test_states_and_frames_are_exact():
+    traj = simulate(Decay(V0, FACES, 0.1), 7, save_every=3, solver=Solver(rtol=1e-14))
+    np.testing.assert_array_equal(traj.steps, [0, 3, 6, 7])
+    np.testing.assert_allclose(traj.t, [0.0, 0.3, 0.6, 0.7])
+    expected = V0[None] / 1.1 ** traj.steps[:, None, None]
+    np.testing.assert_allclose(traj.frames["V"], expected, rtol=1e-13)
+    assert traj.status == "ok" and traj.message == "" and traj.failed_step == -1
+    assert traj.steps_done == 7 and len(traj.iterations) == 7 and np.isnan(traj.t_failed)
+
+
+def test_save_every_zero_keeps_first_and_last():
+    traj = simulate(Decay(V0, FACES, 0.1), 5, save_every=0)
+    np.testing.assert_array_equal(traj.steps, [0, 5])
+
+
+def test_observers_see_every_level_in_order():
+    seen = []
+    simulate(Decay(V0, FACES, 0.1), 3, observers=[lambda f: seen.append(("a", f.n)),
+                                                  lambda f: seen.append(("b", f.n))])
+    assert seen == [("a", 0), ("b", 0), ("a", 1), ("b", 1), ("a", 2), ("b", 2),
+                    ("a", 3), ("b", 3)]
+
+
+def test_defect_stops_the_run_and_keeps_the_invalid_state():
+    traj = simulate(Decay(V0, FACES, 0.5, defect_at=2), 6)
+    assert traj.status == "t_escaped" and traj.failed_step == 2
+    assert traj.message == "t_escaped at step 2 (t = 1): point 0 at 0.444"
+    assert traj.steps_done == 2 and traj.steps[-1] == 2 and traj.t_failed == 1.0
+
+
+def test_defect_recorded_lets_the_run_go_on_but_not_pass_as_ok():
+    traj = simulate(Decay(V0, FACES, 0.5, defect_at=2, status="inverted"), 6,
+                    on_defect="record")
+    assert traj.status == "inverted" and traj.failed_step == 2 and traj.steps_done == 6
+    assert traj.defects == [{"status": "inverted", "step": 2, "time": 1.0,
+                             "detail": "point 0 at 0.444"}]
+    assert traj.message.startswith("inverted at step 2 (t = 1): ")
+
+
+def test_defect_of_the_initial_state_is_reported_at_step_0():
+    traj = simulate(Decay(V0, FACES, 0.5, defect_at=0, status="degenerated"), 4)
+    assert traj.status == "degenerated" and traj.failed_step == 0 and traj.steps_done == 0
+    np.testing.assert_array_equal(traj.steps, [0])
+
+
+def test_solver_failure_keeps_the_last_valid_state():
+    flow = Decay(V0, FACES, 0.5)
+    traj = simulate(flow, 4, solver=Solver(rtol=1e-12, maxiter=1))
+    # the identity-times-1.5 system converges in one iteration from x0 = x^{n-1}
+    assert traj.status == "ok"
+    flow = Decay(V0, FACES, 0.5)
+    flow.step = lambda solve: solve(sp.csr_matrix((12, 12)), flow._X, flow._X)
+    traj = simulate(flow, 4)
+    assert traj.status.startswith("solver_") and traj.failed_step == 1
+    assert traj.message.startswith(f"{traj.status} at step 1 (t = 0.5): ")
+    np.testing.assert_array_equal(traj.frames["V"][-1], V0)
+
+
+def test_until_ends_the_run_at_a_steady_state():
+    traj = simulate(Decay(V0, FACES, 0.5), 50, until=lambda f: f.X[0, 0] < 0.1)
+    assert traj.status == "ok" and traj.steps_done == 6      # 1 / 1.5^6 = 0.088
+    assert traj.steps[-1] == 6
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(steps=-1), "steps must be a whole number"),
+    (dict(steps=1.5), "steps must be a whole number"),
+    (dict(steps=2, save_every=-2), "save_every must be a whole number"),
+    (dict(steps=2, on_defect="ignore"), "unknown on_defect 'ignore'"),
+])
+def test_bad_arguments_are_named(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        simulate(Decay(V0, FACES, 0.1), **kwargs)

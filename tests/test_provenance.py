@@ -1,0 +1,38 @@
+"""Provenance (mcfbench/provenance.py): the code is identified from anywhere."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+from mcfbench.provenance import config_hash, dependency_versions, provenance, source_hash
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_provenance_names_code_dependencies_and_settings():
+    p = provenance({"level": 3})
+    assert p["config"] == {"level": 3} and p["config_hash"] == config_hash({"level": 3})
+    assert set(p["source_hash"]) == {"ddfv", "baselines", "mcfbench"}
+    assert all(len(h) == 16 for h in p["source_hash"].values())
+    for name in ("numpy", "scipy", "libigl", "snakemake", "numba"):
+        assert name in p["packages"], name
+    assert p["packages"] == dependency_versions()
+
+
+def test_git_commit_is_found_from_outside_the_repository(tmp_path):
+    commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True,
+                            text=True)
+    code = "import json; from mcfbench.provenance import provenance; " \
+           "print(json.dumps(provenance({})))"
+    out = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                         text=True, check=True).stdout
+    p = json.loads(out)
+    assert commit.returncode == 0       # the tests run from a checkout (CI's clone is one)
+    assert p["git_commit"] == commit.stdout.strip()
+    assert p["source_hash"]["ddfv"] == source_hash("ddfv")
+
+
+def test_config_hash_ignores_key_order():
+    assert config_hash({"a": 1, "b": [1, 2]}) == config_hash({"b": [1, 2], "a": 1})
+    assert config_hash({"a": 1}) != config_hash({"a": 2})

@@ -1,0 +1,57 @@
+"""Run records (mcfbench/records.py): schema, checksum, stale settings, atomic write."""
+
+import json
+import math
+
+import pytest
+
+from mcfbench.records import RecordError, read_record, write_record
+from mcfbench.studies import run
+
+SETTINGS = {"scheme": "cotan", "problem": "sphere", "level": 1}
+
+
+@pytest.fixture(scope="module")
+def result():
+    return run("cotan", "sphere", 1)[0]
+
+
+def test_record_round_trip(tmp_path, result):
+    path = tmp_path / "level1.json"
+    write_record(path, result, SETTINGS)
+    record = read_record(path, SETTINGS)
+    assert record["l2_error"] == result.metrics["l2_error"]
+    assert record["iterations"] == result.iterations and record["status"] == "ok"
+    assert math.isnan(record["t_failed"]) and math.isnan(record["t_min_barycentric"])
+    assert record["provenance"]["config"] == SETTINGS
+    assert json.loads(path.read_text())["t_failed"] is None       # standard JSON
+
+
+def test_edited_record_is_refused(tmp_path, result):
+    path = tmp_path / "level1.json"
+    write_record(path, result, SETTINGS)
+    record = json.loads(path.read_text())
+    record["l2_error"], record["iterations"] = 0.5, 1          # valid, but not computed
+    path.write_text(json.dumps(record))
+    with pytest.raises(RecordError, match="checksum does not match"):
+        read_record(path, SETTINGS)
+
+
+def test_stale_record_is_refused(tmp_path, result):
+    path = tmp_path / "level1.json"
+    write_record(path, result, SETTINGS)
+    with pytest.raises(RecordError, match="stale"):
+        read_record(path, {**SETTINGS, "level": 2})
+
+
+@pytest.mark.parametrize("text, message", [
+    ("{", "not valid JSON"),
+    ("[1, 2]", "expected a JSON object"),
+    ('{"status": "ok"}', "missing key"),
+])
+def test_damaged_records_are_named(tmp_path, text, message):
+    path = tmp_path / "bad.json"
+    path.write_text(text)
+    with pytest.raises(RecordError, match=message) as err:
+        read_record(path)
+    assert str(path) in str(err.value)

@@ -1,0 +1,61 @@
+"""Studies for any scheme on any problem (mcfbench/studies.py)."""
+
+import numpy as np
+import pytest
+
+from mcfbench.studies import level_sweep, run, space_convergence, time_convergence
+from mcfbench.surfaces import icosphere
+
+
+@pytest.mark.parametrize("scheme", ["ddfv", "cotan"])
+def test_time_convergence_is_first_order(scheme):
+    table = time_convergence(scheme, "sphere", 2, [0.01, 0.005, 0.0025], reference_factor=16)
+    assert (table.status == "ok").all()
+    assert np.all(np.abs(table.eoc[1:] - 1) < 0.15), table.eoc.tolist()
+    assert table.l2_error.is_monotonic_decreasing
+
+
+def test_space_convergence_is_second_order():
+    table = space_convergence("ddfv", "sphere", [2, 3], 0.04 / 4**4)
+    assert (table.status == "ok").all()
+    assert 1.8 < table.eoc_l2_error[1] < 2.3, table.eoc_l2_error.tolist()
+
+
+def test_level_sweep_reports_eoc_of_every_metric():
+    table = level_sweep("cotan", "sphere", [1, 2])
+    assert list(table.level) == [1, 2] and np.isnan(table.eoc_l2_error[0])
+    assert table.eoc_l2_error[1] == pytest.approx(np.log2(table.l2_error[0] / table.l2_error[1]))
+
+
+def test_run_records_quality_and_the_t_monitor():
+    result, traj = run("ddfv", "sphere", 1)
+    assert result.status == "ok" and result.steps_done == result.N == 2
+    assert result.nV == 122 and result.nF == 42 and result.nT == 80
+    assert len(result.series["t_min_barycentric"]) == 3
+    assert 0.2 < result.t_min_barycentric <= 1 / 3
+    assert 30 < result.min_angle < 60 and result.max_flipped == 0
+    cotan, _ = run("cotan", "sphere", 1)
+    assert cotan.nV == cotan.nF == 42 and cotan.nT == 0
+    assert np.isnan(cotan.t_min_barycentric)
+
+
+def test_breakdown_keeps_partial_results_and_names_the_time():
+    from ddfv.topology import diamond_mesh
+
+    V, F = icosphere(1)
+    T0 = V[F].mean(axis=1)
+    a, b, t1, t2 = diamond_mesh(F).diamonds[5]
+    T0[t1] += 1.3 * (V[a] - T0[t1])          # beyond the corner a: outside at t = 0
+    result, traj = run("ddfv", "sphere", 1, T0=T0)
+    assert result.status == "t_escaped" and traj.failed_step == 0
+    assert result.steps_done == 0 and result.t_failed == 0.0
+    assert f"the T-vertex of triangle {t1} left its triangle" in result.message
+    assert np.isnan(result.metrics["l2_error"])
+    assert traj.steps.tolist() == [0]
+    recorded, traj = run("ddfv", "sphere", 1, T0=T0, on_defect="record")
+    assert recorded.status == "t_escaped" and recorded.steps_done == recorded.N == 2
+
+
+def test_running_past_the_extinction_of_the_sphere_is_refused():
+    with pytest.raises(ValueError, match="past the extinction time 0.25 of the sphere"):
+        run("ddfv", "sphere", 1, tau=0.04, t_final=0.32)
