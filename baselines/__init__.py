@@ -1,8 +1,18 @@
-"""Baseline schemes compared with the DDFV scheme.
+"""Schemes compared with the DDFV scheme, on the mesh vertices only.
 
-Every scheme is a module exposing ``sphere_run(level, *, tau, t_final,
-radius, rtol, ...) -> ddfv.sphere.SphereRun`` (see ``baselines/README.md``).
+Every scheme is one class following the contract of ``mcfbench.flow.Flow``
+(constructor ``(vertices, faces, tau, **options)``, ``step(solve)``,
+``defects()``, ``frame()``, ...) and is registered in
+``mcfbench/schemes.py``; this package imports nothing from ``ddfv`` or
+``mcfbench`` (see ``baselines/README.md``).
 
-cotan
-    The classical cotangent scheme (libigl's ``cotmatrix`` / ``massmatrix``).
+cotan (:class:`baselines.cotan.CotanFlow`)
+    The cotangent scheme (Dziuk 1991), barycentric or Voronoi lumped mass.
+cmcf (:class:`baselines.cmcf.CMCFFlow`)
+    Conformalized mean curvature flow (Kazhdan, Solomon, Ben-Chen 2012).
+bgn (:class:`baselines.bgn.BGNFlow`)
+    Barrett, Garcke, Nuernberg (2008), mass-lumped vertex normals.
+
+Shared: :mod:`baselines.mesh` (edge topology, CSR pattern) and
+:mod:`baselines.kernels` (the compiled assembly).
 """

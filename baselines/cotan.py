@@ -1,45 +1,52 @@
-"""The classical cotangent scheme for mean curvature flow (baseline).
+"""The classical cotangent scheme for mean curvature flow (Dziuk 1991).
 
 Mean curvature flow ``d/dt X = Delta_{M(t)} X`` discretised with piecewise
 linear finite elements, lumped mass and the Laplacian frozen at the previous
-time level (Dziuk 1991)::
+time level (G. Dziuk, "An algorithm for evolutionary surfaces", Numer.
+Math. 58 (1991) 603-611, the semi-implicit scheme with mass lumping)::
 
     (M^{n-1} + tau L^{n-1}) X^n = M^{n-1} X^{n-1}                      (C1)
 
-``L = -igl.cotmatrix(V, F)`` is the cotangent stiffness matrix, symmetric
-and positive semi-definite::
+``L`` is the cotangent stiffness matrix (``-igl.cotmatrix``), symmetric and
+positive semi-definite (Pinkall and Polthier 1993, the cotangent formula)::
 
     (L X)_i = 1/2 sum_j (cot alpha_ij + cot beta_ij) (X_i - X_j)      (C2)
 
 (``alpha_ij``, ``beta_ij`` the angles opposite the edge ``ij``) and ``M``
-the lumped mass matrix of ``igl.massmatrix``: barycentric,
-``M_ii = 1/3 sum_{T ni i} |T|`` (default), or Voronoi (Meyer et al. 2003).
-Both are rebuilt from the current surface at every step: this is true mean
-curvature flow, with no re-centring, rescaling or frozen Laplacian.
+the lumped mass: barycentric, ``M_ii = 1/3 sum_{T ni i} |T|`` (default),
+or Voronoi/mixed (Meyer, Desbrun, Schroeder, Barr 2003, Section 3.3;
+``igl.MASSMATRIX_TYPE_VORONOI``). Both are rebuilt from the current
+surface at every step: true mean curvature flow, with no re-centring,
+rescaling or frozen Laplacian.
 
-Open surfaces: boundary vertices are held fixed (Dirichlet boundary (1.2),
-as in the DDFV scheme): their rows of (C3) are replaced by rows of the
-identity, so that ``X_i^n = X_i^{n-1}``. Interior rows keep the cotangent
-weights of the boundary edges (one triangle each).
+Open surfaces: boundary vertices are held fixed (Dirichlet, as in the DDFV
+scheme): their rows of (C3) are rows of the identity, so that
+``X_i^n = X_i^{n-1}``. Interior rows keep the cotangent weights of the
+boundary edges (one triangle each).
 
-To share the solver, stopping rule, warm start and iteration count with the
-DDFV scheme (:mod:`ddfv.stepping`), (C1) is solved in the row-scaled form
+The solver sees (C1) in the row-scaled form
 
     (I + tau diag(1 / M^{n-1}) L^{n-1}) X^n = X^{n-1}                 (C3)
 
-by :func:`ddfv.solver.bicgstab` on the (3, n) block, stopping at
-``|r| <= rtol |X^{n-1}|`` and starting from ``2 X^{n-1} - X^{n-2}``
-(``X^0`` at the first step).
+(the form of the DDFV system, so that the shared solver's stopping rule
+``|r| <= rtol |b|`` and iteration counts mean the same thing), with the
+warm start ``2 X^{n-1} - X^{n-2}`` (``X^0`` at the first step).
 
 Assembly (``assembly=``):
 
 ``"cached"`` (default)
-    libigl's per-triangle cotangent weights (``igl.cotmatrix_entries``)
-    and double areas (``igl.doublearea``) scattered into a CSR pattern
-    built once, like :class:`ddfv.assembly.Assembler`; the matrices equal
-    those of ``"igl"`` up to rounding (``tests/test_cotan.py``).
+    :class:`CotanAssembler`: one compiled loop over the triangles
+    (:func:`baselines.kernels.cotan_geometry`) writes ``L``, ``M`` and the
+    triangle area vectors straight into a CSR pattern built once
+    (:func:`baselines.mesh.laplacian_pattern`), and one loop over the rows
+    writes (C3). Also used by :mod:`baselines.cmcf` and :mod:`baselines.bgn`.
 ``"igl"``
-    ``igl.cotmatrix`` and ``igl.massmatrix`` called at every step.
+    ``igl.cotmatrix`` and ``igl.massmatrix`` at every step (the reference;
+    the matrices agree with ``"cached"`` to rounding).
+
+This module also holds :class:`VertexFlow`, what every vertex-based
+baseline shares: the state, the contract of ``mcfbench.flow.Flow``, the
+warm start and the checks of a state (:meth:`VertexFlow.defects`).
 """
 
 import time
@@ -50,22 +57,20 @@ import igl
 import numpy as np
 import scipy.sparse as sp
 
-from ddfv.errors import SphereL2Error
-from ddfv.solver import bicgstab
-from ddfv.sphere import T_FINAL, SphereRun, level_time_step, time_steps
-from ddfv.stepping import (DEFAULT_RTOL, FlowBreakdown, collapsed_cells, run_steps,
-                           validate_vertices)
-from ddfv.surfaces import icosphere
-from ddfv.topology import diamond_mesh
+from .kernels import cotan_geometry, neighbour_cosines, row_scaled_system
+from .mesh import edge_mesh, laplacian_pattern
 
 MASS_TYPES = {"barycentric": igl.MASSMATRIX_TYPE_BARYCENTRIC,
               "voronoi": igl.MASSMATRIX_TYPE_VORONOI}
 ASSEMBLIES = ("cached", "igl")
-_COLLAPSED = 1e-10  # a triangle whose area fell below this x the mean area
+COLLAPSED = 1e-10
+"""A triangle whose area fell below this times the mean area has collapsed."""
 
 
 def cotangent_laplacian(vertices, faces):
     """Cotangent stiffness matrix ``L = -igl.cotmatrix`` (pos. semi-def.), (C2).
+
+    The libigl reference of :meth:`CotanAssembler.laplacian`.
 
     Parameters
     ----------
@@ -76,13 +81,6 @@ def cotangent_laplacian(vertices, faces):
     -------
     (n, n) scipy.sparse.csr_matrix
         Symmetric, zero row sums, positive diagonal.
-
-    Examples
-    --------
-    >>> V, F = icosphere(1)
-    >>> L = cotangent_laplacian(V, F)
-    >>> bool(abs(L.sum(axis=1)).max() < 1e-12), bool(L.diagonal().min() > 0)
-    (True, True)
     """
     V, F = _igl_arrays(vertices, faces)
     return (-igl.cotmatrix(V, F)).tocsr()
@@ -90,6 +88,8 @@ def cotangent_laplacian(vertices, faces):
 
 def lumped_mass(vertices, faces, mass="barycentric"):
     """Diagonal of the lumped mass matrix ``igl.massmatrix``.
+
+    The libigl reference of :meth:`CotanAssembler.geometry`.
 
     Parameters
     ----------
@@ -118,87 +118,106 @@ def _mass_type(mass):
     return mass
 
 
-class Assembler:
-    """``L`` (C2), ``M`` and the system matrix (C3) on a fixed mesh.
+@dataclass(frozen=True)
+class SurfaceGeometry:
+    """What one state of a surface contributes to a step.
 
-    The CSR pattern of ``L`` (edges and diagonal) and the permutation from
-    the blocks of entries to CSR order are built once; each call scatters
-    libigl's per-triangle weights into it.
+    Attributes
+    ----------
+    L_data : (nnz,) float array or None
+        Values of the stiffness ``L`` (C2) in the pattern of the assembler
+        (None when not computed).
+    mass : (n,) float array
+        Lumped mass ``M_ii``.
+    area_vectors : (m, 3) float array
+        ``(x_1 - x_0) x (x_2 - x_0)`` per triangle (twice the area times
+        the unit normal).
+    """
+
+    L_data: np.ndarray
+    mass: np.ndarray
+    area_vectors: np.ndarray
+
+
+class CotanAssembler:
+    """``L`` (C2), ``M`` and the system matrix (C3) on a fixed mesh, compiled.
+
+    The CSR pattern of ``L`` (edges and diagonal) is built once; every call
+    runs :func:`baselines.kernels.cotan_geometry` (one loop over the
+    triangles) and writes into fresh arrays laid out by that pattern.
 
     Parameters
     ----------
-    mesh : ddfv.topology.DiamondMesh
-        Its diamonds are the edges ``(a, b)``; ``halfedges[t, k]`` is the
-        edge ``faces[t, k] -> faces[t, k + 1]``.
-    fixed : (n,) bool array, optional
-        Dirichlet vertices: their rows of the system matrix (C3) are rows of
-        the identity. Default: the boundary vertices of ``mesh``.
+    mesh : baselines.mesh.EdgeMesh
+    mass : {"barycentric", "voronoi"}
+
+    Examples
+    --------
+    >>> from baselines.mesh import edge_mesh
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0]])
+    >>> F = np.array([[0, 1, 2]])
+    >>> asm = CotanAssembler(edge_mesh(F, 3))
+    >>> g = asm.geometry(V)
+    >>> asm.laplacian(g.L_data).toarray().round(3).tolist()
+    [[1.0, -0.5, -0.5], [-0.5, 0.5, 0.0], [-0.5, 0.0, 0.5]]
+    >>> g.mass.round(4).tolist()
+    [0.1667, 0.1667, 0.1667]
     """
 
-    def __init__(self, mesh, fixed=None):
-        n = mesh.n_f
-        a, b = mesh.diamonds[:, 0], mesh.diamonds[:, 1]
-        diag = np.arange(n)
-        rows = np.concatenate([a, b, diag])
-        cols = np.concatenate([b, a, diag])
-        perm = np.lexsort((cols, rows))
-        inverse = np.empty_like(perm)
-        inverse[perm] = np.arange(len(perm))
-        self.shape = (n, n)
-        self._a, self._b = a, b
-        self._faces = np.ascontiguousarray(mesh.faces, dtype=np.int64)
-        # igl.cotmatrix_entries column k belongs to the edge opposite corner
-        # k, i.e. the half-edge faces[t, k+1] -> faces[t, k+2]
-        self._opposite = np.ascontiguousarray(mesh.halfedges[:, [1, 2, 0]]).ravel()
-        self._corners = self._faces.ravel()
-        self._n_edges = len(a)
-        self._perm = perm
-        self._rows = rows[perm]
-        self._indices = cols[perm].astype(np.int32)
-        self._indptr = np.searchsorted(self._rows, np.arange(n + 1)).astype(np.int32)
-        self._diag = inverse[-n:]
-        fixed = mesh.boundary_vertices if fixed is None else np.asarray(fixed, dtype=bool)
-        # CSR slots of the Dirichlet rows and their identity values
-        self._fixed_slots = np.flatnonzero(fixed[self._rows])
-        self._fixed_values = (self._indices[self._fixed_slots]
-                              == self._rows[self._fixed_slots]).astype(float)
+    def __init__(self, mesh, mass="barycentric"):
+        self.mesh = mesh
+        self.mass_type = _mass_type(mass)
+        self.pattern = laplacian_pattern(mesh)
 
-    def edge_weights(self, vertices):
-        """``w_ab = 1/2 (cot alpha_ab + cot beta_ab)`` for every edge, (C2)."""
-        C = igl.cotmatrix_entries(vertices, self._faces)
-        return np.bincount(self._opposite, C.ravel(), minlength=self._n_edges)
+    @property
+    def shape(self):
+        return self.pattern.shape
 
-    def _data(self, vertices):
-        w = self.edge_weights(vertices)
-        n = self.shape[0]
-        diag = np.bincount(self._a, w, minlength=n) + np.bincount(self._b, w, minlength=n)
-        return np.concatenate([-w, -w, diag]).take(self._perm)
-
-    def laplacian(self, vertices):
-        """``L = -igl.cotmatrix(vertices, faces)`` as CSR, (C2)."""
-        return sp.csr_matrix((self._data(vertices), self._indices, self._indptr),
-                             shape=self.shape)
-
-    def barycentric_mass(self, double_areas):
-        """``M_ii = 1/3 sum_{T ni i} |T|`` from ``igl.doublearea``."""
-        return np.bincount(self._corners, np.repeat(double_areas / 6.0, 3),
-                           minlength=self.shape[0])
-
-    def system(self, vertices, mass, tau):
-        """``I + tau diag(1/M) L`` of (C3) as CSR, Dirichlet rows = identity.
+    def geometry(self, vertices, with_laplacian=True):
+        """Stiffness, lumped mass and area vectors of ``vertices``.
 
         Parameters
         ----------
         vertices : (n, 3) float array
-            Surface of time level ``n - 1``.
-        mass : (n,) float array
-            ``M^{n-1}``.
-        tau : float
+        with_laplacian : bool
+            Compute ``L`` (False: ``L_data`` is None).
+
+        Returns
+        -------
+        SurfaceGeometry
         """
-        data = self._data(vertices) * (tau / mass).take(self._rows)
-        data[self._diag] += 1.0
-        data[self._fixed_slots] = self._fixed_values
-        return sp.csr_matrix((data, self._indices, self._indptr), shape=self.shape)
+        p, mesh = self.pattern, self.mesh
+        L_data = np.empty(p.nnz) if with_laplacian else np.empty(0)
+        mass = np.empty(mesh.n_vertices)
+        area_vectors = np.empty((mesh.n_faces, 3))
+        cotan_geometry(np.ascontiguousarray(vertices, dtype=np.float64), mesh.faces,
+                       p.corner_slots, p.diag_slots, self.mass_type == "voronoi",
+                       with_laplacian, L_data, mass, area_vectors)
+        return SurfaceGeometry(L_data if with_laplacian else None, mass, area_vectors)
+
+    def csr(self, data):
+        """A CSR matrix with the pattern of ``L`` and values ``data``."""
+        p = self.pattern
+        return sp.csr_matrix((data, p.indices, p.indptr), shape=p.shape, copy=False)
+
+    def laplacian(self, L_data):
+        """``L`` (C2) as CSR from :attr:`SurfaceGeometry.L_data`."""
+        return self.csr(L_data)
+
+    def row_scaled(self, L_data, mass, tau, fixed):
+        """``I + tau diag(1/M) L`` (C3) as CSR; rows ``fixed`` = identity.
+
+        Parameters
+        ----------
+        L_data : (nnz,) float array
+        mass : (n,) float array
+        tau : float
+        fixed : (n,) bool array
+        """
+        p = self.pattern
+        data = np.empty(p.nnz)
+        row_scaled_system(L_data, p.indptr, p.diag_slots, mass, float(tau), fixed, data)
+        return self.csr(data)
 
 
 def dirichlet_rows(A, fixed):
@@ -220,8 +239,183 @@ def dirichlet_rows(A, fixed):
     return A
 
 
-class Flow:
-    """Cotangent mean curvature flow of one triangulated surface.
+class VertexFlow:
+    """What every vertex-based baseline shares (the ``mcfbench.flow.Flow`` contract).
+
+    The state is the mesh vertices, stored by components ``X`` (3, n).
+    Subclasses implement :meth:`system`, the linear system of one step at
+    the current state; :meth:`step` solves it once from the warm start
+    ``2 X^{n-1} - X^{n-2}`` (``X^0`` at the first step) and accepts the
+    result.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+        Initial surface ``X^0`` (validated by the harness: manifold,
+        oriented, no degenerate triangle).
+    faces : (m, 3) int array
+    tau : float
+        Time step, positive and finite.
+    mass : {"barycentric", "voronoi"}
+        Lumped mass of :class:`CotanAssembler`.
+
+    Attributes
+    ----------
+    n : int
+        Current time level.
+    tau : float
+    timings : dict
+        Seconds spent in ``"assembly"`` (geometry and system) and ``"solve"``.
+    """
+
+    def __init__(self, vertices, faces, tau, *, mass="barycentric"):
+        if not (np.isfinite(tau) and tau > 0):
+            raise ValueError(f"tau must be a positive finite number, got {tau!r}")
+        V = np.asarray(vertices, dtype=np.float64)
+        if V.ndim != 2 or V.shape[1] != 3:
+            raise ValueError(f"vertices must have shape (n, 3), got {V.shape}")
+        self.mesh = edge_mesh(faces, len(V))
+        self.assembler = CotanAssembler(self.mesh, mass)
+        self.tau = float(tau)
+        self.n = 0
+        self._X = np.ascontiguousarray(V.T)
+        self._X_prev = self._X
+        self.timings = {"assembly": 0.0, "solve": 0.0}
+        # triangles already flipped against their neighbours at step 0
+        self._flipped0 = ~(self._normal_agreement() >= 0.0)
+        self._area0 = self._triangle_checks[1].mean()
+
+    # -- the contract -------------------------------------------------------
+    @property
+    def X(self):
+        """(3, n) read-only view of ``X^n`` by components."""
+        view = self._X.view()
+        view.flags.writeable = False
+        return view
+
+    @property
+    def vertices(self):
+        """(n, 3) read-only view of the vertices ``X^n``."""
+        return self.X.T
+
+    @property
+    def faces(self):
+        """(m, 3) the triangles."""
+        return self.mesh.faces
+
+    @property
+    def fixed(self):
+        """(n,) bool: the Dirichlet (boundary) vertices, held at ``X^0``."""
+        return self.mesh.boundary_vertices
+
+    @property
+    def mass_type(self):
+        return self.assembler.mass_type
+
+    @property
+    def mass(self):
+        """(n,) lumped mass ``M^n_ii`` of the current surface."""
+        return self.geometry.mass
+
+    @property
+    def l2_weights(self):
+        """The lumped mass ``M^n_ii`` (the vertex areas tile the surface once)."""
+        return self.geometry.mass
+
+    @property
+    def t(self):
+        return self.n * self.tau
+
+    def frame(self):
+        """``{"V": (n, 3)}`` copy of the current vertices."""
+        return {"V": self._X.T.copy()}
+
+    @cached_property
+    def geometry(self):
+        """:class:`SurfaceGeometry` of the current state."""
+        return self.assembler.geometry(self._X.T, self._needs_laplacian())
+
+    def _needs_laplacian(self):
+        return True
+
+    def system(self):
+        """``(A, b)`` of the step from the current state (implemented by subclasses)."""
+        raise NotImplementedError
+
+    def step(self, solve):
+        """Advance one time step.
+
+        Parameters
+        ----------
+        solve : callable
+            ``solve(A, b, x0) -> (x, info)``; if it raises, the exception
+            propagates and the state stays at ``n``.
+
+        Returns
+        -------
+        info
+            What ``solve`` returned.
+        """
+        clock = time.perf_counter()
+        A, b = self.system()
+        x0 = 2.0 * self._X - self._X_prev
+        now = time.perf_counter()
+        self.timings["assembly"] += now - clock
+        X, info = solve(A, b, x0)
+        self.timings["solve"] += time.perf_counter() - now
+        self._X_prev, self._X = self._X, np.ascontiguousarray(X, dtype=np.float64)
+        self.n += 1
+        self.__dict__.pop("geometry", None)
+        self.__dict__.pop("_triangle_checks", None)
+        return info
+
+    @cached_property
+    def _triangle_checks(self):
+        """``(cosine, double_areas)`` of the current state, each (m,)
+        (:func:`baselines.kernels.neighbour_cosines`)."""
+        m = self.mesh.n_faces
+        cosine, double_areas = np.empty(m), np.empty(m)
+        neighbour_cosines(self.geometry.area_vectors, self.mesh.face_neighbours, cosine,
+                          double_areas)
+        return cosine, double_areas
+
+    def _normal_agreement(self):
+        return self._triangle_checks[0]
+
+    def defects(self):
+        """What is wrong with the current state: ``[(status, description)]``.
+
+        ``"degenerated"``: non-finite coordinates, or triangles whose area
+        fell below ``1e-10`` x the mean area (a local collapse) or ``1e-12`` x
+        the initial mean area (the surface shrinking to a point, as the DDFV
+        scheme checks its diamonds). ``"inverted"``: triangles whose
+        unit normal has a negative dot product with the area-weighted mean
+        normal of their edge-neighbours and did not at step 0
+        (:func:`baselines.kernels.neighbour_cosines`).
+        """
+        if not np.isfinite(self._X).all():
+            bad = np.flatnonzero(~np.isfinite(self._X).all(axis=0))
+            return [("degenerated", f"non-finite coordinates at {len(bad)} vertex(es), "
+                     f"e.g. vertex {int(bad[0])}")]
+        area = self._triangle_checks[1]
+        collapsed = np.flatnonzero(~(area > max(COLLAPSED * area.mean(),
+                                                1e-2 * COLLAPSED * self._area0)))
+        if len(collapsed):
+            return [("degenerated", f"{len(collapsed)} triangle(s) collapsed (area below "
+                     f"{COLLAPSED:g} x the mean or 1e-12 x the initial mean), e.g. triangle "
+                     f"{int(collapsed[0])}")]
+        cosine = self._normal_agreement()
+        flipped = np.flatnonzero(~(cosine >= 0.0) & ~self._flipped0)
+        if len(flipped):
+            worst = flipped[np.argmin(cosine[flipped])]
+            return [("inverted", f"triangle {int(worst)} flipped against its neighbours "
+                     f"(cosine {cosine[worst]:.3g} with their mean normal; "
+                     f"{len(flipped)} triangle(s) inverted)")]
+        return []
+
+
+class CotanFlow(VertexFlow):
+    """Cotangent mean curvature flow (C1) of one triangulated surface.
 
     Parameters
     ----------
@@ -234,257 +428,51 @@ class Flow:
         Time step.
     mass : {"barycentric", "voronoi"}
         Lumped mass matrix (see :func:`lumped_mass`).
-    rtol : float
-        BiCGStab relative tolerance ``|r| <= rtol |X^{n-1}|``.
-    maxiter : int
-        BiCGStab iteration limit per step.
     assembly : {"cached", "igl"}
         See the module docstring.
 
-    Attributes
-    ----------
-    V : (n, 3) float array
-        Current state ``X^n``.
-    n : int
-        Current time level.
-    fixed : (n,) bool array
-        The boundary (Dirichlet) vertices.
+    Examples
+    --------
+    >>> V = np.array([[1., 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]])   # tetrahedron
+    >>> F = np.array([[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])
+    >>> flow = CotanFlow(V, F, 0.01)
+    >>> A, b = flow.system()
+    >>> A.shape, b.shape, round(float(flow.l2_weights.sum()), 4)
+    ((4, 4), (3, 4), 13.8564)
     """
 
-    def __init__(self, vertices, faces, tau, *, mass="barycentric",
-                 rtol=DEFAULT_RTOL, maxiter=1000, assembly="cached"):
-        if not (np.isfinite(tau) and tau > 0):
-            raise ValueError(f"tau must be a positive number, got {tau!r}")
-        if not (0 < rtol < 1):
-            raise ValueError(f"rtol must lie in (0, 1), got {rtol!r}")
-        if int(maxiter) != maxiter or maxiter < 1:
-            raise ValueError(f"maxiter must be a whole number >= 1, got {maxiter!r}")
+    def __init__(self, vertices, faces, tau, *, mass="barycentric", assembly="cached"):
         if assembly not in ASSEMBLIES:
             raise ValueError(f"unknown assembly {assembly!r}; choose one of "
                              f"{', '.join(ASSEMBLIES)}")
-        self.mass_type = _mass_type(mass)
-        self.mesh = diamond_mesh(faces, len(vertices))
-        V = validate_vertices(vertices, self.mesh.faces)
-        self.fixed = self.mesh.boundary_vertices
-        self.tau, self.rtol, self.maxiter = float(tau), float(rtol), int(maxiter)
         self.assembly = assembly
-        self.faces = np.ascontiguousarray(self.mesh.faces, dtype=np.int64)
-        self._assembler = Assembler(self.mesh) if assembly == "cached" else None
-        self.n = 0
-        self._X = np.ascontiguousarray(V.T)
-        self._X_prev = self._X
-        try:
-            self._check_geometry()
-        except FlowBreakdown as err:
-            raise ValueError(f"initial surface is degenerate: {err}") from None
+        super().__init__(vertices, faces, tau, mass=mass)
 
-    @property
-    def V(self):
-        """(n, 3) view of the vertices ``X^n``."""
-        return self._X.T
-
-    @property
-    def X(self):
-        """(3, n) read-only view of ``X^n`` by components."""
-        view = self._X.view()
-        view.flags.writeable = False
-        return view
-
-    @property
-    def l2_weights(self):
-        """Quadrature weights of the L2 error over the vertices: the lumped
-        mass ``M^n_ii`` (the vertex areas tile the surface once)."""
-        return self.mass
-
-    @property
-    def t(self):
-        return self.n * self.tau
-
-    @cached_property
-    def _vertices(self):
-        return np.ascontiguousarray(self._X.T)
-
-    @cached_property
-    def double_areas(self):
-        """(m,) twice the triangle areas of ``X^n`` (``igl.doublearea``)."""
-        return igl.doublearea(self._vertices, self.faces).ravel()
-
-    @cached_property
-    def mass(self):
-        """(n,) lumped mass ``M^n_ii`` of the current surface."""
-        if self._assembler is not None and self.mass_type == "barycentric":
-            return self._assembler.barycentric_mass(self.double_areas)
-        return lumped_mass(self._vertices, self.faces, self.mass_type)
+    def _needs_laplacian(self):
+        return self.assembly == "cached"
 
     def laplacian(self):
-        """``L^n`` (C2) of the current surface, CSR."""
-        if self._assembler is not None:
-            return self._assembler.laplacian(self._vertices)
-        return cotangent_laplacian(self._vertices, self.faces)
+        """The stiffness of this step's system, CSR: ``L^n`` (C2) of the current surface."""
+        if self.assembly == "igl":
+            return cotangent_laplacian(self._X.T, self.faces)
+        return self.assembler.laplacian(self.geometry.L_data)
+
+    def _system_mass(self):
+        if self.assembly == "igl":
+            return lumped_mass(self._X.T, self.faces, self.mass_type)
+        return self.geometry.mass
+
+    def _laplacian_data(self):
+        return self.geometry.L_data
 
     def system(self):
-        """``I + tau diag(1/M^n) L^n`` (C3), CSR; rows of boundary vertices = identity."""
-        if self._assembler is not None:
-            return self._assembler.system(self._vertices, self.mass, self.tau)
-        L = self.laplacian()
-        L.data *= np.repeat(self.tau / self.mass, np.diff(L.indptr))
-        A = (L + sp.identity(L.shape[0], format="csr")).tocsr()
-        return dirichlet_rows(A, self.fixed) if self.mesh.has_boundary else A
-
-    def step(self):
-        """Advance one time step, (C3).
-
-        Returns
-        -------
-        ddfv.solver.SolveInfo
-
-        Raises
-        ------
-        ddfv.stepping.FlowBreakdown
-            BiCGStab did not converge (the state stays at ``n - 1``) or the
-            new surface is degenerate (the state is the degenerate ``X^n``).
-        """
-        A = self.system()
-        x0 = 2.0 * self._X - self._X_prev
-        X, info = bicgstab(A, self._X, x0, rtol=self.rtol, maxiter=self.maxiter)
-        if not info.converged:
-            raise FlowBreakdown.solver_failed(self.n + 1, self.tau, info, self.rtol)
-        self._X_prev, self._X = self._X, X
-        self.n += 1
-        for name in ("_vertices", "double_areas", "mass"):
-            self.__dict__.pop(name, None)
-        self._check_geometry()
-        return info
-
-    def _check_geometry(self):
-        if not np.isfinite(self._X).all():
-            raise FlowBreakdown.degenerated(self.n, self.tau, "non-finite coordinates")
-        area = self.double_areas
-        what = collapsed_cells(area, _COLLAPSED * area.mean(), "triangle")
-        if what:
-            raise FlowBreakdown.degenerated(self.n, self.tau, what)
-
-
-@dataclass
-class Trajectory:
-    """Result of :func:`simulate`.
-
-    Attributes
-    ----------
-    V : (frames, n, 3) float array
-        Frame 0 is the initial surface, the last frame the final (or last
-        computed) one.
-    t : (frames,) float array
-    steps : (frames,) int array
-        Time level of each frame.
-    iterations : (n_steps,) int array
-        BiCGStab iterations of each completed step.
-    faces : (m, 3) int array
-    status : str
-        ``"ok"``, ``"solver_failed"`` or ``"degenerated"``.
-    message : str
-        Empty when ``status == "ok"``.
-    failed_step : int
-        Time step of the breakdown, ``-1`` when ``status == "ok"``.
-    """
-
-    V: np.ndarray
-    t: np.ndarray
-    steps: np.ndarray
-    iterations: np.ndarray
-    faces: np.ndarray
-    status: str = "ok"
-    message: str = ""
-    failed_step: int = -1
-
-
-def simulate(vertices, faces, tau, steps, *, save_every=1, mass="barycentric",
-             rtol=DEFAULT_RTOL, maxiter=1000, assembly="cached", observer=None):
-    """Run the cotangent flow (C3) for ``steps`` time steps.
-
-    Parameters
-    ----------
-    vertices : (n, 3) float array
-    faces : (m, 3) int array
-        Consistently oriented manifold surface; boundary vertices, if any,
-        stay fixed.
-    tau : float
-    steps : int
-    save_every : int
-        Keep every ``save_every``-th time level as a frame (the first and
-        the last are always kept); ``0`` keeps only those two.
-    mass, rtol, maxiter, assembly
-        See :class:`Flow`.
-    observer : callable, optional
-        ``observer(flow)`` is called at every time level, ``n = 0`` included.
-
-    Returns
-    -------
-    Trajectory
-        On a breakdown, ``status`` and ``message`` say what happened and
-        everything computed before is kept.
-
-    Raises
-    ------
-    ValueError
-        Bad parameters or input mesh (non-manifold, degenerate, ...).
-
-    Examples
-    --------
-    >>> V, F = icosphere(2)
-    >>> traj = simulate(V, F, 0.01, 4, save_every=2)
-    >>> traj.status, traj.steps.tolist()
-    ('ok', [0, 2, 4])
-    """
-    flow = Flow(vertices, faces, tau, mass=mass, rtol=rtol, maxiter=maxiter,
-                assembly=assembly)
-    run = run_steps(flow, steps, save_every=save_every, observer=observer,
-                    state=lambda f: (f.V.copy(),))
-    (V,) = run.frames
-    return Trajectory(V=V, t=run.steps * flow.tau, steps=run.steps,
-                      iterations=run.iterations, faces=flow.faces, status=run.status,
-                      message=run.message, failed_step=run.failed_step)
-
-
-def sphere_run(level, *, tau=None, t_final=T_FINAL, radius=1.0, **options):
-    """Run the cotangent flow on the icosphere of ``level``: one baseline row.
-
-    Same experiment as :func:`ddfv.sphere.sphere_run` (Section 3.1): the
-    icosphere refined ``level`` times, ``tau = 0.04 / 4**(level - 1)`` by
-    default, error :class:`ddfv.errors.SphereL2Error` over the vertices
-    weighted by the lumped mass.
-
-    Parameters
-    ----------
-    level : int
-    tau : float, optional
-    t_final : float
-        Must be a whole multiple of ``tau``.
-    radius : float
-    **options
-        Passed to :class:`Flow` (``mass``, ``rtol``, ``maxiter``, ``assembly``).
-
-    Returns
-    -------
-    ddfv.sphere.SphereRun
-        ``variant`` = the mass matrix, ``nV = nF`` = number of vertices,
-        ``nT = 0``, ``t_min_barycentric = NaN`` and an empty ``t_monitor``
-        (no T-vertices); ``cpu_seconds`` and ``wall_seconds`` time the flow
-        and the error.
-    """
-    tau = level_time_step(level) if tau is None else float(tau)
-    steps = time_steps(t_final, tau)
-    V, F = icosphere(level, radius)
-    error = SphereL2Error(radius)
-    cpu, wall = time.process_time(), time.perf_counter()
-    traj = simulate(V, F, tau, steps, save_every=0, observer=error, **options)
-    cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
-    ok = traj.status == "ok"
-    return SphereRun(
-        level=int(level), variant=options.get("mass", "barycentric"),
-        nV=len(V), nF=len(V), nT=0, tau=tau, N=steps,
-        l2_error=error.value if ok else float("nan"),
-        iterations=int(traj.iterations.sum()), cpu_seconds=cpu, wall_seconds=wall,
-        status=traj.status,
-        t_failed=float("nan") if ok else traj.failed_step * tau,
-        t_min_barycentric=float("nan"), message=traj.message)
+        """``(A, b)``: ``A = I + tau diag(1/M^n) L^n`` (C3), CSR, rows of
+        boundary vertices = identity; ``b = X^n`` (3, n)."""
+        if self.assembly == "igl":
+            L = self.laplacian()
+            L.data *= np.repeat(self.tau / self._system_mass(), np.diff(L.indptr))
+            A = (L + sp.identity(L.shape[0], format="csr")).tocsr()
+            return (dirichlet_rows(A, self.fixed) if self.mesh.has_boundary else A), self._X
+        A = self.assembler.row_scaled(self._laplacian_data(), self.geometry.mass, self.tau,
+                                      self.fixed)
+        return A, self._X

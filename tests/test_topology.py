@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from conftest import flat_lattice
-from ddfv.surfaces import icosphere
 from ddfv.topology import diamond_mesh
+from mcfbench.surfaces import icosphere
 
 
 @pytest.mark.parametrize("level", [0, 1, 2, 3])
@@ -53,17 +53,28 @@ def _tetrahedron():
     return np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
 
 
-@pytest.mark.parametrize("faces, n_vertices, message", [
-    (np.vstack([_tetrahedron(), [[0, 1, 4]]]), None, "non-manifold mesh"),
-    (np.vstack([_tetrahedron()[:3], [[1, 3, 2]]]), None, "inconsistent orientation"),
-    (np.vstack([_tetrahedron(), _tetrahedron() + 3]), None,   # two tetrahedra at vertex 3
-     r"vertex\(es\) \[3\] join separate fans"),
-    (_tetrahedron(), 5, r"unreferenced vertex\(es\): \[4\]"),
-    (np.vstack([_tetrahedron(), [[1, 1, 2]]]), None, "repeating a vertex"),
-    (_tetrahedron()[:3], None, "at least 4 triangles"),
-    (_tetrahedron(), 3, "face indices must lie in"),
-    (_tetrahedron().astype(float), None, "must be integers"),
+def test_single_triangle_has_three_boundary_diamonds():
+    mesh = diamond_mesh([[0, 1, 2]])
+    assert (mesh.n_f, mesh.n_t, len(mesh.diamonds)) == (3, 1, 3)
+    assert mesh.boundary.all() and mesh.boundary_vertices.all()
+    assert sorted(map(tuple, mesh.diamonds[:, :3].tolist())) == [(0, 1, 0), (1, 2, 0), (2, 0, 0)]
+
+
+def test_two_tetrahedra_give_two_closed_diamond_meshes():
+    # validation (e.g. of non-manifold vertices) is the harness's, see test_mesh.py
+    mesh = diamond_mesh(np.vstack([_tetrahedron(), _tetrahedron() + 4]))
+    assert (mesh.n_f, mesh.n_t, len(mesh.diamonds)) == (8, 8, 12)
+    assert not mesh.has_boundary
+
+
+@pytest.mark.parametrize("faces, message", [
+    (np.vstack([_tetrahedron(), [[0, 1, 4]]]),
+     r"cannot build diamonds: edge \(1, 0\) has more than two triangles"),
+    (np.vstack([_tetrahedron()[:3], [[1, 3, 2]]]),
+     r"cannot build diamonds: triangles 0 and 3 both traverse edge 2 -> 1"),
+    (_tetrahedron().astype(float), r"\(n_t, 3\) integer array, got shape \(4, 3\), dtype float64"),
+    (_tetrahedron()[:, :2], r"\(n_t, 3\) integer array, got shape \(4, 2\)"),
 ])
-def test_bad_topology_is_named(faces, n_vertices, message):
+def test_what_cannot_be_built_is_refused(faces, message):
     with pytest.raises(ValueError, match=message):
-        diamond_mesh(faces, n_vertices)
+        diamond_mesh(faces)

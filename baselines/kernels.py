@@ -1,0 +1,279 @@
+"""Compiled (numba) assembly kernels of the vertex baselines.
+
+One loop over the triangles computes everything a step of the cotangent
+(:mod:`baselines.cotan`), conformalized (:mod:`baselines.cmcf`) and BGN
+(:mod:`baselines.bgn`) schemes needs from the current surface, and writes
+it straight into arrays laid out by a cached CSR pattern
+(:func:`baselines.mesh.laplacian_pattern`); small loops over the rows then
+write the system matrices. This puts the baselines on the same footing as
+the compiled DDFV assembly: the time of a step is that of the scheme, not
+of scipy's sparse-matrix construction. ``neighbour_cosines`` is the
+compiled check of :meth:`baselines.cotan.VertexFlow.defects`.
+
+Formulas
+--------
+For triangle ``t = (x_0, x_1, x_2)`` with edge vectors ``e_k`` opposite
+corner ``k`` and area vector ``N = (x_1 - x_0) x (x_2 - x_0)``:
+
+* ``2|t| = |N|``;
+* cotangent of the angle at corner ``k``, with ``u, v`` the two edges
+  leaving it: ``cot_k = (u . v) / |u x v| = (u . v) / |N|``;
+* stiffness ``L_ij = -1/2 (cot alpha_ij + cot beta_ij)`` for an edge,
+  ``L_ii = -sum_j L_ij``: the P1 stiffness matrix ``int grad phi_i . grad
+  phi_j`` (Dziuk 1991; the cotangent formula of Pinkall and Polthier 1993;
+  libigl ``cotmatrix`` with the opposite sign): each triangle adds
+  ``cot_k / 2`` to the edge opposite corner ``k``;
+* barycentric lumped mass ``m_i = sum_{t ni i} |t| / 3``;
+* Voronoi (mixed) mass (Meyer, Desbrun, Schroeder, Barr 2003, Section 3.3
+  and Fig. 4): the Voronoi area ``(|e_j|^2 cot_j + |e_k|^2 cot_k) / 8`` of
+  corner ``i`` in a non-obtuse triangle, ``|t|/2`` at an obtuse corner and
+  ``|t|/4`` at the other two corners of an obtuse triangle. Computed as
+  libigl's ``massmatrix`` does (circumcentre barycentric coordinates
+  ``cos_k |e_k|``, normalised, times ``|t|``; the quad of corner ``i`` is
+  half the sum of the two sub-triangles adjacent to it), so the two agree
+  to rounding.
+"""
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def cotan_geometry(V, faces, corner_slots, diag_slots, voronoi, with_laplacian,
+                   L_data, mass, area_vectors):
+    """Cotangent stiffness, lumped mass and area vectors of one surface.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+        Vertices (C-contiguous).
+    faces : (m, 3) int64 array
+    corner_slots : (m, 3, 2) int64 array
+        CSR positions of ``(i, j)`` and ``(j, i)`` for the edge opposite each
+        corner (:class:`baselines.mesh.LaplacianPattern`).
+    diag_slots : (n,) int64 array
+    voronoi : bool
+        Voronoi (mixed) mass instead of barycentric.
+    with_laplacian : bool
+        Fill ``L_data`` (False: only the mass and the area vectors).
+    L_data : (nnz,) float64 array, output
+        Values of the stiffness ``L`` (positive semi-definite) in the pattern.
+    mass : (n,) float64 array, output
+        Lumped mass ``m_i``.
+    area_vectors : (m, 3) float64 array, output
+        ``N_t``; ``|N_t| = 2 |t|``.
+    """
+    m = faces.shape[0]
+    if with_laplacian:
+        L_data[:] = 0.0
+    mass[:] = 0.0
+    for t in range(m):
+        i0, i1, i2 = faces[t, 0], faces[t, 1], faces[t, 2]
+        # edges leaving each corner: corner 0: u0 = x1 - x0, v0 = x2 - x0
+        ax, ay, az = V[i1, 0] - V[i0, 0], V[i1, 1] - V[i0, 1], V[i1, 2] - V[i0, 2]
+        bx, by, bz = V[i2, 0] - V[i0, 0], V[i2, 1] - V[i0, 1], V[i2, 2] - V[i0, 2]
+        cx, cy, cz = V[i2, 0] - V[i1, 0], V[i2, 1] - V[i1, 1], V[i2, 2] - V[i1, 2]
+        nx, ny, nz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+        area_vectors[t, 0], area_vectors[t, 1], area_vectors[t, 2] = nx, ny, nz
+        dbl = np.sqrt(nx * nx + ny * ny + nz * nz)              # 2 |t|
+        # u.v at each corner: 0: (x1-x0).(x2-x0); 1: (x2-x1).(x0-x1); 2: (x0-x2).(x1-x2)
+        d0 = ax * bx + ay * by + az * bz
+        d1 = -(cx * ax + cy * ay + cz * az)
+        d2 = cx * bx + cy * by + cz * bz
+        if with_laplacian:
+            for k, d in ((0, d0), (1, d1), (2, d2)):
+                w = 0.5 * d / dbl                               # cot_k / 2
+                L_data[corner_slots[t, k, 0]] -= w
+                L_data[corner_slots[t, k, 1]] -= w
+                L_data[diag_slots[faces[t, (k + 1) % 3]]] += w
+                L_data[diag_slots[faces[t, (k + 2) % 3]]] += w
+        if not voronoi:
+            third = dbl / 6.0
+            mass[i0] += third
+            mass[i1] += third
+            mass[i2] += third
+            continue
+        # squared edge lengths opposite each corner
+        s0 = cx * cx + cy * cy + cz * cz
+        s1 = bx * bx + by * by + bz * bz
+        s2 = ax * ax + ay * ay + az * az
+        if d0 < 0.0:
+            mass[i0] += 0.25 * dbl
+            mass[i1] += 0.125 * dbl
+            mass[i2] += 0.125 * dbl
+        elif d1 < 0.0:
+            mass[i0] += 0.125 * dbl
+            mass[i1] += 0.25 * dbl
+            mass[i2] += 0.125 * dbl
+        elif d2 < 0.0:
+            mass[i0] += 0.125 * dbl
+            mass[i1] += 0.125 * dbl
+            mass[i2] += 0.25 * dbl
+        else:
+            # Voronoi area of corner i: (|e_j|^2 cot_j + |e_k|^2 cot_k) / 8
+            c0, c1, c2 = d0 / dbl, d1 / dbl, d2 / dbl
+            mass[i0] += (s1 * c1 + s2 * c2) / 8.0
+            mass[i1] += (s2 * c2 + s0 * c0) / 8.0
+            mass[i2] += (s0 * c0 + s1 * c1) / 8.0
+
+
+@njit(cache=True)
+def vertex_normals(faces, area_vectors, n, omega):
+    """Mass-lumped vertex normals ``omega_k = sum |t| nu_t / sum |t|`` (not normalised).
+
+    Barrett, Garcke, Nuernberg 2008, Section 2 ((B3) of
+    :mod:`baselines.bgn`): ``omega_k`` is the area-weighted mean of the unit
+    normals ``nu_t`` of the triangles at ``k``; with ``N_t = 2 |t| nu_t``,
+    ``omega_k = sum N_t / sum |N_t|``.
+
+    Parameters
+    ----------
+    faces : (m, 3) int64 array
+    area_vectors : (m, 3) float64 array
+    n : int
+    omega : (n, 3) float64 array, output
+    """
+    weight = np.zeros(n)
+    omega[:] = 0.0
+    for t in range(faces.shape[0]):
+        nx, ny, nz = area_vectors[t, 0], area_vectors[t, 1], area_vectors[t, 2]
+        dbl = np.sqrt(nx * nx + ny * ny + nz * nz)
+        for k in range(3):
+            i = faces[t, k]
+            omega[i, 0] += nx
+            omega[i, 1] += ny
+            omega[i, 2] += nz
+            weight[i] += dbl
+    for i in range(n):
+        omega[i, 0] /= weight[i]
+        omega[i, 1] /= weight[i]
+        omega[i, 2] /= weight[i]
+
+
+@njit(cache=True)
+def row_scaled_system(L_data, indptr, diag_slots, mass, tau, fixed, A_data):
+    """Values of ``I + tau diag(1/m) L`` in the pattern of ``L``; rows ``fixed`` = identity.
+
+    The row-scaled form (C3) of ``(M + tau L) X^n = M X^{n-1}`` ((C1) of
+    :mod:`baselines.cotan`, (K2) of :mod:`baselines.cmcf`); the Dirichlet
+    rows give ``X_i^n = X_i^{n-1}``.
+
+    Parameters
+    ----------
+    L_data : (nnz,) float64 array
+    indptr : (n + 1,) int32 array
+    diag_slots : (n,) int64 array
+    mass : (n,) float64 array
+    tau : float
+    fixed : (n,) bool array
+    A_data : (nnz,) float64 array, output
+    """
+    for i in range(len(mass)):
+        lo, hi = indptr[i], indptr[i + 1]
+        if fixed[i]:
+            for p in range(lo, hi):
+                A_data[p] = 0.0
+            A_data[diag_slots[i]] = 1.0
+            continue
+        s = tau / mass[i]
+        for p in range(lo, hi):
+            A_data[p] = L_data[p] * s
+        A_data[diag_slots[i]] += 1.0
+
+
+@njit(cache=True)
+def bgn_system(L_data, indptr, diag_slots, mass, omega, X, tau, fixed, scaled, A_data, b):
+    """Values and right-hand side of the BGN system (B4) ``(A + P/tau) X = P X^m / tau``.
+
+    Unknowns by components ``[x_1..x_n, y_1..y_n, z_1..z_n]``; row
+    ``c n + i`` of the (3n, 3n) pattern of :func:`baselines.bgn.block_pattern`
+    holds, in column order, the couplings ``(d n + i)`` for ``d < c``, the
+    entries ``c n + j`` of row ``i`` of ``L``, and the couplings for
+    ``d > c``. ``P = diag_k(m_k omega_k omega_k^T)``.
+
+    Parameters
+    ----------
+    L_data : (nnz,) float64 array
+        Cotangent stiffness ``A`` (one coordinate).
+    indptr : (n + 1,) int32 array
+        Row pointers of ``L``.
+    diag_slots : (n,) int64 array
+    mass : (n,) float64 array
+        Lumped mass ``m_k``.
+    omega : (n, 3) float64 array
+        Vertex normals ``omega_k``.
+    X : (3, n) float64 array
+        ``X^m``.
+    tau : float
+    fixed : (n,) bool array
+        Dirichlet vertices: identity rows, right-hand side ``X^m``.
+    scaled : bool
+        Multiply row ``(c, k)`` by ``tau / m_k`` (exact: row scaling).
+    A_data : (3 (nnz + 2 n),) float64 array, output
+    b : (3, n) float64 array, output
+    """
+    n = len(mass)
+    nnz = indptr[n]
+    for c in range(3):
+        for i in range(n):
+            start = c * (nnz + 2 * n) + indptr[i] + 2 * i
+            lo, hi = indptr[i], indptr[i + 1]
+            length = hi - lo
+            if fixed[i]:
+                for p in range(start, start + length + 2):
+                    A_data[p] = 0.0
+                A_data[start + c + diag_slots[i] - lo] = 1.0
+                b[c, i] = X[c, i]
+                continue
+            coef = 1.0 if scaled else mass[i] / tau
+            s = tau / mass[i] if scaled else 1.0
+            wc = omega[i, c]
+            # couplings: d < c before the block of L, d > c after it
+            q = start
+            for d in range(3):
+                if d == c:
+                    q = start + c + length
+                    continue
+                A_data[q] = coef * wc * omega[i, d]
+                q += 1
+            base = start + c
+            for p in range(lo, hi):
+                A_data[base + p - lo] = L_data[p] * s
+            A_data[base + diag_slots[i] - lo] += coef * wc * wc
+            normal = omega[i, 0] * X[0, i] + omega[i, 1] * X[1, i] + omega[i, 2] * X[2, i]
+            b[c, i] = coef * wc * normal
+
+
+@njit(cache=True)
+def neighbour_cosines(area_vectors, face_neighbours, cosine, double_areas):
+    """How each triangle's normal agrees with those of its edge-neighbours.
+
+    For triangle ``t`` with area vector ``N_t`` (twice its area times its
+    unit normal ``nu_t``) the cosine of the angle between ``nu_t`` and the
+    area-weighted mean normal of its edge-neighbours ``s``,
+    ``nu_t . sum_s N_s / |sum_s N_s|``; negative for a triangle folded
+    over its neighbours.
+
+    Parameters
+    ----------
+    area_vectors : (m, 3) float64 array
+    face_neighbours : (m, 3) int64 array
+        ``-1`` for no neighbour (boundary edge).
+    cosine : (m,) float64 array, output
+        NaN for a degenerate triangle or neighbours whose normals cancel.
+    double_areas : (m,) float64 array, output
+        ``|N_t| = 2 |t|``.
+    """
+    for t in range(area_vectors.shape[0]):
+        sx, sy, sz = 0.0, 0.0, 0.0
+        for k in range(3):
+            s = face_neighbours[t, k]
+            if s >= 0:
+                sx += area_vectors[s, 0]
+                sy += area_vectors[s, 1]
+                sz += area_vectors[s, 2]
+        nx, ny, nz = area_vectors[t, 0], area_vectors[t, 1], area_vectors[t, 2]
+        dbl = np.sqrt(nx * nx + ny * ny + nz * nz)
+        double_areas[t] = dbl
+        norm = dbl * np.sqrt(sx * sx + sy * sy + sz * sz)
+        cosine[t] = (nx * sx + ny * sy + nz * sz) / norm if norm > 0.0 else np.nan

@@ -1,0 +1,418 @@
+"""Problem metrics and mesh-quality monitors: pure functions of a triangle mesh.
+
+Every function takes ``vertices``, an ``(n, 3)`` float array (one row per
+vertex, as the generators of :mod:`mcfbench.surfaces` return them), and,
+where it needs them, ``faces``, an ``(m, 3)`` int array of consistently
+oriented triangles; none keeps state. All are vectorized over vertices
+and triangles.
+
+Exact answers of the problems (``NOTES.md``, "Exact and reference answers
+beyond the sphere"):
+
+* sphere of radius ``R``: ``r(t) = sqrt(R^2 - 4t)``
+  (:func:`mcfbench.errors.sphere_radius`);
+* cylinder between the circles of radius ``R`` at ``z = +-h``: the
+  catenoid ``r(z) = a cosh(z/a)``, ``a cosh(h/a) = R``
+  (:func:`catenoid_parameter`, :func:`catenoid_profile_error`);
+* hemisphere with its equator fixed, flat disk: the disk ``z = 0``
+  (:func:`max_height`, :func:`l2_height`).
+
+Problem metrics: :func:`catenoid_profile_error`, :func:`max_height`,
+:func:`l2_height`, :func:`volume`, :func:`area`. Mesh quality:
+:func:`min_angle`, :func:`max_aspect_ratio`, :func:`area_ratio`,
+:func:`flipped_triangles`, all four in :func:`quality`. Steady state:
+:func:`max_speed`.
+"""
+
+import numpy as np
+from scipy.optimize import brentq
+
+# ------------------------------------------------------------ measures
+
+
+def triangle_areas(vertices, faces):
+    """Area of every triangle, ``|(b - a) x (c - a)| / 2``.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+
+    Returns
+    -------
+    (m,) float array
+    """
+    return 0.5 * np.linalg.norm(_normals(*_mesh(vertices, faces)), axis=1)
+
+
+def area(vertices, faces):
+    """Surface area, the sum of the triangle areas.
+
+    Examples
+    --------
+    >>> V = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]
+    >>> area(V, [[0, 1, 2]])
+    0.5
+    """
+    return float(triangle_areas(vertices, faces).sum())
+
+
+def volume(vertices, faces):
+    """Signed enclosed volume ``(1/6) sum_t a_t . (b_t x c_t)`` (divergence theorem).
+
+    Positive for a closed surface whose normals point outwards; for an open
+    surface it is the signed volume of the cone from the origin over it.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+        Triangles ``(a, b, c)``.
+
+    Returns
+    -------
+    float
+    """
+    V, F = _mesh(vertices, faces)
+    a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    return float(np.einsum("ij,ij->", a, np.cross(b, c)) / 6.0)
+
+
+def lumped_mass(vertices, faces):
+    """Barycentric (lumped) vertex areas: a third of the area of each triangle at the vertex.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+
+    Returns
+    -------
+    (n,) float array
+        Sums to :func:`area`.
+    """
+    V, F = _mesh(vertices, faces)
+    third = triangle_areas(V, F) / 3.0
+    return np.bincount(F.ravel(), weights=np.repeat(third, 3), minlength=len(V))
+
+
+def mean_edge_length(vertices, faces):
+    """Mean length of the edges, each undirected edge counted once.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+
+    Returns
+    -------
+    float
+    """
+    V, F = _mesh(vertices, faces)
+    edges = np.unique(np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1),
+                      axis=0)
+    return float(np.linalg.norm(V[edges[:, 1]] - V[edges[:, 0]], axis=1).mean())
+
+
+# ----------------------------------------------------- problem metrics
+
+
+def max_height(vertices):
+    """``max_i |z_i|``: distance of the vertices from the plane ``z = 0`` (0 for the flat disk).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+
+    Returns
+    -------
+    float
+    """
+    V = _vertices(vertices)
+    return float(np.abs(V[:, 2]).max())
+
+
+def l2_height(vertices, faces):
+    """``sqrt(sum_i m_i z_i^2)``, the lumped L2 norm of the height ``z`` (0 for the flat disk).
+
+    ``m_i`` are the barycentric vertex areas (:func:`lumped_mass`).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+
+    Returns
+    -------
+    float
+    """
+    V, F = _mesh(vertices, faces)
+    return float(np.sqrt(np.dot(lumped_mass(V, F), V[:, 2] ** 2)))
+
+
+def catenoid_parameter(radius=1.0, half_height=0.5):
+    """Neck radius ``a`` of the stable catenoid spanning the circles of ``radius`` at ``z = +-h``.
+
+    Solves ``a cosh(h / a) = R`` on the branch of the larger root (the
+    stable catenoid, the steady state of the flow from the cylinder;
+    ``NOTES.md``, "Exact solutions for tests").
+
+    Parameters
+    ----------
+    radius : float
+        ``R``, radius of the circles at ``z = +-h``.
+    half_height : float
+        ``h``.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ValueError
+        When ``h / R`` exceeds the critical ratio ~0.6627 (no catenoid).
+
+    Examples
+    --------
+    >>> round(catenoid_parameter(1.0, 0.5), 15)
+    0.848337938094979
+    """
+    R, h = float(radius), float(half_height)
+    # a cosh(h/a) is smallest where tanh(h/a) = a/h
+    a_min = brentq(lambda a: np.tanh(h / a) - a / h, 1e-6 * h, h)
+    if a_min * np.cosh(h / a_min) > R:
+        raise ValueError(f"no catenoid spans circles of radius {R} at z = +-{h} "
+                         f"(h/R = {h / R:.4f} exceeds about 0.6627)")
+    return brentq(lambda a: a * np.cosh(h / a) - R, a_min, R,
+                  xtol=1e-15, rtol=4 * np.finfo(float).eps)
+
+
+def catenoid_profile_error(vertices, a, fixed_mask=None, neck_band=None):
+    """Distance of a surface about the ``z`` axis from the catenoid ``r = a cosh(z/a)``.
+
+    With ``rho_i = sqrt(x_i^2 + y_i^2)`` over the free vertices (not in
+    ``fixed_mask``):
+
+    ``max_radial_error``
+        ``max_i |rho_i - a cosh(z_i/a)| / (a cosh(z_i/a))``, the largest
+        relative radial error.
+    ``neck_radius``
+        The mean of ``rho_i / cosh(z_i/a)`` over the neck ring: the free
+        vertices whose ``|z_i|`` is within ``neck_band`` of the smallest
+        ``|z|`` (for :func:`mcfbench.surfaces.cylinder` with even ``along``
+        the middle ring, on ``z = 0``, where this is the mean radius).
+        Dividing by ``cosh(z_i/a)`` makes each term exactly ``a`` on the
+        catenoid, so a ring slightly off ``z = 0`` still measures the neck.
+    ``neck_error``
+        ``|neck_radius - a| / a``.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+        The catenoid's axis is the ``z`` axis, its neck at ``z = 0``.
+    a : float
+        Catenoid parameter (:func:`catenoid_parameter`), ``> 0``.
+    fixed_mask : (n,) bool array or int array of indices, optional
+        Vertices to leave out (the boundary circles, exact by construction).
+    neck_band : float, optional
+        Width of the neck ring in ``z``; default ``1e-3 a``.
+
+    Returns
+    -------
+    dict
+        ``neck_radius``, ``neck_error``, ``max_radial_error`` (floats).
+    """
+    V = _vertices(vertices)
+    if not a > 0:
+        raise ValueError(f"the catenoid parameter a must be positive, got {a!r}")
+    free = np.ones(len(V), bool)
+    if fixed_mask is not None:
+        free[np.asarray(fixed_mask)] = False
+    if not free.any():
+        raise ValueError("every vertex is fixed: nothing to compare with the catenoid")
+    rho, z = np.hypot(V[free, 0], V[free, 1]), V[free, 2]
+    scale = np.cosh(z / a)
+    radial = np.abs(rho - a * scale) / (a * scale)
+    band = 1e-3 * a if neck_band is None else float(neck_band)
+    ring = np.abs(z) <= np.abs(z).min() + band
+    neck = float(np.mean(rho[ring] / scale[ring]))
+    return {"neck_radius": neck, "neck_error": abs(neck - a) / a,
+            "max_radial_error": float(radial.max())}
+
+
+# -------------------------------------------------------- mesh quality
+
+
+def triangle_angles(vertices, faces):
+    """Interior angles in degrees; column ``k`` at corner ``faces[:, k]``.
+
+    ``atan2(|u x v|, u . v)`` of the two edge vectors leaving the corner
+    (accurate for angles near 0 and 180 degrees).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+
+    Returns
+    -------
+    (m, 3) float array
+        Each row sums to 180.
+    """
+    V, F = _mesh(vertices, faces)
+    u = V[F[:, [1, 2, 0]]] - V[F]
+    v = V[F[:, [2, 0, 1]]] - V[F]
+    return np.degrees(np.arctan2(np.linalg.norm(np.cross(u, v), axis=2),
+                                 np.einsum("ijk,ijk->ij", u, v)))
+
+
+def min_angle(vertices, faces):
+    """Smallest interior angle of the mesh, in degrees (60 for equilateral triangles)."""
+    return float(triangle_angles(vertices, faces).min())
+
+
+def aspect_ratios(vertices, faces):
+    """Aspect ratio ``R / (2 r)`` of every triangle: circumradius over twice the inradius.
+
+    With side lengths ``a, b, c``, semi-perimeter ``s`` and area ``A``:
+    ``R = abc / (4A)``, ``r = A / s``, so ``R / (2r) = abc s / (8 A^2)``
+    (``A`` from the cross product). It is 1 for an equilateral triangle
+    (the minimum), ``(1 + sqrt 2) / 2 = 1.2071`` for a right isosceles
+    one, and ``inf`` for a degenerate one.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+
+    Returns
+    -------
+    (m,) float array
+    """
+    V, F = _mesh(vertices, faces)
+    sides = np.linalg.norm(V[F[:, [1, 2, 0]]] - V[F], axis=2)
+    A = triangle_areas(V, F)
+    with np.errstate(divide="ignore"):
+        return sides.prod(axis=1) * (0.5 * sides.sum(axis=1)) / (8.0 * A**2)
+
+
+def max_aspect_ratio(vertices, faces):
+    """Largest :func:`aspect_ratios` of the mesh (1 when all triangles are equilateral)."""
+    return float(aspect_ratios(vertices, faces).max())
+
+
+def area_ratio(vertices, faces):
+    """Largest triangle area over the smallest (``inf`` if a triangle has zero area)."""
+    A = triangle_areas(vertices, faces)
+    with np.errstate(divide="ignore"):
+        return float(A.max() / A.min())
+
+
+def flipped_triangles(vertices, faces, reference_normals=None):
+    """Number of triangles folded over.
+
+    Without ``reference_normals``, triangle ``t`` counts when its normal
+    ``n_t = (b - a) x (c - a)`` points against the sum of the normals of
+    its edge-neighbours (the triangles sharing an edge with it), i.e.
+    against their area-weighted mean normal: ``n_t . sum_s n_s < 0``. A
+    single folded triangle in a smooth region counts once (its neighbours
+    still agree with theirs). With ``reference_normals`` (e.g. the normals
+    of the initial mesh) it counts when ``n_t . reference_t < 0``.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+        Consistently oriented.
+    reference_normals : (m, 3) float array, optional
+
+    Returns
+    -------
+    int
+    """
+    V, F = _mesh(vertices, faces)
+    N = _normals(V, F)
+    if reference_normals is None:
+        src, dst = F.ravel(), F[:, [1, 2, 0]].ravel()
+        key = np.minimum(src, dst) * len(V) + np.maximum(src, dst)
+        order = np.argsort(key, kind="stable")
+        tri = order // 3  # triangle of each sorted half-edge
+        shared = key[order][1:] == key[order][:-1]
+        t1, t2 = tri[:-1][shared], tri[1:][shared]
+        reference = np.zeros_like(N)
+        np.add.at(reference, t1, N[t2])
+        np.add.at(reference, t2, N[t1])
+    else:
+        reference = np.asarray(reference_normals, dtype=float)
+        if reference.shape != N.shape:
+            raise ValueError(f"reference_normals must have shape {N.shape} (one per "
+                             f"triangle), got {reference.shape}")
+    return int((np.einsum("ij,ij->i", N, reference) < 0).sum())
+
+
+def quality(vertices, faces):
+    """The mesh-quality monitors of one state.
+
+    Returns
+    -------
+    dict
+        ``min_angle`` (degrees), ``max_aspect_ratio``, ``area_ratio``,
+        ``flipped_triangles``: :func:`min_angle`, :func:`max_aspect_ratio`,
+        :func:`area_ratio`, :func:`flipped_triangles`.
+    """
+    return {"min_angle": min_angle(vertices, faces),
+            "max_aspect_ratio": max_aspect_ratio(vertices, faces),
+            "area_ratio": area_ratio(vertices, faces),
+            "flipped_triangles": flipped_triangles(vertices, faces)}
+
+
+# -------------------------------------------------------- steady state
+
+
+def max_speed(previous, vertices, tau):
+    """Largest vertex speed ``max_i |x_i - x_i^prev| / tau`` between two states.
+
+    Parameters
+    ----------
+    previous, vertices : (n, 3) float arrays
+        Two states of the same mesh, ``tau`` apart.
+    tau : float
+        ``> 0``.
+
+    Returns
+    -------
+    float
+    """
+    P, V = _vertices(previous), _vertices(vertices)
+    if P.shape != V.shape:
+        raise ValueError(f"the two states must have the same shape, got {P.shape} and {V.shape}")
+    if not tau > 0:
+        raise ValueError(f"tau must be positive, got {tau!r}")
+    return float(np.linalg.norm(V - P, axis=1).max() / tau)
+
+
+# ------------------------------------------------------------- helpers
+
+
+def _vertices(vertices):
+    V = np.asarray(vertices, dtype=float)
+    if V.ndim != 2 or V.shape[1] != 3 or len(V) == 0:
+        raise ValueError(f"vertices must have shape (n, 3) with n >= 1, got {V.shape}")
+    return V
+
+
+def _mesh(vertices, faces):
+    V = _vertices(vertices)
+    F = np.asarray(faces)
+    if F.ndim != 2 or F.shape[1] != 3 or not np.issubdtype(F.dtype, np.integer):
+        raise ValueError(f"faces must be an (m, 3) integer array, got shape {F.shape}, "
+                         f"dtype {F.dtype}")
+    if F.size and (F.min() < 0 or F.max() >= len(V)):
+        raise ValueError(f"face indices must lie in [0, {len(V)}), got [{F.min()}, {F.max()}]")
+    return V, F
+
+
+def _normals(V, F):
+    """(m, 3) normals ``(b - a) x (c - a)`` (length twice the area)."""
+    return np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
