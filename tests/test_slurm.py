@@ -1,9 +1,11 @@
 """The pipeline gives the same numbers through Slurm as when run locally.
 
-Runs the real workflow twice, each in its own copy of the repository's
-workflow files: once with the local executor and once through the Slurm
-profile (``profiles/slurm``), and compares ``results/tables/convergence.csv``
-from both, leaving out timing columns.
+Runs the real workflow twice, each in its own copy of the repository (every
+git-tracked file, as in the working tree): once with the local executor and
+once through the Slurm profile (``profiles/slurm``), and compares
+``results/tables/convergence.csv`` from both, leaving out timing columns.
+Untracked files are not copied, so a file the pipeline needs but that was
+never ``git add``-ed fails here as it would on a fresh clone.
 
 Needs a live Slurm (``sinfo`` on PATH and answering), e.g. the single-node
 one of ``bash workflow/ci/local-slurm.sh start``; skipped otherwise. Run with
@@ -25,6 +27,9 @@ Environment (optional, for real clusters):
 ``SLURM_TEST_TARGETS``
     targets for both runs (default: the workflow's default target), e.g.
     ``results/tables/convergence.csv`` to build only what is compared.
+``SLURM_TEST_UNTRACKED``
+    if set to 1, also copy untracked files that git does not ignore (to test
+    work not yet added to git).
 """
 
 from __future__ import annotations
@@ -46,12 +51,22 @@ import pytest
 pytestmark = pytest.mark.slurm
 
 REPO = Path(__file__).resolve().parents[1]
-# what a run needs from the repository (the Python packages are installed)
-REQUIRED = ["Snakefile"]
-OPTIONAL = ["workflow", "config", "profiles"]
 TABLE = Path("results") / "tables" / "convergence.csv"
 CONFIG = ["--config", "levels=[1,2]"]
-IGNORE_COPY = shutil.ignore_patterns(".snakemake", "__pycache__", "*.pyc")
+# without git (e.g. an unpacked source archive): the whole tree minus these
+# and minus the outputs of earlier runs (results/ except its README.md)
+IGNORE_PATTERNS = shutil.ignore_patterns(
+    ".git", ".snakemake", ".pytest_cache", ".venv", "__pycache__", "*.pyc", "*.egg-info", "build"
+)
+
+
+def ignore_copy(directory: str, names: list[str]) -> set[str]:
+    ignored = set(IGNORE_PATTERNS(directory, names))
+    if Path(directory).resolve() == (REPO / "results").resolve():
+        ignored |= {name for name in names if name != "README.md"}
+    return ignored
+
+
 TIMEOUT = float(os.environ.get("SLURM_TEST_TIMEOUT", "900"))
 USABLE_NODE_STATES = {"idle", "mixed", "allocated", "completing"}
 
@@ -91,19 +106,42 @@ def slurm():
         pytest.skip(reason)
 
 
+def repository_files() -> list[str] | None:
+    """Paths (relative to REPO) of the git-tracked files, or None without git."""
+    if shutil.which("git") is None:
+        return None
+    top = subprocess.run(
+        ["git", "-C", str(REPO), "rev-parse", "--show-toplevel"], capture_output=True, text=True
+    )
+    if top.returncode != 0 or Path(top.stdout.strip()).resolve() != REPO.resolve():
+        return None  # not a git checkout (or REPO lies inside another one)
+    cmd = ["git", "-C", str(REPO), "ls-files", "-z", "--cached"]
+    if os.environ.get("SLURM_TEST_UNTRACKED") == "1":
+        cmd += ["--others", "--exclude-standard"]
+    proc = subprocess.run(cmd, capture_output=True, check=True)
+    return sorted({p for p in proc.stdout.decode().split("\0") if p})
+
+
 def copy_workflow(dest: Path) -> Path:
-    """Copy the files a pipeline run needs from the repository into dest."""
-    dest.mkdir(parents=True)
-    for name in REQUIRED + OPTIONAL:
-        src = REPO / name
-        if not src.exists():
-            if name in REQUIRED:
-                pytest.fail(f"{src} is missing: the pipeline cannot run")
-            continue
-        if src.is_dir():
-            shutil.copytree(src, dest / name, ignore=IGNORE_COPY, symlinks=True)
-        else:
-            shutil.copy2(src, dest / name)
+    """Copy the repository into dest: every git-tracked file, as it is in the
+    working tree (tracked files deleted there are left out), so that the run
+    sees what a fresh clone of the working tree would see."""
+    files = repository_files()
+    if files is None:
+        shutil.copytree(REPO, dest, ignore=ignore_copy, symlinks=True)
+    else:
+        dest.mkdir(parents=True)
+        for name in files:
+            src, target = REPO / name, dest / name
+            if not src.exists() and not src.is_symlink():
+                continue  # deleted in the working tree, not yet in git
+            target.parent.mkdir(parents=True, exist_ok=True)
+            if src.is_dir() and not src.is_symlink():  # a submodule
+                shutil.copytree(src, target, ignore=IGNORE_PATTERNS, symlinks=True)
+            else:
+                shutil.copy2(src, target, follow_symlinks=False)
+    if not (dest / "Snakefile").is_file():
+        pytest.fail(f"{REPO / 'Snakefile'} is missing (or not tracked by git): the pipeline cannot run")
     return dest
 
 
