@@ -21,7 +21,7 @@ from .atomic import check_writable, save_npz, write_json
 from .memory import tune_malloc
 from .mesh import summarize
 from .meshio import read_mesh
-from .problems import PROBLEMS, get_problem
+from .problems import PROBLEMS, Problem, get_problem
 from .provenance import provenance
 from .schemes import SCHEMES, get_scheme
 from .solver import METHODS, Solver
@@ -230,9 +230,7 @@ def _run(args):
     for note in intake.notes():
         print(f"note: {note}")
     print(f"mesh: {summarize(V, F)}")
-    problem = get_problem("sphere").with_settings(
-        name="user", label=args.mesh.name, metrics=(), tau_rule="mesh",
-        tau_1=args.tau_edge or 1.0, steps=args.steps)
+    problem = Problem.user_mesh(args.mesh.name, args.steps, args.tau_edge or 1.0)
     tau = args.tau
     print(f"scheme {scheme.name}, solver {args.solver}"
           f"{'' if args.solver == 'direct' else f' (rtol {args.rtol:g})'}, "

@@ -97,6 +97,14 @@ class Problem:
                              f"{self.t_max:g} of the {self.name} ({self.exact})")
         return steps
 
+    @classmethod
+    def user_mesh(cls, label, steps, tau_edge=0.1):
+        """The problem of a user's mesh: ``tau = tau_edge h^2``, ``steps`` steps, no
+        exact answer (the mesh is passed to :func:`mcfbench.studies.run`)."""
+        return cls("user", label, "", lambda level: {}, levels=(0,), tau_1=tau_edge,
+                   t_final=0.0, metrics=(), tau_rule="mesh", steps=int(steps),
+                   exact="no exact solution: a user's mesh")
+
     def observers(self):
         """Fresh metric observers for one run."""
         return [METRICS[name](self) for name in self.metrics]
@@ -232,6 +240,43 @@ PROBLEMS = {p.name: p for p in (
             exact="no exact solution: the neck pinches before the bulbs vanish",
             description="Two spheres joined by a thin neck: when each scheme breaks down or "
                         "the neck pinches, and the mesh quality before it."),
+    # real-world-like meshes the suite generates itself (issue: every scheme runs a
+    # scanned or CAD-like mesh or says precisely why not)
+    Problem("perturbed_sphere", "sphere, randomly perturbed mesh", "perturbed_sphere",
+            lambda level: {"level": int(level), "amplitude": 0.25, "seed": 0},
+            levels=(1, 2, 3, 4), tau_1=0.04, t_final=0.08, metrics=("sphere_l2",),
+            exact="r(t) = sqrt(R^2 - 4t)", t_max=0.25,
+            description="The icosphere with vertices moved at random along the sphere: "
+                        "irregular valences and angles, exact solution known."),
+    Problem("remeshed_sphere", "sphere, random convex-hull mesh", "remeshed_sphere",
+            lambda level: {"n_points": 10 * 4 ** int(level) + 2, "seed": 0},
+            levels=(1, 2, 3, 4), tau_1=0.04, t_final=0.08, metrics=("sphere_l2",),
+            exact="r(t) = sqrt(R^2 - 4t)", t_max=0.25,
+            description="Random points on the unit sphere triangulated by their convex hull "
+                        "(slivers, valences 3 to 10)."),
+    Problem("anisotropic_sphere", "sphere, anisotropic UV mesh", "anisotropic_sphere",
+            lambda level: {"level": int(level), "stretch": 4.0},
+            levels=(1, 2, 3, 4), tau_1=0.04, t_final=0.08, metrics=("sphere_l2",),
+            exact="r(t) = sqrt(R^2 - 4t)", t_max=0.25,
+            description="A UV sphere with long thin triangles (length/width 4 at the "
+                        "equator) and poles of high valence."),
+    Problem("flat_patch", "flat patch stays flat and still", "flat_patch",
+            lambda level: {"level": int(level), "jitter": 0.3, "seed": 0},
+            levels=(1, 2, 3), tau_1=0.01, t_final=0.2, metrics=("still",),
+            exact="no motion: the flat disk is its own steady state",
+            description="An irregular Delaunay mesh of the unit disk with its boundary fixed: "
+                        "every vertex must stay where it is."),
+    Problem("blobby", "marching-cubes blob (genus 0)", "blobby",
+            lambda level: {"resolution": 20 * 2 ** int(level)},
+            levels=(1,), tau_1=0.1, t_final=0.0, metrics=("shape",), tau_rule="mesh", steps=40,
+            exact="no exact solution: smoothing of a scanned-like mesh",
+            description="Marching cubes of a sum of metaballs: irregular valences and slivers "
+                        "as in scanned meshes; tau = 0.1 h^2, 40 steps."),
+    Problem("marching_torus", "marching-cubes torus (genus 1)", "implicit_torus",
+            lambda level: {"resolution": 24 * 2 ** int(level)},
+            levels=(1,), tau_1=0.1, t_final=0.0, metrics=("shape",), tau_rule="mesh", steps=40,
+            exact="no exact solution: smoothing of a scanned-like mesh",
+            description="Marching cubes of a tilted torus (genus 1); tau = 0.1 h^2, 40 steps."),
 )}
 """Problem name -> :class:`Problem`."""
 

@@ -1,0 +1,164 @@
+"""The bad-input sweep: every kind of bad input gets an exit status and a message
+naming the problem and the offending element or key (``python -m mcfbench run``
+and ``sphere-table``; the pipeline's config in tests/test_pipeline.py)."""
+
+import numpy as np
+import pytest
+
+from mcfbench.cli import main
+from mcfbench.surfaces import icosphere
+
+TET_V = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+TET_F = "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n"
+
+
+def _obj(V, F):
+    return "".join(f"v {float(x)!r} {float(y)!r} {float(z)!r}\n" for x, y, z in V) + \
+           "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in F)
+
+
+def _run(tmp_path, capsys, text, *options, name="mesh.obj", out="run.npz"):
+    mesh = tmp_path / name
+    if text is not None:
+        mesh.write_text(text)
+    args = ["run", str(mesh), "--steps", "2", "--out", str(tmp_path / out)]
+    args += list(options) if any(o.startswith("--tau") for o in options) else \
+        ["--tau", "0.001", *options]
+    code = main(args)
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def _sphere_obj(level=1):
+    return _obj(*icosphere(level))
+
+
+MESHES = [
+    # kind, file text, message (a regular expression)
+    ("non-manifold edge", TET_V + "v 1 1 1\n" + TET_F + "f 1 2 5\n",
+     r"non-manifold.*edge"),
+    ("non-manifold vertex (two cones sharing an apex)",
+     "v 0 0 0\n" + "".join(f"v {np.cos(a):.6f} {np.sin(a):.6f} 1\n" for a in np.arange(3) * 2.1)
+     + "".join(f"v {np.cos(a):.6f} {np.sin(a):.6f} -1\n" for a in np.arange(3) * 2.1)
+     + "f 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\nf 1 6 5\nf 1 7 6\nf 1 5 7\nf 5 6 7\n",
+     r"non-manifold vertex.*\b0\b"),
+    ("inconsistent orientation", TET_V + "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 3 4\n",
+     r"orientation"),
+    ("duplicate faces", TET_V + TET_F + "f 1 3 2\n", r"duplicate"),
+    ("zero-area triangle", TET_V + "v 0.5 0.5 0\n" + "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n"
+     .replace("f 1 3 2\n", "f 1 3 5\nf 1 5 2\nf 2 5 3\n"), r"zero-area"),
+    ("NaN coordinate", "v nan 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + TET_F,
+     r"(NaN|nan).*vertex 0"),
+    ("empty file", "", r"empty"),
+    ("not a mesh", "hello world\n", r"mesh\.obj"),
+]
+
+
+@pytest.mark.parametrize("kind, text, message", MESHES, ids=[m[0] for m in MESHES])
+def test_bad_meshes_are_refused_with_a_named_element(tmp_path, capsys, kind, text, message):
+    code, out, err = _run(tmp_path, capsys, text)
+    assert code == 2, (kind, out, err)
+    assert err.startswith("error: ") and "Traceback" not in err
+    assert __import__("re").search(message, err), (kind, err)
+    assert not (tmp_path / "run.npz").exists()
+
+
+def test_unreferenced_vertices_are_dropped_with_a_note(tmp_path, capsys):
+    code, out, err = _run(tmp_path, capsys, _sphere_obj() + "v 5 5 5\nv 6 6 6\n",
+                          "--scheme", "cotan")
+    assert code == 0, err
+    assert "dropped 2 unreferenced vertices" in out
+    run = np.load(tmp_path / "run.npz")
+    assert run["V"].shape == (3, 42, 3) and run["vertex_map"].tolist() == list(range(42))
+
+
+def test_single_triangle_is_an_open_surface_that_stays_put(tmp_path, capsys):
+    code, out, err = _run(tmp_path, capsys, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+                          "--scheme", "cotan")
+    assert code == 0, err
+    assert "1 boundary loop" in out
+    run = np.load(tmp_path / "run.npz")
+    np.testing.assert_array_equal(run["V"][-1], run["V"][0])
+
+
+def test_disconnected_components_flow_each_on_its_own(tmp_path, capsys):
+    V, F = icosphere(1)
+    both = _obj(np.vstack([V, V + 3.0]), np.vstack([F, F + len(V)]))
+    code, out, err = _run(tmp_path, capsys, both, "--scheme", "cotan")
+    assert code == 0, err
+    assert "2 components" in out
+    run = np.load(tmp_path / "run.npz")
+    np.testing.assert_allclose(run["V"][-1, :42], run["V"][-1, 42:] - 3.0, atol=1e-9)
+
+
+@pytest.mark.parametrize("name, text, message", [
+    ("mesh.txt", TET_V + TET_F, r"unsupported mesh format '\.txt'"),
+    ("missing.obj", None, r"mesh file not found"),
+])
+def test_bad_paths_are_named(tmp_path, capsys, name, text, message):
+    code, out, err = _run(tmp_path, capsys, text, name=name)
+    assert code == 2 and __import__("re").search(message, err), err
+
+
+@pytest.mark.parametrize("options, message", [
+    (["--tau", "0"], r"--tau: must be a positive number"),
+    (["--tau", "-1"], r"--tau: must be a positive number"),
+    (["--tau", "nan"], r"--tau: must be a positive number"),
+    (["--steps", "0"], r"--steps: must be a whole number >= 1"),
+    (["--rtol", "0"], r"--rtol: must be a positive number"),
+    (["--scheme", "fast"], r"--scheme: invalid choice: 'fast'"),
+    (["--solver", "magic"], r"--solver: invalid choice: 'magic'"),
+])
+def test_bad_settings_are_named(tmp_path, capsys, options, message):
+    mesh = tmp_path / "sphere.obj"
+    mesh.write_text(_sphere_obj())
+    args = ["run", str(mesh), "--tau", "0.001", "--steps", "2", "--out",
+            str(tmp_path / "run.npz"), *options]
+    with pytest.raises(SystemExit) as exit_:
+        main(args)
+    assert exit_.value.code == 2
+    assert __import__("re").search(message, capsys.readouterr().err)
+
+
+def test_save_every_larger_than_steps_keeps_first_and_last(tmp_path, capsys):
+    code, out, err = _run(tmp_path, capsys, _sphere_obj(), "--save-every", "10",
+                          "--scheme", "cotan")
+    assert code == 0, err
+    assert np.load(tmp_path / "run.npz")["steps"].tolist() == [0, 2]
+
+
+def test_unwritable_output_is_refused_before_the_run(tmp_path, capsys):
+    (tmp_path / "blocker").write_text("a file")
+    code, out, err = _run(tmp_path, capsys, _sphere_obj(), out="blocker/run.npz")
+    assert code == 2 and "blocker is a file, not a directory" in err
+    assert "wrote" not in out and "mesh:" not in out       # nothing was computed
+
+
+def test_output_name_is_kept_or_refused(tmp_path, capsys):
+    code, out, err = _run(tmp_path, capsys, _sphere_obj(), out="result.dat")
+    assert code == 2 and "name it *.npz" in err
+    assert not (tmp_path / "result.dat").exists() and not (tmp_path / "result.dat.npz").exists()
+
+
+def test_tau_past_the_extinction_of_a_sphere_is_named(capsys):
+    code = main(["sphere-table", "--levels", "1", "--scheme", "cotan"])
+    assert code == 0
+    capsys.readouterr()
+    with pytest.raises(SystemExit):
+        main(["sphere-table", "--levels", "0"])
+    assert "--levels: must be a whole number >= 1" in capsys.readouterr().err
+
+
+def test_flow_past_extinction_on_a_users_sphere_ends_with_a_named_status(tmp_path, capsys):
+    for scheme, cells in (("cotan", "320 triangle(s)"), ("ddfv", "480 diamond cell(s)")):
+        code, out, err = _run(tmp_path, capsys, _sphere_obj(2), "--tau", "10", "--steps",
+                              "3", "--scheme", scheme)       # extinction at t = 0.25
+        assert code == 1
+        assert f"error: degenerated at step 3 (t = 30): {cells} collapsed" in err
+        assert str(np.load(tmp_path / "run.npz")["status"]) == "degenerated"
+
+
+def test_ddfv_option_on_another_scheme_is_named(tmp_path, capsys):
+    code, out, err = _run(tmp_path, capsys, _sphere_obj(), "--scheme", "cotan",
+                          "--t-init", "exact")
+    assert code == 2 and "--t-init applies to the DDFV schemes only, not to cotan" in err

@@ -1,0 +1,87 @@
+"""The problem registry (mcfbench/problems.py): meshes, time rules, metrics."""
+
+import numpy as np
+import pytest
+
+from mcfbench.flow import STATUSES
+from mcfbench.mesh import summarize
+from mcfbench.metrics import catenoid_parameter
+from mcfbench.problems import PROBLEMS, Problem, get_problem, time_steps
+from mcfbench.schemes import SCHEMES
+from mcfbench.studies import run
+
+CLOSED = {"sphere": 0, "torus": 1, "dumbbell": 0, "perturbed_sphere": 0, "remeshed_sphere": 0,
+          "anisotropic_sphere": 0, "blobby": 0, "marching_torus": 1}
+OPEN = {"catenoid": 2, "hemisphere": 1, "flat_patch": 1}
+
+
+@pytest.mark.parametrize("name", sorted(PROBLEMS))
+def test_every_problem_has_a_valid_mesh_and_time_rule(name):
+    problem = get_problem(name)
+    level = problem.levels[0]
+    V, F = problem.mesh(level)
+    summary = summarize(V, F)
+    assert summary.components == 1
+    if name in CLOSED:
+        assert summary.boundary_loops == 0 and summary.genus == (CLOSED[name],)
+    else:
+        assert summary.boundary_loops == OPEN[name]
+    tau = problem.tau(level, (V, F))
+    assert tau > 0 and problem.time_steps(tau) >= 1
+    assert len(problem.observers()) == len(problem.metrics)
+    assert problem.label and problem.exact and problem.description
+
+
+def test_refinement_series_halves_h_and_quarters_tau():
+    from mcfbench.metrics import mean_edge_length
+
+    for name in ("sphere", "catenoid", "hemisphere", "torus"):
+        problem = get_problem(name)
+        h = [mean_edge_length(*problem.mesh(k)) for k in problem.levels[:3]]
+        np.testing.assert_allclose(np.array(h[:-1]) / h[1:], 2.0, rtol=0.08, err_msg=name)
+        assert problem.tau(2) == problem.tau(1) / 4
+
+
+def test_catenoid_metric_vanishes_on_the_catenoid():
+    """The metric of the final state: a cylinder moved onto r = a cosh(z/a) has no error."""
+    problem = get_problem("catenoid")
+    V, F = problem.mesh(1)
+    a = catenoid_parameter(1.0, 0.5)
+    rho = np.linalg.norm(V[:, :2], axis=1)
+    V[:, :2] *= (a * np.cosh(V[:, 2] / a) / rho)[:, None]
+    observer = problem.observers()[0]
+
+    class State:
+        n, tau, vertices, faces = 10, 0.1, V, F
+        fixed = np.abs(np.abs(V[:, 2]) - 0.5) < 1e-12
+
+    observer(State)
+    result = observer.result()
+    assert abs(result["neck_error"]) < 1e-12 and abs(result["max_radial_error"]) < 1e-12
+
+
+def test_time_steps_refuse_what_is_not_a_multiple():
+    assert time_steps(0.08, 0.01) == 8
+    with pytest.raises(ValueError, match="not a whole multiple of tau = 0.03"):
+        time_steps(0.08, 0.03)
+    with pytest.raises(ValueError, match="tau must be a positive number"):
+        time_steps(0.08, float("nan"))
+
+
+def test_user_mesh_problem_uses_the_mesh_size():
+    problem = Problem.user_mesh("my.obj", steps=7, tau_edge=0.5)
+    V, F = get_problem("sphere").mesh(2)
+    from mcfbench.metrics import mean_edge_length
+
+    assert problem.tau(0, (V, F)) == pytest.approx(0.5 * mean_edge_length(V, F) ** 2)
+    assert problem.time_steps(0.01) == 7
+
+
+@pytest.mark.parametrize("scheme", sorted(SCHEMES))
+def test_every_scheme_runs_a_marching_cubes_mesh_or_names_why_not(scheme):
+    """A scanned-like mesh (slivers, irregular valences): a few steps, no traceback."""
+    result, traj = run(scheme, "blobby", 1, t_final=None)
+    assert result.status in STATUSES
+    assert result.steps_done == result.N or result.message.startswith(
+        f"{result.status} at step {traj.failed_step}")
+    assert result.min_angle >= 0.0 and result.iterations >= 0
