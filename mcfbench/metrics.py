@@ -205,7 +205,8 @@ def catenoid_profile_error(vertices, a, fixed_mask=None, neck_band=None):
         Dividing by ``cosh(z_i/a)`` makes each term exactly ``a`` on the
         catenoid, so a ring slightly off ``z = 0`` still measures the neck.
     ``neck_error``
-        ``|neck_radius - a| / a``.
+        ``(neck_radius - a) / a``, signed: negative for a neck thinner than
+        the catenoid's.
 
     Parameters
     ----------
@@ -237,7 +238,7 @@ def catenoid_profile_error(vertices, a, fixed_mask=None, neck_band=None):
     band = 1e-3 * a if neck_band is None else float(neck_band)
     ring = np.abs(z) <= np.abs(z).min() + band
     neck = float(np.mean(rho[ring] / scale[ring]))
-    return {"neck_radius": neck, "neck_error": abs(neck - a) / a,
+    return {"neck_radius": neck, "neck_error": (neck - a) / a,
             "max_radial_error": float(radial.max())}
 
 

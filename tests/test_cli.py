@@ -1,11 +1,17 @@
+"""The command line (mcfbench/cli.py; ``python -m ddfv`` is an alias)."""
+
 import json
+import subprocess
+import sys
 
 import igl
 import numpy as np
 import pandas as pd
+import pytest
 
 from conftest import bumpy_sphere, cylinder
-from ddfv.cli import main
+from mcfbench.cli import main
+from mcfbench.schemes import SCHEMES
 
 
 def test_sphere_table_prints_and_writes_csv(tmp_path, capsys):
@@ -20,6 +26,34 @@ def test_sphere_table_prints_and_writes_csv(tmp_path, capsys):
     assert abs(table.l2_error[1] / 3.26e-3 - 1) < 0.01
     meta = json.loads((tmp_path / "table.csv.json").read_text())
     assert meta["config"]["levels"] == [1, 2] and "numpy" in meta["packages"]
+    assert meta["config"]["scheme"] == "ddfv" and meta["git_commit"] != "unknown"
+
+
+def test_sphere_table_runs_any_scheme(capsys):
+    assert main(["sphere-table", "--levels", "1", "--scheme", "bgn"]) == 0
+    out = capsys.readouterr().out
+    assert "3.2624e-03" in out                 # BGN's error at level 1 (NOTES.md)
+
+
+def test_study_runs_a_problem_series(tmp_path, capsys):
+    csv = tmp_path / "study.csv"
+    assert main(["study", "catenoid", "--levels", "1", "--scheme", "ddfv-chord-eliminate",
+                 "--csv", str(csv)]) == 0
+    table = pd.read_csv(csv)
+    assert table.neck_error[0] == pytest.approx(-0.00321, abs=0.00002)   # issue #12
+    assert "cylinder to catenoid" in capsys.readouterr().out
+
+
+def test_registries_are_listed(capsys):
+    assert main(["schemes"]) == 0 and main(["problems"]) == 0
+    out = capsys.readouterr().out
+    assert all(name in out for name in SCHEMES) and "catenoid" in out
+
+
+def test_python_m_ddfv_is_an_alias():
+    out = subprocess.run([sys.executable, "-m", "ddfv", "schemes"], capture_output=True,
+                         text=True, check=True).stdout
+    assert "ddfv-chord-eliminate" in out
 
 
 def test_run_writes_frames(tmp_path):
@@ -28,8 +62,9 @@ def test_run_writes_frames(tmp_path):
     igl.write_triangle_mesh(str(mesh), V, F)
     out = tmp_path / "run.npz"
     assert main(["run", str(mesh), "--tau", "0.001", "--steps", "5",
-                 "--save-every", "2", "--out", str(out)]) == 0
+                 "--save-every", "2", "--solver", "bicgstab", "--out", str(out)]) == 0
     run = np.load(out)
+    assert str(run["scheme"]) == "ddfv"
     assert run["F"].shape == (4, len(V), 3) and run["T"].shape == (4, len(F), 3)
     np.testing.assert_array_equal(run["faces"], F)
     np.testing.assert_allclose(run["F"][0], V, atol=1e-6)     # OBJ keeps ~7 digits
@@ -45,6 +80,7 @@ def test_run_holds_the_boundary_of_open_meshes(tmp_path):
     out = tmp_path / "run.npz"
     assert main(["run", str(mesh), "--tau", "0.002", "--steps", "3",
                  "--variant", "eliminate", "--out", str(out)]) == 0
+    assert str(np.load(out)["scheme"]) == "ddfv-eliminate"
     run = np.load(out)
     rim = np.abs(np.abs(V[:, 2]) - 0.5) < 1e-12
     np.testing.assert_allclose(run["F"][-1][rim], run["F"][0][rim])
@@ -59,9 +95,33 @@ def test_run_reports_a_breakdown_and_keeps_frames(tmp_path, capsys):
                  "--out", str(out)]) == 2
     assert "rtol must lie in" in capsys.readouterr().err
     assert main(["run", str(mesh), "--tau", "0.01", "--steps", "5", "--maxiter", "1",
-                 "--rtol", "1e-15", "--out", str(out)]) == 1
-    assert "did not converge at step 1" in capsys.readouterr().err
-    assert str(np.load(out)["status"]) == "solver_failed"
+                 "--solver", "bicgstab", "--rtol", "1e-15", "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "error: solver_failed at step 1 (t = 0.01): bicgstab did not converge" in err
+    assert "iteration limit 1 reached" in err
+    run = np.load(out)
+    assert str(run["status"]) == "solver_failed" and run["steps"].tolist() == [0]
+
+
+def test_run_names_the_escape_of_a_t_vertex(tmp_path, capsys):
+    """A cube split twice (192 triangles): the T-vertices leave their triangles."""
+    from mcfbench.surfaces import subdivide
+
+    V = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
+    F = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+    for _ in range(2):
+        V, F = subdivide(V, F)
+    mesh = tmp_path / "cube.obj"
+    igl.write_triangle_mesh(str(mesh), V, F)
+    out = tmp_path / "run.npz"
+    code = main(["run", str(mesh), "--tau", "0.01", "--steps", "60", "--save-every", "0",
+                 "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 1 and "error: t_escaped at step " in err and "left its triangle" in err
+    run = np.load(out)
+    assert str(run["status"]) == "t_escaped" and run["t_min_barycentric"].min() < 0
+    assert json.loads(str(run["defects"]))[0]["status"] == "t_escaped"
 
 
 def test_missing_mesh_file(tmp_path, capsys):

@@ -8,7 +8,9 @@ from ddfv import Flow
 from ddfv.topology import diamond_mesh
 from mcfbench.driver import simulate as drive
 from mcfbench.solver import Solver
-from mcfbench.surfaces import icosphere
+from mcfbench import surfaces
+from mcfbench.metrics import catenoid_parameter
+from mcfbench.surfaces import hemisphere, icosphere
 
 TIGHT = dict(rtol=1e-13, t_init="paper")
 
@@ -177,3 +179,58 @@ def test_paper_initialisation_keeps_t_vertices_in_their_triangles():
     flow = Flow(V, F, 0.001)
     assert flow.t_min_barycentric() >= 0.0
     assert flow.defects() == []
+
+
+# -- open surfaces against their exact steady states (Dirichlet boundary (1.2)) --
+
+
+def twisted_cylinder(segments=24, bands=8, radius=1.0, half_height=0.55):
+    """The cylinder of Figs. 3.5-3.7: rings turned by half a segment."""
+    return surfaces.cylinder(segments, bands, radius, half_height, diagonals="twisted")
+
+
+@pytest.mark.parametrize("segments, bands, radius, half_height", [(32, 12, 1.0, 0.5),
+                                                                  (32, 12, 1.5, 0.9)])
+def test_cylinder_converges_to_the_catenoid(segments, bands, radius, half_height):
+    """h/R < 0.66: the steady state is r(z) = a cosh(z/a), a cosh(h/a) = R."""
+    V, F = twisted_cylinder(segments, bands, radius, half_height)
+    tau = 0.005 * radius**2
+    traj = simulate(V, F, tau, 240, save_every=0, tangential="eliminate")
+    assert traj.status == "ok", traj.message
+    a = catenoid_parameter(radius, half_height)
+    X = traj.F[-1]
+    r, z = np.hypot(X[:, 0], X[:, 1]), X[:, 2]
+    neck = r[np.abs(z) < 1e-9 * radius]
+    assert len(neck) == segments
+    np.testing.assert_allclose(neck, a, rtol=0.01)
+    np.testing.assert_allclose(r, a * np.cosh(z / a), atol=0.01 * radius)
+
+
+def test_catenoid_error_decreases_under_refinement():
+    errors = []
+    for segments, bands in ((16, 6), (32, 12)):
+        traj = simulate(*twisted_cylinder(segments, bands, 1.0, 0.5), 0.005, 240,
+                        save_every=0, tangential="eliminate")
+        X = traj.F[-1]
+        errors.append(abs(np.hypot(X[:, 0], X[:, 1])[np.abs(X[:, 2]) < 1e-9].mean()
+                          - catenoid_parameter(1.0, 0.5)))
+    assert errors[1] < 0.5 * errors[0]
+
+
+def test_hemisphere_with_fixed_equator_converges_to_the_disk():
+    V, F = hemisphere(rings=6)
+    boundary = diamond_mesh(F, len(V)).boundary_vertices
+    traj = simulate(V, F, 0.005, 400, save_every=0, tangential="eliminate")
+    assert traj.status == "ok", traj.message
+    X, T = traj.F[-1], traj.T[-1]
+    np.testing.assert_array_equal(X[boundary], V[boundary])
+    assert np.abs(X[:, 2]).max() < 1e-3 and np.abs(T[:, 2]).max() < 1e-3
+    assert np.hypot(X[:, 0], X[:, 1]).max() <= 1.0 + 1e-12
+
+
+def test_boundary_vertices_stay_fixed_without_elimination():
+    V, F = twisted_cylinder()
+    boundary = diamond_mesh(F, len(V)).boundary_vertices
+    traj = simulate(V, F, 0.0025, 40, save_every=20)
+    for X in traj.F:
+        np.testing.assert_array_equal(X[boundary], V[boundary])
