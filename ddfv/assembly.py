@@ -28,17 +28,24 @@ with the rows of boundary F-vertices replaced by ``F^n = F^{n-1}``
 (Section 2.2.4) and the missing T-vertex of a boundary diamond substituted
 by ``F_a + F_b - T_t1`` in the T-equation (Section 2.2.5).
 
-Assembly works per half-edge ``h = 3 t + k`` (``faces[t, k] -> faces[t, k+1]``
-in triangle ``t``): each half-edge sees its diamond in the frame
-``a -> b`` with ``t1 = t``, in which ``u . v`` and hence all four
-coefficients are the same for both half-edges of a diamond. The entry of
-F-row ``i`` at T-column ``t`` (the corner ``(i, t)``) collects the
-diamonds of the two half-edges of ``t`` at ``i``:
-``K[i, t] = -beta(out) + beta(in)`` and ``K[t, i] = -beta_hat(out) +
-beta_hat(in)``, ``out`` leaving ``i`` and ``in`` entering it. With the
-F-F, T-T and diagonal entries, every slot of the sparsity pattern is
-written exactly once, so assembly is one permutation of concatenated
-blocks.
+Assembly: each diamond ``(a, b, t1, t2)`` adds its entries of ``K`` (the
+row and column of T-vertex ``t`` is ``n_F + t``)::
+
+    K[a, b] = K[b, a] = -alpha,          K[a, a] += alpha, K[b, b] += alpha
+    K[a, t1] -= beta,  K[b, t1] += beta,  K[a, t2] += beta,  K[b, t2] -= beta
+    K[t1, a] -= beta_hat,  K[t1, b] += beta_hat,  K[t2, a] += beta_hat,
+    K[t2, b] -= beta_hat,  K[t1, t2] = K[t2, t1] = -alpha_hat,
+    K[t1, t1] += alpha_hat, K[t2, t2] += alpha_hat
+
+and on a boundary diamond, with ``f_t2 = f_a + f_b - f_t1`` in the
+T-equation, ``K[t1, a] -= beta_hat + alpha_hat``, ``K[t1, b] += beta_hat -
+alpha_hat``, ``K[t1, t1] += 2 alpha_hat`` (its F-rows are Dirichlet rows).
+The entry of F-row ``i`` at T-column ``t`` thus collects the diamonds of
+the two edges of triangle ``t`` at ``i``. The CSR pattern and the CSR
+position of each of these entries are computed once per mesh
+(:class:`Assembler`); one compiled loop over the diamonds scatters the
+values into them and one pass over the rows scales them by ``tau / chi``
+and adds the identity (:func:`ddfv.kernels.system_kernel`).
 """
 
 import numpy as np
@@ -51,25 +58,26 @@ def flux_coefficients(geom):
     Parameters
     ----------
     geom : DiamondGeometry
+        Or any object with the attributes ``gamma_t, gamma_f, J, len_u,
+        len_v, uv`` (arrays or floats).
 
     Returns
     -------
     alpha, beta, alpha_hat, beta_hat : (n_d,) float arrays
         See the module docstring; (2.12) and (2.15).
     """
-    gt_J = geom.gamma_t / geom.J
-    gf_J = geom.gamma_f / geom.J
-    return (gt_J * geom.len_v,             # alpha = q^F / 2              (2.12)
-            gt_J * geom.uv / geom.len_v,   # beta = |g^T|/d^T cot(omega)  (2.12)
-            gf_J * geom.len_u,             # alpha_hat = q_hat^T / 2      (2.15)
-            gf_J * geom.uv / geom.len_u)   # beta_hat = q_hat^F           (2.15)
+    from .kernels import flux_coefficients_kernel
+
+    # the formulas of the compiled assembly, evaluated elementwise by numpy
+    return flux_coefficients_kernel.py_func(geom.gamma_t, geom.gamma_f, geom.J,
+                                            geom.len_u, geom.len_v, geom.uv)
 
 
 class Assembler:
     """Sparse assembly of ``K`` and of the system matrix on a fixed mesh.
 
-    The CSR sparsity pattern and the permutation from the blocks of
-    entries to CSR order are built once.
+    The CSR sparsity pattern and, for every diamond, the CSR positions of
+    its entries are built once.
 
     Parameters
     ----------
@@ -77,94 +85,84 @@ class Assembler:
     """
 
     def __init__(self, mesh):
+        from . import kernels as k
+
         n_f, n_t, n = mesh.n_f, mesh.n_t, mesh.n_unknowns
         a, b, t1, t2 = mesh.diamonds.T
+        n_d = len(a)
         inner = ~mesh.boundary
-        # corner (k, t): vertex faces[t, k]; its out half-edge is k, its in
-        # half-edge k - 1 (stored as (3, n_t) rows for contiguous passes)
+        n_i = int(inner.sum())
+        # corner (k, t): vertex faces[t, k] of triangle t, stored k-major
         corner_f = mesh.faces.T.ravel()
         corner_t = n_f + np.tile(np.arange(n_t), 3)
         diag = np.arange(n)
-        # blocks: F-F, F-T corners, T-F corners, T-T, diagonal
+        # entry blocks: F-F, F-T corners, T-F corners, T-T, diagonal; every
+        # nonzero of the pattern appears once
         rows = np.concatenate([a, b, corner_f, corner_t,
                                n_f + t1[inner], n_f + t2[inner], diag])
         cols = np.concatenate([b, a, corner_t, corner_f,
                                n_f + t2[inner], n_f + t1[inner], diag])
+        if len(rows) >= 2**31:
+            raise ValueError(f"{len(rows)} nonzeros do not fit 32-bit CSR indices")
         perm = np.lexsort((cols, rows))
+        slot = np.empty(len(perm), dtype=np.uint32)
+        slot[perm] = np.arange(len(perm))          # CSR position of each block entry
+        cuts = np.cumsum([0, n_d, n_d, 3 * n_t, 3 * n_t, n_i, n_i, n])
+        s_ab, s_ba, s_ft, s_tf, s_t12, s_t21, s_diag = (
+            slot[i:j] for i, j in zip(cuts[:-1], cuts[1:]))
+        s_ft, s_tf = s_ft.reshape(3, n_t), s_tf.reshape(3, n_t)
+        # corners of a diamond: the edge is the half-edge a -> b of t1
+        # (faces[t1, k1] = a, faces[t1, k1 + 1] = b) and b -> a of t2
+        he_t, he_k = np.divmod(np.arange(3 * n_t), 3)
+        he_d = mesh.halfedges.ravel()
+        in_t1 = he_t == t1[he_d]
+        k1, k2 = np.zeros(n_d, dtype=np.int64), np.zeros(n_d, dtype=np.int64)
+        k1[he_d[in_t1]] = he_k[in_t1]
+        k2[he_d[~in_t1]] = he_k[~in_t1]
+        k1_next, k2_next = (k1 + 1) % 3, (k2 + 1) % 3
+        t2_i = t2[inner]
+        slots = np.zeros((n_d, k.N_SLOTS), dtype=np.uint32)
+        slots[:, k.SLOT_AB], slots[:, k.SLOT_BA] = s_ab, s_ba
+        slots[:, k.SLOT_AA], slots[:, k.SLOT_BB] = s_diag[a], s_diag[b]
+        slots[:, k.SLOT_A_T1], slots[:, k.SLOT_B_T1] = s_ft[k1, t1], s_ft[k1_next, t1]
+        slots[:, k.SLOT_T1_A], slots[:, k.SLOT_T1_B] = s_tf[k1, t1], s_tf[k1_next, t1]
+        slots[:, k.SLOT_T1_T1] = s_diag[n_f + t1]
+        slots[inner, k.SLOT_A_T2] = s_ft[k2_next[inner], t2_i]
+        slots[inner, k.SLOT_B_T2] = s_ft[k2[inner], t2_i]
+        slots[inner, k.SLOT_T2_A] = s_tf[k2_next[inner], t2_i]
+        slots[inner, k.SLOT_T2_B] = s_tf[k2[inner], t2_i]
+        slots[inner, k.SLOT_T1_T2], slots[inner, k.SLOT_T2_T1] = s_t12, s_t21
+        slots[inner, k.SLOT_T2_T2] = s_diag[n_f + t2_i]
         self.shape = (n, n)
-        self._perm = perm
+        self._slots = slots
+        self._diag = np.ascontiguousarray(s_diag)
         self._indices = cols[perm].astype(np.int32)
         self._indptr = np.searchsorted(rows[perm], np.arange(n + 1)).astype(np.int32)
-        self._he_out = np.ascontiguousarray(mesh.halfedges.T)
-        self._he_in = np.ascontiguousarray(mesh.halfedges[:, [2, 0, 1]].T)
-        self._mesh = mesh
-        self._inner = inner
+        self._inner = np.ascontiguousarray(inner)
         self._has_boundary = mesh.has_boundary
-        if self._has_boundary:
-            self._bnd_out = mesh.boundary[self._he_out]
-            self._bnd_in = mesh.boundary[self._he_in]
-        # rows of the F-F, F-T and T-T blocks, for the row scaling
-        self._rows_ff = (a, b)
-        self._rows_ft = np.ascontiguousarray(mesh.faces.T)
-        self._rows_tt = (t1[inner], t2[inner])
         # Rows of boundary F-vertices are Dirichlet rows (Section 2.2.4).
         self._dirichlet = np.r_[mesh.boundary_vertices, np.zeros(n_t, bool)]
-        # block boundaries within the entry buffer
-        n_d, n_i = len(a), int(inner.sum())
-        self._cuts = np.cumsum([0, n_d, n_d, 3 * n_t, 3 * n_t, n_i, n_i, n_f, n_t])
-        self._vals = np.empty(self._cuts[-1])
 
     @property
     def nnz(self):
         return len(self._indices)
 
-    def _entries(self, geom, scale, shift):
-        """Values of ``diag(scale) K + shift I`` in CSR order.
+    def _matrix(self, geom, scale, shift):
+        """``diag(scale) K + shift I`` in CSR (:func:`ddfv.kernels.system_kernel`)."""
+        from .kernels import system_kernel
 
-        Each block of entries is scaled by the ``scale`` of its rows before
-        the one permutation to CSR order.
-        """
-        mesh = self._mesh
-        alpha, beta, alpha_hat, beta_hat = flux_coefficients(geom)
-        s_f, s_t = scale[:mesh.n_f], scale[mesh.n_f:]
-        ff_ab, ff_ba, ft, tf, tt_12, tt_21, d_f, d_t = (
-            self._vals[i:j] for i, j in zip(self._cuts[:-1], self._cuts[1:]))
-        ft = ft.reshape(3, -1)
-        tf = tf.reshape(3, -1)
-        # off-diagonal entries -flux coefficient (module docstring)
-        np.multiply(alpha, s_f.take(self._rows_ff[0]), out=ff_ab)
-        np.multiply(alpha, s_f.take(self._rows_ff[1]), out=ff_ba)
-        np.subtract(beta.take(self._he_in), beta.take(self._he_out), out=ft)
-        ft *= s_f.take(self._rows_ft)
-        np.subtract(beta_hat.take(self._he_in), beta_hat.take(self._he_out), out=tf)
-        ah = alpha_hat.take(self._he_out)
-        np.add(ah[0], ah[1], out=d_t)
-        d_t += ah[2]
-        if self._has_boundary:
-            # T_t2 = F_a + F_b - T_t1 on boundary diamonds (Section 2.2.5)
-            ah_b = ah * self._bnd_out
-            tf -= ah_b + alpha_hat.take(self._he_in) * self._bnd_in
-            d_t += ah_b[0] + ah_b[1] + ah_b[2]
-            alpha_hat = alpha_hat[self._inner]
-        tf *= s_t
-        np.multiply(alpha_hat, s_t.take(self._rows_tt[0]), out=tt_12)
-        np.multiply(alpha_hat, s_t.take(self._rows_tt[1]), out=tt_21)
-        for block in (ff_ab, ff_ba, tt_12, tt_21):
-            np.negative(block, out=block)
-        # diagonal K_ii = sum of alpha (F rows) or alpha_hat (T rows): zero row sums
-        a, b = self._rows_ff
-        np.add(np.bincount(a, alpha, minlength=mesh.n_f),
-               np.bincount(b, alpha, minlength=mesh.n_f), out=d_f)
-        d_f *= s_f
-        d_t *= s_t
-        if shift:
-            d_f += shift
-            d_t += shift
-        return self._vals.take(self._perm)
-
-    def _csr(self, data):
-        return sp.csr_matrix((data, self._indices, self._indptr),
-                             shape=self.shape)
+        n_d = self._slots.shape[0]
+        factors = []
+        for name in ("gamma_t", "gamma_f", "J", "len_u", "len_v", "uv"):
+            x = np.asarray(getattr(geom, name), dtype=np.float64)
+            if x.shape != (n_d,):
+                raise ValueError(f"geometry field {name} has shape {x.shape}, "
+                                 f"the mesh needs ({n_d},)")
+            factors.append(x)
+        data = np.empty(self.nnz)
+        system_kernel(self._inner, *factors, self._slots, self._indptr.view(np.uint32),
+                      self._diag, scale, float(shift), data)
+        return sp.csr_matrix((data, self._indices, self._indptr), shape=self.shape)
 
     def stiffness(self, geom):
         """``K``: minus the sum of fluxes, zero rows at Dirichlet vertices.
@@ -179,8 +177,7 @@ class Assembler:
             Zero row sums; ``-(K X)_i`` approximates the integral of the
             Laplace-Beltrami operator of ``X`` over covolume ``i`` (2.9).
         """
-        data = self._entries(geom, (~self._dirichlet).astype(float), 0.0)
-        return self._csr(data)
+        return self._matrix(geom, (~self._dirichlet).astype(float), 0.0)
 
     def system(self, geom, chi, tau):
         """System matrix ``I + tau diag(1/chi) K`` of (2.10)-(2.11), (2.13)-(2.14).
@@ -200,7 +197,10 @@ class Assembler:
         (n, n) scipy.sparse.csr_matrix
             Dirichlet rows are rows of the identity.
         """
+        chi = np.asarray(chi, dtype=np.float64)
+        if chi.shape != (self.shape[0],):
+            raise ValueError(f"chi must have shape ({self.shape[0]},), got {chi.shape}")
         scale = tau / chi
         if self._has_boundary:
             scale[self._dirichlet] = 0.0
-        return self._csr(self._entries(geom, scale, 1.0))
+        return self._matrix(geom, scale, 1.0)

@@ -6,6 +6,10 @@ Notation of the paper (Sections 2.2.3-2.2.5) per diamond ``(a, b, t1, t2)``:
 missing T-vertex is the reflection ``F_a + F_b - T_t1`` (end of Section
 2.2.5), so ``S`` is the edge midpoint and the cell is the triangle
 ``F_a, F_b, T_t1`` (see ``ddfv/README.md``).
+
+The per-step functions (:func:`diamond_geometry`, :func:`covolume_areas`,
+:func:`vertex_normals`, :func:`t_barycentric`) are one compiled loop each,
+in :mod:`ddfv.kernels` (numba, imported on first use).
 """
 
 from dataclasses import dataclass
@@ -42,6 +46,12 @@ class DiamondGeometry:
         ``(F_b, T_t1, S)``, ``(F_b, S, T_t2)`` that cut the diamond at
         ``S`` (Section 2.2.4), see :func:`covolume_areas`; zero on the
         ``T_t2`` side of boundary diamonds.
+
+    Notes
+    -----
+    The arrays of one geometry are rows of one buffer whose row stride is
+    padded (:func:`ddfv.kernels.padded_length`): the (3, n_d) and (4, n_d)
+    fields are views with a row stride above ``n_d``, not C-contiguous.
     """
 
     u: np.ndarray
@@ -86,9 +96,12 @@ DUAL_LENGTHS = ("broken", "chord")
 def diamond_geometry(mesh, F, T, dual_length="broken"):
     """Geometric factors of all diamonds, see :class:`DiamondGeometry`.
 
-    Every length and area follows from the Gram matrix of ``u, v, e``
-    (``|x x y|^2 = |x|^2 |y|^2 - (x.y)^2``), which costs far fewer array
-    passes than cross products of the corner vectors.
+    One pass over the diamonds (:func:`ddfv.kernels.diamond_geometry_kernel`)
+    gathers the corners and computes every length and area from the Gram
+    matrix of ``u, v, e`` (``|x x y|^2 = |x|^2 |y|^2 - (x.y)^2``):
+    with ``S`` the centre, ``|F_a - S|^2 = |u|^2/4 + |e|^2 - u.e`` etc., and
+    the quarter ``(F_a, T_t1, S)`` has area
+    ``sqrt(|F_a - S|^2 |T_t1 - S|^2 - ((F_a - S).(T_t1 - S))^2) / 2``.
 
     Parameters
     ----------
@@ -106,43 +119,23 @@ def diamond_geometry(mesh, F, T, dual_length="broken"):
     if dual_length not in DUAL_LENGTHS:
         raise ValueError(f"unknown dual_length {dual_length!r}; choose one of "
                          f"{', '.join(DUAL_LENGTHS)}")
-    Fa, Fb, T1, T2 = diamond_corners(mesh, F, T)
-    u = Fb - Fa
-    v = T2 - T1
-    e = Fa + Fb
-    e -= T1
-    e -= T2
-    e *= 0.25
-    uu, vv, ee = _dot(u, u), _dot(v, v), _dot(e, e)
-    uv, ue, ve = _dot(u, v), _dot(u, e), _dot(v, e)
-    # squared lengths of F_a - S, F_b - S, T_t1 - S, T_t2 - S
-    base_f, base_t = 0.25 * uu + ee, 0.25 * vv + ee
-    ra2, rb2, p2, q2 = base_f - ue, base_f + ue, base_t + ve, base_t - ve
-    # (F_a - S).(T_t1 - S) etc. for the four quarter triangles at S
-    c_minus, c_plus = 0.25 * uv - ee, 0.25 * uv + ee
-    d_minus, d_plus = 0.5 * (ue - ve), 0.5 * (ue + ve)
-    ra_p, rb_q = c_minus + d_minus, c_minus - d_minus
-    ra_q, rb_p = d_plus - c_plus, d_plus + c_plus  # rb_p up to its sign
-    quarters = np.empty((4, len(uu)))
-    for out, x2, y2, xy in ((quarters[0], ra2, p2, ra_p), (quarters[1], ra2, q2, ra_q),
-                            (quarters[2], rb2, p2, rb_p), (quarters[3], rb2, q2, rb_q)):
-        np.multiply(x2, y2, out=out)
-        out -= xy * xy
-    np.maximum(quarters, 0.0, out=quarters)
-    np.sqrt(quarters, out=quarters)
-    quarters *= 0.5
-    if mesh.has_boundary:
-        quarters[[1, 3]] *= ~mesh.boundary
-    len_u, len_v = np.sqrt(uu), np.sqrt(vv)
-    if dual_length == "chord":
-        gamma_t, gamma_f = len_v, len_u
-    else:
-        gamma_t = np.sqrt(p2) + np.sqrt(q2)    # (2.5)
-        gamma_f = np.sqrt(ra2) + np.sqrt(rb2)  # (2.15), Section 2.2.5
+    from . import kernels as k
+
+    F, T = _coordinates(F, mesh.n_f, "F"), _coordinates(T, mesh.n_t, "T")
+    diamonds = _diamond_indices(mesh)
+    n_d = diamonds.shape[1]
+    buf = np.empty((k.GEOMETRY_ROWS, k.padded_length(n_d)))
+    broken = dual_length == "broken"
+    k.diamond_geometry_kernel(F, T, diamonds, broken, buf)
+    rows = buf[:, :n_d]
+    len_u, len_v = rows[k.ROW_LEN_U], rows[k.ROW_LEN_V]
     return DiamondGeometry(
-        u=u, v=v, e=e, len_u=len_u, len_v=len_v,
-        J=np.sqrt(np.maximum(0.0, uu * vv - uv**2)), uv=uv,
-        gamma_t=gamma_t, gamma_f=gamma_f, quarters=quarters)
+        u=rows[k.ROW_U:k.ROW_U + 3], v=rows[k.ROW_V:k.ROW_V + 3],
+        e=rows[k.ROW_E:k.ROW_E + 3], len_u=len_u, len_v=len_v,
+        J=rows[k.ROW_J], uv=rows[k.ROW_UV],
+        gamma_t=rows[k.ROW_GAMMA_T] if broken else len_v,
+        gamma_f=rows[k.ROW_GAMMA_F] if broken else len_u,
+        quarters=rows[k.ROW_QUARTERS:k.ROW_QUARTERS + 4])
 
 
 def covolume_areas(mesh, geom):
@@ -163,14 +156,15 @@ def covolume_areas(mesh, geom):
     -------
     chi_f : (n_f,) float array
     chi_t : (n_t,) float array
+        Views of one (n_f + n_t,) buffer, F-vertices first.
     """
-    q_a1, q_a2, q_b1, q_b2 = geom.quarters
-    a, b, t1, t2 = mesh.diamonds.T
-    chi_f = (np.bincount(a, q_a1 + q_a2, minlength=mesh.n_f)
-             + np.bincount(b, q_b1 + q_b2, minlength=mesh.n_f))
-    inner = ~mesh.boundary
-    chi_t = np.bincount(t1, q_a1 + q_b1, minlength=mesh.n_t)
-    chi_t += np.bincount(t2[inner], (q_a2 + q_b2)[inner], minlength=mesh.n_t)
+    from .kernels import covolume_kernel
+
+    diamonds = _diamond_indices(mesh)
+    quarters = _diamond_array(geom.quarters, (4, diamonds.shape[1]), "quarters")
+    chi = np.empty(mesh.n_unknowns)
+    chi_f, chi_t = chi[:mesh.n_f], chi[mesh.n_f:]
+    covolume_kernel(diamonds, quarters, chi_f, chi_t)
     return chi_f, chi_t
 
 
@@ -182,18 +176,23 @@ def vertex_normals(mesh, geom):
     normalised sum of ``u x v = 2 chi(V^D) N^D`` over the diamonds of its
     covolume, i.e. the area-weighted mean of the diamond normals.
 
+    Parameters
+    ----------
+    mesh : DiamondMesh
+    geom : DiamondGeometry
+
     Returns
     -------
     (3, n_f + n_t) float array
     """
-    uxv = _cross(geom.u, geom.v)
-    a, b, t1, t2 = mesh.diamonds.T
-    inner = ~mesh.boundary
-    rows = np.concatenate([a, b, mesh.n_f + t1, mesh.n_f + t2[inner]])
-    n = mesh.n_unknowns
-    N = np.stack([np.bincount(rows, np.concatenate([c, c, c, c[inner]]), minlength=n)
-                  for c in uxv])
-    return N / _norm(N)
+    from .kernels import vertex_normals_kernel
+
+    diamonds = _diamond_indices(mesh)
+    shape = (3, diamonds.shape[1])
+    N = np.empty((3, mesh.n_unknowns))
+    vertex_normals_kernel(diamonds, _diamond_array(geom.u, shape, "u"),
+                          _diamond_array(geom.v, shape, "v"), mesh.n_f, N)
+    return N
 
 
 def triangle_areas(F, faces):
@@ -206,7 +205,11 @@ def t_barycentric(F, T, faces):
     """Barycentric coordinates of each T-vertex projected into its triangle.
 
     ``(1/3, 1/3, 1/3)`` at the barycentre; a negative coordinate means the
-    projection of ``T_i`` has left the triangle (Section 3.2).
+    projection of ``T_i`` has left the triangle (Section 3.2). The
+    coordinates ``(1 - l1 - l2, l1, l2)`` solve the normal equations
+    ``G (l1, l2) = (e1.d, e2.d)`` with ``e1 = p1 - p0``, ``e2 = p2 - p0``,
+    ``d = T_i - p0`` and ``G`` the Gram matrix of ``e1, e2``
+    (:func:`ddfv.kernels.t_barycentric_kernel`).
 
     Parameters
     ----------
@@ -218,15 +221,41 @@ def t_barycentric(F, T, faces):
     -------
     (n_t, 3) float array
     """
-    p0, p1, p2 = np.take(F.T, faces.T, axis=1).swapaxes(0, 1)
-    e1, e2, d = p1 - p0, p2 - p0, T.T - p0
-    # normal equations of the projection onto the plane of the triangle
-    g11, g12, g22 = _dot(e1, e1), _dot(e1, e2), _dot(e2, e2)
-    r1, r2 = _dot(e1, d), _dot(e2, d)
-    det = g11 * g22 - g12**2
-    l1 = (g22 * r1 - g12 * r2) / det
-    l2 = (g11 * r2 - g12 * r1) / det
-    return np.column_stack([1.0 - l1 - l2, l1, l2])
+    from .kernels import t_barycentric_kernel
+
+    faces = np.asarray(faces)
+    if faces.ndim != 2 or faces.shape[1] != 3 or not np.issubdtype(faces.dtype, np.integer):
+        raise ValueError(f"faces must be an (n_t, 3) int array, got {faces.dtype} {faces.shape}")
+    T = _coordinates(T, len(faces), "T")
+    out = np.empty((len(faces), 3))
+    t_barycentric_kernel(_coordinates(F, None, "F"), T,
+                         faces.astype(np.int64, copy=False).view(np.uint64), out)
+    return out
+
+
+def _coordinates(X, n, name):
+    """``X`` as an (n, 3) float64 array (any strides: no copy of a view)."""
+    X = np.asarray(X, dtype=np.float64)
+    if X.ndim != 2 or X.shape[1] != 3 or (n is not None and X.shape[0] != n):
+        raise ValueError(f"{name} must have shape ({n if n is not None else 'n'}, 3), "
+                         f"got {X.shape}")
+    return X
+
+
+def _diamond_indices(mesh):
+    """(4, n_d) uint64 view of ``mesh.diamonds`` (``t2 = -1`` -> ``kernels.NO_T``)."""
+    diamonds = mesh.diamonds.T
+    if diamonds.dtype != np.int64:
+        diamonds = diamonds.astype(np.int64)
+    return diamonds.view(np.uint64)
+
+
+def _diamond_array(x, shape, name):
+    """A per-diamond field of a DiamondGeometry, checked against the mesh."""
+    x = np.asarray(x, dtype=np.float64)
+    if x.shape != shape:
+        raise ValueError(f"geometry field {name} has shape {x.shape}, the mesh needs {shape}")
+    return x
 
 
 def _cross(x, y):
@@ -236,10 +265,6 @@ def _cross(x, y):
                      x[0] * y[1] - x[1] * y[0]])
 
 
-def _dot(x, y):
-    """Dot products of the columns of (3, m) component arrays."""
-    return np.einsum("ij,ij->j", x, y)
-
-
 def _norm(x):
-    return np.sqrt(_dot(x, x))
+    """Lengths of the columns of a (3, m) component array."""
+    return np.sqrt(np.einsum("ij,ij->j", x, x))

@@ -1,13 +1,14 @@
 import numpy as np
 import pytest
 
-from conftest import bumpy_sphere, flat_lattice
+from conftest import bumpy_sphere, cylinder, flat_lattice
 from reference import literal_system
+from ddfv import kernels
 from ddfv.assembly import Assembler, flux_coefficients
 from ddfv.geometry import covolume_areas, diamond_geometry
-from ddfv.surfaces import icosphere
 from ddfv.t_vertices import initial_t_vertices
 from ddfv.topology import diamond_mesh
+from mcfbench.surfaces import icosphere
 
 
 def _state(V, F, t_init="paper", noise=0.0, seed=0):
@@ -98,3 +99,71 @@ def test_discrete_laplacian_of_sphere_converges_to_mean_curvature():
         errors.append(np.sqrt(np.sum(chi[:, None] * (h + 2 * X) ** 2) / 2))   # h = -2 x
     assert errors[2] < errors[1] < errors[0]
     assert np.log2(errors[0] / errors[1]) > 0.5 and np.log2(errors[1] / errors[2]) > 0.5
+
+
+def _flux_loop_system(mesh, geom, chi, tau):
+    """Dense ``I + tau diag(1/chi) K`` from the flux form, diamond by diamond:
+    ``K`` collects minus the fluxes (module docstring of ddfv.assembly), the
+    missing ``f_t2`` of a boundary diamond is ``f_a + f_b - f_t1``
+    (Section 2.2.5) and boundary F-rows are rows of the identity."""
+    n_f, n = mesh.n_f, mesh.n_unknowns
+    K = np.zeros((n, n))
+    for d, (a, b, t1, t2) in enumerate(mesh.diamonds):
+        gt, gf, J = geom.gamma_t[d], geom.gamma_f[d], geom.J[d]
+        lu, lv, uv = geom.len_u[d], geom.len_v[d], geom.uv[d]
+        alpha, beta = gt * lv / J, gt * uv / (lv * J)              # (2.12)
+        alpha_hat, beta_hat = gf * lu / J, gf * uv / (lu * J)      # (2.15)
+        ta = n_f + t1
+        # f_t2 as a combination of unknowns
+        f_t2 = {n_f + t2: 1.0} if t2 >= 0 else {a: 1.0, b: 1.0, ta: -1.0}
+        # flux_a = alpha (f_b - f_a) - beta (f_t2 - f_t1),
+        # flux_t1 = alpha_hat (f_t2 - f_t1) - beta_hat (f_b - f_a)
+        flux_a = {b: alpha, a: -alpha, ta: beta}
+        flux_t1 = {ta: -alpha_hat, b: -beta_hat, a: beta_hat}
+        for col, w in f_t2.items():
+            flux_a[col] = flux_a.get(col, 0.0) - beta * w
+            flux_t1[col] = flux_t1.get(col, 0.0) + alpha_hat * w
+        for col, w in flux_a.items():
+            K[a, col] -= w
+            K[b, col] += w                                         # flux_b = -flux_a
+        for col, w in flux_t1.items():
+            K[ta, col] -= w
+            if t2 >= 0:
+                K[n_f + t2, col] += w                              # flux_t2 = -flux_t1
+    A = np.eye(n) + tau / chi[:, None] * K
+    dirichlet = np.flatnonzero(mesh.boundary_vertices)
+    A[dirichlet] = np.eye(n)[dirichlet]
+    return A
+
+
+@pytest.mark.parametrize("make", [lambda: cylinder(10, 4), lambda: flat_lattice(4, 3),
+                                  lambda: bumpy_sphere(1)])
+def test_compiled_assembly_matches_flux_loop(make):
+    V, F = make()
+    mesh, T, geom = _state(V, F, t_init="barycenter", noise=0.02, seed=4)
+    chi = np.concatenate(covolume_areas(mesh, geom))
+    A = Assembler(mesh).system(geom, chi, 0.05)
+    assert A.has_canonical_format                # sorted, no duplicate entries
+    np.testing.assert_allclose(A.toarray(), _flux_loop_system(mesh, geom, chi, 0.05),
+                               rtol=1e-12, atol=1e-14)
+
+
+def test_flux_coefficients_are_the_compiled_formulas():
+    rng = np.random.default_rng(11)
+    values = rng.uniform(0.1, 2.0, size=(6, 50))
+    values[5] -= 1.0                                       # u.v of either sign
+    geom = type("G", (), dict(zip(("gamma_t", "gamma_f", "J", "len_u", "len_v", "uv"),
+                                  values)))
+    arrays = np.array(flux_coefficients(geom))
+    compiled = np.array([kernels.flux_coefficients_kernel(*column) for column in values.T]).T
+    np.testing.assert_array_equal(arrays, compiled)
+
+
+def test_geometry_of_another_mesh_is_refused():
+    V, F = icosphere(1)
+    mesh, T, geom = _state(V, F)
+    other_mesh, _, other_geom = _state(*icosphere(2))
+    with pytest.raises(ValueError, match="gamma_t"):
+        Assembler(mesh).stiffness(other_geom)
+    with pytest.raises(ValueError, match="chi"):
+        Assembler(mesh).system(geom, np.ones(other_mesh.n_unknowns), 0.1)

@@ -1,12 +1,12 @@
 import numpy as np
 import pytest
 
-from conftest import bumpy_sphere, flat_lattice
+from conftest import bumpy_sphere, cylinder, flat_lattice
 from ddfv.geometry import (covolume_areas, diamond_corners, diamond_geometry,
                            t_barycentric, triangle_areas, vertex_normals)
-from ddfv.surfaces import icosphere
 from ddfv.t_vertices import initial_t_vertices
-from ddfv.topology import diamond_mesh
+from ddfv.topology import DiamondMesh, diamond_mesh
+from mcfbench.surfaces import icosphere
 
 
 def _random_state(seed=1):
@@ -81,3 +81,133 @@ def test_vertex_normals_of_sphere_are_radial():
 def test_triangle_areas_of_lattice():
     V, F = flat_lattice(3, 2)
     np.testing.assert_allclose(triangle_areas(V, F), 0.5)
+
+
+def _random_diamonds(seed, n_f=30, n_t=20, n_d=80, boundary=0.25):
+    """Random corners and random diamonds (a quarter of them boundary diamonds)."""
+    rng = np.random.default_rng(seed)
+    a = rng.integers(n_f, size=n_d)
+    b = (a + 1 + rng.integers(n_f - 1, size=n_d)) % n_f
+    t1 = rng.integers(n_t, size=n_d)
+    t2 = (t1 + 1 + rng.integers(n_t - 1, size=n_d)) % n_t
+    t2[rng.random(n_d) < boundary] = -1
+    mesh = DiamondMesh(n_f=n_f, faces=np.zeros((n_t, 3), dtype=np.int64),
+                       diamonds=np.asfortranarray(np.column_stack([a, b, t1, t2])),
+                       halfedges=np.zeros((n_t, 3), dtype=np.int64))
+    return mesh, rng.normal(size=(n_f, 3)), rng.normal(size=(n_t, 3))
+
+
+def _loop_geometry(mesh, F, T, dual_length):
+    """Each field of DiamondGeometry, the covolumes and the vertex normals,
+    diamond by diamond from the corners (cross products, no Gram matrix)."""
+    norm, cross = np.linalg.norm, np.cross
+    area = lambda p, q, r: 0.5 * norm(cross(q - p, r - p))
+    n_d = len(mesh.diamonds)
+    out = {name: np.zeros(n) for name, n in (("u", (3, n_d)), ("v", (3, n_d)), ("e", (3, n_d)),
+                                             ("quarters", (4, n_d)))}
+    out.update({name: np.zeros(n_d) for name in ("len_u", "len_v", "J", "uv", "gamma_t",
+                                                 "gamma_f")})
+    chi_f, chi_t = np.zeros(mesh.n_f), np.zeros(mesh.n_t)
+    normals = np.zeros((mesh.n_unknowns, 3))
+    for d, (a, b, t1, t2) in enumerate(mesh.diamonds):
+        Fa, Fb, T1 = F[a], F[b], T[t1]
+        T2 = T[t2] if t2 >= 0 else Fa + Fb - T1                   # Section 2.2.5
+        S = (Fa + Fb + T1 + T2) / 4
+        u, v = Fb - Fa, T2 - T1
+        quarters = [area(Fa, T1, S), area(Fa, S, T2) if t2 >= 0 else 0.0,
+                    area(Fb, T1, S), area(Fb, S, T2) if t2 >= 0 else 0.0]
+        broken = dual_length == "broken"
+        for name, value in (("u", u), ("v", v), ("e", (Fa + Fb - T1 - T2) / 4),
+                            ("len_u", norm(u)), ("len_v", norm(v)), ("J", norm(cross(u, v))),
+                            ("uv", u @ v), ("quarters", quarters),
+                            ("gamma_t", norm(T1 - S) + norm(T2 - S) if broken else norm(v)),
+                            ("gamma_f", norm(Fa - S) + norm(Fb - S) if broken else norm(u))):
+            out[name][..., d] = value
+        chi_f[a] += quarters[0] + quarters[1]
+        chi_f[b] += quarters[2] + quarters[3]
+        chi_t[t1] += quarters[0] + quarters[2]
+        rows = [a, b, mesh.n_f + t1] + ([mesh.n_f + t2] if t2 >= 0 else [])
+        for i in rows:
+            normals[i] += cross(u, v)
+        if t2 >= 0:
+            chi_t[t2] += quarters[1] + quarters[3]
+    normals /= norm(normals, axis=1, keepdims=True)
+    return out, chi_f, chi_t, normals.T
+
+
+@pytest.mark.parametrize("dual_length", ["broken", "chord"])
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_compiled_geometry_matches_loop_over_random_diamonds(seed, dual_length):
+    mesh, F, T = _random_diamonds(seed)
+    g = diamond_geometry(mesh, F, T, dual_length)
+    expected, chi_f, chi_t, normals = _loop_geometry(mesh, F, T, dual_length)
+    for name, value in expected.items():
+        got = getattr(g, name)
+        assert got.shape == value.shape, name
+        # Gram-matrix areas of thin triangles lose digits to cancellation (1e-10 absolute)
+        np.testing.assert_allclose(got, value, rtol=1e-10, atol=1e-10, err_msg=name)
+    got_f, got_t = covolume_areas(mesh, g)
+    np.testing.assert_allclose(got_f, chi_f, rtol=1e-10, atol=1e-10)
+    np.testing.assert_allclose(got_t, chi_t, rtol=1e-10, atol=1e-10)
+    np.testing.assert_allclose(vertex_normals(mesh, g), normals, rtol=1e-10, atol=1e-12)
+
+
+def test_compiled_geometry_matches_loop_on_open_mesh():
+    V, F = cylinder(12, 4)
+    mesh = diamond_mesh(F, len(V))
+    rng = np.random.default_rng(5)
+    T = initial_t_vertices(V, mesh, "barycenter") + 0.05 * rng.normal(size=(mesh.n_t, 3))
+    assert mesh.has_boundary
+    g = diamond_geometry(mesh, V, T)
+    expected, chi_f, chi_t, normals = _loop_geometry(mesh, V, T, "broken")
+    for name, value in expected.items():
+        np.testing.assert_allclose(getattr(g, name), value, rtol=1e-10, atol=1e-12, err_msg=name)
+    np.testing.assert_allclose(np.concatenate(covolume_areas(mesh, g)),
+                               np.concatenate([chi_f, chi_t]), rtol=1e-12)
+    np.testing.assert_allclose(vertex_normals(mesh, g), normals, rtol=1e-10, atol=1e-12)
+
+
+def test_results_do_not_depend_on_memory_layout():
+    """Strided views of one (3, n) state, as a flow passes them, give the
+    same bits as contiguous copies."""
+    mesh, F, T = _random_state(3)
+    X = np.ascontiguousarray(np.concatenate([F, T]).T)
+    Fv, Tv = X[:, :mesh.n_f].T, X[:, mesh.n_f:].T
+    assert not Fv.flags.c_contiguous and not Tv.flags.c_contiguous
+    g, gv = diamond_geometry(mesh, F, T), diamond_geometry(mesh, Fv, Tv)
+    for name in g.__dataclass_fields__:
+        np.testing.assert_array_equal(getattr(g, name), getattr(gv, name), err_msg=name)
+    np.testing.assert_array_equal(t_barycentric(F, T, mesh.faces),
+                                  t_barycentric(Fv, Tv, mesh.faces))
+    faces_c = np.ascontiguousarray(mesh.faces, dtype=np.int32)
+    np.testing.assert_array_equal(t_barycentric(F, T, mesh.faces), t_barycentric(F, T, faces_c))
+
+
+def test_t_barycentric_matches_least_squares_projection():
+    rng = np.random.default_rng(7)
+    F = rng.normal(size=(12, 3))
+    faces = np.array([rng.choice(12, 3, replace=False) for _ in range(40)])
+    T = rng.normal(size=(40, 3))
+    lam = t_barycentric(F, T, faces)
+    for t, f in enumerate(faces):
+        p = F[f]
+        l12 = np.linalg.lstsq(np.column_stack([p[1] - p[0], p[2] - p[0]]), T[t] - p[0],
+                              rcond=None)[0]
+        np.testing.assert_allclose(lam[t], [1 - l12.sum(), *l12], rtol=1e-9, atol=1e-12)
+
+
+def test_out_of_range_indices_raise_instead_of_reading_memory():
+    mesh, F, T = _random_diamonds(0)
+    for column, index in ((0, mesh.n_f), (1, -1), (2, mesh.n_t), (3, -2), (3, mesh.n_t)):
+        bad = mesh.diamonds.copy()
+        bad[5, column] = index                     # only t2 may be -1
+        bad_mesh = DiamondMesh(n_f=mesh.n_f, faces=mesh.faces, diamonds=bad,
+                               halfedges=mesh.halfedges)
+        with pytest.raises(IndexError):
+            diamond_geometry(bad_mesh, F, T)
+    with pytest.raises(IndexError):
+        t_barycentric(F, T[:2], np.array([[0, 1, 2], [0, 1, len(F)]]))
+    with pytest.raises(IndexError):
+        t_barycentric(F, T[:2], np.array([[0, 1, 2], [0, -1, 2]]))
+    with pytest.raises(ValueError, match="T must have shape"):
+        diamond_geometry(mesh, F, T[:-1])

@@ -1,0 +1,310 @@
+"""Compiled (numba) kernels of the per-step hot path.
+
+One loop over the diamonds (or triangles, or CSR rows) per kernel; the
+formulas are those of :mod:`ddfv.geometry` and :mod:`ddfv.assembly`, whose
+public functions call these kernels and document the results. This is the
+only module of ``ddfv`` that imports numba; :mod:`ddfv.geometry` and
+:mod:`ddfv.assembly` import it on first use, so ``import ddfv`` does not
+pay for it.
+
+Conventions
+-----------
+- Every kernel has one explicit signature whose arrays have layout ``A``
+  (any strides), so views of the flow state (``Flow.F`` is a strided
+  ``(n_f, 3)`` view) need no copy and no second compilation.
+- Index arrays are unsigned views of the topology's int64 arrays
+  (``uint64``) or ``uint32`` CSR slots: no negative-index wraparound code.
+  The missing ``t2 = -1`` of a boundary diamond is :data:`NO_T`
+  (``2**64 - 1``). Every gathered index is checked against its array
+  (``IndexError``); the check is one predictable compare per index.
+- ``error_model="numpy"``: a division by zero gives inf/nan as in numpy.
+- ``cache=True``: compiled once into numba's cache (``NUMBA_CACHE_DIR``, by
+  default ``__pycache__`` next to this file) and loaded from it afterwards.
+"""
+
+import numba
+import numpy as np
+
+#: ``t2`` of a boundary diamond (the int64 ``-1`` seen as uint64)
+NO_T = np.uint64(2**64 - 1)
+
+_OPTIONS = dict(cache=True, nogil=True, error_model="numpy", boundscheck=False)
+
+#: rows of the buffer filled by :func:`diamond_geometry_kernel`
+ROW_U, ROW_V, ROW_E = 0, 3, 6
+ROW_LEN_U, ROW_LEN_V, ROW_J, ROW_UV, ROW_GAMMA_T, ROW_GAMMA_F = 9, 10, 11, 12, 13, 14
+ROW_QUARTERS = 15
+GEOMETRY_ROWS = 19
+
+#: columns of the per-diamond CSR slot table of :func:`system_kernel`:
+#: entry (row, column) of K, ``a, b`` F-rows/columns, ``t1, t2`` T-rows/columns
+(SLOT_AB, SLOT_BA, SLOT_AA, SLOT_BB, SLOT_A_T1, SLOT_B_T1, SLOT_A_T2, SLOT_B_T2,
+ SLOT_T1_A, SLOT_T1_B, SLOT_T2_A, SLOT_T2_B, SLOT_T1_T2, SLOT_T2_T1, SLOT_T1_T1,
+ SLOT_T2_T2) = range(16)
+N_SLOTS = 16
+
+
+def padded_length(n):
+    """Row length ``>= n`` for buffers of many rows of ``n`` float64.
+
+    The byte stride of the rows is 192 modulo 4096, so any two of up to 21
+    rows written together by one loop start at least 192 bytes apart modulo
+    4 KiB. Rows whose stride is a multiple of 4 KiB alias in the store
+    buffer ("4K aliasing"): at level 5, ``n_d = 30720 = 60 * 512``, that
+    made :func:`diamond_geometry_kernel` about 3 times slower.
+    """
+    return n + (24 - n) % 512
+
+
+@numba.njit("void(float64[:, :], float64[:, :], uint64[:, :], boolean, float64[:, ::1])",
+            **_OPTIONS)
+def diamond_geometry_kernel(F, T, diamonds, broken, out):
+    """Per-diamond geometry in one pass, see :func:`ddfv.geometry.diamond_geometry`.
+
+    Parameters
+    ----------
+    F : (n_f, 3) float64 array
+    T : (n_t, 3) float64 array
+    diamonds : (4, n_d) uint64 array
+        Rows ``a, b, t1, t2``; ``t2 = NO_T`` on boundary diamonds.
+    broken : bool
+        Write ``|gamma^T|``, ``|gamma^F|`` as broken lines (2.5), (2.15);
+        otherwise the rows ``ROW_GAMMA_T``, ``ROW_GAMMA_F`` are left alone
+        (the chord is ``|v|``, ``|u|``).
+    out : (GEOMETRY_ROWS, >= n_d) float64 array
+        Rows ``u`` (3), ``v`` (3), ``e`` (3), ``|u|``, ``|v|``, ``J``,
+        ``u.v``, ``|gamma^T|``, ``|gamma^F|``, the four quarters.
+    """
+    # uint64 sizes: a comparison of uint64 with int64 would go through float64
+    n_f, n_t = np.uint64(F.shape[0]), np.uint64(T.shape[0])
+    for d in range(diamonds.shape[1]):
+        a, b, t1, t2 = diamonds[0, d], diamonds[1, d], diamonds[2, d], diamonds[3, d]
+        inner = t2 != NO_T
+        if a >= n_f or b >= n_f or t1 >= n_t or (inner and t2 >= n_t):
+            raise IndexError("diamond index out of range")
+        uu = vv = ee = uv = ue = ve = 0.0
+        for k in range(3):
+            fa, fb, p = F[a, k], F[b, k], T[t1, k]
+            # T_t2 = F_a + F_b - T_t1 on a boundary diamond (Section 2.2.5)
+            q = T[t2, k] if inner else (fa + fb) - p
+            u, v = fb - fa, q - p                          # diagonals (2.3)
+            e = (((fa + fb) - p) - q) * 0.25               # F_a - S = e - u/2 etc.
+            out[ROW_U + k, d] = u
+            out[ROW_V + k, d] = v
+            out[ROW_E + k, d] = e
+            uu += u * u
+            vv += v * v
+            ee += e * e
+            uv += u * v
+            ue += u * e
+            ve += v * e
+        # squared lengths of F_a - S, F_b - S, T_t1 - S, T_t2 - S
+        base_f, base_t = 0.25 * uu + ee, 0.25 * vv + ee
+        ra2, rb2, p2, q2 = base_f - ue, base_f + ue, base_t + ve, base_t - ve
+        # (F_a - S).(T_t1 - S) etc. for the four quarter triangles at S (Section 2.2.4)
+        c_minus, c_plus = 0.25 * uv - ee, 0.25 * uv + ee
+        d_minus, d_plus = 0.5 * (ue - ve), 0.5 * (ue + ve)
+        ra_p, rb_q = c_minus + d_minus, c_minus - d_minus
+        ra_q, rb_p = d_plus - c_plus, d_plus + c_plus      # rb_p up to its sign
+        # area = |x| |y| sin / 2 = sqrt(|x|^2 |y|^2 - (x.y)^2) / 2
+        out[ROW_QUARTERS, d] = 0.5 * np.sqrt(max(ra2 * p2 - ra_p * ra_p, 0.0))
+        out[ROW_QUARTERS + 2, d] = 0.5 * np.sqrt(max(rb2 * p2 - rb_p * rb_p, 0.0))
+        if inner:
+            out[ROW_QUARTERS + 1, d] = 0.5 * np.sqrt(max(ra2 * q2 - ra_q * ra_q, 0.0))
+            out[ROW_QUARTERS + 3, d] = 0.5 * np.sqrt(max(rb2 * q2 - rb_q * rb_q, 0.0))
+        else:  # only the two triangles on the side of T_t1
+            out[ROW_QUARTERS + 1, d] = 0.0
+            out[ROW_QUARTERS + 3, d] = 0.0
+        out[ROW_LEN_U, d] = np.sqrt(uu)
+        out[ROW_LEN_V, d] = np.sqrt(vv)                    # d^T (2.8)
+        out[ROW_J, d] = np.sqrt(max(0.0, uu * vv - uv * uv))   # |u x v| = 2 chi(V^D) (2.8)
+        out[ROW_UV, d] = uv
+        if broken:
+            out[ROW_GAMMA_T, d] = np.sqrt(p2) + np.sqrt(q2)    # (2.5)
+            out[ROW_GAMMA_F, d] = np.sqrt(ra2) + np.sqrt(rb2)  # (2.15), Section 2.2.5
+
+
+@numba.njit("void(uint64[:, :], float64[:, :], float64[::1], float64[::1])", **_OPTIONS)
+def covolume_kernel(diamonds, quarters, chi_f, chi_t):
+    """Scatter the quarters of each diamond into ``chi(V^F)``, ``chi(V^T)`` (Section 2.2.4).
+
+    Parameters
+    ----------
+    diamonds : (4, n_d) uint64 array
+    quarters : (4, n_d) float64 array
+        Areas of ``(F_a, T_t1, S)``, ``(F_a, S, T_t2)``, ``(F_b, T_t1, S)``,
+        ``(F_b, S, T_t2)``.
+    chi_f : (n_f,) float64 array, output
+    chi_t : (n_t,) float64 array, output
+    """
+    n_f, n_t = np.uint64(chi_f.shape[0]), np.uint64(chi_t.shape[0])
+    chi_f[:] = 0.0
+    chi_t[:] = 0.0
+    for d in range(diamonds.shape[1]):
+        a, b, t1, t2 = diamonds[0, d], diamonds[1, d], diamonds[2, d], diamonds[3, d]
+        inner = t2 != NO_T
+        if a >= n_f or b >= n_f or t1 >= n_t or (inner and t2 >= n_t):
+            raise IndexError("diamond index out of range")
+        q_a1, q_a2, q_b1, q_b2 = quarters[0, d], quarters[1, d], quarters[2, d], quarters[3, d]
+        chi_f[a] += q_a1 + q_a2
+        chi_f[b] += q_b1 + q_b2
+        chi_t[t1] += q_a1 + q_b1
+        if inner:
+            chi_t[t2] += q_a2 + q_b2
+
+
+@numba.njit("void(uint64[:, :], float64[:, :], float64[:, :], int64, float64[:, ::1])",
+            **_OPTIONS)
+def vertex_normals_kernel(diamonds, u, v, n_f, out):
+    """Unit normals at F- and T-vertices: normalised sums of ``u x v`` (3.6).
+
+    Parameters
+    ----------
+    diamonds : (4, n_d) uint64 array
+    u, v : (3, n_d) float64 arrays
+    n_f : int
+    out : (3, n_f + n_t) float64 array, output
+    """
+    n_t = np.uint64(out.shape[1] - n_f)
+    nf = np.uint64(n_f)    # uint64 + int64 would be float64 in numba
+    out[:, :] = 0.0
+    for d in range(diamonds.shape[1]):
+        a, b, t1, t2 = diamonds[0, d], diamonds[1, d], diamonds[2, d], diamonds[3, d]
+        inner = t2 != NO_T
+        if a >= nf or b >= nf or t1 >= n_t or (inner and t2 >= n_t):
+            raise IndexError("diamond index out of range")
+        # u x v = 2 chi(V^D) N^D
+        c0 = u[1, d] * v[2, d] - u[2, d] * v[1, d]
+        c1 = u[2, d] * v[0, d] - u[0, d] * v[2, d]
+        c2 = u[0, d] * v[1, d] - u[1, d] * v[0, d]
+        for k in range(3):
+            i = a if k == 0 else (b if k == 1 else nf + t1)
+            out[0, i] += c0
+            out[1, i] += c1
+            out[2, i] += c2
+        if inner:
+            out[0, nf + t2] += c0
+            out[1, nf + t2] += c1
+            out[2, nf + t2] += c2
+    for i in range(out.shape[1]):
+        norm = np.sqrt(out[0, i] * out[0, i] + out[1, i] * out[1, i] + out[2, i] * out[2, i])
+        out[0, i] /= norm
+        out[1, i] /= norm
+        out[2, i] /= norm
+
+
+@numba.njit("UniTuple(float64, 4)(float64, float64, float64, float64, float64, float64)",
+            **_OPTIONS, inline="always")
+def flux_coefficients_kernel(gamma_t, gamma_f, J, len_u, len_v, uv):
+    """``alpha, beta, alpha_hat, beta_hat`` of one diamond (2.12), (2.15).
+
+    The Python function (``.py_func``) also evaluates arrays elementwise:
+    :func:`ddfv.assembly.flux_coefficients` uses it, so the formulas exist
+    once.
+    """
+    gt_J = gamma_t / J
+    gf_J = gamma_f / J
+    return (gt_J * len_v,              # alpha = q^F / 2              (2.12)
+            gt_J * uv / len_v,         # beta = |g^T|/d^T cot(omega)  (2.12)
+            gf_J * len_u,              # alpha_hat = q_hat^T / 2      (2.15)
+            gf_J * uv / len_u)         # beta_hat = q_hat^F           (2.15)
+
+
+@numba.njit("void(boolean[::1], float64[:], float64[:], float64[:], float64[:], float64[:], "
+            "float64[:], uint32[:, ::1], uint32[::1], uint32[::1], float64[::1], float64, "
+            "float64[::1])", **_OPTIONS)
+def system_kernel(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, indptr, diag,
+                  scale, shift, data):
+    """Values of ``diag(scale) K + shift I`` in a fixed CSR pattern (2.10)-(2.15).
+
+    Each diamond scatters its entries of ``K`` (minus its fluxes, see
+    :mod:`ddfv.assembly`) into their CSR slots; one pass over the rows then
+    scales them and adds ``shift`` on the diagonal. The slots, ``indptr``
+    and ``diag`` come from :class:`ddfv.assembly.Assembler` (positions in
+    its CSR pattern, all below ``nnz`` by construction) and are not checked
+    here.
+
+    Parameters
+    ----------
+    inner : (n_d,) bool array
+        False on boundary diamonds (``t2 = -1``).
+    gamma_t, gamma_f, J, len_u, len_v, uv : (n_d,) float64 arrays
+        The geometric factors of :class:`ddfv.geometry.DiamondGeometry`.
+    slots : (n_d, N_SLOTS) uint32 array
+        CSR position of each entry of the diamond (``SLOT_*``); the ``t2``
+        slots of boundary diamonds are unused.
+    indptr : (n + 1,) uint32 array
+    diag : (n,) uint32 array
+        CSR position of the diagonal entry of each row.
+    scale : (n,) float64 array
+    shift : float
+    data : (nnz,) float64 array, output
+    """
+    data[:] = 0.0
+    for d in range(inner.shape[0]):
+        alpha, beta, alpha_hat, beta_hat = flux_coefficients_kernel(
+            gamma_t[d], gamma_f[d], J[d], len_u[d], len_v[d], uv[d])
+        s = slots[d]
+        # F-rows: flux_a = alpha (f_b - f_a) - beta (f_t2 - f_t1) = -flux_b
+        data[s[SLOT_AB]] = -alpha
+        data[s[SLOT_BA]] = -alpha
+        data[s[SLOT_AA]] += alpha
+        data[s[SLOT_BB]] += alpha
+        data[s[SLOT_A_T1]] -= beta
+        data[s[SLOT_B_T1]] += beta
+        if inner[d]:
+            data[s[SLOT_A_T2]] += beta
+            data[s[SLOT_B_T2]] -= beta
+            # T-rows: flux_t1 = alpha_hat (f_t2 - f_t1) - beta_hat (f_b - f_a) = -flux_t2
+            data[s[SLOT_T1_A]] -= beta_hat
+            data[s[SLOT_T1_B]] += beta_hat
+            data[s[SLOT_T2_A]] += beta_hat
+            data[s[SLOT_T2_B]] -= beta_hat
+            data[s[SLOT_T1_T2]] = -alpha_hat
+            data[s[SLOT_T2_T1]] = -alpha_hat
+            data[s[SLOT_T1_T1]] += alpha_hat
+            data[s[SLOT_T2_T2]] += alpha_hat
+        else:
+            # f_t2 = f_a + f_b - f_t1 in the T-equation (Section 2.2.5)
+            data[s[SLOT_T1_A]] -= beta_hat + alpha_hat
+            data[s[SLOT_T1_B]] += beta_hat - alpha_hat
+            data[s[SLOT_T1_T1]] += 2.0 * alpha_hat
+    for i in range(diag.shape[0]):
+        s_i = scale[i]
+        for j in range(indptr[i], indptr[i + 1]):
+            data[j] *= s_i
+        data[diag[i]] += shift
+
+
+@numba.njit("void(float64[:, :], float64[:, :], uint64[:, :], float64[:, ::1])", **_OPTIONS)
+def t_barycentric_kernel(F, T, faces, out):
+    """Barycentric coordinates of the projection of ``T_i`` into triangle ``i``.
+
+    Parameters
+    ----------
+    F : (n_f, 3) float64 array
+    T : (n_t, 3) float64 array
+    faces : (n_t, 3) uint64 array
+    out : (n_t, 3) float64 array, output
+    """
+    n_f = np.uint64(F.shape[0])
+    for t in range(faces.shape[0]):
+        i0, i1, i2 = faces[t, 0], faces[t, 1], faces[t, 2]
+        if i0 >= n_f or i1 >= n_f or i2 >= n_f:
+            raise IndexError("face index out of range")
+        g11 = g12 = g22 = r1 = r2 = 0.0
+        for k in range(3):
+            p0 = F[i0, k]
+            e1, e2, dk = F[i1, k] - p0, F[i2, k] - p0, T[t, k] - p0
+            g11 += e1 * e1
+            g12 += e1 * e2
+            g22 += e2 * e2
+            r1 += e1 * dk
+            r2 += e2 * dk
+        # normal equations of the projection onto the plane of the triangle
+        det = g11 * g22 - g12 * g12
+        l1 = (g22 * r1 - g12 * r2) / det
+        l2 = (g11 * r2 - g12 * r1) / det
+        out[t, 0] = 1.0 - l1 - l2
+        out[t, 1] = l1
+        out[t, 2] = l2
