@@ -1,54 +1,341 @@
+"""The shared linear solver (mcfbench.solver): methods, failures, invariances.
+
+The oracle is a literal copy of the former numpy BiCGStab (ddfv/solver.py at
+6cc720c): the compiled kernel must reproduce its iteration counts and its
+iterates up to round-off.
+"""
+
 import numpy as np
+import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ddfv.solver import bicgstab
+from mcfbench.solver import (METHODS, SolveInfo, Solver, SolverFailure, apply_block,
+                             solve)
+
+pytestmark = pytest.mark.filterwarnings("error")   # no arithmetic warning may escape
 
 
-def _system(n=300, seed=0):
-    rng = np.random.default_rng(seed)
+def oracle_bicgstab(A, b, x0, rtol, maxiter):
+    """The former ddfv.solver.bicgstab (stopping test |r| <= rtol |b|)."""
+    dot = lambda x, y: float(np.vdot(x, y))          # noqa: E731
+    norm = lambda x: float(np.sqrt(np.vdot(x, x)))   # noqa: E731
+    bnorm = norm(b)
+    tol = rtol * bnorm
+    x = np.array(x0, dtype=float, copy=True)
+    r = b - np.stack([A @ xi for xi in x])
+    if norm(r) <= tol:
+        return x, 0
+    r_hat, p = r.copy(), r.copy()
+    rho = dot(r_hat, r)
+    for it in range(1, maxiter + 1):
+        v = np.stack([A @ pi for pi in p])
+        alpha = rho / dot(r_hat, v)
+        s = r - v * alpha
+        x += p * alpha
+        if norm(s) <= tol:
+            return x, it
+        t = np.stack([A @ si for si in s])
+        omega = dot(t, s) / dot(t, t)
+        x += s * omega
+        r = s - t * omega
+        if norm(r) <= tol:
+            return x, it
+        rho_new = dot(r_hat, r)
+        beta = (rho_new / rho) * (alpha / omega)
+        rho = rho_new
+        p = (p - v * omega) * beta + r
+    return x, maxiter
+
+
+def nonsymmetric(n=300, seed=0):
     A = sp.random(n, n, density=0.02, random_state=seed) * 0.3
-    A = (sp.eye(n) * 3 + A - A.T * 0.5).tocsr()   # nonsymmetric, diagonally dominant
-    return A, rng.normal(size=(3, n))
+    A = (sp.eye(n) * 3 + A - A.T * 0.5).tocsr()          # diagonally dominant
+    return A, np.random.default_rng(seed).normal(size=(3, n))
 
 
-def test_bicgstab_solves_a_block_of_right_hand_sides():
-    A, b = _system()
-    x, info = bicgstab(A, b, np.zeros_like(b), rtol=1e-12)
-    assert info.converged and info.iterations > 0
+def spd(n=200, seed=1):
+    B = sp.random(n, n, density=0.03, random_state=seed)
+    A = (B @ B.T + sp.eye(n)).tocsr()
+    return A, np.random.default_rng(seed).normal(size=(3, n))
+
+
+def ring_system(n=400, tau=0.3, seed=2):
+    """Like a DDFV/cotangent step: ``I + tau diag(1/m) L`` (row sums one,
+    nonsymmetric) on a ring with chords, ``b`` smooth positions off the origin."""
+    rng = np.random.default_rng(seed)
+    i = np.arange(n)
+    rows = np.r_[i, i, i]
+    cols = np.r_[(i + 1) % n, (i + 7) % n, (i + 31) % n]
+    W = sp.coo_matrix((rng.uniform(0.5, 2.0, rows.size), (rows, cols)), shape=(n, n))
+    W = (W + W.T).tocsr()
+    L = sp.diags(np.asarray(W.sum(axis=1)).ravel()) - W
+    m = rng.uniform(0.5, 2.0, n)
+    A = (sp.eye(n) + tau * sp.diags(1.0 / m) @ L).tocsr()
+    theta = 2 * np.pi * i / n
+    b = np.stack([np.cos(theta), np.sin(theta), 0.3 * np.sin(3 * theta)]) + 0.01 * rng.normal(
+        size=(3, n))
+    return A, b
+
+
+def residual(A, b, x):
+    return np.linalg.norm(b - np.stack([A @ xi for xi in x]))
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("system", [spd, nonsymmetric])
+def test_methods_solve_against_spsolve(method, system):
+    A, b = system()
+    x, info = Solver(method, rtol=1e-12)(A, b, np.zeros_like(b))
     exact = spla.spsolve(A.tocsc(), b.T).T
-    assert np.abs(x - exact).max() < 1e-10
-    assert np.linalg.norm(b - np.stack([A @ xi for xi in x])) <= 1e-12 * np.linalg.norm(b) * 1.01
+    assert info.converged and info.status == "converged" and info.method == method
+    assert info.detail == ""
+    assert np.abs(x - exact).max() < 1e-9 * np.abs(exact).max()
     assert info.residual <= 1e-12
+    assert residual(A, b, x) <= 1.01e-12 * np.linalg.norm(b)   # c = 0 here: |b - A c| = |b|
+    if method == "direct":
+        assert info.iterations == 0
+    elif method == "ilu-bicgstab":
+        assert 1 <= info.iterations <= 5
+    else:
+        assert 5 <= info.iterations <= 60
 
 
-def test_exact_initial_guess_needs_no_iteration():
-    A, b = _system()
+@pytest.mark.parametrize("method", METHODS)
+def test_shared_and_coupled_matrices_agree(method):
+    """(n, n) shared by the rows == block-diagonal (3n, 3n) on b.ravel()."""
+    A, b = ring_system(tau=1.0)
+    x0 = b + 0.01
+    xs, infos = Solver(method, rtol=1e-11)(A, b, x0)
+    xc, infoc = Solver(method, rtol=1e-11)(sp.block_diag([A, A, A], format="csr"), b, x0)
+    assert xc.shape == b.shape
+    assert np.abs(xs - xc).max() < 1e-10 * np.abs(xs).max()
+    assert infos.converged and infoc.converged
+    if method != "ilu-bicgstab":     # spilu orders the (3n, 3n) matrix differently
+        assert infos.iterations == infoc.iterations
+        assert infos.residual == pytest.approx(infoc.residual, rel=1e-3)
+
+
+def test_coupled_matrix_acts_on_the_raveled_block():
+    rng = np.random.default_rng(3)
+    n = 50
+    A = (sp.random(3 * n, 3 * n, density=0.05, random_state=3) + 4 * sp.eye(3 * n)).tocsr()
+    b = rng.normal(size=(3, n))
+    x, info = Solver(rtol=1e-12)(A, b, np.zeros_like(b))
+    assert np.abs(A @ x.ravel() - b.ravel()).max() < 1e-10
+    assert np.array_equal(apply_block(A, x).ravel(), A @ x.ravel())
+
+
+def test_block_product_is_bitwise_scipy():
+    A, b = ring_system()
+    assert np.array_equal(apply_block(A, b), np.stack([A @ row for row in b]))
+    out = np.empty_like(b)
+    assert apply_block(A, b, out=out) is out
+
+
+@pytest.mark.parametrize("rtol", [1e-6, 1e-9, 1e-12])
+@pytest.mark.parametrize("system", [ring_system, nonsymmetric])
+def test_bicgstab_reproduces_the_former_iterations(system, rtol):
+    """Same iteration count (half-step exits included) and iterates as the numpy
+    oracle; b is centred so that |b - A c| = |b| up to round-off."""
+    A, b = system()
+    b = b - b.mean(axis=1, keepdims=True)
+    x0 = b + 1e-3 * np.sin(np.arange(b.size)).reshape(b.shape)
+    x0 -= x0.mean(axis=1, keepdims=True)
+    x_ref, it_ref = oracle_bicgstab(A, b, x0, rtol, 1000)
+    x, info = Solver(rtol=rtol)(A, b, x0)
+    assert info.iterations == it_ref > 0
+    assert np.abs(x - x_ref).max() <= 1e-10 * np.abs(x_ref).max()
+
+
+def test_iteration_count_conventions():
+    A, b = nonsymmetric()
     exact = spla.spsolve(A.tocsc(), b.T).T
-    x, info = bicgstab(A, b, exact, rtol=1e-8)
-    assert info.iterations == 0 and info.converged
+    assert Solver()(A, b, exact)[1].iterations == 0              # converged at x0
+    # a half-step exit counts one: the oracle's count matches at every tolerance
+    for rtol in np.logspace(-2, -12, 11):
+        assert Solver(rtol=rtol)(A, b, np.zeros_like(b))[1].iterations == \
+            oracle_bicgstab(A, b, np.zeros_like(b), rtol, 1000)[1]
 
 
-def test_non_convergence_is_reported():
-    A, b = _system()
-    x, info = bicgstab(A, b, np.zeros_like(b), rtol=1e-14, maxiter=1)
-    assert not info.converged
-    assert info.iterations == 1 and info.residual > 1e-14
+def test_translation_invariance():
+    """Row sums one: shifting b and x0 by a constant shifts the solution and
+    leaves iterations and relative residual unchanged (|b - A c| is shift-free)."""
+    A, b = ring_system()
+    x0 = b.copy()
+    x, info = Solver(rtol=1e-10)(A, b, x0)
+    shift = np.array([[1e3], [-250.0], [40.0]])
+    xs, infos = Solver(rtol=1e-10)(A, b + shift, x0 + shift)
+    assert infos.iterations == info.iterations > 0
+    assert infos.residual == pytest.approx(info.residual, rel=1e-3)
+    assert np.abs(xs - shift - x).max() < 1e-9
 
 
-def test_iteration_count_is_not_undercounted():
-    """Each iteration costs at most two products: count them."""
-    A, b = _system()
-    products = []
+@pytest.mark.parametrize("scale", [1e-6, 7.0, 1e8])
+def test_scale_invariance(scale):
+    A, b = ring_system()
+    x0 = b.copy()
+    x, info = Solver(rtol=1e-10)(A, b, x0)
+    xs, infos = Solver(rtol=1e-10)(A, scale * b, scale * x0)
+    assert infos.iterations == info.iterations > 0
+    assert infos.residual == pytest.approx(info.residual, rel=1e-6)
+    assert np.abs(xs / scale - x).max() < 1e-12
 
-    class Counting:
-        def __matmul__(self, x):
-            products.append(1)
-            return A @ x
 
-    x, info = bicgstab(Counting(), b, np.zeros_like(b), rtol=1e-10)
-    assert info.converged
-    # per block (3 vector products): one for the initial residual, then one
-    # (half-step exit) or two per iteration
-    blocks = len(products) / 3
-    assert 2 * info.iterations - 1 <= blocks - 1 <= 2 * info.iterations
+def test_constant_right_hand_side_is_solved_at_once():
+    """b = A c exactly (c the mean of x0): c is the solution, nothing to iterate."""
+    A, _ = ring_system()
+    b = np.ones((3, A.shape[0])) * np.array([[1.0], [2.0], [3.0]])
+    x, info = Solver()(A, b, b.copy())
+    assert info.iterations == 0 and info.residual == 0.0
+    assert np.array_equal(x, b)
+
+
+def test_breakdown_r_hat_v():
+    """A rotation: v = A r0 is orthogonal to r_hat = r0 at the first iteration."""
+    R = sp.csr_matrix(np.array([[0.0, 1.0], [-1.0, 0.0]]))
+    with pytest.raises(SolverFailure) as err:
+        Solver()(R, np.array([[1.0, 0.0], [0.0, 2.0], [3.0, 0.0]]), None)
+    assert err.value.status == "solver_breakdown"
+    assert err.value.info.status == "breakdown" and not err.value.info.converged
+    assert err.value.info.iterations == 1
+    assert "(r_hat, v) = 0" in str(err.value) and "bicgstab" in str(err.value)
+
+
+def test_breakdown_rho():
+    """r_1 is orthogonal to r_hat = r_0 (exactly, in floating point)."""
+    A = sp.csr_matrix(np.array([[1.0, 1, 1], [1, 2, 0], [-1, 0, 3]]))
+    x, info = solve(A, np.array([[1.0, 0, 0]]), None)
+    assert info.status == "breakdown" and info.iterations == 1
+    assert "rho" in info.detail
+    assert info.residual == pytest.approx(np.sqrt(13) / 13)    # |r_1| = |(0, -3, -2)| / 13
+    with pytest.raises(SolverFailure, match="rho = "):
+        Solver()(A, np.array([[1.0, 0, 0]]), None)
+
+
+def test_breakdown_omega():
+    """(t, s) = 0 with t != 0: omega = 0."""
+    A = sp.csr_matrix(np.array([[1.0, -1, 0], [1, 1, -1], [2, 0, 1]]))
+    with pytest.raises(SolverFailure, match=r"omega = 0") as err:
+        Solver()(A, np.array([[1.0, 1, 0]]), None)
+    assert err.value.status == "solver_breakdown"
+
+
+def test_iteration_limit():
+    A, b = nonsymmetric()
+    with pytest.raises(SolverFailure) as err:
+        Solver(maxiter=1)(A, b, np.zeros_like(b))
+    assert err.value.status == "solver_failed"
+    assert err.value.info.status == "max_iterations" and err.value.info.iterations == 1
+    message = str(err.value)
+    assert "iteration limit 1 reached" in message and "rtol 1.0e-09" in message
+    assert "after 1 iterations" in message and "\n" not in message
+    assert 1e-3 < err.value.info.residual < 1   # one iteration reduces, does not converge
+    # without raising, the last iterate comes back
+    x, info = solve(A, b, np.zeros_like(b), maxiter=1)
+    assert not info.converged and residual(A, b, x) < np.linalg.norm(b)
+
+
+def test_stagnation_below_round_off():
+    """rtol = 1e-18 is below what double precision can attain (~1e-16)."""
+    A, b = nonsymmetric()
+    with pytest.raises(SolverFailure) as err:
+        Solver(rtol=1e-18)(A, b, np.zeros_like(b))
+    info = err.value.info
+    assert err.value.status == "solver_stagnated" and info.status == "stagnated"
+    assert 1e-17 < info.residual < 1e-14
+    assert info.iterations < 40          # detected, not run to maxiter
+    assert "stagnation" in str(err.value)
+
+
+def test_tight_but_attainable_tolerance_converges():
+    A, b = nonsymmetric()
+    x, info = Solver(rtol=1e-15)(A, b, np.zeros_like(b))
+    assert residual(A, b, x) <= 1e-15 * np.linalg.norm(b)   # the true residual
+
+
+@pytest.mark.parametrize("where", ["b", "x0", "A"])
+@pytest.mark.parametrize("method", METHODS)
+def test_non_finite_input_fails_clearly(where, method):
+    A, b = ring_system(n=50)
+    x0 = b.copy()
+    if where == "b":
+        b[1, 3] = np.nan
+    elif where == "x0":
+        x0[2, 7] = np.inf
+    else:
+        A = A.copy()
+        A.data[5] = np.nan
+    with pytest.raises(SolverFailure) as err:
+        Solver(method)(A, b, x0)
+    assert err.value.status == "solver_breakdown"
+    assert f"NaN/inf in {'the matrix A' if where == 'A' else where}" in str(err.value)
+
+
+def test_direct_singular_matrix_fails_clearly():
+    S = sp.csr_matrix(np.array([[1.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 0.0, 2.0]]))
+    with pytest.raises(SolverFailure) as err:
+        Solver("direct")(S, np.array([[1.0, 2.0, 3.0]]), None)
+    assert err.value.status == "solver_breakdown"
+    assert "singular" in str(err.value) and str(err.value).startswith("direct")
+    with pytest.raises(SolverFailure, match="singular"):
+        Solver("ilu-bicgstab")(S, np.array([[1.0, 2.0, 3.0]]), None)
+
+
+def test_direct_ill_conditioned_matrix_fails_clearly():
+    """Hilbert matrix of order 14 (condition ~1e17): LU plus refinement
+    cannot reach 1e-9."""
+    i = np.arange(14)
+    H = sp.csr_matrix(1.0 / (i[:, None] + i[None, :] + 1))
+    with pytest.raises(SolverFailure) as err:
+        Solver("direct")(H, np.ones((1, 14)), None)
+    assert err.value.status == "solver_stagnated"
+    assert "ill-conditioned" in str(err.value)
+    assert 1e-9 < err.value.info.residual < 1e-3 and err.value.info.iterations == 0
+
+
+def test_krylov_methods_report_a_singular_system():
+    """A s = 0 along the way, or no convergence: never an exception or a NaN."""
+    S = sp.csr_matrix(np.array([[1.0, 1.0], [1.0, 1.0]]))
+    for method in ("bicgstab", "jacobi-bicgstab"):
+        x, info = solve(S, np.array([[1.0, 2.0]]), None, method=method)
+        assert not info.converged and info.status == "breakdown"
+        assert np.isfinite(x).all()
+
+
+def test_preconditioners_help_on_an_ill_conditioned_system():
+    """Rows scaled over six decades (tiny covolumes) and a large tau: plain
+    BiCGStab does not converge in 1000 iterations, the preconditioned ones do."""
+    A, b = ring_system(tau=1e4)
+    A = (sp.diags(np.geomspace(1e-3, 1e3, A.shape[0])) @ A).tocsr()
+    b = np.stack([A @ row for row in b])
+    its = {m: solve(A, b, np.zeros_like(b), method=m, rtol=1e-9)[1] for m in METHODS}
+    assert its["bicgstab"].status == "max_iterations"
+    assert its["jacobi-bicgstab"].converged and its["jacobi-bicgstab"].iterations < 100
+    assert its["ilu-bicgstab"].converged and its["ilu-bicgstab"].iterations < 30
+    assert its["direct"].converged and its["direct"].residual < 1e-12
+
+
+@pytest.mark.parametrize("field, value", [("method", "cg"), ("rtol", 0.0), ("rtol", 1.5),
+                                          ("maxiter", 0), ("maxiter", 2.5),
+                                          ("stagnation_window", 0), ("ilu_drop_tol", -1.0),
+                                          ("ilu_fill_factor", 0.5)])
+def test_solver_validates_its_fields(field, value):
+    with pytest.raises(ValueError, match=field.replace("_", ".") if field != "method"
+                       else "method"):
+        Solver(**{field: value})
+
+
+def test_shapes_are_checked():
+    A, b = ring_system(n=20)
+    with pytest.raises(ValueError, match="shape"):
+        Solver()(A, b[:, :10], None)
+    with pytest.raises(ValueError, match="x0"):
+        Solver()(A, b, b[:2])
+
+
+def test_solve_info_api():
+    info = SolveInfo(3, 1e-10, True, "converged", "bicgstab")
+    assert info.detail == ""
+    with pytest.raises(AttributeError):
+        info.iterations = 4
