@@ -238,16 +238,17 @@ class Flow:
             if not np.isfinite(self._X).all():
                 return [("degenerated", "non-finite coordinates")]
             J = self.geometry.J
-            what = collapsed_cells(J, max(1e-10 * J.mean(), 1e-12 * self._J0), "diamond cell")
-            if what:
-                return [("degenerated", what)]
+            threshold = max(1e-10 * J.mean(), 1e-12 * self._J0)
+            if not J.min() > threshold:
+                return [("degenerated", collapsed_cells(J, threshold, "diamond cell"))]
             bary = self.barycentric
-            worst = int(np.argmin(bary.min(axis=1)))
-            value = float(bary[worst].min())
-            if not value >= 0.0:
-                count = int(np.count_nonzero(~(bary.min(axis=1) >= 0.0)))
+            if not bary.min() >= 0.0:        # the rows only when one is outside
+                smallest = bary.min(axis=1)
+                worst = int(np.argmin(smallest))
+                count = int(np.count_nonzero(~(smallest >= 0.0)))
                 return [("t_escaped", f"the T-vertex of triangle {worst} left its triangle "
-                         f"(barycentric coordinate {value:.3g}; {count} T-vertex(es) outside)")]
+                         f"(barycentric coordinate {smallest[worst]:.3g}; {count} T-vertex(es) "
+                         "outside)")]
             return []
         finally:
             self._tick("geometry", clock)

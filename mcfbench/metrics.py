@@ -269,8 +269,20 @@ def triangle_angles(vertices, faces):
 
 
 def min_angle(vertices, faces):
-    """Smallest interior angle of the mesh, in degrees (60 for equilateral triangles)."""
-    return float(triangle_angles(vertices, faces).min())
+    """Smallest interior angle of the mesh, in degrees (60 for equilateral triangles).
+
+    The smallest angle of a triangle is the one opposite its shortest side:
+    one ``atan2(|u x v|, u . v)`` per triangle instead of three.
+    """
+    V, F = _mesh(vertices, faces)
+    P = V[F]                                   # (m, 3 corners, 3)
+    e = P[:, [1, 2, 0]] - P                    # e_k: corner k -> corner k + 1
+    shortest = np.argmin(np.einsum("ijk,ijk->ij", e, e), axis=1)
+    rows = np.arange(len(F))
+    u = e[rows, (shortest + 2) % 3]            # the two sides at the opposite corner
+    v = -e[rows, (shortest + 1) % 3]
+    angle = np.arctan2(np.linalg.norm(np.cross(u, v), axis=1), np.einsum("ij,ij->i", u, v))
+    return float(np.degrees(angle.min()))
 
 
 def aspect_ratios(vertices, faces):
@@ -310,7 +322,28 @@ def area_ratio(vertices, faces):
         return float(A.max() / A.min())
 
 
-def flipped_triangles(vertices, faces, reference_normals=None):
+def edge_neighbours(faces):
+    """Pairs ``(t1, t2)`` of triangles sharing an edge.
+
+    Parameters
+    ----------
+    faces : (m, 3) int array
+
+    Returns
+    -------
+    t1, t2 : (k,) int arrays
+    """
+    F = np.asarray(faces)
+    n = int(F.max()) + 1
+    src, dst = F.ravel(), F[:, [1, 2, 0]].ravel()
+    key = np.minimum(src, dst) * n + np.maximum(src, dst)
+    order = np.argsort(key, kind="stable")
+    tri = order // 3  # triangle of each sorted half-edge
+    shared = key[order][1:] == key[order][:-1]
+    return tri[:-1][shared], tri[1:][shared]
+
+
+def flipped_triangles(vertices, faces, reference_normals=None, neighbours=None):
     """Number of triangles folded over.
 
     Without ``reference_normals``, triangle ``t`` counts when its normal
@@ -327,6 +360,8 @@ def flipped_triangles(vertices, faces, reference_normals=None):
     faces : (m, 3) int array
         Consistently oriented.
     reference_normals : (m, 3) float array, optional
+    neighbours : (t1, t2), optional
+        :func:`edge_neighbours` of ``faces``, when already known.
 
     Returns
     -------
@@ -335,15 +370,11 @@ def flipped_triangles(vertices, faces, reference_normals=None):
     V, F = _mesh(vertices, faces)
     N = _normals(V, F)
     if reference_normals is None:
-        src, dst = F.ravel(), F[:, [1, 2, 0]].ravel()
-        key = np.minimum(src, dst) * len(V) + np.maximum(src, dst)
-        order = np.argsort(key, kind="stable")
-        tri = order // 3  # triangle of each sorted half-edge
-        shared = key[order][1:] == key[order][:-1]
-        t1, t2 = tri[:-1][shared], tri[1:][shared]
-        reference = np.zeros_like(N)
-        np.add.at(reference, t1, N[t2])
-        np.add.at(reference, t2, N[t1])
+        t1, t2 = edge_neighbours(F) if neighbours is None else neighbours
+        reference = np.column_stack([
+            np.bincount(t1, N[t2, c], minlength=len(F)) + np.bincount(t2, N[t1, c],
+                                                                     minlength=len(F))
+            for c in range(3)])
     else:
         reference = np.asarray(reference_normals, dtype=float)
         if reference.shape != N.shape:
@@ -352,8 +383,16 @@ def flipped_triangles(vertices, faces, reference_normals=None):
     return int((np.einsum("ij,ij->i", N, reference) < 0).sum())
 
 
-def quality(vertices, faces):
+def quality(vertices, faces, neighbours=None):
     """The mesh-quality monitors of one state.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+    neighbours : (t1, t2), optional
+        :func:`edge_neighbours` of ``faces`` (a monitor of many states
+        computes them once).
 
     Returns
     -------
@@ -365,7 +404,7 @@ def quality(vertices, faces):
     return {"min_angle": min_angle(vertices, faces),
             "max_aspect_ratio": max_aspect_ratio(vertices, faces),
             "area_ratio": area_ratio(vertices, faces),
-            "flipped_triangles": flipped_triangles(vertices, faces)}
+            "flipped_triangles": flipped_triangles(vertices, faces, neighbours=neighbours)}
 
 
 # -------------------------------------------------------- steady state

@@ -120,6 +120,7 @@ class _Monitor:
         self.every = max(1, int(every))
         self.t, self.t_monitor = [], []
         self.quality = {"quality_t": [], "min_angle": [], "max_aspect": [], "flipped": []}
+        self._neighbours = None
 
     def __call__(self, flow):
         t = flow.n * flow.tau
@@ -140,7 +141,9 @@ class _Monitor:
     def sample(self, flow):
         if self.quality["quality_t"] and self.quality["quality_t"][-1] == flow.n * flow.tau:
             return
-        q = metrics.quality(flow.vertices, flow.faces)
+        if self._neighbours is None:
+            self._neighbours = metrics.edge_neighbours(flow.faces)
+        q = metrics.quality(flow.vertices, flow.faces, self._neighbours)
         self.quality["quality_t"].append(flow.n * flow.tau)
         self.quality["min_angle"].append(q["min_angle"])
         self.quality["max_aspect"].append(q["max_aspect_ratio"])
@@ -163,7 +166,7 @@ class _Steady:
 
 
 def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defect="stop",
-        save_every=0, samples=50, mesh=None, **options):
+        save_every=0, samples=20, mesh=None, **options):
     """Run ``scheme`` on ``problem`` at refinement ``level``.
 
     Parameters
