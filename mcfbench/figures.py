@@ -4,21 +4,39 @@ An :class:`Experiment` is one figure: the runs it needs (:class:`Run`:
 initial shape and its parameters, scheme, ``tau``, number of steps,
 tangential setting) and the panels to draw (:class:`Shot`: which run,
 which time level, zoom). ``EXPERIMENTS`` maps the figure name
-(``"fig_3_2"``) to it; ``workflow/scripts/figure.py`` runs one experiment
-with :func:`run_experiment` and draws it with :func:`draw_experiment`.
+(``"fig_3_2"``) to it; :func:`mcfbench.pipeline.figure_job` runs one
+experiment with :func:`run_experiment` and draws it with
+:func:`draw_experiment`.
+
+What a figure shows, so that its PNG can be read alone:
+
+* every panel label gives the time level ``n``, ``n_V`` (DDFV: F- plus
+  T-vertices, the paper's count; the other schemes: the mesh vertices) and
+  ``tau`` (:data:`LABEL`); Fig. 3.1 has no time step and says so instead
+  of a ``tau``;
+* a legend below the panels names the primal edges (blue), the diamond
+  edges (red), the tracked cells and the detail region where drawn
+  (:func:`mcfbench.render.legend_handles`);
+* :class:`Track` (Fig. 3.4): a few diamond cells, chosen once, are filled
+  in amber in every panel of their run, and the details follow them
+  (``Zoom(at="tracked")``) with one half-width for all detail panels.
 
 Choices not stated in the paper (it gives only ``n_V``, ``tau`` for
 Figs. 3.2 and 3.5, and the time levels shown):
 
-* shapes and their parameters: see :mod:`ddfv.shapes` (bumpy sphere with
-  eight Gaussian bumps; cymling with flattening 0.4, 9 scallops of 10 %;
-  cylinder ``R = 1``, ``h = 0.55``, 24 x 8 twisted quads; hemisphere of
-  radius 1 with 10 rings);
+* shapes and their parameters: see :mod:`mcfbench.surfaces` (bumpy sphere
+  with eight Gaussian bumps; cymling with flattening 0.4, 9 scallops of
+  10 %; cylinder ``R = 1``, ``h = 0.55``, 24 x 8 twisted quads; hemisphere
+  of radius 1 with 10 rings);
 * ``tau = 0.0025`` everywhere (the paper's value for Figs. 3.2 and 3.5,
   assumed for the others);
 * the cymling's flattening is chosen so that, as in the paper, ``n = 12``
   is the last level before the contracted diamond cells go wrong (a
   T-vertex leaves its triangle at ``n = 13``);
+* Fig. 3.4 is seen from the viewpoint of Fig. 3.3; its tracked cells are
+  the five diamond cells of the two triangles of the visible diamond with
+  the smallest angle at ``n = 12`` (one of these triangles is the one whose
+  T-vertex leaves it at ``n = 13``);
 * with these choices the cylinder without elimination loses a T-vertex
   from its triangle between ``n = 580`` and ``n = 640`` (at ``n = 592``),
   as in Fig. 3.6.
@@ -37,6 +55,10 @@ from .surfaces import make_surface
 
 TAU = 0.0025
 
+#: default panel label: ``{n}`` time level shown, ``{n_V}`` number of
+#: vertices (DDFV: F + T), ``{n_F}``, ``{n_T}``, ``{tau}``
+LABEL = "n = {n}\nn_V = {n_V}, \u03c4 = {tau:g}"
+
 
 @dataclass(frozen=True)
 class Run:
@@ -47,7 +69,7 @@ class Run:
     key : str
         Name of the run inside its experiment.
     shape : str
-        A name of :data:`ddfv.shapes.SHAPES`.
+        A name of :data:`mcfbench.surfaces.SURFACES`.
     params : dict
         Parameters of the shape generator.
     tau : float
@@ -79,13 +101,14 @@ class Run:
 
 @dataclass(frozen=True)
 class Zoom:
-    """A square detail of half-width ``half`` (in length units of the surface).
+    """A detail of half-width ``half`` (in length units of the surface).
 
-    ``at`` is a 3-D point, or ``"worst"``: the visible element worst by
-    the measure ``by`` (:func:`ddfv.render.worst_element`: the diamond
+    ``at`` is a 3-D point; ``"worst"``: the visible element worst by the
+    measure ``by`` (:func:`mcfbench.render.worst_element`: the diamond
     with the smallest angle, or the T-vertex with the smallest barycentric
     coordinate) at time level ``step`` (by default the panel's own),
-    followed to the panel's time level.
+    followed to the panel's time level; or ``"tracked"``: the centre of the
+    experiment's tracked cells (:class:`Track`) at the panel's time level.
     """
 
     half: float
@@ -95,24 +118,47 @@ class Zoom:
 
 
 @dataclass(frozen=True)
+class Track:
+    """Diamond cells of run ``run`` marked in every panel of that run.
+
+    At time level ``step`` the visible element worst by ``by`` is taken
+    (:func:`mcfbench.render.worst_element`): for ``"angle"`` the diamond
+    with the smallest angle, and the cells tracked are the diamonds of its
+    two triangles (:func:`mcfbench.render.tracked_cells`); for
+    ``"barycentric"`` the three diamonds of the triangle whose T-vertex is
+    nearest to leaving it. The same diamond indices are then filled in
+    every panel of the run.
+    """
+
+    run: str
+    step: int
+    by: str = "angle"
+
+
+@dataclass(frozen=True)
 class Shot:
     """One panel: run ``run`` at time level ``step``.
 
-    ``label`` is a template with ``{n}`` for the time level. ``zoom`` shows
+    ``label`` is a template (:data:`LABEL`) with ``{n}`` for the time level
+    shown, ``{n_V}``, ``{n_F}``, ``{n_T}`` and ``{tau}``. ``zoom`` shows
     a detail; ``box`` outlines, in a full view, the region of a detail
     shown in another panel (the :class:`Zoom` of that panel).
     """
 
     run: str
     step: int
-    label: str = "n = {n}"
+    label: str = LABEL
     zoom: Zoom | None = None
     box: Zoom | None = None
 
 
 @dataclass(frozen=True)
 class Experiment:
-    """A figure: runs, panels, view and caption."""
+    """A figure: runs, panels, view and caption.
+
+    ``track`` marks the same diamond cells in every panel of its run
+    (:class:`Track`).
+    """
 
     name: str
     title: str
@@ -123,6 +169,7 @@ class Experiment:
     rows: int = 1
     size: float = 2.6
     aspect: float = 1.0
+    track: Track | None = None
 
     def run(self, key):
         for r in self.runs:
@@ -131,8 +178,11 @@ class Experiment:
         raise KeyError(f"experiment {self.name} has no run {key!r}")
 
     def config(self):
-        return {"name": self.name, "runs": [r.config() for r in self.runs],
-                "shots": [asdict(s) for s in self.shots], "view": list(self.view)}
+        config = {"name": self.name, "runs": [r.config() for r in self.runs],
+                  "shots": [asdict(s) for s in self.shots], "view": list(self.view)}
+        if self.track is not None:
+            config["track"] = asdict(self.track)
+        return config
 
     def describe(self):
         """The runs as a reStructuredText bullet list (for report captions)."""
@@ -148,6 +198,10 @@ class Experiment:
         steps = ", ".join(str(s.step) + (" (detail)" if s.zoom else "") for s in self.shots)
         lines.append(f"- panels at n = {steps}; view elevation {self.view[0]:g}, "
                      f"azimuth {self.view[1]:g} degrees")
+        if self.track is not None:
+            lines.append(f"- tracked diamond cells (amber) of run ``{self.track.run}``: those "
+                         f"around the visible element worst by {self.track.by} at "
+                         f"n = {self.track.step}")
         return "\n".join(lines)
 
 
@@ -157,73 +211,86 @@ def _shots(run, steps, **kw):
 
 _CYLINDER = dict(around=24, along=8, radius=1.0, half_height=0.55, diagonals="twisted")
 _CYMLING = dict(level=3, flattening=0.4, lobes=9, wave=0.1)
+_CYMLING_VIEW = (35.0, -60.0)    # Figs. 3.3, 3.4 and the cymling comparison
 _BUMPY = dict(level=3, amplitude=0.25, width=0.2)
-_RIM_ZOOM = Zoom(0.12, "worst", 12)
+_RIM_ZOOM = Zoom(0.15, "tracked")
 _CYL_ZOOM = Zoom(0.25, "worst", 640, by="barycentric")
+_DETAIL = "n = {n} (detail)\nn_V = {n_V}, \u03c4 = {tau:g}"
+_CYLINDER_RUN = "n_V = 600 (216 F-vertices, 384 T-vertices), tau = 0.0025"
 
 EXPERIMENTS = {e.name: e for e in [
     Experiment(
         "fig_3_1", "Sphere discretisations for the DDFV method",
         "Discretisations of the unit sphere used by the DDFV method, from left to "
-        "right n_V = 122, 482, 1922 and 7682 (icosphere levels 1 to 4). Blue: the "
-        "primal triangles (F-edges); red: the diamond mesh joining every F-vertex to "
+        "right n_V = 122, 482, 1922 and 7682 (icosphere levels 1 to 4; n_V counts the "
+        "F-vertices and the T-vertices), the initial meshes n = 0 (no time step). Blue: "
+        "the primal triangles (F-edges); red: the diamond mesh joining every F-vertex to "
         "the T-vertices of its triangles, initialised as in Section 3.",
         runs=tuple(Run(f"level{k}", "sphere", {"level": k}, steps=0,
-                       label=f"icosphere level {k}") for k in (1, 2, 3, 4)),
-        shots=tuple(Shot(f"level{k}", 0, label=f"n_V = {30 * 4**k + 2}") for k in (1, 2, 3, 4)),
+                       label=f"level {k}, n_V = {30 * 4**k + 2}") for k in (1, 2, 3, 4)),
+        shots=tuple(Shot(f"level{k}", 0, label=f"icosphere level {k}: n_V = {{n_V}}\n"
+                         "n = {n} (initial mesh, no time step)") for k in (1, 2, 3, 4)),
         view=(20.0, -60.0), size=3.2),
     Experiment(
         "fig_3_2", "Bumpy sphere",
         "Mean curvature flow of a bumpy sphere with n_V = 1922 and tau = 0.0025, "
         "shown at time steps n = 0, 4, 12 and 32. The T-vertices follow the "
         "F-vertices; none escapes from its triangle.",
-        runs=(Run("ddfv", "bumpy_sphere", _BUMPY, steps=32, save_every=4),),
+        runs=(Run("ddfv", "bumpy_sphere", _BUMPY, steps=32, save_every=4, label="DDFV"),),
         shots=_shots("ddfv", (0, 4, 12, 32))),
     Experiment(
         "fig_3_3", "Cymling-like shape",
         "Mean curvature flow of a cymling-like (pattypan squash) shape with "
         "n_V = 1922 and tau = 0.0025, at time steps n = 0, 4, 8 and 12. The rim, "
         "where the initial curvature is high, is where the diamond mesh deteriorates.",
-        runs=(Run("ddfv", "cymling", _CYMLING, steps=12, save_every=1),),
-        shots=_shots("ddfv", (0, 4, 8, 12)), view=(35.0, -60.0), aspect=0.7),
+        runs=(Run("ddfv", "cymling", _CYMLING, steps=12, save_every=1, label="DDFV"),),
+        shots=_shots("ddfv", (0, 4, 8, 12)), view=_CYMLING_VIEW, aspect=0.7),
     Experiment(
         "fig_3_4", "Contraction of diamond cells (cymling, detail)",
-        "Detail of the cymling-like shape of Fig. 3.3 at its rim, the region of high "
-        "initial curvature: the same diamond cells at n = 0, 8 and 12 (tau = 0.0025). "
-        "The cells contract; one step later (n = 13) a T-vertex leaves its triangle.",
-        runs=(Run("ddfv", "cymling", _CYMLING, steps=13, save_every=1),),
-        shots=(Shot("ddfv", 12, box=_RIM_ZOOM),
-               Shot("ddfv", 0, "n = {n} (detail)", zoom=_RIM_ZOOM),
-               Shot("ddfv", 8, "n = {n} (detail)", zoom=_RIM_ZOOM),
-               Shot("ddfv", 12, "n = {n} (detail)", zoom=_RIM_ZOOM)),
-        view=(10.0, -75.0), aspect=0.8),
+        "Detail of the cymling-like shape of Fig. 3.3 (n_V = 1922, tau = 0.0025, seen "
+        "from the same viewpoint) at its rim, the region of high initial curvature. "
+        "Left: the whole shape at n = 12, the dashed square marking the detail; then "
+        "the same diamond cells at n = 0, 8 and 12, all details at the same scale "
+        "(half-width 0.15) and centred on the tracked cells. Highlighted in amber in "
+        "every panel: the five diamond cells of the two triangles of the most "
+        "contracted diamond at n = 12 (the same cells in every panel). The cells "
+        "contract; one step later (n = 13) the T-vertex of one of these triangles "
+        "leaves it.",
+        runs=(Run("ddfv", "cymling", _CYMLING, steps=13, save_every=1, label="DDFV"),),
+        shots=(Shot("ddfv", 12, "n = {n} (whole shape)\nn_V = {n_V}, \u03c4 = {tau:g}",
+                    box=_RIM_ZOOM),
+               Shot("ddfv", 0, _DETAIL, zoom=_RIM_ZOOM),
+               Shot("ddfv", 8, _DETAIL, zoom=_RIM_ZOOM),
+               Shot("ddfv", 12, _DETAIL, zoom=_RIM_ZOOM)),
+        view=_CYMLING_VIEW, aspect=0.7, track=Track("ddfv", 12, "angle")),
     Experiment(
         "fig_3_5", "Cylinder to catenoid",
         "Mean curvature flow of an open cylinder (radius 1, height 1.1) with both "
         "boundary circles fixed, n_V = 600, tau = 0.0025, diamond mesh shown, at time "
         "steps n = 0, 40, 100 and 200: the surface approaches the catenoid.",
-        runs=(Run("ddfv", "cylinder", _CYLINDER, steps=200, save_every=20),),
+        runs=(Run("ddfv", "cylinder", _CYLINDER, steps=200, save_every=20, label="DDFV"),),
         shots=_shots("ddfv", (0, 40, 100, 200)), view=(12.0, -60.0), aspect=0.8),
     Experiment(
         "fig_3_6", "Degeneration of the diamond mesh (cylinder)",
-        "Continuation of the cylinder of Fig. 3.5 without tangential control. At "
-        "n = 580 the T-vertices in the second row of triangles from each boundary circle "
-        "have drifted towards the edges of their triangles; by n = 640 they "
-        "have left them and the diamond mesh folds over (dark cells near the rims). "
+        f"Continuation of the cylinder of Fig. 3.5 ({_CYLINDER_RUN}) without tangential "
+        "control. At n = 580 the T-vertices in the second row of triangles from each "
+        "boundary circle have drifted towards the edges of their triangles; by n = 640 "
+        "they have left them and the diamond mesh folds over (dark cells near the rims). "
         "Right: the folded region at n = 640 "
         "in detail. The run record gives the first step at which a T-vertex left its "
         "triangle.",
-        runs=(Run("ddfv", "cylinder", _CYLINDER, steps=640, save_every=20),),
+        runs=(Run("ddfv", "cylinder", _CYLINDER, steps=640, save_every=20,
+                  label="DDFV, no tangential control"),),
         shots=(Shot("ddfv", 580), Shot("ddfv", 640, box=_CYL_ZOOM),
-               Shot("ddfv", 640, "n = {n} (detail)", zoom=_CYL_ZOOM)),
+               Shot("ddfv", 640, _DETAIL, zoom=_CYL_ZOOM)),
         view=(12.0, -60.0), aspect=0.8),
     Experiment(
         "fig_3_7", "Cylinder with tangential velocity eliminated",
-        "The cylinder of Fig. 3.5 computed with the tangential velocity eliminated "
-        "(3.6), at time steps n = 0, 100, 200 and 640: the T-vertices stay inside "
-        "their triangles and the diamond mesh does not degenerate.",
+        f"The cylinder of Fig. 3.5 ({_CYLINDER_RUN}) computed with the tangential "
+        "velocity eliminated (3.6), at time steps n = 0, 100, 200 and 640: the "
+        "T-vertices stay inside their triangles and the diamond mesh does not degenerate.",
         runs=(Run("ddfv", "cylinder", _CYLINDER, steps=640, save_every=20,
-                  scheme="ddfv-eliminate"),),
+                  scheme="ddfv-eliminate", label="DDFV, elimination (3.6)"),),
         shots=_shots("ddfv", (0, 100, 200, 640)), view=(12.0, -60.0), aspect=0.8),
     Experiment(
         "fig_3_8", "Hemisphere with fixed equator",
@@ -231,32 +298,32 @@ EXPERIMENTS = {e.name: e for e in [
         "tangential velocity eliminated (3.6), n_V = 931, tau = 0.0025, at time steps "
         "n = 0, 40, 80 and 600: the surface flattens to the disk spanned by the equator.",
         runs=(Run("ddfv", "hemisphere", {"rings": 10}, steps=600, save_every=40,
-                  scheme="ddfv-eliminate"),),
+                  scheme="ddfv-eliminate", label="DDFV, elimination (3.6)"),),
         shots=_shots("ddfv", (0, 40, 80, 600)), view=(25.0, -60.0), aspect=0.75),
     Experiment(
         "fig_3_6_cotan", "Cylinder: DDFV and the cotangent scheme",
-        "The cylinder of Figs. 3.5-3.6 (n_V = 600 for DDFV; the cotangent scheme has "
-        "the 216 F-vertices only) at n = 200, 580 and 640: top, DDFV without "
-        "tangential control; bottom, the cotangent scheme (baselines/cotan.py) with "
-        "the same fixed boundary circles. Both approach the catenoid; the cotangent "
+        "The cylinder of Figs. 3.5-3.6 (tau = 0.0025; n_V = 600 for DDFV; the cotangent "
+        "scheme has the n_V = 216 F-vertices only) at n = 200, 580 and 640: top, DDFV "
+        "without tangential control; bottom, the cotangent scheme (baselines/cotan.py) "
+        "with the same fixed boundary circles. Both approach the catenoid; the cotangent "
         "mesh has no T-vertices to drift and stays regular.",
         runs=(Run("ddfv", "cylinder", _CYLINDER, steps=640, save_every=20, label="DDFV"),
               Run("cotan", "cylinder", _CYLINDER, steps=640, save_every=20,
                   scheme="cotan", label="cotangent")),
-        shots=(_shots("ddfv", (200, 580, 640), label="DDFV, n = {n}")
-               + _shots("cotan", (200, 580, 640), label="cotangent, n = {n}")),
+        shots=(_shots("ddfv", (200, 580, 640), label="DDFV, " + LABEL)
+               + _shots("cotan", (200, 580, 640), label="cotangent, " + LABEL)),
         rows=2, view=(12.0, -60.0), aspect=0.8),
     Experiment(
         "fig_3_4_cotan", "Cymling: DDFV and the cotangent scheme",
         "The cymling-like shape of Fig. 3.3 (tau = 0.0025) at n = 0, 8 and 12: top, "
-        "DDFV; bottom, the cotangent scheme (baselines/cotan.py) on the same "
-        "F-vertices. The mesh contracts at the rim in both.",
+        "DDFV (n_V = 1922); bottom, the cotangent scheme (baselines/cotan.py) on the same "
+        "n_V = 642 F-vertices. The mesh contracts at the rim in both.",
         runs=(Run("ddfv", "cymling", _CYMLING, steps=12, save_every=1, label="DDFV"),
               Run("cotan", "cymling", _CYMLING, steps=12, save_every=1,
                   scheme="cotan", label="cotangent")),
-        shots=(_shots("ddfv", (0, 8, 12), label="DDFV, n = {n}")
-               + _shots("cotan", (0, 8, 12), label="cotangent, n = {n}")),
-        rows=2, view=(35.0, -60.0), aspect=0.7),
+        shots=(_shots("ddfv", (0, 8, 12), label="DDFV, " + LABEL)
+               + _shots("cotan", (0, 8, 12), label="cotangent, " + LABEL)),
+        rows=2, view=_CYMLING_VIEW, aspect=0.7),
 ]}
 """Figure name -> :class:`Experiment`."""
 
@@ -264,15 +331,48 @@ PAPER_FIGURES = tuple(f"fig_3_{k}" for k in range(1, 9))
 
 
 def validate(experiment):
-    """Check that every panel's time level is computed and kept as a frame."""
+    """Check that the experiment can be drawn from what its runs keep.
+
+    Every panel's time level (and those of its zoom, box and of the
+    tracked cells) is computed and kept as a frame, runs and schemes
+    exist, a ``"tracked"`` zoom has a :class:`Track` of its run, and every
+    label template has only the fields of :data:`LABEL`.
+
+    Raises
+    ------
+    ValueError
+    """
+    from .render import WORST_MEASURES
+
+    def kept(run, step, what):
+        if step > run.steps or (step % run.save_every and step != run.steps):
+            raise ValueError(f"{experiment.name}: time level {step} of run {run.key} "
+                             f"({what}) is not kept (steps {run.steps}, "
+                             f"save_every {run.save_every})")
+
+    for run in experiment.runs:
+        get_scheme(run.scheme)
+    track = experiment.track
+    if track is not None:
+        kept(experiment.run(track.run), track.step, "tracked cells")
+        if track.by not in WORST_MEASURES:
+            raise ValueError(f"{experiment.name}: unknown track measure {track.by!r}")
     for shot in experiment.shots:
         run = experiment.run(shot.run)
-        for step in (shot.step, getattr(shot.zoom, "step", None), getattr(shot.box, "step", None)):
-            if step is None:
+        kept(run, shot.step, "panel")
+        for zoom in (shot.zoom, shot.box):
+            if zoom is None:
                 continue
-            if step > run.steps or (step % run.save_every and step != run.steps):
-                raise ValueError(f"{experiment.name}: time level {step} of run {run.key} "
-                                 f"is not kept (steps {run.steps}, save_every {run.save_every})")
+            if zoom.step is not None:
+                kept(run, zoom.step, "zoom")
+            if zoom.at == "tracked" and (track is None or track.run != shot.run):
+                raise ValueError(f"{experiment.name}: a zoom at the tracked cells needs a "
+                                 f"Track of run {shot.run}")
+        try:
+            shot.label.format(n=0, n_V=0, n_F=0, n_T=0, tau=1.0)
+        except (KeyError, IndexError, ValueError) as err:
+            raise ValueError(f"{experiment.name}: bad panel label {shot.label!r} "
+                             f"({err!r}); fields n, n_V, n_F, n_T, tau") from None
 
 
 @dataclass
@@ -289,7 +389,7 @@ class RunResult:
     message: str
     failed_step: int
     wall_seconds: float
-    quality: object = None  # pandas.DataFrame of mcfbench.quality, DDFV runs only
+    quality: object = None  # pandas.DataFrame of mcfbench.quality.MeshQuality
 
     def frame(self, step):
         """Index of the last kept frame at or before ``step``."""
@@ -318,7 +418,9 @@ def run_one(run):
     The run goes on past an invalid state (``on_defect="record"``: the
     figures show what happens after a T-vertex leaves its triangle), and
     its status says what went wrong first; a breakdown of the solver ends
-    it, keeping the frames computed before. A scheme that refuses the
+    it, keeping the frames computed before. The mesh quality of every time
+    level is recorded (:class:`mcfbench.quality.MeshQuality`: diamond and
+    primal monitors for DDFV, primal ones for the other schemes). A scheme that refuses the
     surface (ValueError) gives ``status = "unsupported"`` with the initial
     surface as the only frame.
 
@@ -335,13 +437,13 @@ def run_one(run):
     except ValueError as err:
         return RunResult(run, V[None], None, np.array([0]), faces, np.array([], int),
                          "unsupported", str(err), -1, time.perf_counter() - start)
-    quality = MeshQuality() if scheme.family == "ddfv" else None
+    quality = MeshQuality()   # diamond and primal monitors (DDFV), primal (the others)
     traj = simulate(flow, run.steps, save_every=run.save_every, on_defect="record",
-                    observers=[quality] if quality else [])
+                    observers=[quality])
     frames = traj.frames
     return RunResult(run, frames.get("F", frames.get("V")), frames.get("T"), traj.steps,
                      traj.faces, traj.iterations, traj.status, traj.message, traj.failed_step,
-                     time.perf_counter() - start, quality.frame() if quality else None)
+                     time.perf_counter() - start, quality.frame())
 
 
 def run_experiment(experiment):
@@ -358,26 +460,61 @@ def experiment_status(results):
     return "ok"
 
 
-def draw_experiment(experiment, results):
-    """The figure of an experiment from its runs' frames.
-
-    A panel whose time level was not reached shows the last frame of its
-    run, labelled with the level shown and a note.
+def tracked(experiment, results):
+    """The tracked diamond cells of the experiment (:class:`Track`).
 
     Returns
     -------
-    matplotlib.figure.Figure
+    dict
+        ``{run key: (k,) int array}`` of diamond indices (empty without a
+        track or when the run has no frame at the track's time level).
     """
-    from .render import Panel, element_centre, panel_row, worst_element
+    from .render import tracked_cells, worst_element
 
-    def zoom_of(spec, result, i):
+    track = experiment.track
+    if track is None:
+        return {}
+    result = results[track.run]
+    j = result.frame(track.step)
+    if j < 0 or int(result.steps[j]) != track.step:
+        return {}
+    F, T = result.F[j], None if result.T is None else result.T[j]
+    k = worst_element(F, T, result.faces, experiment.view, track.by)
+    if track.by == "angle":
+        cells = tracked_cells(result.faces, k, F.shape[0])
+    else:
+        from ddfv.topology import diamond_mesh
+
+        cells = np.unique(diamond_mesh(result.faces, F.shape[0]).halfedges[k])
+    return {track.run: cells}
+
+
+def experiment_panels(experiment, results):
+    """The :class:`mcfbench.render.Panel` of every shot, in order.
+
+    A panel whose time level was not reached shows the last frame of its
+    run, labelled with the level shown and a note. Panels of a tracked run
+    have the tracked cells as ``highlight``; a zoom ``"tracked"`` is centred
+    on their centre in the panel's own frame, with the half-width of its
+    :class:`Zoom` (one for all panels that share it).
+    """
+    from .render import Panel, cells_centre, element_centre, worst_element
+
+    cells = tracked(experiment, results)
+
+    def zoom_of(spec, result, i, run):
         """Centre and half-width of a zoom in frame ``i`` of ``result``."""
         if spec is None:
             return None
+        T = result.T
         if not isinstance(spec.at, str):
             return np.asarray(spec.at, dtype=float), spec.half
+        if spec.at == "tracked":
+            if run not in cells:
+                return None
+            return cells_centre(result.F[i], None if T is None else T[i], result.faces,
+                                cells[run]), spec.half
         j = result.frame(spec.step) if spec.step is not None else i
-        T = None if result.T is None else result.T
         k = worst_element(result.F[j], None if T is None else T[j], result.faces,
                           experiment.view, spec.by)
         centre = element_centre(result.F[i], None if T is None else T[i], result.faces, k,
@@ -389,7 +526,10 @@ def draw_experiment(experiment, results):
         result = results[shot.run]
         i = result.frame(shot.step)
         reached = int(result.steps[i])
-        label = shot.label.format(n=reached)
+        n_f = result.F.shape[1]
+        n_t = 0 if result.T is None else result.T.shape[1]
+        label = shot.label.format(n=reached, n_V=n_f + n_t, n_F=n_f, n_T=n_t,
+                                  tau=result.run.tau)
         note = ""
         if result.status == "unsupported":
             name = result.run.label or result.run.scheme
@@ -398,11 +538,27 @@ def draw_experiment(experiment, results):
             note = f"n = {shot.step} not reached:\n{_short(result.message or result.status)}"
         T = None if result.T is None else result.T[i]
         panels.append(Panel(result.F[i], T, result.faces, label=label,
-                            zoom=zoom_of(shot.zoom, result, i),
-                            zoom_box=zoom_of(shot.box, result, i),
-                            note=note))
-    return panel_row(panels, view=experiment.view, rows=experiment.rows, size=experiment.size,
-                     aspect=experiment.aspect)
+                            zoom=zoom_of(shot.zoom, result, i, shot.run),
+                            zoom_box=zoom_of(shot.box, result, i, shot.run),
+                            note=note, highlight=cells.get(shot.run)))
+    return panels
+
+
+def draw_experiment(experiment, results):
+    """The figure of an experiment from its runs' frames.
+
+    The panels of :func:`experiment_panels` in a grid, titled with the
+    experiment's name and title, with a legend of what is drawn.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from .render import panel_row
+
+    return panel_row(experiment_panels(experiment, results), view=experiment.view,
+                     rows=experiment.rows, size=experiment.size, aspect=experiment.aspect,
+                     title=f"{experiment.name}: {experiment.title}")
 
 
 def _short(text, width=34):

@@ -15,6 +15,13 @@ surface.) The view ``(elev, azim)`` in degrees has the meaning of mplot3d's
 ``view_init``; shading is Lambertian from a light above-left of the viewer,
 with the back side of the surface tinted.
 
+Tracked diamond cells (:attr:`Panel.highlight`, diamond indices of
+:func:`ddfv.topology.diamond_mesh`) are filled in an amber highlight colour
+instead of the surface colour, so that the same cells can be found in every
+panel of a figure (Fig. 3.4). :func:`panel_row` adds a small legend of what
+is drawn (primal and diamond edges, tracked cells, detail region) so that a
+picture read alone can be understood.
+
 Typical use::
 
     panels = [Panel(F, T, faces, label="n = 0"), ...]
@@ -32,7 +39,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import PolyCollection  # noqa: E402
 from matplotlib.colors import to_rgba  # noqa: E402
-from matplotlib.patches import Rectangle  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.patches import Patch, Rectangle  # noqa: E402
 
 from ddfv.topology import diamond_mesh  # noqa: E402
 
@@ -40,6 +48,7 @@ PRIMAL_COLOR = "#1f4fd8"     # F-edges (blue, as in Fig. 2.2)
 DIAMOND_COLOR = "#d62020"    # F-T edges and boundary edges (red)
 FRONT_COLOR = "#e9e4da"      # outer side of the surface
 BACK_COLOR = "#b9c7d9"       # inner side (seen through openings)
+HIGHLIGHT_COLOR = "#ffb000"  # tracked diamond cells (amber)
 DPI = 150
 AMBIENT = 0.4                # share of the light that does not depend on the normal
 
@@ -55,7 +64,7 @@ class Panel:
         ``None`` draws the primal mesh only (e.g. the cotangent scheme).
     faces : (n_t, 3) int array
     label : str
-        Printed under the picture, e.g. ``"n = 12"``.
+        Printed under the picture, e.g. ``"n = 12"``; may have several lines.
     zoom : tuple (centre, half_width), optional
         Show only the square of ``half_width`` around the projection of
         the 3-D point ``centre``.
@@ -63,6 +72,12 @@ class Panel:
         Outline that square (the region of a detail shown elsewhere).
     note : str
         Printed in small italics inside the panel (e.g. a missing frame).
+    highlight : (k,) int array, optional
+        Diamond cells (indices of :func:`ddfv.topology.diamond_mesh`) filled
+        in :data:`HIGHLIGHT_COLOR`; with ``T = None`` the primal triangles
+        on either side of their edges are filled.
+    options : dict
+        More keyword arguments of :func:`draw_mesh`.
     """
 
     F: np.ndarray
@@ -72,6 +87,7 @@ class Panel:
     zoom: tuple | None = None
     zoom_box: tuple | None = None
     note: str = ""
+    highlight: np.ndarray | None = None
     options: dict = field(default_factory=dict)
 
 
@@ -123,7 +139,8 @@ def diamond_faces(F, T, faces):
 def draw_mesh(ax, F, T, faces, *, view=(20.0, -60.0), primal_width=None,
               diamond_width=None, primal_color=PRIMAL_COLOR, diamond_color=DIAMOND_COLOR,
               front_color=FRONT_COLOR, back_color=BACK_COLOR, edges=True, smooth=True,
-              light=(-0.4, 0.6, 0.7), points_per_unit=100.0):
+              light=(-0.4, 0.6, 0.7), points_per_unit=100.0, highlight=None,
+              highlight_color=HIGHLIGHT_COLOR):
     """Draw one shaded surface into a 2-D axes (see module docstring).
 
     Parameters
@@ -148,6 +165,10 @@ def draw_mesh(ax, F, T, faces, *, view=(20.0, -60.0), primal_width=None,
     points_per_unit : float
         Scale of the picture (typographic points per length unit), for the
         default line widths.
+    highlight : sequence of int, optional
+        Diamond cells filled in ``highlight_color`` (shaded like the rest):
+        their triangles ``(F_a, F_b, T)``, or with ``T = None`` the primal
+        triangles on either side of their edges.
 
     Returns
     -------
@@ -156,13 +177,19 @@ def draw_mesh(ax, F, T, faces, *, view=(20.0, -60.0), primal_width=None,
     """
     faces = np.asarray(faces)
     n_f = len(F)
-    boundary_edge = _boundary_halfedges(faces, n_f)
+    mesh = diamond_mesh(faces, n_f)
+    boundary_edge = mesh.boundary[mesh.halfedges.ravel()]
+    marked = np.zeros(len(mesh.diamonds), bool)
+    if highlight is not None:
+        marked[np.asarray(highlight, dtype=int)] = True
     if T is None:
         points, tri = np.asarray(F, float), faces
         primal = None
+        lit = marked[mesh.halfedges].any(axis=1)     # a triangle with a tracked edge
     else:
         points, tri = diamond_faces(F, T, faces)
         primal = tri[:, :2]
+        lit = marked[mesh.halfedges.ravel()]          # row 3 t + k: half-edge k of t
     xy, depth = project(points, view)
     right, up, towards = view_frame(view)
     P = points[tri]
@@ -182,6 +209,8 @@ def draw_mesh(ax, F, T, faces, *, view=(20.0, -60.0), primal_width=None,
     specular = 0.25 * np.maximum(0.0, seen @ halfway) ** 24
     shade = AMBIENT + (1.0 - AMBIENT) * lambert
     base = np.where((facing >= 0)[:, None], to_rgba(front_color)[:3], to_rgba(back_color)[:3])
+    base[lit] = to_rgba(highlight_color)[:3]
+    shade = np.where(lit, 0.6 + 0.4 * shade, shade)   # tracked cells stay bright in shadow
     rgb = np.clip(base * shade[:, None] + specular[:, None], 0.0, 1.0)
     fill = np.column_stack([rgb, np.ones(len(tri))])
 
@@ -250,7 +279,7 @@ def worst_element(F, T, faces, view=None, by="angle", max_tilt=60.0):
         shows the front of the surface.
     by : {"angle", "barycentric"}
         ``"angle"``: the diamond with the smallest angle
-        (:func:`ddfv.diagnostics.diamond_min_angles`); ``"barycentric"``:
+        (:func:`mcfbench.quality.diamond_min_angles`); ``"barycentric"``:
         the T-vertex with the smallest barycentric coordinate in its
         triangle (the first to leave it).
 
@@ -261,7 +290,7 @@ def worst_element(F, T, faces, view=None, by="angle", max_tilt=60.0):
         see :func:`element_centre`.
     """
     from .quality import diamond_min_angles
-    from .geometry import t_barycentric
+    from ddfv.geometry import t_barycentric
 
     if by not in WORST_MEASURES:
         raise ValueError(f"unknown measure {by!r}; choose one of {', '.join(WORST_MEASURES)}")
@@ -297,14 +326,72 @@ def _unit(x):
     return x / np.maximum(np.linalg.norm(x, axis=1, keepdims=True), 1e-300)
 
 
-def _boundary_halfedges(faces, n_f):
-    """(3 n_t,) bool: the half-edge ``faces[t, k] -> faces[t, k+1]`` is a boundary edge."""
-    mesh = diamond_mesh(faces, n_f)
-    return mesh.boundary[mesh.halfedges.ravel()]
+def tracked_cells(faces, diamond, n_vertices=None):
+    """The diamond cells around ``diamond``: those of its two triangles.
+
+    The diamond itself and the other diamonds of the triangles ``t1``,
+    ``t2`` on either side of its edge (5 cells for an inner diamond, 3 on
+    the boundary), sorted: a small patch that is easy to find again.
+
+    Parameters
+    ----------
+    faces : (n_t, 3) int array
+    diamond : int
+        Index of :func:`ddfv.topology.diamond_mesh`.
+    n_vertices : int, optional
+
+    Returns
+    -------
+    (k,) int array
+    """
+    mesh = diamond_mesh(faces, n_vertices)
+    tri = mesh.diamonds[diamond, 2:]
+    return np.unique(mesh.halfedges[tri[tri >= 0]].ravel())
+
+
+def cells_centre(F, T, faces, cells):
+    """Mean of the centres (:func:`element_centre`) of the diamond ``cells``."""
+    mesh = diamond_mesh(faces, len(F))
+    a, b, t1, t2 = np.asarray(mesh.diamonds[np.asarray(cells, dtype=int)]).T
+    if T is None:
+        centre = 0.5 * (F[a] + F[b])
+    else:
+        inner = t2 >= 0
+        centre = np.where(inner[:, None], 0.25 * (F[a] + F[b] + T[t1] + T[np.maximum(t2, 0)]),
+                          0.5 * (F[a] + F[b]))
+    return centre.mean(axis=0)
+
+
+def cells_points(F, T, faces, cells):
+    """(m, 3) corners of the diamond ``cells``: their F-vertices and T-vertices
+    (with ``T = None`` the corners of the primal triangles on either side)."""
+    mesh = diamond_mesh(faces, len(F))
+    d = mesh.diamonds[np.asarray(cells, dtype=int)]
+    tri = d[:, 2:][d[:, 2:] >= 0]
+    if T is None:
+        return F[np.unique(mesh.faces[tri].ravel())]
+    return np.concatenate([F[np.unique(d[:, :2].ravel())], T[np.unique(tri)]])
+
+
+def legend_handles(panels):
+    """Legend entries for what ``panels`` show (see :func:`panel_row`)."""
+    diamond = any(p.T is not None for p in panels)
+    handles = [Line2D([], [], color=PRIMAL_COLOR, lw=1.6,
+                      label="primal edges (F\u2013F)")]
+    if diamond:
+        handles.append(Line2D([], [], color=DIAMOND_COLOR, lw=1.0,
+                              label="diamond edges (F\u2013T, boundary)"))
+    if any(p.highlight is not None and len(p.highlight) for p in panels):
+        handles.append(Patch(fc=HIGHLIGHT_COLOR, ec="0.3", lw=0.5,
+                             label="tracked diamond cells (ringed in a full view)"))
+    if any(p.zoom_box is not None for p in panels):
+        handles.append(Patch(fill=False, ec="0.15", ls="--", lw=1.0,
+                             label="region of the details"))
+    return handles
 
 
 def panel_row(panels, *, view=(20.0, -60.0), size=2.6, aspect=1.0, rows=1,
-              share_scale=True, margin=0.04, title=None, label_size=10):
+              share_scale=True, margin=0.04, title=None, label_size=10, legend=True):
     """Lay out panels in a grid (one row by default), each labelled below.
 
     Parameters
@@ -319,11 +406,16 @@ def panel_row(panels, *, view=(20.0, -60.0), size=2.6, aspect=1.0, rows=1,
     share_scale : bool
         Show all full (non-zoom) panels with the same length scale and
         centre, so that a shrinking surface looks smaller and a fixed
-        boundary stays in place.
+        boundary stays in place. (Details have the scale of their own
+        half-width.)
     margin : float
         Empty border around the surface, relative to its extent.
     title : str, optional
         Figure title.
+    label_size : float
+        Font size of the panel labels (points); the title is one larger.
+    legend : bool
+        A legend of what is drawn (:func:`legend_handles`) below the panels.
 
     Returns
     -------
@@ -331,8 +423,14 @@ def panel_row(panels, *, view=(20.0, -60.0), size=2.6, aspect=1.0, rows=1,
     """
     cols = int(np.ceil(len(panels) / rows))
     height = size * aspect
-    fig, axes = plt.subplots(rows, cols, figsize=(size * cols, (height + 0.3) * rows),
-                             squeeze=False)
+    lines = max([p.label.count("\n") + 1 if p.label else 0 for p in panels] + [1])
+    label_h = 0.06 + lines * label_size * 1.25 / 72.0     # inches under each panel
+    handles = legend_handles(panels) if legend else []
+    legend_cols = min(len(handles), max(1, int(size * cols // 2.4)))
+    legend_h = 0.12 + 0.19 * np.ceil(len(handles) / max(legend_cols, 1)) if handles else 0.0
+    title_h = 0.35 if title else 0.05
+    fig_h = (height + label_h) * rows + legend_h + title_h
+    fig, axes = plt.subplots(rows, cols, figsize=(size * cols, fig_h), squeeze=False)
     boxes = []
     for panel in panels:
         xy = project(panel.F if panel.T is None else np.concatenate([panel.F, panel.T]),
@@ -354,6 +452,8 @@ def panel_row(panels, *, view=(20.0, -60.0), size=2.6, aspect=1.0, rows=1,
                 (0.5 * (lo_i + hi_i),
                  0.5 * (1 + 2 * margin) * max((hi_i - lo_i)[0], (hi_i - lo_i)[1] / aspect))
         options = {"points_per_unit": 72.0 * size / (2 * half), **panel.options}
+        if panel.highlight is not None:
+            options.setdefault("highlight", panel.highlight)
         draw_mesh(ax, panel.F, panel.T, panel.faces, view=view, **options)
         ax.set_xlim(c[0] - half, c[0] + half)
         ax.set_ylim(c[1] - half * aspect, c[1] + half * aspect)
@@ -362,13 +462,19 @@ def panel_row(panels, *, view=(20.0, -60.0), size=2.6, aspect=1.0, rows=1,
         if panel.zoom is not None:  # a frame marks a detail
             ax.add_patch(Rectangle((0, 0), 1, 1, transform=ax.transAxes, fill=False,
                                    lw=1.2, ec="0.2", clip_on=False))
+        if panel.highlight is not None and len(panel.highlight) and panel.zoom is None:
+            # in a full view the tracked cells are small: a ring around them too
+            hc = project(cells_centre(panel.F, panel.T, panel.faces, panel.highlight)[None],
+                         view)[0][0]
+            ax.plot([hc[0]], [hc[1]], "o", ms=9, mfc="none", mec=HIGHLIGHT_COLOR, mew=1.6,
+                    zorder=6)
         if panel.zoom_box is not None:
             zc, zh = panel.zoom_box
             z = project(np.asarray(zc, float)[None], view)[0][0]
             ax.add_patch(Rectangle((z[0] - zh, z[1] - zh * aspect), 2 * zh, 2 * zh * aspect,
                                    fill=False, lw=1.0, ec="0.15", ls="--", zorder=5))
-        ax.set_title(panel.label, y=-0.03 if panel.zoom is None else -0.06, va="top",
-                     fontsize=label_size)
+        ax.set_title(panel.label, y=-0.02 if panel.zoom is None else -0.05, va="top",
+                     fontsize=label_size, linespacing=1.15)
         if panel.note:
             ax.text(0.5, 0.98, panel.note, transform=ax.transAxes, ha="center", va="top",
                     fontsize=7, style="italic", color="0.1", zorder=10,
@@ -376,10 +482,14 @@ def panel_row(panels, *, view=(20.0, -60.0), size=2.6, aspect=1.0, rows=1,
     for ax in axes.ravel()[len(panels):]:
         ax.set_axis_off()
     if title:
-        fig.suptitle(title, fontsize=label_size + 1)
-    fig.subplots_adjust(left=0.01, right=0.99, top=0.92 if title else 0.98,
-                        bottom=0.3 / (height + 0.3) / rows, wspace=0.05,
-                        hspace=0.3 / height)
+        fig.suptitle(title, fontsize=label_size + 1, y=1 - 0.08 / fig_h, va="top")
+    if handles:
+        fig.legend(handles=handles, loc="lower center", ncol=legend_cols, frameon=False,
+                   fontsize=label_size - 2, handlelength=1.8, columnspacing=1.5,
+                   bbox_to_anchor=(0.5, 0.02 / fig_h))
+    fig.subplots_adjust(left=0.01, right=0.99, top=1 - title_h / fig_h,
+                        bottom=(label_h + legend_h) / fig_h, wspace=0.05,
+                        hspace=label_h / height)
     return fig
 
 
