@@ -6,9 +6,20 @@
 #   snakemake --report results/report.html       # HTML report afterwards
 #
 # Settings: config/config.yaml (documented in config/README.md), validated
-# against workflow/schemas/config.schema.yaml before any job runs.
+# against workflow/schemas/config.schema.yaml and across keys (scheme names
+# against the registry mcfbench.schemes.SCHEMES, time steps; mcfbench.pipeline)
+# before any job runs. The logic of the rules is in the harness (mcfbench);
+# workflow/scripts/*.py are thin adapters. Needs the packages installed:
+# `pip install -e .` in the repository.
+
+import os
 
 from snakemake.utils import min_version, validate
+
+# One BLAS thread per job, set once here: every job inherits it (local or
+# Slurm), before any of them imports numpy. The jobs' run records store these
+# variables (mcfbench.provenance.BLAS_THREAD_VARIABLES).
+os.environ.update(dict.fromkeys(("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"), "1"))
 
 min_version("9.0")
 
@@ -29,6 +40,8 @@ include: "workflow/rules/convergence.smk"
 include: "workflow/rules/figures.smk"
 include: "workflow/rules/beyond.smk"
 include: "workflow/rules/report.smk"
+include: "workflow/rules/matrix.smk"
+include: "workflow/rules/gallery.smk"
 
 
 rule all:
@@ -45,3 +58,19 @@ rule beyond:
     localrule: True
     input:
         BEYOND_TARGETS,
+
+
+rule matrix:
+    """Target: every scheme x every problem x its levels (config key `matrix`;
+    about 15 minutes on 2 cores), tables, figures and findings in results/matrix/."""
+    localrule: True
+    input:
+        MATRIX_TARGETS,
+
+
+rule gallery:
+    """Target: every scheme on every mesh file (`--config meshes=DIR`; default the
+    suite's own meshes), table and pictures in results/gallery/."""
+    localrule: True
+    input:
+        GALLERY_TARGETS,

@@ -1,146 +1,200 @@
-"""Speed and memory of a level-6 DDFV run against the targets of issue #5.
+"""Speed and memory of a level-6 (or 7) sphere run on the harness, one thread.
 
-The paper's variant breaks down on level 6 (ddfv/README.md, results/beyond/),
-so the run timed is one that completes: ``--variant chord`` (default) or
-``eliminate``. Levels 4 and 5 are timed too, to show how the cost grows
-with the problem size: per unknown and step it should stay about constant
-(the solver needs about 1.3 BiCGStab iterations a step at every level).
+The paper's DDFV variant breaks down on level 6 (ddfv/README.md,
+results/beyond/), so the scheme timed by default is one that completes,
+``ddfv-chord``; any scheme of the registry can be given. Each run is
+``mcfbench.studies.run(scheme, "sphere", level)`` as on the command line
+(flow construction, every step, the error (3.2), the T monitor, quality
+samples), in a FRESH child process pinned to one core with one BLAS thread
+and glibc's malloc tuned, after a warm-up on level 1 in that process (no
+JIT compilation or cache loading timed), so that its peak resident memory
+(``resource.getrusage(...).ru_maxrss``) is its own.
 
-Every run is a fresh child process pinned to one core with one BLAS
-thread, so that its peak resident memory (``ru_maxrss``) is its own. For
-each level the script prints the median wall time over the repeats, its
-split into geometry (diamond quantities, covolumes, checks), assembly,
-solve and the rest (T monitor, L2 error, set-up), the peak memory, and the
-cost in microseconds per unknown and step with its growth from the previous
-level; then the verdict against the targets (default 60 s, 2 GB).
+Levels 4 and 5 are timed too (``--compare-levels``, interleaved over
+``--repeats-small`` runs) to show the cost per unknown and step against
+the problem size; it should stay about constant (the solver needs about
+1.3 BiCGStab iterations a step at every level). Then the verdict against
+the targets of the issue (<= 35 s, <= 1 GB) and, for every level above
+the finest one run up to 7, an ESTIMATE of its time (cost per unknown and
+step of the finest level run x unknowns x steps) and memory (the growth of
+the peak above the warmed-up process, scaled with the unknowns).
 
-    python benchmarks/bench_level6.py                         # levels 4 5 6, chord
-    python benchmarks/bench_level6.py --variant eliminate --repeats 3
-    python benchmarks/bench_level6.py --levels 6 --json level6.json
+    python benchmarks/bench_level6.py                      # level 6, ddfv-chord, + 4, 5
+    python benchmarks/bench_level6.py --level 7            # 491 522 unknowns, 8192 steps
+    python benchmarks/bench_level6.py --scheme cotan --compare-levels
+    python benchmarks/bench_level6.py --level 7 --steps 2  # smoke test: 2 steps only
 
 The machine is shared and noisy: compare ratios, not absolute seconds.
 """
 
 import os
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
     os.environ[_var] = "1"          # before numpy is imported
 
 import argparse  # noqa: E402
+import gc  # noqa: E402
 import json  # noqa: E402
 import resource  # noqa: E402
-import statistics  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
-import time  # noqa: E402
 
-PHASES = ("geometry", "assembly", "solve")
+from _harness import footing, harness_run, machine_line, median, one_core, split  # noqa: E402
+
+PHASES = ("geometry", "assembly", "solve", "other")
 
 
-def child(level, variant):
+def child(scheme, level, steps):
     """One run in this process; prints a JSON line with its measurements."""
-    if hasattr(os, "sched_setaffinity"):
-        os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})   # one core
-    from ddfv import SphereL2Error, icosphere, simulate, variant_options
-    from ddfv.sphere import T_FINAL, level_time_step
+    from mcfbench.memory import tune_malloc
 
-    V, F = icosphere(level)
-    tau = level_time_step(level)
-    steps = int(round(T_FINAL / tau))
-    error = SphereL2Error()
-    rss_before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    start = time.perf_counter()
-    traj = simulate(V, F, tau, steps, save_every=0, observer=error, **variant_options(variant))
-    wall = time.perf_counter() - start
+    tune_malloc()
+    one_core()
+    harness_run(scheme, 1)                                  # JIT / cache loading
+    gc.collect()
+    rss_warm = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    result, flow = harness_run(scheme, level, steps=steps)
     print(json.dumps({
-        "level": level, "variant": variant, "nV": len(V) + len(F), "steps": steps,
-        "iterations": int(traj.iterations.sum()), "status": traj.status,
-        "l2_error": error.value if traj.status == "ok" else None,
-        "wall": wall, "timings": traj.timings,
-        # kilobytes on Linux
-        "rss_before_mb": rss_before / 1024,
+        "scheme": scheme, "level": level, "nV": result.nV, "N": result.N,
+        "steps_done": result.steps_done, "iterations": result.iterations,
+        "status": result.status, "message": result.message,
+        "l2_error": result.metrics.get("l2_error"), "wall": result.wall_seconds,
+        "cpu": result.cpu_seconds, "phases": split(result, flow),
+        "warm_rss_mb": rss_warm / 1024,                     # kilobytes on Linux
         "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
 
 
-def run_child(level, variant):
-    out = subprocess.run([sys.executable, __file__, "--child", str(level), variant],
-                         capture_output=True, text=True, check=True)
+def run_child(scheme, level, steps):
+    command = [sys.executable, __file__, "--child", scheme, str(level)]
+    if steps is not None:
+        command += ["--steps", str(steps)]
+    out = subprocess.run(command, capture_output=True, text=True)
+    if out.returncode:
+        raise RuntimeError(f"level {level}: the child failed:\n{out.stderr}")
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def measure(level, variant, repeats):
-    """Medians over ``repeats`` fresh runs; memory: the largest peak."""
-    runs = [run_child(level, variant) for _ in range(repeats)]
+def summary(runs):
+    """Medians over runs of one level (memory: the largest peak)."""
     first = runs[0]
-    wall = statistics.median(r["wall"] for r in runs)
-    return {"level": level, "variant": variant, "nV": first["nV"], "steps": first["steps"],
-            "iterations": first["iterations"], "status": first["status"],
-            "l2_error": first["l2_error"], "repeats": repeats, "wall": wall,
-            "walls": [r["wall"] for r in runs],
-            "phases": {k: statistics.median(r["timings"][k] for r in runs) for k in PHASES},
+    wall = median(r["wall"] for r in runs)
+    cpu = median(r["cpu"] for r in runs)
+    work = first["nV"] * first["steps_done"]
+    return {**{k: first[k] for k in ("scheme", "level", "nV", "N", "steps_done", "iterations",
+                                     "status", "message", "l2_error")},
+            "runs": len(runs), "wall": wall, "cpu": cpu, "walls": [r["wall"] for r in runs],
+            "phases": {k: median(r["phases"][k] for r in runs) for k in PHASES},
             "peak_rss_mb": max(r["peak_rss_mb"] for r in runs),
-            "rss_before_mb": max(r["rss_before_mb"] for r in runs),
-            "us_per_unknown_step": 1e6 * wall / (first["nV"] * first["steps"])}
+            "warm_rss_mb": max(r["warm_rss_mb"] for r in runs),
+            "ns_per_unknown_step": 1e9 * wall / work, "cpu_ns_per_unknown_step": 1e9 * cpu / work}
+
+
+def size(scheme, level):
+    """``(unknowns, steps)`` of the sphere at ``level`` for ``scheme`` (without running)."""
+    from mcfbench.problems import get_problem
+    from mcfbench.schemes import get_scheme
+
+    problem = get_problem("sphere")
+    n_f, n_t = 10 * 4 ** level + 2, 20 * 4 ** level            # icosphere
+    unknowns = n_f + n_t if get_scheme(scheme).family == "ddfv" else n_f
+    return unknowns, problem.time_steps(problem.tau(level))
 
 
 def main(argv=None):
+    from mcfbench.schemes import SCHEMES
+
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--variant", default="chord",
-                        help="DDFV variant (ddfv.variants.VARIANTS); default chord")
-    parser.add_argument("--levels", type=int, nargs="+", default=[4, 5, 6])
-    parser.add_argument("--repeats", type=int, default=1,
-                        help="runs of the finest level (median); default 1")
+    parser.add_argument("--level", type=int, default=6, help="the level timed (default 6)")
+    parser.add_argument("--scheme", default="ddfv-chord", choices=list(SCHEMES),
+                        help="default ddfv-chord (the paper's variant breaks down on level 6)")
+    parser.add_argument("--compare-levels", type=int, nargs="*", default=[4, 5],
+                        help="coarser levels timed for the cost per unknown and step "
+                             "(default 4 5; none: --compare-levels)")
+    parser.add_argument("--repeats", type=int, default=1, help="runs of --level (median)")
     parser.add_argument("--repeats-small", type=int, default=3,
-                        help="runs of every coarser level; default 3")
-    parser.add_argument("--target-seconds", type=float, default=60.0)
-    parser.add_argument("--target-gb", type=float, default=2.0)
+                        help="runs of each compared level (median), interleaved")
+    parser.add_argument("--steps", type=int, help="stop every run after this many steps "
+                        "(smoke test; the targets then do not apply)")
+    parser.add_argument("--target-seconds", type=float, default=35.0)
+    parser.add_argument("--target-gb", type=float, default=1.0)
     parser.add_argument("--json", help="also write the measurements to this file")
-    parser.add_argument("--child", nargs=2, metavar=("LEVEL", "VARIANT"),
-                        help=argparse.SUPPRESS)
+    parser.add_argument("--child", nargs=2, metavar=("SCHEME", "LEVEL"), help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.child:
-        child(int(args.child[0]), args.child[1])
+        child(args.child[0], int(args.child[1]), args.steps)
         return 0
-    levels = sorted(args.levels)
-    print(f"DDFV variant {args.variant!r}, one core, one BLAS thread, every run a fresh "
-          f"process; t_f = 0.08, tau = 0.04 / 4^(level-1)")
-    print(f"{'level':>5} {'nV':>7} {'steps':>5} {'iter':>5} {'runs':>4} {'wall s':>8} "
-          f"{'geom':>6} {'assem':>6} {'solve':>6} {'other':>6} {'peak MB':>8} "
-          f"{'us/(nV*step)':>12} {'growth':>6}")
-    results, previous = [], None
-    for level in levels:
-        m = measure(level, args.variant, args.repeats if level == levels[-1]
-                    else args.repeats_small)
-        other = m["wall"] - sum(m["phases"].values())
-        growth = m["us_per_unknown_step"] / previous["us_per_unknown_step"] if previous \
-            else float("nan")
-        print(f"{level:5d} {m['nV']:7d} {m['steps']:5d} {m['iterations']:5d} "
-              f"{m['repeats']:4d} {m['wall']:8.2f} "
-              + " ".join(f"{m['phases'][k] / m['wall']:6.1%}" for k in PHASES)
-              + f" {other / m['wall']:6.1%} {m['peak_rss_mb']:8.0f} "
-              f"{m['us_per_unknown_step']:12.3f} {growth:6.2f}")
+
+    one_core()                                   # the children inherit the affinity
+    compare = sorted(set(args.compare_levels) - {args.level})
+    print(f"bench_level6: {machine_line()}")
+    print(f"{args.scheme} on the sphere (Table 3.1 setting: t_f = 0.08, tau = 0.04/4^(k-1)), "
+          "one core, one BLAS thread, every run a fresh process warmed up on level 1"
+          + (f"; only {args.steps} steps per run (smoke test)" if args.steps else ""))
+    small = {lv: [] for lv in compare}
+    for _ in range(args.repeats_small if compare else 0):
+        for level in compare:
+            small[level].append(run_child(args.scheme, level, args.steps))
+    results = [summary(small[lv]) for lv in compare]
+    results.append(summary([run_child(args.scheme, args.level, args.steps)
+                            for _ in range(args.repeats)]))
+
+    head = (f"{'level':>5} {'unknowns':>8} {'steps':>5} {'iter':>5} {'runs':>4} {'wall s':>8} "
+            f"{'cpu s':>8} {'ms/step':>8} {'geom':>6} {'assem':>6} {'solve':>6} {'other':>6} "
+            f"{'peak MB':>8} {'+MB':>6} {'ns/(unk*step)':>13} {'cpu ns':>7} {'growth':>6}")
+    print(head)
+    print("-" * len(head))
+    previous = None
+    for m in sorted(results, key=lambda m: m["level"]):
+        growth = (m["ns_per_unknown_step"] / previous["ns_per_unknown_step"]
+                  if previous else float("nan"))
+        cells = " ".join(f"{m['phases'][k] / m['wall']:6.1%}" if m["phases"][k] == m["phases"][k]
+                         else f"{'-':>6}" for k in PHASES)
+        print(f"{m['level']:5d} {m['nV']:8d} {m['steps_done']:5d} {m['iterations']:5d} "
+              f"{m['runs']:4d} {m['wall']:8.2f} {m['cpu']:8.2f} "
+              f"{1e3 * m['wall'] / max(1, m['steps_done']):8.2f} {cells} "
+              f"{m['peak_rss_mb']:8.0f} {m['peak_rss_mb'] - m['warm_rss_mb']:6.0f} "
+              f"{m['ns_per_unknown_step']:13.1f} {m['cpu_ns_per_unknown_step']:7.1f} "
+              f"{growth:6.2f}")
         if m["status"] != "ok":
-            print(f"      level {level}: the run broke down ({m['status']})")
-        results.append(m)
+            print(f"      level {m['level']}: the run broke down: {m['message']}")
         previous = m
+    print("(peak MB: ru_maxrss of the child process; +MB: above the process warmed up on "
+          "level 1; growth: ns per unknown and step over the previous row)")
+    print(footing())
+
     finest = results[-1]
-    wall_ok = finest["wall"] <= args.target_seconds
-    mem_ok = finest["peak_rss_mb"] <= 1024 * args.target_gb
-    print(f"level {finest['level']}: {finest['wall']:.1f} s wall (target <= "
-          f"{args.target_seconds:g} s: {'met' if wall_ok else 'NOT met'}), peak memory "
-          f"{finest['peak_rss_mb']:.0f} MB (target <= {args.target_gb:g} GB: "
-          f"{'met' if mem_ok else 'NOT met'}); L2 error {finest['l2_error']}")
-    if len(results) > 1:
+    print(f"\nload average at the end: {machine_line()}")
+    if args.steps is None:
+        wall_ok = finest["wall"] <= args.target_seconds
+        mem_ok = finest["peak_rss_mb"] <= 1024 * args.target_gb
+        print(f"TARGET level {finest['level']} {args.scheme}, one thread, <= "
+              f"{args.target_seconds:g} s: wall {finest['wall']:.1f} s, CPU "
+              f"{finest['cpu']:.1f} s: {'met' if wall_ok else 'NOT met'} (in CPU time: "
+              f"{'met' if finest['cpu'] <= args.target_seconds else 'NOT met'})")
+        print(f"TARGET peak memory <= {args.target_gb:g} GB: {finest['peak_rss_mb']:.0f} MB: "
+              f"{'met' if mem_ok else 'NOT met'}; L2 error {finest['l2_error']}, "
+              f"{finest['iterations']} iterations")
+    if compare:
         first = results[0]
-        size = (finest["nV"] * finest["steps"]) / (first["nV"] * first["steps"])
-        print(f"level {first['level']} -> {finest['level']}: unknowns x steps x{size:.0f}, "
-              f"wall x{finest['wall'] / first['wall']:.0f}, cost per unknown and step "
-              f"x{finest['us_per_unknown_step'] / first['us_per_unknown_step']:.2f}")
+        print(f"level {first['level']} -> {finest['level']}: unknowns x steps "
+              f"x{finest['nV'] * finest['steps_done'] / (first['nV'] * first['steps_done']):.0f}, "
+              f"wall x{finest['wall'] / first['wall']:.1f}, cost per unknown and step "
+              f"x{finest['ns_per_unknown_step'] / first['ns_per_unknown_step']:.2f}")
+    for level in range(finest["level"] + 1, 8) if args.steps is None else ():
+        unknowns, steps = size(args.scheme, level)
+        scale = unknowns * steps
+        grown = (finest["peak_rss_mb"] - finest["warm_rss_mb"]) * unknowns / finest["nV"]
+        print(f"ESTIMATE level {level} (not run): {unknowns} unknowns, {steps} steps: about "
+              f"{finest['ns_per_unknown_step'] * scale / 1e9:.0f} s wall "
+              f"({finest['cpu_ns_per_unknown_step'] * scale / 1e9:.0f} s CPU) at level "
+              f"{finest['level']}'s cost per unknown and step, peak about "
+              f"{finest['warm_rss_mb'] + grown:.0f} MB (the growth above the warm process "
+              "scaled with the unknowns); the iteration count per step may grow too")
     if args.json:
         with open(args.json, "w") as out:
-            json.dump({"variant": args.variant, "levels": results,
-                       "targets": {"seconds": args.target_seconds, "gb": args.target_gb},
-                       "met": {"wall": wall_ok, "memory": mem_ok}}, out, indent=2)
+            json.dump({"scheme": args.scheme, "levels": results,
+                       "targets": {"seconds": args.target_seconds, "gb": args.target_gb}},
+                      out, indent=2)
     return 0
 
 

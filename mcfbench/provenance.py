@@ -31,15 +31,33 @@ def package_dir(name):
     return Path(spec.origin).parent if spec is not None and spec.origin else None
 
 
+# harness modules that present results (tables, plots, report, command line,
+# file handling) but do not change what a run computes: left out of the code
+# hash that decides when the pipeline redoes a run
+PRESENTATION_MODULES = ("matrix.py", "matrix_plots.py", "render.py", "figures.py", "tables.py",
+                        "plots.py", "report.py", "pipeline.py", "cli.py", "__main__.py",
+                        "records.py", "atomic.py", "provenance.py", "memory.py", "meshio.py")
+
+
 @functools.cache
-def source_hash(name):
-    """Short SHA-256 of the Python sources of package ``name`` (paths and contents)."""
+def source_hash(name, leave_out=()):
+    """Short SHA-256 of the Python sources of package ``name`` (paths and contents),
+    without the top-level modules named in ``leave_out``."""
     digest = hashlib.sha256()
     root = package_dir(name)
     for path in sorted(root.rglob("*.py")):
+        if path.parent == root and path.name in leave_out:
+            continue
         digest.update(path.relative_to(root).as_posix().encode() + b"\0")
         digest.update(path.read_bytes() + b"\0")
     return digest.hexdigest()[:16]
+
+
+def code_hash():
+    """``{package: hash}`` of the code that determines what a run computes: the
+    scheme packages and the harness without :data:`PRESENTATION_MODULES`."""
+    return {name: source_hash(name, PRESENTATION_MODULES if name == "mcfbench" else ())
+            for name in SOURCE_PACKAGES if package_dir(name) is not None}
 
 
 def git_commit(path=None):
@@ -116,6 +134,7 @@ def provenance(config=None):
         "version": version,
         "source_hash": {name: source_hash(name) for name in SOURCE_PACKAGES
                         if package_dir(name) is not None},
+        "code_hash": code_hash(),
         "git_commit": commit,
         "git_dirty": dirty,
         "packages": dependency_versions(),

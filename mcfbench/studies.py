@@ -256,7 +256,7 @@ def level_sweep(scheme, problem, levels=None, **options):
 
 
 def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_final=None,
-                     **options):
+                     solver=None, **options):
     """Error at ``t_final`` against a fine-``tau`` reference of the same scheme on one mesh.
 
     Parameters
@@ -270,8 +270,9 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
         The reference uses ``min(taus) / reference_factor``.
     t_final : float, optional
         Default: the problem's.
+    solver : mcfbench.solver.Solver, optional
     **options
-        Passed to :func:`run`.
+        Options of the scheme's flow (passed to :func:`run`).
 
     Returns
     -------
@@ -288,7 +289,8 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
         The reference run broke down (its message).
     """
     def final(tau):
-        result, traj = run(scheme, problem, level, tau=tau, t_final=t_final, **options)
+        result, traj = run(scheme, problem, level, tau=tau, t_final=t_final, solver=solver,
+                           **options)
         X = np.concatenate([traj.frames[k][-1] for k in traj.frames]).T
         return result, X
 

@@ -491,12 +491,13 @@ def monitor_summary(record):
     Returns
     -------
     dict
-        ``t_reached`` (last time level computed and valid), ``t_monitor_start``
-        (at n = 0), ``t_monitor_end`` (at ``t_reached``: for a run that broke
-        down, the last value before the breakdown), ``t_exit`` (first time a
-        T-vertex was outside its triangle: the monitor < 0, or the breakdown
-        when the status is ``t_escaped``; NaN if never). The monitor values
-        are NaN for schemes without T-vertices.
+        ``t_reached`` (last time level computed: for a run stopped by an
+        invalid state, e.g. ``t_escaped``, that state; after a solver failure
+        the last state before it), ``t_monitor_start`` (at n = 0),
+        ``t_monitor_end`` (at ``t_reached``), ``t_exit`` (first time a T-vertex
+        was outside its triangle: the monitor < 0, or the breakdown when the
+        status is ``t_escaped``; NaN if never). The monitor values are NaN for
+        schemes without T-vertices.
     """
     series = record["series"]
     t = np.asarray(series["t"], dtype=float)
@@ -735,9 +736,10 @@ def _beyond_descriptions(beyond, settings):
             "its triangle (1/3 at the barycentre; below 0 a T-vertex is outside, and the "
             "run stops with status `t_escaped`). `levels`: the runs of the L2 table (t_f as "
             f"there); `long_time`: level {long['level']} continued to t_f = "
-            f"{long['t_final']:g}. 'T monitor at end': at the last valid time level (for a "
-            "run that broke down, the last one before the breakdown); 'T outside from t': "
-            "first time a T-vertex was outside its triangle."),
+            f"{long['t_final']:g}. 'T monitor at end': at the last time level computed (for a "
+            "run stopped by an invalid state, that state; after a solver failure, the last "
+            "state before it); 'T outside from t': first time a T-vertex was outside its "
+            "triangle."),
         "time_convergence": (
             f"Icosphere level {time['level']} (fixed mesh), t_f = {time['t_final']:g}, "
             f"tau = {', '.join(f'{t:g}' for t in time['taus'])}. error: distance at t_f to "

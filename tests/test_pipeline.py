@@ -1,11 +1,12 @@
 """The Snakemake pipeline, run for real on levels 1-2 in a temporary copy.
 
 The copy holds ``Snakefile``, ``workflow/`` and ``config/``; the packages
-come from this checkout through ``PYTHONPATH``. Checked: the numbers of
+(ddfv, baselines, mcfbench) are those of this checkout (installed with
+``pip install -e .``; ``PYTHONPATH`` makes sure). Checked: the numbers of
 ``results/tables/convergence.csv`` against Table 3.1, every output, that a
 second run has nothing to do, that a bad run record stops the aggregation
-with a message naming the file, and that bad config values stop before any
-job.
+with a message naming the file, that bad config values stop before any
+job, and that the scripts are thin adapters of the harness.
 
 If the Slurm executor plugin is installed, Snakemake imports it at start-up
 and it asks ``scontrol show config``, which takes 10 s to give up when Slurm
@@ -23,6 +24,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+
+from mcfbench.records import checksum
 
 REPO = Path(__file__).resolve().parents[1]
 # the study's own target (rule all also builds the figures of another rule
@@ -118,13 +121,17 @@ def test_table_layout(table):
 def test_provenance(workdir, table):
     sidecar = json.loads((workdir / "results/tables/convergence.csv.json").read_text())
     assert sidecar["config"]["levels"] == [1, 2] and sidecar["config_hash"]
+    assert "scheme_modules" not in sidecar["config"]
     assert len(sidecar["inputs"]) == 4
     record = json.loads((workdir / "results/runs/cotan/level2.json").read_text())
+    # set once by the Snakefile, inherited by every job
     assert record["provenance"]["blas_threads"] == dict.fromkeys(
         ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"), "1")
-    assert record["provenance"]["blas_pinned_before_numpy"] is True
     assert record["l2_error"] == table.set_index(["scheme", "level"]).loc[
         ("cotan", 2), "l2_error"]
+    assert record["settings"]["code"].keys() == {"ddfv", "baselines", "mcfbench"}
+    assert len(record["series"]["t_min_barycentric"]) == record["N"] + 1
+    assert record["checksum"] == checksum(record)
 
 
 def test_second_run_has_nothing_to_do(workdir, env):
@@ -139,17 +146,19 @@ def test_bad_run_records_stop_the_aggregation(workdir, env, tmp_path):
     runs = work / "results" / "runs"
     (runs / "cotan" / "level2.json").write_text('{"scheme": "cotan", "level": 2,')
     record = json.loads((runs / "ddfv" / "level1.json").read_text())
-    record["iterations"] = "8"
+    record["iterations"] = 9                     # edited by hand
     (runs / "ddfv" / "level1.json").write_text(json.dumps(record))
     record = json.loads((runs / "ddfv" / "level2.json").read_text())
-    record["provenance"]["config_hash"] = "0123456789abcdef"
+    record["settings"]["rtol"] = 1e-6            # other settings, consistent checksum:
+    record["provenance"]["config_hash"] = "0123456789abcdef"   # a stale record
+    record["checksum"] = checksum(record)
     (runs / "ddfv" / "level2.json").write_text(json.dumps(record))
     before = (work / TABLE).read_text()
     code, out = snakemake(work, env, *RUN)
     assert code != 0
     assert "results/runs/cotan/level2.json: not valid JSON" in out
-    assert "results/runs/ddfv/level1.json: key 'iterations' should be int" in out
-    assert "results/runs/ddfv/level2.json: config hash '0123456789abcdef' does not match" in out
+    assert "results/runs/ddfv/level1.json: checksum does not match the content" in out
+    assert "results/runs/ddfv/level2.json: its settings are not the current ones" in out
     assert "3 invalid run record(s)" in out
     assert "Error in rule convergence_table" in out
     # the table of the good run is gone (Snakemake removes outputs of a failed job)
@@ -159,7 +168,7 @@ def test_bad_run_records_stop_the_aggregation(workdir, env, tmp_path):
 BAD_CONFIGS = {  # --config value -> expected part of the message
     "levels=[0]": "schema['properties']['levels']",
     'levels=["a"]': "schema['properties']['levels']",
-    "schemes=[ddfv,fem]": "config key 'schemes': unknown scheme(s) ['fem']",
+    "schemes=[ddfv,fem]": "config key 'schemes': unknown scheme(s) ['fem']; known schemes",
     "tau_level_1=-0.04": "schema['properties']['tau_level_1']",
     "tau_level_1=0.03": "config keys 't_final' and 'tau_level_1'",
 }
@@ -176,3 +185,51 @@ def test_bad_config_stops_before_any_job(tmp_path, env):
         assert proc.returncode != 0, setting
         assert BAD_CONFIGS[setting] in out, (setting, out[-2000:])
     assert not (work / "results").exists()
+
+
+SCRIPTS = REPO / "workflow" / "scripts"
+OWN_SCRIPTS = ["run_scheme", "beyond_time", "figure", "convergence_table", "plot_convergence",
+               "beyond_tables", "beyond_plots", "beyond_findings", "report", "report_pdf"]
+
+
+@pytest.mark.parametrize("name", OWN_SCRIPTS)
+def test_scripts_are_thin_adapters_of_the_harness(name):
+    """One script per rule, about 50 lines at most, importing the harness only:
+    no other script, no sys.path edits, no BLAS pinning of its own."""
+    text = (SCRIPTS / f"{name}.py").read_text()
+    assert len(text.splitlines()) <= 50
+    assert "sys.path" not in text and "OMP_NUM_THREADS" not in text
+    imports = [line.split()[1] for line in text.splitlines()
+               if line.startswith(("import ", "from "))]
+    local = {p.stem for p in SCRIPTS.glob("*.py")}
+    assert not [m for m in imports if m.split(".")[0] in local], imports
+    assert any(m.startswith("mcfbench") for m in imports)
+    if name in ("run_scheme", "beyond_time", "figure"):    # jobs that run flows
+        assert "tune_malloc()" in text
+
+
+def test_rules_use_the_registry_and_one_code_digest():
+    rules = "".join((REPO / "workflow" / "rules" / f"{name}.smk").read_text()
+                    for name in ("common", "convergence", "beyond", "figures", "report"))
+    for gone in ("scheme_modules", "code_digest", "_package_dir", "DDFV_MODULE",
+                 "importlib", "def _"):
+        assert gone not in rules, gone
+
+
+def test_failed_output_leaves_every_previous_output_in_place(tmp_path):
+    from mcfbench.pipeline import write_files
+
+    first, second = tmp_path / "table.csv", tmp_path / "table.md"
+    write_files({first: "old csv\n", second: "old md\n"})
+
+    import matplotlib.pyplot as plt
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("drawing failed")
+
+    fig = plt.figure()
+    fig.savefig = broken
+    with pytest.raises(RuntimeError, match="drawing failed"):
+        write_files({first: "new csv\n", second: "new md\n", tmp_path / "plot.png": fig})
+    assert first.read_text() == "old csv\n" and second.read_text() == "old md\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["table.csv", "table.md"]

@@ -1,23 +1,24 @@
 # Beyond Table 3.1: level 6, the scheme variants and the T-vertex stability
 # study (issue #5). Not part of `rule all`:
 #
-#   snakemake --cores 2 beyond      # about 5 minutes on 2 cores
+#   snakemake --cores 2 beyond      # about 8 minutes on 2 cores
 #
 # Settings: the config key `beyond` (config/README.md), checked by
-# workflow/scripts/beyond_config.py. Four studies, all under results/beyond/
-# (results/README.md):
+# mcfbench.pipeline.beyond_settings. Four studies, all under results/beyond/
+# (results/README.md), for any scheme of the registry mcfbench.schemes.SCHEMES:
 #
 # - levels: every scheme on every level with tau ~ h^2 as in Table 3.1; the
 #   ordinary run records results/runs/{scheme}/level{k}.json of rule
 #   run_scheme (shared with the convergence study);
 # - long_time: one level continued past t_final (onset of the breakdown);
 # - space: refined meshes with one tiny time step (order 2 in space);
-# - time: one mesh, tau halved repeatedly (order 1 in time; DDFV only).
+# - time: one mesh, tau halved repeatedly (order 1 in time;
+#   mcfbench.studies.time_convergence).
 #
 # Runs that break down are records like any other (status, t_failed, the T
 # monitor of every time level reached); the tables show them as such.
-# Settings, record paths and resources of the jobs: workflow/rules/common.smk
-# (BEYOND, beyond_run_settings, time_settings, BEYOND_*_RUNS).
+# Settings, record paths and resources: mcfbench.pipeline.Pipeline, through
+# workflow/rules/common.smk (BEYOND, BEYOND_RUNS, beyond_run_settings, ...).
 
 BEYOND_TABLE_NAMES = ["levels", "stability", "time_convergence", "space_convergence"]
 BEYOND_TABLES = {
@@ -49,9 +50,7 @@ rule beyond_run:
     output:
         "results/beyond/runs/{study}/{scheme}/level{level}.json",
     params:
-        settings=lambda wildcards: beyond_run_settings(
-            wildcards.study, wildcards.scheme, wildcards.level
-        ),
+        settings=beyond_run_settings,
     log:
         "results/logs/beyond/{study}/{scheme}/level{level}.log",
     threads: 1
@@ -66,11 +65,11 @@ rule beyond_run:
 
 
 rule beyond_time:
-    """Time convergence of one DDFV scheme on one mesh (ddfv.convergence)."""
+    """Time convergence of one scheme on one mesh (mcfbench.studies.time_convergence)."""
     output:
         "results/beyond/runs/time/{scheme}.json",
     params:
-        settings=lambda wildcards: time_settings(wildcards.scheme),
+        settings=time_settings,
     log:
         "results/logs/beyond/time/{scheme}.log",
     threads: 1
@@ -87,10 +86,10 @@ rule beyond_time:
 rule beyond_tables:
     """The tables of the beyond study and the T monitor series."""
     input:
-        levels=list(BEYOND_LEVEL_RUNS),
-        long_time=list(BEYOND_LONG_RUNS),
-        space=list(BEYOND_SPACE_RUNS),
-        time=list(BEYOND_TIME_RUNS),
+        levels=list(BEYOND_RUNS["levels"]),
+        long_time=list(BEYOND_RUNS["long_time"]),
+        space=list(BEYOND_RUNS["space"]),
+        time=list(BEYOND_RUNS["time"]),
     output:
         **{
             key: (
@@ -108,17 +107,10 @@ rule beyond_tables:
         t_monitor="results/beyond/tables/t_monitor.csv",
         provenance="results/beyond/tables/beyond.json",
     params:
-        expected={
-            **BEYOND_LEVEL_RUNS,
-            **BEYOND_LONG_RUNS,
-            **BEYOND_SPACE_RUNS,
-            **BEYOND_TIME_RUNS,
-        },
+        expected={path: s for runs in BEYOND_RUNS.values() for path, s in runs.items()},
         beyond=BEYOND,
         paper_schemes=BEYOND_PAPER_SCHEMES,
-        settings={
-            k: config[k] for k in ("tau_level_1", "t_final", "rtol")
-        },
+        settings={k: config[k] for k in ("tau_level_1", "t_final", "rtol")},
     log:
         "results/logs/beyond/tables.log",
     localrule: True
@@ -188,6 +180,7 @@ rule beyond_findings:
         beyond=BEYOND,
         paper_schemes=BEYOND_PAPER_SCHEMES,
         t_final=config["t_final"],
+        tau_level_1=config["tau_level_1"],
     log:
         "results/logs/beyond/findings.log",
     localrule: True

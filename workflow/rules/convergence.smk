@@ -16,8 +16,8 @@ rule run_scheme:
     output:
         "results/runs/{scheme}/level{level}.json",
     params:
-        # includes a digest of the schemes' code: changed code reruns the job
-        settings=lambda wildcards: run_settings(wildcards.scheme, wildcards.level),
+        # includes the source hash of ddfv, baselines, mcfbench: changed code reruns it
+        settings=run_settings,
     log:
         "results/logs/runs/{scheme}/level{level}.log",
     threads: 1
@@ -35,7 +35,7 @@ rule run_scheme:
 rule convergence_table:
     """Table 3.1 with the paper's values and the baselines side by side."""
     input:
-        records=run_records(),
+        records=PIPELINE.run_records(),
     output:
         csv=report(
             "results/tables/convergence.csv",
@@ -47,10 +47,10 @@ rule convergence_table:
         tex="results/tables/convergence.tex",
         provenance="results/tables/convergence.csv.json",
     params:
-        expected=expected_runs(),
+        expected=PIPELINE.expected_runs(),
         schemes=SCHEMES,
         levels=LEVELS,
-        settings=convergence_settings(),
+        settings=PIPELINE.convergence_settings(),
     log:
         "results/logs/convergence_table.log",
     localrule: True

@@ -1,13 +1,12 @@
 # Figures 3.1-3.8 of the paper (and two comparisons with the cotangent
 # baseline): one job per figure runs its experiment and draws it. What each
-# figure computes (shape, parameters, tau, steps, tangential setting, panels)
-# is defined in one place, ddfv/experiments.py (EXPERIMENTS); this file only
-# maps the registry to files.
+# figure computes (shape, parameters, scheme, tau, steps, panels) is defined
+# in one place, mcfbench/figures.py (EXPERIMENTS); the job is
+# mcfbench.pipeline.figure_job; this file only maps the registry to files.
 #
 #   snakemake --cores 2 results/figures/fig_3_6.png   # one figure
-#   python workflow/scripts/figure.py fig_3_6         # the same, by hand
 
-from ddfv.experiments import EXPERIMENTS
+from mcfbench.figures import EXPERIMENTS
 
 FIGURES = list(EXPERIMENTS)
 
@@ -29,7 +28,7 @@ wildcard_constraints:
 
 
 rule figure:
-    """Run the experiment of one figure (ddfv/experiments.py) and draw it.
+    """Run the experiment of one figure (mcfbench/figures.py) and draw it.
 
     Writes the figure, the kept frames, per-step mesh-quality diagnostics
     (CSV and plot) and a JSON record with the status of every run. A run

@@ -2,7 +2,7 @@
 # Markdown, one self-contained HTML page, a JSON of every check, and LaTeX
 # fragments. Sources: paper/ (published values, captions, checks, text,
 # templates) and the section "Deviations and interpretations" of
-# ddfv/README.md. Logic: workflow/scripts/report*.py.
+# ddfv/README.md. Logic: mcfbench/report.py (python -m mcfbench.report by hand).
 #
 #   snakemake --cores 2                       # builds it (part of rule all)
 #   snakemake --cores 2 reproduction_report   # only the report (and what it needs)
@@ -67,7 +67,7 @@ REPORT_INPUTS = {
     "table": "results/tables/convergence.csv",
     "table_provenance": "results/tables/convergence.csv.json",
     "convergence_figure": "results/figures/convergence.png",
-    "records": run_records(),
+    "records": PIPELINE.run_records(),
     "figures": expand("results/figures/{figure}.png", figure=FIGURES),
     "figure_records": expand("results/runs/figures/{figure}.json", figure=FIGURES),
     "frames": expand("results/runs/figures/{figure}.npz", figure=FIGURES),

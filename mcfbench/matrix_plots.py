@@ -1,0 +1,335 @@
+"""Plots of the benchmark matrix and the gallery (PNG and PDF, written atomically).
+
+* :func:`error_figure`: the main metric against ``h`` per problem, every
+  scheme, with slope-2 guides; a problem without an exact error shows the
+  time each run reached (the breakdown time) against ``h`` instead;
+* :func:`quality_figure`: the smallest angle and the DDFV T monitor over
+  time per problem (finest level of each scheme, from the records'
+  ``series``);
+* :func:`picture_grid`: the final surfaces, scheme x problem, from the
+  saved frames (:mod:`mcfbench.render`);
+* :func:`gallery_grid`: per mesh the initial surface and every scheme's
+  last frame.
+"""
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from .atomic import save_figure  # noqa: E402
+from .matrix import is_error, main_metric  # noqa: E402
+
+T_FLOOR = -0.5
+"""Lower limit of the T monitor axes (values below are clipped and noted)."""
+PER_ROW = 4
+"""Panels per row of the error and quality figures."""
+DIAMONDS_UP_TO = 1500
+"""Draw the DDFV diamond mesh (T-vertices) of meshes with at most this many triangles."""
+VIEWS = {"catenoid": (15.0, -60.0), "hemisphere": (25.0, -60.0)}
+"""View (elev, azim) of the pictures per problem (default ``(20, -60)``)."""
+
+
+def _style(scheme):
+    from .schemes import SCHEMES
+
+    entry = SCHEMES.get(scheme)
+    style = dict(entry.style) if entry is not None else {}
+    return style, (entry.label if entry is not None else scheme)
+
+
+def _grid(n, width=3.4, height=3.0, rows=1):
+    cols = int(np.ceil(n / rows))
+    fig, axes = plt.subplots(rows, cols, figsize=(width * cols, height * rows), squeeze=False)
+    for ax in axes.ravel()[n:]:
+        ax.set_axis_off()
+    return fig, axes
+
+
+def _legend(fig, schemes):
+    """One legend for the whole figure (the schemes' registry styles)."""
+    from matplotlib.lines import Line2D
+
+    handles = []
+    for scheme in schemes:
+        style, label = _style(scheme)
+        handles.append(Line2D([], [], label=label, **style))
+    fig.legend(handles=handles, loc="lower center", ncol=min(4, len(handles)), fontsize=8,
+               frameon=False)
+
+
+def _log_axis(axis):
+    from matplotlib.ticker import NullFormatter
+
+    axis.set_minor_formatter(NullFormatter())
+
+
+def error_figure(table, paths, problems=None, schemes=None):
+    """Main metric (absolute value) against ``h``, log-log, one panel per problem.
+
+    Runs that did not finish are left out and their schemes named in the
+    panel ("broke down: ..."); a zero error (exact) cannot be drawn on a log
+    axis and is named too. Dotted slope-2 guides go through the smallest and
+    largest error at the finest ``h``. A problem whose main metric is not
+    an error shows the time each run reached (the breakdown time of a run
+    that broke down) against ``h``.
+    """
+    problems = problems or list(dict.fromkeys(table["problem"]))
+    schemes = schemes or list(dict.fromkeys(table["scheme"]))
+    rows_ = int(np.ceil(len(problems) / PER_ROW))
+    fig, axes = _grid(len(problems), rows=rows_)
+    for problem, ax in zip(problems, axes.ravel()):
+        part = table[table["problem"] == problem]
+        metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
+        runs = part[part["metric"] == metric]
+        error = is_error(metric)
+        points, broke, exact = [], [], []
+        for scheme in schemes:
+            rows = runs[runs["scheme"] == scheme].sort_values("level")
+            if not len(rows):
+                continue
+            style, label = _style(scheme)
+            if (rows["status"] != "ok").any():
+                broke.append(scheme)
+            if error:
+                ok = rows[(rows["status"] == "ok") & np.isfinite(rows["value"])]
+                x, y = ok["h"].to_numpy(), np.abs(ok["value"].to_numpy())
+                if len(y) and (y == 0).all():
+                    exact.append(scheme)
+                keep = y > 0
+                x, y = x[keep], y[keep]
+            else:
+                x = rows["h"].to_numpy()
+                y = np.where(rows["status"] == "ok", rows["steps_done"] * rows["tau"],
+                             rows["t_failed"])
+            ax.plot(x, y, label=label, **style)
+            points += [(a, b) for a, b in zip(x, y) if np.isfinite(b) and b > 0]
+        if error and points:
+            xs = np.array([p[0] for p in points])
+            ys = np.array([p[1] for p in points])
+            h = np.array([xs.min(), xs.max()])
+            if h[1] > h[0]:
+                for anchor in (ys[xs == xs.min()].min(), ys[xs == xs.min()].max()):
+                    ax.plot(h, anchor * (h / h[0]) ** 2, color="0.6", lw=0.8, ls=":")
+                ax.text(h[1], ys[xs == xs.min()].max() * (h[1] / h[0]) ** 2, "slope 2",
+                        fontsize=7, color="0.4", ha="right", va="bottom")
+        if error and points:
+            ax.set_yscale("log")
+            _log_axis(ax.yaxis)
+        ax.set_xscale("log")
+        _log_axis(ax.xaxis)
+        notes = []
+        if broke:
+            notes.append("broke down: " + ", ".join(broke))
+        if exact:
+            notes.append("error 0 (exact): " + ", ".join(exact))
+        if notes:
+            ax.text(0.02, 0.98, "\n".join(_wrap(n) for n in notes), transform=ax.transAxes,
+                    ha="left", va="top", fontsize=5.5, color="0.2",
+                    bbox={"fc": "white", "ec": "0.8", "alpha": 0.85, "pad": 1.5})
+        ax.set_xlabel("h (mean edge length)")
+        ax.set_ylabel(f"|{metric}|" if error else "time reached (breakdown)")
+        ax.set_title(problem)
+        ax.grid(True, which="both", lw=0.3, alpha=0.5)
+    fig.suptitle("Benchmark matrix: main metric against h", fontsize=10)
+    fig.tight_layout(rect=(0, 0.06 / rows_, 1, 1))
+    _legend(fig, schemes)
+    save_figure(fig, *paths)
+
+
+def _wrap(text, width=48):
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, width))
+
+
+def quality_figure(records, paths, problems=None, schemes=None):
+    """Smallest angle (top) and T monitor (bottom, DDFV) over time, finest level."""
+    by_run = {}
+    for r in records:
+        key = (r["problem"], r["scheme"])
+        if key not in by_run or r["level"] > by_run[key]["level"]:
+            by_run[key] = r
+    problems = problems or list(dict.fromkeys(p for p, _ in by_run))
+    schemes = schemes or list(dict.fromkeys(s for _, s in by_run))
+    cols = min(PER_ROW, len(problems))
+    rows = int(np.ceil(len(problems) / cols))
+    fig, axes = plt.subplots(2 * rows, cols, figsize=(3.4 * cols, 5.6 * rows), squeeze=False)
+    for ax in axes[:, :].ravel():
+        ax.set_visible(False)
+    for j, problem in enumerate(problems):
+        top, bottom = axes[2 * (j // cols), j % cols], axes[2 * (j // cols) + 1, j % cols]
+        top.set_visible(True)
+        bottom.set_visible(True)
+        levels = set()
+        for scheme in schemes:
+            r = by_run.get((problem, scheme))
+            if r is None or not r.get("series"):
+                continue
+            levels.add(int(r["level"]))
+            style, label = _style(scheme)
+            style = {k: v for k, v in style.items() if k != "marker"}
+            series = r["series"]
+            t, angle = np.asarray(series.get("quality_t", []), float), \
+                np.asarray(series.get("min_angle", []), float)
+            if len(t):
+                top.plot(t, angle, label=label, **style)
+                if r["status"] != "ok":
+                    top.plot(t[-1:], angle[-1:], "x", color=style.get("color"), ms=6)
+            tm = np.asarray([np.nan if v is None else v
+                             for v in series.get("t_min_barycentric", [])], float)
+            if np.isfinite(tm).any():
+                tt = np.asarray(series["t"], float)
+                bottom.plot(tt, tm, label=label, **style)
+                if r["status"] != "ok":
+                    bottom.plot(tt[-1:], tm[-1:], "x", color=style.get("color"), ms=6)
+        top.set_title(f"{problem} (level {', '.join(map(str, sorted(levels)))})")
+        top.set_ylabel("smallest angle (degrees)")
+        bottom.set_ylabel("T monitor (min barycentric)")
+        bottom.axhline(0.0, color="0.5", lw=0.6)
+        lows = [min(line.get_ydata()) for line in bottom.lines if len(line.get_ydata())]
+        if lows and min(lows) < T_FLOOR:  # a T-vertex far outside: keep 0 readable
+            bottom.set_ylim(T_FLOOR, 0.36)
+            bottom.text(0.98, 0.02, f"clipped at {T_FLOOR} (lowest {min(lows):.3g})",
+                        transform=bottom.transAxes, ha="right", va="bottom", fontsize=6)
+        bottom.set_xlabel("t")
+        for ax in (top, bottom):
+            ax.grid(True, lw=0.3, alpha=0.5)
+    fig.suptitle("Mesh quality over time (finest level; x = breakdown)", fontsize=10)
+    fig.tight_layout(rect=(0, 0.04 / rows, 1, 1 - 0.03 / rows))
+    _legend(fig, schemes)
+    save_figure(fig, *paths)
+
+
+def _surface(frames, which=-1):
+    """``(F, T, faces)`` of a saved frame (``T`` None for vertex schemes)."""
+    faces = np.asarray(frames["faces"])
+    if "F" in frames:
+        T = frames["T"][which] if "T" in frames and len(frames["T"]) else None
+        return np.asarray(frames["F"][which]), T, faces
+    if "V" in frames and len(frames["V"]):
+        return np.asarray(frames["V"][which]), None, faces
+    return None, None, faces
+
+
+def _draw_grid(cells, row_labels, col_labels, paths, title, views=None, share="column",
+               size=1.9):
+    """Draw ``cells[i][j] = (F, T, faces, note)`` or None; one length scale per
+    column (``share="column"``) or per row (``"row"``)."""
+    from .render import draw_mesh, project
+
+    rows, cols = len(row_labels), len(col_labels)
+    fig, axes = plt.subplots(rows, cols, figsize=(size * cols + 1.2, size * rows + 0.5),
+                             squeeze=False)
+    views = views or [(20.0, -60.0)] * cols
+
+    def group(i, j):
+        return j if share == "column" else i
+
+    def finite(cell):
+        return cell is not None and cell[0] is not None and np.isfinite(cell[0]).all() \
+            and (cell[1] is None or np.isfinite(cell[1]).all())
+
+    boxes = {}
+    for i in range(rows):
+        for j in range(cols):
+            if finite(cells[i][j]):
+                xy = project(cells[i][j][0], views[j])[0]
+                boxes.setdefault(group(i, j), []).append((xy.min(axis=0), xy.max(axis=0)))
+    scale = {}
+    for key, bs in boxes.items():
+        lo, hi = np.min([b[0] for b in bs], axis=0), np.max([b[1] for b in bs], axis=0)
+        scale[key] = (0.5 * (lo + hi), 0.55 * max(max(hi - lo), 1e-12))
+    for i in range(rows):
+        for j in range(cols):
+            ax, cell = axes[i, j], cells[i][j]
+            ax.set_xticks([])
+            ax.set_yticks([])
+            for spine in ax.spines.values():
+                spine.set_visible(False)
+            if i == 0:
+                ax.set_title(col_labels[j], fontsize=8)
+            if j == 0:
+                ax.set_ylabel(row_labels[i], fontsize=7)
+            if not finite(cell):
+                text = "no frame" if cell is None else cell[3] if cell[0] is None \
+                    else "non-finite state"
+                ax.text(0.5, 0.5, text, ha="center", va="center", fontsize=6,
+                        transform=ax.transAxes)
+                continue
+            F, T, faces, note = cell
+            if T is not None and len(faces) > DIAMONDS_UP_TO:
+                T = None  # the diamonds of a fine mesh are a solid colour at this size
+            centre, half = scale[group(i, j)]
+            draw_mesh(ax, F, T, faces, view=views[j], points_per_unit=72.0 * size / (2 * half))
+            ax.set_xlim(centre[0] - half, centre[0] + half)
+            ax.set_ylim(centre[1] - half, centre[1] + half)
+            ax.set_aspect("equal")
+            if note:
+                ax.text(0.5, 0.01, note, ha="center", va="bottom", fontsize=5.5,
+                        transform=ax.transAxes)
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    for ax in fig.axes:
+        for coll in ax.collections:
+            coll.set_rasterized(True)
+    save_figure(fig, *paths, dpi=120)
+
+
+def _note(record):
+    t = record["steps_done"] * record["tau"]
+    if record["status"] == "ok":
+        return f"t = {t:.3g}"
+    return f"{record['status']} t = {record['t_failed']:.3g}"
+
+
+def picture_grid(entries, paths, problems, schemes):
+    """Final surfaces, schemes as rows (the initial surface first), problems as columns.
+
+    Parameters
+    ----------
+    entries : dict
+        ``(problem, scheme) -> (record, frames)``, ``frames`` a mapping of
+        the saved arrays (``np.load`` of the npz).
+    """
+    cells = [[None] * len(problems) for _ in range(len(schemes) + 1)]
+    for j, problem in enumerate(problems):
+        for i, scheme in enumerate(schemes):
+            entry = entries.get((problem, scheme))
+            if entry is None:
+                continue
+            record, frames = entry
+            F, T, faces = _surface(frames, -1)
+            cells[i + 1][j] = (F, T, faces, f"L{record['level']}: {_note(record)}")
+            if cells[0][j] is None:
+                F0, T0, _ = _surface(frames, 0)
+                cells[0][j] = (F0, None, faces, f"level {record['level']}, t = 0")
+    labels = ["initial"] + [_style(s)[1] for s in schemes]
+    _draw_grid(cells, labels, problems, paths, "Final surfaces (coarsest level of each problem)",
+               views=[VIEWS.get(p, (20.0, -60.0)) for p in problems])
+
+
+def gallery_grid(entries, paths, meshes, schemes):
+    """Per mesh (row) the initial surface and each scheme's last frame (columns).
+
+    ``entries``: ``(mesh, scheme) -> (record, frames)``.
+    """
+    cells = [[None] * (len(schemes) + 1) for _ in meshes]
+    for i, mesh in enumerate(meshes):
+        for j, scheme in enumerate(schemes):
+            entry = entries.get((mesh, scheme))
+            if entry is None:
+                continue
+            record, frames = entry
+            if "faces" not in frames or not len(frames["faces"]):
+                cells[i][j + 1] = (None, None, None, record["status"])
+                continue
+            F, T, faces = _surface(frames, -1)
+            cells[i][j + 1] = (F, T, faces, _note(record))
+            if cells[i][0] is None:
+                F0, _, _ = _surface(frames, 0)
+                cells[i][0] = (F0, None, faces, f"{len(faces)} triangles")
+    labels = ["initial"] + [_style(s)[1] for s in schemes]
+    _draw_grid(cells, list(meshes), labels, paths, "Gallery: first and last frame per scheme",
+               share="row")

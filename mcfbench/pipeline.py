@@ -1,0 +1,524 @@
+"""The Snakemake pipeline's logic: config checks, run settings, targets, jobs.
+
+The workflow (``Snakefile``, ``workflow/rules/*.smk``) holds target lists
+and input functions only; its scripts (``workflow/scripts/*.py``) are thin
+adapters that read Snakemake's inputs and params and call this module (or
+:mod:`mcfbench.tables`, :mod:`mcfbench.plots`, :mod:`mcfbench.report`).
+
+Config
+    :class:`Pipeline` checks the config (after the schema,
+    ``workflow/schemas/config.schema.yaml``) across keys while Snakemake
+    reads the workflow: every scheme name is one of the registry
+    :data:`mcfbench.schemes.SCHEMES`, every final time a whole multiple of
+    its time steps. A bad value raises :class:`ConfigError` naming the key.
+Settings
+    Everything that determines one run record (scheme, problem, level, tau,
+    t_final, solver tolerance, the source hash of every package): passed to
+    the job, stored and hashed in the record, and recomputed by the
+    aggregation to refuse stale records (:func:`mcfbench.records.read_record`).
+Jobs
+    :func:`run_job`, :func:`time_job`, :func:`figure_job` run flows;
+    :func:`read_records` checks records for the aggregations;
+    :func:`write_files` writes every output of a job at once.
+"""
+
+import contextlib
+import hashlib
+import json
+import logging
+import math
+import re
+import sys
+import time
+from pathlib import Path
+
+from .atomic import _figure_metadata, atomic_path, json_value, save_npz
+from .problems import get_problem
+from .provenance import code_hash, provenance
+from .records import FIELDS, RecordError, read_record, write_record
+from .schemes import SCHEMES, get_scheme
+from .solver import Solver
+
+PROBLEM = "sphere"        # the problem of Table 3.1 and of the beyond study
+FIGURE_DPI = 200
+
+
+class ConfigError(ValueError):
+    """A config value the schema cannot check; the message names the key."""
+
+
+# -- logging and output ---------------------------------------------------------------
+
+def setup_logging(log_file):
+    """Log to the job's log file and to stderr (shown by Snakemake)."""
+    Path(log_file).parent.mkdir(parents=True, exist_ok=True)
+    handlers = [logging.FileHandler(log_file, mode="w"), logging.StreamHandler(sys.stderr)]
+    logging.basicConfig(level=logging.INFO, handlers=handlers, force=True,
+                        format="%(asctime)s %(levelname)s %(message)s")
+    return logging.getLogger("pipeline")
+
+
+def write_files(files):
+    """Write every output of a job, all or nothing.
+
+    ``files`` maps a path to its content: text, bytes, a matplotlib figure
+    (saved in the format of the suffix at :data:`FIGURE_DPI`, without dates)
+    or ``(figure, savefig keyword arguments)``. Every content goes to a
+    temporary file next to its target first; only when all are written are
+    they renamed over the targets, so a failure leaves every previous output
+    in place. The figures are closed.
+    """
+    figures = []
+    try:
+        with contextlib.ExitStack() as stack:
+            for path, content in files.items():
+                tmp = stack.enter_context(atomic_path(path))
+                if isinstance(content, str):
+                    tmp.write_text(content)
+                elif isinstance(content, bytes):
+                    tmp.write_bytes(content)
+                else:
+                    fig, options = content if isinstance(content, tuple) else (content, {})
+                    figures.append(fig)
+                    suffix = Path(path).suffix
+                    fig.savefig(tmp, **{"dpi": FIGURE_DPI, "format": suffix.lstrip("."),
+                                        "metadata": _figure_metadata(suffix), **options})
+    finally:
+        if figures:
+            import matplotlib.pyplot as plt
+
+            for fig in set(figures):
+                plt.close(fig)
+
+
+def json_text(data):
+    """``data`` as indented standard JSON text (NaN as null), as :mod:`mcfbench.atomic`."""
+    return json.dumps(json_value(data), indent=2, allow_nan=False) + "\n"
+
+
+def sidecar(settings, records, texts):
+    """Provenance of aggregated tables: the settings, per input record its hash,
+    commit, host and time, and the SHA-256 of every output text."""
+    data = provenance(settings)
+    data["inputs"] = {path: {key: rec["provenance"].get(key) for key in
+                             ("config_hash", "git_commit", "git_dirty", "host", "created",
+                              "blas_threads")}
+                      for path, rec in records.items()}
+    data["outputs"] = {str(path): hashlib.sha256(text.encode()).hexdigest()
+                       for path, text in texts.items()}
+    return data
+
+
+# -- the config ---------------------------------------------------------------------
+
+def check_schemes(key, names):
+    """``names`` as a list, every one a registry name.
+
+    Raises
+    ------
+    ConfigError
+        Naming ``key``, the unknown names and every known scheme.
+    """
+    names = list(names)
+    unknown = [s for s in names if s not in SCHEMES]
+    if unknown:
+        raise ConfigError(f"config key {key!r}: unknown scheme(s) {unknown}; known schemes "
+                          f"(mcfbench.schemes.SCHEMES): {', '.join(SCHEMES)}")
+    return names
+
+
+def _steps(key, problem, tau, t_final, what):
+    """``problem.time_steps``, its error as a ConfigError naming ``key``."""
+    try:
+        return problem.time_steps(tau, t_final)
+    except ValueError as err:
+        raise ConfigError(f"config key{'s' if ' and ' in key else ''} {key}: {err} "
+                          f"({what} time step)") from None
+
+
+def beyond_settings(config, problem):
+    """Check ``config["beyond"]`` against the other keys and normalise it.
+
+    Parameters
+    ----------
+    config : dict
+        The whole config, already checked against the schema.
+    problem : mcfbench.problems.Problem
+        The sphere with the config's ``tau_level_1`` and ``t_final``.
+
+    Returns
+    -------
+    dict
+        ``levels`` (sorted ints), ``schemes``, ``long_time`` (``level``,
+        ``t_final``, ``tau``, ``schemes``), ``time_study`` (``level``,
+        ``taus`` (descending), ``reference_factor``, ``t_final``,
+        ``schemes``) and ``space_study`` (``levels``, ``tau``, ``t_final``,
+        ``schemes``); times as floats.
+
+    Raises
+    ------
+    ConfigError
+        An unknown scheme, or a final time that is not a whole multiple of a
+        time step; the message names the key.
+    """
+    beyond = config["beyond"]
+    t_final = problem.t_final
+    levels = sorted({int(level) for level in beyond["levels"]})
+    for level in levels:
+        _steps("'beyond.levels'", problem, problem.tau(level), t_final, f"the level-{level}")
+    long, time_, space = beyond["long_time"], beyond["time_study"], beyond["space_study"]
+    long_level, long_t = int(long["level"]), float(long["t_final"])
+    _steps("'beyond.long_time.t_final'", problem, problem.tau(long_level), long_t,
+           f"the level-{long_level}")
+    taus = sorted({float(tau) for tau in time_["taus"]}, reverse=True)
+    time_t = float(time_.get("t_final", t_final))
+    for tau in taus:
+        _steps("'beyond.time_study.taus'", problem, tau, time_t, "a")
+    factor = int(time_["reference_factor"])
+    _steps("'beyond.time_study.reference_factor'", problem, taus[-1] / factor, time_t,
+           "the reference's")
+    space_tau, space_t = float(space["tau"]), float(space.get("t_final", t_final))
+    _steps("'beyond.space_study.tau'", problem, space_tau, space_t, "the")
+    return {
+        "levels": levels,
+        "schemes": check_schemes("beyond.schemes", beyond["schemes"]),
+        "long_time": {"level": long_level, "t_final": long_t, "tau": problem.tau(long_level),
+                      "schemes": check_schemes("beyond.long_time.schemes", long["schemes"])},
+        "time_study": {"level": int(time_["level"]), "taus": taus, "reference_factor": factor,
+                       "t_final": time_t,
+                       "schemes": check_schemes("beyond.time_study.schemes",
+                                                time_["schemes"])},
+        "space_study": {"levels": sorted({int(level) for level in space["levels"]}),
+                        "tau": space_tau, "t_final": space_t,
+                        "schemes": check_schemes("beyond.space_study.schemes",
+                                                 space["schemes"])},
+    }
+
+
+def used_schemes(beyond):
+    """Every scheme the beyond study runs, in order of first appearance."""
+    names = list(beyond["schemes"])
+    for key in ("long_time", "time_study", "space_study"):
+        names += [s for s in beyond[key]["schemes"] if s not in names]
+    return names
+
+
+def run_seconds(level, steps):
+    """Rough single-core wall time of a run of ``steps`` steps on ``level``, with
+    margin (10-13 ms a step on level 5, x4 per level, plus about 0.6 ms a step of
+    fixed cost; up to 1.5x that with other jobs running)."""
+    return steps * (0.02 * 4.0 ** (int(level) - 5) + 0.001)
+
+
+def runtime_minutes(level, steps):
+    """Slurm time limit in minutes: 4x :func:`run_seconds`, at least 5."""
+    return max(5, math.ceil(4 * run_seconds(level, steps) / 60))
+
+
+def mem_mb(level):
+    """Peak memory with margin (level 5 about 95 MB, x4 per level)."""
+    return 500 + 100 * 4 ** max(int(level) - 5, 0)
+
+
+class Pipeline:
+    """The checked config and everything derived from it.
+
+    Parameters
+    ----------
+    config : dict
+        Snakemake's config after the schema check (``--config levels=[1,2]``
+        gives strings: normalised here).
+
+    Raises
+    ------
+    ConfigError
+        See :func:`check_schemes`, :func:`beyond_settings`, and a ``t_final``
+        that is not a whole multiple of every level's time step.
+    """
+
+    def __init__(self, config):
+        self.levels = sorted({int(level) for level in config["levels"]})
+        self.schemes = check_schemes("schemes", config["schemes"])
+        self.rtol = float(config["rtol"])
+        self.problem = get_problem(PROBLEM).with_settings(
+            tau_1=float(config["tau_level_1"]), t_final=float(config["t_final"]))
+        for level in self.levels:
+            _steps("'t_final' and 'tau_level_1'", self.problem, self.problem.tau(level),
+                   self.problem.t_final, f"the level-{level}")
+        self.beyond = beyond_settings(config, self.problem)
+        self.config = {**config, "levels": self.levels}
+        self.code = code_hash()
+
+    # -- settings of one record
+    def run_settings(self, scheme, level, *, study=None, tau=None, t_final=None):
+        """Everything that determines the run record of (scheme, level).
+
+        ``study``, ``tau`` and ``t_final`` override the convergence study's
+        settings (the studies beyond Table 3.1); without them the settings,
+        and so the hash, are those of Table 3.1.
+        """
+        level = int(level)
+        settings = {"scheme": scheme, "problem": self.problem.name, "level": level,
+                    "tau": self.problem.tau(level) if tau is None else float(tau),
+                    "t_final": self.problem.t_final if t_final is None else float(t_final),
+                    "rtol": self.rtol, "code": self.code}
+        return settings if study is None else {"study": study, **settings}
+
+    def beyond_run_settings(self, study, scheme, level):
+        """Settings of one run of the long-time or the space study."""
+        if study == "long_time":
+            return self.run_settings(scheme, level, study=study,
+                                     t_final=self.beyond["long_time"]["t_final"])
+        space = self.beyond["space_study"]
+        return self.run_settings(scheme, level, study=study, tau=space["tau"],
+                                 t_final=space["t_final"])
+
+    def time_settings(self, scheme):
+        """Settings of the time study of one scheme."""
+        study = self.beyond["time_study"]
+        return {"study": "time", "scheme": scheme, "problem": self.problem.name,
+                "level": study["level"], "taus": study["taus"],
+                "reference_factor": study["reference_factor"], "t_final": study["t_final"],
+                "rtol": self.rtol, "code": self.code}
+
+    def convergence_settings(self):
+        """The config as far as Table 3.1 depends on it (not the other studies)."""
+        return {k: self.config[k] for k in ("levels", "schemes", "tau_level_1", "t_final",
+                                            "rtol")}
+
+    # -- record paths and targets
+    @staticmethod
+    def run_record(scheme, level):
+        return f"results/runs/{scheme}/level{level}.json"
+
+    def run_records(self):
+        """Run records of every (scheme, level), schemes in config order."""
+        return [self.run_record(s, level) for s in self.schemes for level in self.levels]
+
+    def expected_runs(self):
+        """``{record path: settings}`` of the convergence study."""
+        return {self.run_record(s, lv): self.run_settings(s, lv)
+                for s in self.schemes for lv in self.levels}
+
+    def beyond_runs(self):
+        """``{study: {record path: settings}}`` of the beyond study."""
+        b = self.beyond
+        return {
+            "levels": {self.run_record(s, lv): self.run_settings(s, lv)
+                       for s in b["schemes"] for lv in b["levels"]},
+            "long_time": {
+                f"results/beyond/runs/long_time/{s}/level{b['long_time']['level']}.json":
+                    self.beyond_run_settings("long_time", s, b["long_time"]["level"])
+                for s in b["long_time"]["schemes"]},
+            "space": {f"results/beyond/runs/space/{s}/level{lv}.json":
+                      self.beyond_run_settings("space", s, lv)
+                      for s in b["space_study"]["schemes"] for lv in b["space_study"]["levels"]},
+            "time": {f"results/beyond/runs/time/{s}.json": self.time_settings(s)
+                     for s in b["time_study"]["schemes"]},
+        }
+
+    def paper_schemes(self):
+        """Schemes of the beyond study compared with the published Table 3.1: the DDFV ones."""
+        return [s for s in self.beyond["schemes"] if get_scheme(s).family == "ddfv"]
+
+    @staticmethod
+    def scheme_pattern():
+        """Regular expression of the registry's names, longest first."""
+        return "|".join(re.escape(s) for s in sorted(SCHEMES, key=len, reverse=True))
+
+    # -- resources of the jobs (minutes, MB)
+    @staticmethod
+    def mem_mb(level):
+        return mem_mb(level)
+
+    def run_runtime(self, level):
+        return runtime_minutes(level, self.problem.time_steps(self.problem.tau(int(level))))
+
+    def beyond_runtime(self, study, scheme, level):
+        settings = self.beyond_run_settings(study, scheme, level)
+        return runtime_minutes(level, round(settings["t_final"] / settings["tau"]))
+
+    def time_runtime(self):
+        study = self.beyond["time_study"]
+        steps = sum(round(study["t_final"] / tau) for tau in study["taus"])
+        steps += round(study["t_final"] * study["reference_factor"] / study["taus"][-1])
+        return runtime_minutes(study["level"], steps)
+
+
+# -- jobs --------------------------------------------------------------------------
+
+def solver_of(settings):
+    """The shared solver with the settings' tolerance (and ``maxiter`` if given)."""
+    return Solver(rtol=settings["rtol"], **({"maxiter": settings["maxiter"]}
+                                            if "maxiter" in settings else {}))
+
+
+def run_job(settings, output, log):
+    """One scheme on one level of the problem with ``settings``: its run record.
+
+    Returns
+    -------
+    mcfbench.studies.RunResult
+    """
+    from .studies import run
+
+    problem = get_problem(settings["problem"]).with_settings(t_final=settings["t_final"])
+    log.info("%s level %d: tau %g, t_final %g, rtol %g", settings["scheme"], settings["level"],
+             settings["tau"], settings["t_final"], settings["rtol"])
+    result, _ = run(settings["scheme"], problem, settings["level"], tau=settings["tau"],
+                    t_final=settings["t_final"], solver=solver_of(settings))
+    write_record(output, result, settings)
+    log.info("%s level %d: status %s, L2 error %.4e, %d iterations, %.3f s wall -> %s",
+             result.scheme, result.level, result.status,
+             result.metrics.get("l2_error", math.nan), result.iterations, result.wall_seconds,
+             output)
+    if result.status != "ok":
+        log.warning("%s", result.message)
+    return result
+
+
+TIME_FIELDS = {"scheme": str, "level": int, "reference_tau": float, "t_final": float,
+               "outcome": str, "message": str, "rows": list, "wall_seconds": float,
+               "settings": dict, "provenance": dict, "checksum": str}
+"""Key -> type of a time-study record (:func:`time_job`)."""
+
+
+def time_job(settings, output, log):
+    """Time convergence of one scheme on one mesh (:func:`mcfbench.studies.time_convergence`).
+
+    A reference run that breaks down does not fail the job: the record has
+    ``outcome = "reference_failed"``, the message and no rows; single runs
+    that break down are rows with their status.
+    """
+    from .studies import time_convergence
+
+    problem = get_problem(settings["problem"]).with_settings(t_final=settings["t_final"])
+    taus, factor = settings["taus"], settings["reference_factor"]
+    log.info("%s level %d: time_convergence(taus=%s, reference_factor=%d, t_final=%g, "
+             "rtol=%g)", settings["scheme"], settings["level"], taus, factor,
+             settings["t_final"], settings["rtol"])
+    wall = time.perf_counter()
+    try:
+        table = time_convergence(settings["scheme"], problem, settings["level"], taus,
+                                 reference_factor=factor, t_final=settings["t_final"],
+                                 solver=solver_of(settings))
+        rows, outcome, message = table.to_dict("records"), "ok", ""
+    except RuntimeError as err:
+        rows, outcome, message = [], "reference_failed", str(err)
+    wall = time.perf_counter() - wall
+    write_record(output, {"scheme": settings["scheme"], "level": settings["level"],
+                          "taus": taus, "reference_factor": factor,
+                          "reference_tau": min(taus) / factor, "t_final": settings["t_final"],
+                          "outcome": outcome, "message": message, "rows": rows,
+                          "wall_seconds": wall}, settings)
+    log.info("%s: %s in %.1f s -> %s", settings["scheme"], outcome, wall, output)
+    if outcome != "ok":
+        log.warning("%s", message)
+    for row in rows:
+        log.info("tau %-10g error %.4e eoc %.3f %s", row["tau"], row["error"], row["eoc"],
+                 row["status"])
+
+
+def read_records(expected, log):
+    """Read and check every record of ``expected`` (``{path: settings}``).
+
+    Returns
+    -------
+    dict
+        ``{path: record}``.
+
+    Raises
+    ------
+    RecordError
+        Listing every invalid record (each message names its file), after
+        logging them.
+    """
+    records, errors = {}, []
+    for path, settings in expected.items():
+        required = TIME_FIELDS if settings.get("study") == "time" else FIELDS
+        try:
+            records[path] = read_record(path, settings, required=required)
+        except RecordError as err:
+            errors.append(str(err))
+            log.error("invalid run record: %s", err)
+    if errors:
+        raise RecordError(f"aggregation stopped: {len(errors)} invalid run record(s):\n"
+                          + "\n".join(errors))
+    return records
+
+
+FIGURE_OUTPUTS = ("png", "pdf", "frames", "record", "csv", "plot")
+
+
+def figure_outputs(name, results="results"):
+    """Output paths of the figure ``name`` (those of workflow/rules/figures.smk)."""
+    root = Path(results)
+    return {"png": root / "figures" / f"{name}.png", "pdf": root / "figures" / f"{name}.pdf",
+            "frames": root / "runs" / "figures" / f"{name}.npz",
+            "record": root / "runs" / "figures" / f"{name}.json",
+            "csv": root / "diagnostics" / f"{name}.csv",
+            "plot": root / "diagnostics" / f"{name}.png"}
+
+
+def figure_job(name, outputs, log):
+    """Run the experiment of one figure (:mod:`mcfbench.figures`) and draw it.
+
+    Writes the figure (PNG + PDF), the kept frames of every run (npz, keys
+    ``<run>.F``, ``<run>.T``, ``<run>.steps``, ``<run>.faces``,
+    ``<run>.iterations``), the per-step diagnostics of the DDFV runs (CSV
+    with a ``run`` column, and a plot) and a JSON record (status per run,
+    first violation, timings, provenance). A run that breaks down keeps its
+    frames and the figure is drawn from them with a note.
+    """
+    import pandas as pd
+
+    from .figures import EXPERIMENTS, draw_experiment, experiment_status, run_experiment
+    from .quality import COLUMNS, plot_quality
+    from .render import DPI
+
+    experiment = EXPERIMENTS[name]
+    wall = time.perf_counter()
+    results = run_experiment(experiment)
+    compute = time.perf_counter() - wall
+    arrays = {}
+    for key, r in results.items():
+        arrays.update({f"{key}.F": r.F, f"{key}.steps": r.steps, f"{key}.faces": r.faces,
+                       f"{key}.iterations": r.iterations})
+        if r.T is not None:
+            arrays[f"{key}.T"] = r.T
+    quality = {key: r for key, r in results.items() if r.quality is not None}
+    frames = [r.quality.assign(run=key) for key, r in quality.items()]
+    table = pd.concat(frames, ignore_index=True) if frames else \
+        pd.DataFrame(columns=["run", *COLUMNS])
+    plot = plot_quality({r.run.label or key: r.quality for key, r in quality.items()},
+                        title=f"{experiment.name}: {experiment.title}",
+                        marks=sorted({s.step for s in experiment.shots}))
+    draw = time.perf_counter()
+    figure = draw_experiment(experiment, results)
+    draw = time.perf_counter() - draw
+    for ax in figure.axes:          # meshes rasterised in the PDF, as render.save_figure
+        for collection in ax.collections:
+            collection.set_rasterized(True)
+    status = experiment_status(results)
+    record = {
+        "experiment": experiment.name, "title": experiment.title, "status": status,
+        "first_violation": {key: r.record()["first_violation"] for key, r in quality.items()},
+        "runs": {key: r.record() for key, r in results.items()},
+        "seconds": {"compute": round(compute, 3), "draw": round(draw, 3),
+                    "total": round(time.perf_counter() - wall, 3)},
+        "outputs": {k: str(v) for k, v in outputs.items()},
+        "provenance": provenance(experiment.config()),
+    }
+    save_npz(outputs["frames"], **arrays)
+    write_files({outputs["csv"]: table[["run", *COLUMNS]].to_csv(index=False),
+                 outputs["plot"]: (plot, {"dpi": DPI}), outputs["png"]: (figure, {"dpi": DPI}),
+                 outputs["pdf"]: (figure, {"dpi": 2 * DPI}),
+                 outputs["record"]: json_text(record)})
+    for key, r in results.items():
+        line = f"{experiment.name}/{key}: {r.status}, n = {int(r.steps[-1])}"
+        line += f" ({r.message})" if r.message else ""
+        violation = r.record()["violation"]
+        line += f"; first violation at {violation}" if violation else ""
+        (log.warning if r.status != "ok" else log.info)("%s", line)
+    log.info("%s: %s; compute %.1f s, draw %.1f s", experiment.name, status, compute, draw)
+    return status

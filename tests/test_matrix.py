@@ -1,0 +1,262 @@
+"""The benchmark matrix (mcfbench.matrix, workflow/rules/matrix.smk): the config
+check against the registries, one tiny matrix run for real (2 schemes x 2
+problems at level 1) through the job function, records, tables, findings and
+plots, the EOC and summary logic on records with known numbers, and the
+Snakemake DAG of the targets `matrix` and `gallery`."""
+
+import math
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mcfbench import matrix
+from mcfbench.flow import STATUSES
+from mcfbench.problems import PROBLEMS
+from mcfbench.records import FIELDS, read_record, write_record
+from mcfbench.schemes import SCHEMES
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+# ------------------------------------------------------------ config
+
+
+def test_plan_defaults_to_every_scheme_and_problem():
+    plan = matrix.matrix_plan({})
+    assert plan["schemes"] == list(SCHEMES)
+    assert list(plan["problems"]) == list(PROBLEMS)
+    assert plan["problems"]["sphere"] == sorted(PROBLEMS["sphere"].levels)
+    assert plan["solver"] == "bicgstab"
+
+
+def test_plan_levels_and_leaving_out():
+    plan = matrix.matrix_plan({"schemes": ["cotan"], "problems": {"sphere": ["2", 1],
+                                                                   "torus": []}})
+    assert plan["schemes"] == ["cotan"]
+    assert plan["problems"]["sphere"] == [1, 2]
+    assert "torus" not in plan["problems"]
+
+
+@pytest.mark.parametrize("section, key", [
+    ({"schemes": ["ddfv", "nope"]}, "matrix.schemes"),
+    ({"problems": {"spere": [1]}}, "matrix.problems"),
+    ({"problems": {"sphere": [0]}}, "matrix.problems.sphere"),
+    ({"solver": "gmres"}, "matrix.solver"),
+])
+def test_plan_names_the_bad_key(section, key):
+    with pytest.raises(matrix.ConfigError, match=key.replace(".", r"\.")):
+        matrix.matrix_plan(section)
+
+
+def test_mesh_problems_get_the_robust_solver():
+    plan = matrix.matrix_plan({})
+    for name, problem in PROBLEMS.items():
+        expected = plan["mesh_solver"] if problem.tau_rule == "mesh" else "bicgstab"
+        assert matrix.solver_method(plan, name) == expected
+
+
+# ------------------------------------------------------------ a tiny matrix for real
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    """ddfv and cotan on sphere and catenoid, level 1, through run_job."""
+    root = tmp_path_factory.mktemp("matrix")
+    plan = matrix.matrix_plan({"schemes": ["ddfv", "cotan"],
+                               "problems": {p: ([1] if p in ("sphere", "catenoid") else [])
+                                            for p in PROBLEMS}})
+    runs = matrix.planned_runs(plan, code="test", root=str(root))
+    for path, settings in runs.items():
+        frames = path.replace("/runs/", "/frames/").removesuffix(".json") + ".npz"
+        matrix.run_job(settings, path, frames)
+    table, summary = matrix.aggregate(runs, plan, root / "tables")
+    return root, plan, runs, table, summary
+
+
+def test_tiny_records_and_frames(tiny):
+    root, plan, runs, table, _ = tiny
+    for path, settings in runs.items():
+        record = read_record(path, settings=settings)
+        assert record["status"] in STATUSES
+        if record["problem"] == "sphere":
+            assert record["status"] == "ok", record["message"]
+        if record["status"] != "ok":  # e.g. the paper's DDFV on the catenoid
+            assert record["message"].startswith(record["status"])
+            assert record["t_failed"] == pytest.approx(record["steps_done"] * record["tau"],
+                                                       abs=2 * record["tau"])
+        assert record["metric_names"]
+        frames = matrix.load_frames(path.replace("/runs/", "/frames/")
+                                    .removesuffix(".json") + ".npz")
+        assert len(frames["steps"]) == 2 and frames["steps"][0] == 0
+        assert frames["steps"][-1] == record["steps_done"]
+    assert not list(root.rglob("*.tmp"))
+    sphere = table[(table["problem"] == "sphere") & (table["metric"] == "l2_error")]
+    assert set(sphere["scheme"]) == {"ddfv", "cotan"}
+    # the paper's level-1 value (Table 3.1: 1.34e-2) within 10 %
+    ddfv = sphere[sphere["scheme"] == "ddfv"]["value"].iloc[0]
+    assert ddfv == pytest.approx(1.34e-2, rel=0.1)
+    assert list(table.columns) == matrix.LONG_COLUMNS
+
+
+def test_tiny_tables_and_findings(tiny):
+    root, plan, runs, table, summary = tiny
+    out = root / "tables"
+    for name in ("matrix.csv", "sphere.md", "sphere.tex", "catenoid.md", "catenoid.tex",
+                 "summary.md", "summary.tex", "summary.csv"):
+        assert (out / name).is_file(), name
+    for name in ("sphere.md", "catenoid.md", "summary.md"):
+        assert "same footing" in (out / name).read_text()
+    text = matrix.write_findings(out / "summary.csv", root / "findings.md", plan)
+    for problem in plan["problems"]:
+        assert f"### {problem}" in text
+    for r in summary.itertuples():  # every status is shown, in the tables and the text
+        if r.status != "ok":
+            assert f"{r.status} at t = {r.t_failed:.4g}" in (out / "summary.md").read_text()
+            assert f"{r.status} at t = {r.t_failed:.4g}" in text
+    assert "## Across problems" in text
+    back = matrix.read_long_table(out / "matrix.csv")
+    assert len(back) == len(table)
+    assert np.allclose(back["value"], table["value"], equal_nan=True, rtol=1e-9)
+
+
+def test_tiny_plots(tiny):
+    from mcfbench.matrix_plots import error_figure, picture_grid, quality_figure
+
+    root, plan, runs, table, _ = tiny
+    problems, schemes = list(plan["problems"]), plan["schemes"]
+    figs = root / "figures"
+    error_figure(table, [figs / "errors.png"], problems, schemes)
+    quality_figure(matrix.read_runs(runs), [figs / "quality.png"], problems, schemes)
+    entries = {key: (read_record(r), matrix.load_frames(f))
+               for key, (r, f) in matrix.picture_runs(plan, str(root)).items()}
+    picture_grid(entries, [figs / "pictures.png"], problems, schemes)
+    for name in ("errors.png", "quality.png", "pictures.png"):
+        assert (figs / name).stat().st_size > 1000
+
+
+# ------------------------------------------------------------ EOC and summary on known numbers
+
+
+def _record(scheme, problem, level, value, status="ok", t_failed=float("nan"),
+            metric="l2_error"):
+    row = {k: (float("nan") if kind is float else 0 if kind is int else "" if kind is str
+               else {} if kind is dict else False) for k, kind in FIELDS.items()
+           if k not in ("settings", "provenance", "checksum")}
+    row.update(scheme=scheme, problem=problem, level=level, h=0.5 / 2 ** level,
+               tau=0.04 / 4 ** level, N=2 * 4 ** level, steps_done=2 * 4 ** level,
+               status=status, t_failed=t_failed, min_angle=30.0, max_flipped=0.0,
+               iterations=10 * level, cpu_seconds=0.1 * level, solver="bicgstab",
+               series={"t": [], "t_min_barycentric": []}, metric_names=[metric])
+    row[metric] = value
+    return row
+
+
+def test_eoc_is_log2_of_the_error_ratio(tmp_path):
+    errors = {"a": [1.0e-2, 2.5e-3, 6.0e-4], "b": [2.0e-2, 1.8e-2, 2.1e-2]}
+    records = [_record(s, "sphere", k + 1, e) for s, es in errors.items()
+               for k, e in enumerate(es)]
+    records += [_record("a", "catenoid", 1, -0.01, metric="neck_error"),
+                _record("a", "catenoid", 2, float("nan"), "t_escaped", 0.25,
+                        metric="neck_error")]
+    # through a real record file: NaN as null and back
+    path = tmp_path / "r.json"
+    write_record(path, records[0], {"x": 1})
+    assert read_record(path, settings={"x": 1})["l2_error"] == 1.0e-2
+    table = matrix.long_table(records)
+    for scheme, es in errors.items():
+        eoc = table[(table["scheme"] == scheme) & (table["problem"] == "sphere")]["eoc"]
+        assert math.isnan(eoc.iloc[0])
+        assert eoc.iloc[1:].tolist() == pytest.approx(
+            [math.log2(es[0] / es[1]), math.log2(es[1] / es[2])])
+    cat = table[table["problem"] == "catenoid"]
+    assert cat["status"].tolist() == ["ok", "t_escaped"]
+    assert cat["eoc"].isna().all()
+    summary = matrix.summary_table(table)
+    a = summary[(summary["problem"] == "sphere") & (summary["scheme"] == "a")].iloc[0]
+    assert a["eoc"] == pytest.approx(math.log2(2.5e-3 / 6.0e-4))
+    assert a["finest_value"] == 6.0e-4 and a["status"] == "ok"
+    c = summary[summary["problem"] == "catenoid"].iloc[0]
+    assert c["status"] == "t_escaped" and c["t_failed"] == 0.25 and c["failed_level"] == 2
+    assert "t_escaped at t = 0.25 (level 2)" in matrix.summary_cell(c)
+    text = matrix.findings(summary)
+    assert "**a** converges at order ~2" in text
+    assert "**b** does not converge" in text
+    assert "broke down in 1 of 2 runs (level 2: t_escaped at t = 0.25)" in text
+    assert "No scheme wins everywhere" in text  # a broke down on the catenoid
+
+
+def test_recommendation_when_one_scheme_wins():
+    records = []
+    for scheme, c in (("good", 1.0), ("fine", 3.0)):
+        for problem in ("sphere", "hemisphere"):
+            records += [_record(scheme, problem, k, c * 4.0 ** -k,
+                                metric="l2_error" if problem == "sphere" else "max_height")
+                        for k in (1, 2, 3)]
+    text = matrix.findings(matrix.summary_table(matrix.long_table(records)))
+    assert "**Recommendation: good**" in text
+
+
+# ------------------------------------------------------------ the Snakemake DAG
+
+
+def test_snakemake_dry_run(tmp_path):
+    """Both targets resolve to the planned jobs, in a copy of the repository."""
+    work = tmp_path / "work"
+    work.mkdir()
+    for name in ("Snakefile", "workflow", "config", "ddfv", "baselines", "mcfbench"):
+        src = REPO / name
+        (shutil.copytree if src.is_dir() else shutil.copy)(
+            src, work / name, **({"ignore": shutil.ignore_patterns("__pycache__")}
+                                 if src.is_dir() else {}))
+    meshes = tmp_path / "meshes"
+    matrix.write_obj(meshes / "tet.obj", [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]],
+                     [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    out = subprocess.run([sys.executable, "-m", "snakemake", "-n", "--cores", "2",
+                          "matrix", "gallery", "--config", f"meshes={meshes}"],
+                         cwd=work, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr[-3000:]
+    plan = matrix.matrix_plan(
+        __import__("yaml").safe_load((REPO / "config" / "config.yaml").read_text())["matrix"])
+    runs = sum(len(levels) for levels in plan["problems"].values()) * len(plan["schemes"])
+    counts = dict(line.split()[:2] for line in out.stdout.splitlines()
+                  if len(line.split()) == 2 and line.split()[1].isdigit())
+    assert int(counts["matrix_run"]) == runs
+    assert int(counts["gallery_run"]) == len(SCHEMES)  # one mesh file, every scheme
+    assert "gallery_mesh" not in counts  # a folder given: no generated meshes
+
+
+# ------------------------------------------------------------ the gallery
+
+
+def test_gallery_runs_every_scheme_on_every_file(tmp_path):
+    from mcfbench.surfaces import make_surface
+
+    meshes = tmp_path / "meshes"
+    matrix.write_obj(meshes / "ball.obj", *make_surface("sphere", level=2))
+    (meshes / "broken.off").write_text("OFF\n3 1 0\n0 0 0\n1 0 0\n")
+    (meshes / "notes.txt").write_text("not a mesh")
+    plan = matrix.gallery_plan({"schemes": ["ddfv", "cotan"], "steps": 3}, str(meshes))
+    assert list(plan["meshes"]) == ["ball.obj", "broken.off"]
+    assert plan["C"] == 0.1 and plan["solver"] == matrix.robust_method()
+    records = []
+    for mesh, path in plan["meshes"].items():
+        for scheme in plan["schemes"]:
+            settings = {"study": "gallery", "mesh": mesh, "scheme": scheme,
+                        **{k: plan[k] for k in ("C", "steps", "solver", "rtol", "maxiter")}}
+            out = tmp_path / "runs" / mesh / f"{scheme}.json"
+            matrix.gallery_job(path, scheme, settings, out, out.with_suffix(".npz"))
+            records.append(read_record(out, settings=settings))
+    table = matrix.gallery_table(records)
+    ball = table[table["mesh"] == "ball.obj"]
+    assert ball["status"].tolist() == ["ok", "ok"] and ball["steps_done"].tolist() == [3, 3]
+    h = ball["h"].iloc[0]
+    assert ball["tau"].iloc[0] == pytest.approx(0.1 * h * h)
+    assert (table[table["mesh"] == "broken.off"]["status"] == "unsupported").all()
+    text = matrix.gallery_markdown(table, plan)
+    assert "same footing" in text and "| ball.obj | ddfv | ok | 3/3 |" in text
+    with pytest.raises(matrix.ConfigError, match="'meshes'"):
+        matrix.gallery_plan({}, str(tmp_path / "missing"))

@@ -1,0 +1,130 @@
+# The gallery of real meshes (issue "Real meshes"): every scheme on every mesh
+# file of a folder. Not part of `rule all`:
+#
+#   snakemake --cores 2 gallery                       # the suite's own meshes
+#   snakemake --cores 2 gallery --config meshes=DIR   # every .obj .off .ply .stl in DIR
+#
+# Each run: the mesh read by mcfbench.meshio.read_mesh (repaired and
+# validated), tau = C * (mean edge length)^2, `steps` steps, the robust solver
+# (config key `gallery`). Without `meshes` the suite first writes its own
+# real-world-like meshes as OBJ to results/gallery/meshes/. Uses MATRIX_CODE
+# and _alternatives of workflow/rules/matrix.smk (included before).
+#
+# Outputs under results/gallery/: runs/{mesh}/{scheme}.json,
+# frames/{mesh}/{scheme}.npz, table.md, table.csv, pictures.png, pictures.pdf.
+
+GALLERY = _matrix.gallery_plan(config.get("gallery"), config.get("meshes"))
+GALLERY_SETTINGS = {
+    "study": "gallery",
+    **{k: GALLERY[k] for k in ("C", "steps", "solver", "rtol", "maxiter")},
+    "code": MATRIX_CODE,
+}
+# {record path: settings} of every run
+GALLERY_RUNS = {
+    f"results/gallery/runs/{mesh}/{scheme}.json": {
+        **GALLERY_SETTINGS,
+        "mesh": mesh,
+        "scheme": scheme,
+    }
+    for mesh in GALLERY["meshes"]
+    for scheme in GALLERY["schemes"]
+}
+GALLERY_FRAMES = [
+    f"results/gallery/frames/{mesh}/{scheme}.npz"
+    for mesh in GALLERY["meshes"]
+    for scheme in GALLERY["schemes"]
+]
+GALLERY_TARGETS = [
+    "results/gallery/table.md",
+    "results/gallery/table.csv",
+    "results/gallery/pictures.png",
+    "results/gallery/pictures.pdf",
+]
+
+
+if GALLERY["generated"]:
+
+    rule gallery_mesh:
+        """One of the suite's own meshes as OBJ (when no `meshes` folder is given)."""
+        output:
+            "results/gallery/meshes/{mesh}",
+        params:
+            entry=lambda wildcards: GALLERY["generated"][wildcards.mesh],
+            code=MATRIX_CODE,
+        log:
+            "results/logs/gallery/meshes/{mesh}.log",
+        wildcard_constraints:
+            mesh=_alternatives(GALLERY["generated"]),
+        threads: 1
+        resources:
+            mem_mb=1000,
+            runtime=10,
+        script:
+            "../scripts/gallery_mesh.py"
+
+
+rule gallery_run:
+    """One scheme on one mesh file."""
+    input:
+        mesh=lambda wildcards: GALLERY["meshes"][wildcards.mesh],
+    output:
+        record="results/gallery/runs/{mesh}/{scheme}.json",
+        frames="results/gallery/frames/{mesh}/{scheme}.npz",
+    params:
+        settings=lambda wildcards: GALLERY_RUNS[
+            f"results/gallery/runs/{wildcards.mesh}/{wildcards.scheme}.json"
+        ],
+    log:
+        "results/logs/gallery/{mesh}/{scheme}.log",
+    wildcard_constraints:
+        mesh=_alternatives(GALLERY["meshes"]),
+        scheme=_alternatives(GALLERY["schemes"]),
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=60,
+    script:
+        "../scripts/gallery_run.py"
+
+
+rule gallery_table:
+    """Mesh x scheme: status, steps, breakdown time, mesh quality, CPU time."""
+    input:
+        list(GALLERY_RUNS),
+    output:
+        md="results/gallery/table.md",
+        csv="results/gallery/table.csv",
+    params:
+        expected=GALLERY_RUNS,
+        plan=GALLERY,
+    log:
+        "results/logs/gallery/table.log",
+    localrule: True
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    script:
+        "../scripts/gallery_table.py"
+
+
+rule gallery_pictures:
+    """Per mesh the initial surface and every scheme's last frame."""
+    input:
+        records=list(GALLERY_RUNS),
+        frames=GALLERY_FRAMES,
+    output:
+        png="results/gallery/pictures.png",
+        pdf="results/gallery/pictures.pdf",
+    params:
+        expected=GALLERY_RUNS,
+        plan=GALLERY,
+    log:
+        "results/logs/gallery/pictures.log",
+    localrule: True
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    script:
+        "../scripts/gallery_pictures.py"

@@ -1,0 +1,140 @@
+# The benchmark matrix: every scheme x every problem x its refinement series
+# (issue "The benchmark matrix"). Not part of `rule all`:
+#
+#   snakemake --cores 2 matrix      # the default matrix: about 15 minutes on 2 cores
+#
+# Settings: the config key `matrix` (config/config.yaml), checked against the
+# registries mcfbench.schemes.SCHEMES and mcfbench.problems.PROBLEMS by
+# mcfbench.matrix.matrix_plan before any job runs. Everything but the rules
+# is in mcfbench/matrix.py (tables, findings) and mcfbench/matrix_plots.py.
+#
+# Outputs under results/matrix/:
+#   runs/{problem}/{scheme}/level{level}.json    one record per run (mcfbench.records)
+#   frames/{problem}/{scheme}/level{level}.npz   its first and last frame
+#   tables/matrix.csv                            the long table (one row per metric)
+#   tables/{problem}.md, .tex                    one table per problem, schemes as rows
+#   tables/summary.md, .tex, .csv                problem x scheme
+#   figures/errors, quality, pictures (.png, .pdf)
+#   findings.md                                  written from the numbers only
+
+import re as _re
+
+from mcfbench import matrix as _matrix
+from mcfbench.provenance import code_hash as _code_hash
+
+MATRIX = _matrix.matrix_plan(config.get("matrix"))
+# a run is redone when the code that computes it changes (not the tables or plots)
+MATRIX_CODE = _code_hash()
+# {record path: settings} of every run
+MATRIX_RUNS = _matrix.planned_runs(MATRIX, MATRIX_CODE)
+
+
+def _alternatives(names):
+    """A wildcard constraint matching exactly `names` (longest first)."""
+    return "|".join(_re.escape(n) for n in sorted(names, key=len, reverse=True))
+
+
+MATRIX_PROBLEM_TABLES = [
+    f"results/matrix/tables/{p}.{ext}" for p in MATRIX["problems"] for ext in ("md", "tex")
+]
+MATRIX_TABLES = [
+    "results/matrix/tables/matrix.csv",
+    *MATRIX_PROBLEM_TABLES,
+    "results/matrix/tables/summary.md",
+    "results/matrix/tables/summary.tex",
+    "results/matrix/tables/summary.csv",
+]
+MATRIX_FIGURES = {
+    f"{name}_{ext}": f"results/matrix/figures/{name}.{ext}"
+    for name in ("errors", "quality", "pictures")
+    for ext in ("png", "pdf")
+}
+MATRIX_TARGETS = [*MATRIX_TABLES, *MATRIX_FIGURES.values(), "results/matrix/findings.md"]
+
+
+rule matrix_run:
+    """One scheme on one problem at one level: record and first/last frame."""
+    output:
+        record="results/matrix/runs/{problem}/{scheme}/level{level}.json",
+        frames="results/matrix/frames/{problem}/{scheme}/level{level}.npz",
+    params:
+        settings=lambda wildcards: MATRIX_RUNS[
+            _matrix.record_path(wildcards.problem, wildcards.scheme, wildcards.level)
+        ],
+    log:
+        "results/logs/matrix/{problem}/{scheme}/level{level}.log",
+    wildcard_constraints:
+        problem=_alternatives(MATRIX["problems"]),
+        scheme=_alternatives(MATRIX["schemes"]),
+        level=r"[1-9][0-9]*",
+    threads: 1
+    resources:
+        mem_mb=1500,
+        runtime=60,
+    # the finest levels first: long jobs start early and the two cores stay busy
+    priority: lambda wildcards: 1 + int(wildcards.level) - min(MATRIX["problems"][wildcards.problem])
+    script:
+        "../scripts/matrix_run.py"
+
+
+rule matrix_tables:
+    """The long table, one table per problem and the summary."""
+    input:
+        list(MATRIX_RUNS),
+    output:
+        MATRIX_TABLES,
+    params:
+        expected=MATRIX_RUNS,
+        plan=MATRIX,
+        out_dir="results/matrix/tables",
+    log:
+        "results/logs/matrix/tables.log",
+    localrule: True
+    threads: 1
+    resources:
+        mem_mb=1500,
+        runtime=10,
+    script:
+        "../scripts/matrix_tables.py"
+
+
+rule matrix_plots:
+    """Error against h, mesh quality over time, the picture grid."""
+    input:
+        table="results/matrix/tables/matrix.csv",
+        records=list(MATRIX_RUNS),
+        frames=[f for _, f in _matrix.picture_runs(MATRIX).values()],
+    output:
+        **MATRIX_FIGURES,
+    params:
+        expected=MATRIX_RUNS,
+        plan=MATRIX,
+        pictures=_matrix.picture_runs(MATRIX),
+    log:
+        "results/logs/matrix/plots.log",
+    localrule: True
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    script:
+        "../scripts/matrix_plots.py"
+
+
+rule matrix_findings:
+    """findings.md from the summary table (no hand-typed numbers)."""
+    input:
+        summary="results/matrix/tables/summary.csv",
+    output:
+        "results/matrix/findings.md",
+    params:
+        plan=MATRIX,
+    log:
+        "results/logs/matrix/findings.log",
+    localrule: True
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    script:
+        "../scripts/matrix_findings.py"

@@ -1,0 +1,14 @@
+"""The gallery table, mesh x scheme (rule ``gallery_table``,
+workflow/rules/gallery.smk; :func:`mcfbench.matrix.gallery_table`)."""
+
+import logging
+
+from mcfbench.atomic import write_text
+from mcfbench.matrix import gallery_markdown, gallery_table, read_runs
+
+sm = snakemake  # noqa: F821
+logging.basicConfig(filename=sm.log[0], level=logging.INFO, force=True)
+table = gallery_table(read_runs(sm.params.expected))
+write_text(sm.output.csv, table.to_csv(index=False, float_format="%.10g"))
+write_text(sm.output.md, gallery_markdown(table, sm.params.plan))
+logging.info("\n%s", table.to_string())

@@ -1,0 +1,25 @@
+"""The figures of the benchmark matrix (mcfbench.matrix_plots).
+
+Called by rule ``matrix_plots`` (workflow/rules/matrix.smk): error against h
+from the long table, mesh quality over time from the records' series, and
+the picture grid of final surfaces from the saved frames.
+"""
+
+import logging
+
+from mcfbench.matrix import load_frames, read_long_table, read_runs
+from mcfbench.matrix_plots import error_figure, picture_grid, quality_figure
+from mcfbench.records import read_record
+
+sm = snakemake  # noqa: F821
+logging.basicConfig(filename=sm.log[0], level=logging.INFO, force=True)
+plan, out = sm.params.plan, sm.output
+problems, schemes = list(plan["problems"]), plan["schemes"]
+error_figure(read_long_table(sm.input.table), [out.errors_png, out.errors_pdf],
+             problems, schemes)
+quality_figure(read_runs(sm.params.expected), [out.quality_png, out.quality_pdf],
+               problems, schemes)
+entries = {key: (read_record(record), load_frames(frames))
+           for key, (record, frames) in sm.params.pictures.items()}
+picture_grid(entries, [out.pictures_png, out.pictures_pdf], problems, schemes)
+logging.info("wrote %s", ", ".join(out))

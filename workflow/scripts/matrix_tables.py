@@ -1,0 +1,17 @@
+"""The tables of the benchmark matrix from its run records.
+
+Called by rule ``matrix_tables`` (workflow/rules/matrix.smk): every record is
+read and checked against the settings of its run (stale or edited records are
+refused), then :func:`mcfbench.matrix.aggregate` writes ``matrix.csv``, one
+table per problem and the summary.
+"""
+
+import logging
+
+from mcfbench.matrix import aggregate
+
+logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, force=True)  # noqa: F821
+table, summary = aggregate(snakemake.params.expected, snakemake.params.plan,  # noqa: F821
+                           snakemake.params.out_dir)  # noqa: F821
+logging.info("%d runs, %d rows; summary:\n%s", len(snakemake.params.expected),  # noqa: F821
+             len(table), summary.to_string())
