@@ -16,6 +16,8 @@ import os
 
 from snakemake.utils import min_version, validate
 
+from mcfbench.pipeline import check_keys
+
 # One BLAS thread per job, set once here: every job inherits it (local or
 # Slurm), before any of them imports numpy. The jobs' run records store these
 # variables (mcfbench.provenance.BLAS_THREAD_VARIABLES).
@@ -27,6 +29,7 @@ min_version("9.0")
 configfile: "config/config.yaml"
 
 
+check_keys(config, "workflow/schemas/config.schema.yaml")
 validate(config, "workflow/schemas/config.schema.yaml")
 
 

@@ -52,7 +52,7 @@ from pathlib import Path
 import igl
 import numpy as np
 
-from .mesh import MeshError, validate_mesh
+from .mesh import MeshError, _count, _few, validate_mesh
 
 SUPPORTED = (".obj", ".off", ".ply", ".stl")
 
@@ -370,14 +370,3 @@ def _refuse_vertex_lines(path, ext):
         text = text[:80] + "..."
     raise ValueError(f"{path}: NaN, inf or unreadable coordinates at vertex {i} "
                      f"(0-based; line {number}: {text!r}){more}") from None
-
-
-def _few(ids, limit=10):
-    ids = np.asarray(ids).ravel()
-    shown = ", ".join(str(int(i)) for i in ids[:limit])
-    more = f" (and {len(ids) - limit} more)" if len(ids) > limit else ""
-    return f"[{shown}]{more}"
-
-
-def _count(k, singular, plural=None):
-    return f"{k} {singular if k == 1 else (plural or singular + 's')}"

@@ -220,6 +220,18 @@ def mem_mb(level):
     return 500 + 100 * 4 ** max(int(level) - 5, 0)
 
 
+def check_keys(config, schema_path):
+    """Refuse unknown top-level config keys in one line, naming them and the known
+    ones (Snakemake's schema check would print the whole schema after it)."""
+    import yaml
+
+    known = yaml.safe_load(Path(schema_path).read_text())["properties"]
+    unknown = sorted(set(config) - set(known))
+    if unknown:
+        raise ConfigError(f"unknown config key(s) {unknown}; known keys: "
+                          f"{', '.join(sorted(known))} (config/README.md)")
+
+
 class Pipeline:
     """The checked config and everything derived from it.
 
@@ -240,6 +252,8 @@ class Pipeline:
         self.levels = sorted({int(level) for level in config["levels"]})
         self.schemes = check_schemes("schemes", config["schemes"])
         self.rtol = float(config["rtol"])
+        if not 0 < self.rtol < 1:          # the schema lets NaN through
+            raise ConfigError(f"config key 'rtol': must lie in (0, 1), got {config['rtol']!r}")
         self.problem = get_problem(PROBLEM).with_settings(
             tau_1=float(config["tau_level_1"]), t_final=float(config["t_final"]))
         for level in self.levels:

@@ -160,9 +160,37 @@ def test_bad_run_records_stop_the_aggregation(workdir, env, tmp_path):
     assert "results/runs/ddfv/level1.json: checksum does not match the content" in out
     assert "results/runs/ddfv/level2.json: its settings are not the current ones" in out
     assert "3 invalid run record(s)" in out
-    assert "Error in rule convergence_table" in out
-    # the table of the good run is gone (Snakemake removes outputs of a failed job)
-    assert not (work / TABLE).exists() or (work / TABLE).read_text() == before
+    assert "Error in rule convergence_records" in out
+    # the check is its own job: the tables of the previous good run stay
+    assert (work / TABLE).read_text() == before
+
+
+TIMINGS = ["cpu_seconds", "wall_seconds", "wall_time_ratio"]
+
+
+def test_killed_run_resumes_to_the_same_tables(workdir, env, tmp_path):
+    """SIGKILL in the middle of a run, then --unlock and --rerun-incomplete as the
+    README says: the tables equal those of the uninterrupted run (timings aside)."""
+    import signal
+    import time
+
+    work = copy_workflow(tmp_path / "work")
+    proc = subprocess.Popen([sys.executable, "-m", "snakemake", *RUN], cwd=work, env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True)
+    runs = work / "results" / "runs"
+    deadline = time.monotonic() + TIMEOUT
+    while not any(runs.glob("*/level*.json")) and time.monotonic() < deadline:
+        time.sleep(0.05)                 # killed after the first record, mid-pipeline
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    assert not (work / TABLE).exists()
+    code, out = snakemake(work, env, "--unlock", *RUN[2:])
+    assert code == 0, out[-3000:]
+    code, out = snakemake(work, env, *RUN[:2], "--rerun-incomplete", *RUN[2:])
+    assert code == 0, out[-3000:]
+    resumed = pd.read_csv(work / TABLE).drop(columns=TIMINGS)
+    pd.testing.assert_frame_equal(resumed, pd.read_csv(workdir / TABLE).drop(columns=TIMINGS))
 
 
 BAD_CONFIGS = {  # --config value -> expected part of the message
@@ -171,6 +199,11 @@ BAD_CONFIGS = {  # --config value -> expected part of the message
     "schemes=[ddfv,fem]": "config key 'schemes': unknown scheme(s) ['fem']; known schemes",
     "tau_level_1=-0.04": "schema['properties']['tau_level_1']",
     "tau_level_1=0.03": "config keys 't_final' and 'tau_level_1'",
+    "tau_level_1=nan": "config keys 't_final' and 'tau_level_1': tau must be a positive number",
+    "t_final=nan": "config keys 't_final' and 'tau_level_1': t_final must be a positive number",
+    "rtol=-1e-9": "schema['properties']['rtol']",
+    "rtol=nan": "config key 'rtol': must lie in (0, 1), got nan",
+    "foo=1": "unknown config key(s) ['foo']; known keys: beyond, gallery,",
 }
 
 
@@ -189,7 +222,8 @@ def test_bad_config_stops_before_any_job(tmp_path, env):
 
 SCRIPTS = REPO / "workflow" / "scripts"
 OWN_SCRIPTS = ["run_scheme", "beyond_time", "figure", "convergence_table", "plot_convergence",
-               "beyond_tables", "beyond_plots", "beyond_findings", "report", "report_pdf"]
+               "beyond_tables", "beyond_plots", "beyond_findings", "report", "report_pdf",
+               "check_records"]
 
 
 @pytest.mark.parametrize("name", OWN_SCRIPTS)

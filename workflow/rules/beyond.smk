@@ -83,9 +83,31 @@ rule beyond_time:
         "../scripts/beyond_time.py"
 
 
+rule beyond_records:
+    """Check every run record of the beyond study (a bad one stops here: the tables stay)."""
+    input:
+        [path for runs in BEYOND_RUNS.values() for path in runs],
+    output:
+        "results/beyond/tables/records.json",
+    params:
+        expected={path: s for runs in BEYOND_RUNS.values() for path, s in runs.items()},
+    log:
+        "results/logs/beyond/records.log",
+    localrule: True
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    conda:
+        "../envs/ddfv.yaml"
+    script:
+        "../scripts/check_records.py"
+
+
 rule beyond_tables:
     """The tables of the beyond study and the T monitor series."""
     input:
+        checked="results/beyond/tables/records.json",
         levels=list(BEYOND_RUNS["levels"]),
         long_time=list(BEYOND_RUNS["long_time"]),
         space=list(BEYOND_RUNS["space"]),

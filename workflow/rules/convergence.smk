@@ -32,9 +32,31 @@ rule run_scheme:
         "../scripts/run_scheme.py"
 
 
+rule convergence_records:
+    """Check every run record of Table 3.1 (a bad one stops here: the tables stay)."""
+    input:
+        PIPELINE.run_records(),
+    output:
+        "results/tables/convergence.records.json",
+    params:
+        expected=PIPELINE.expected_runs(),
+    log:
+        "results/logs/convergence_records.log",
+    localrule: True
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    conda:
+        "../envs/ddfv.yaml"
+    script:
+        "../scripts/check_records.py"
+
+
 rule convergence_table:
     """Table 3.1 with the paper's values and the baselines side by side."""
     input:
+        checked="results/tables/convergence.records.json",
         records=PIPELINE.run_records(),
     output:
         csv=report(

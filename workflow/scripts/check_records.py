@@ -1,0 +1,15 @@
+"""Rules convergence_records, beyond_records: check every run record before an aggregation.
+
+A separate job, so that a bad record stops the pipeline here and the tables
+of the previous good run stay in place (Snakemake removes the outputs of a
+job before it runs it). Writes the checksum of every record
+(:func:`mcfbench.pipeline.read_records`: checksum, schema, stale settings).
+"""
+
+from mcfbench.pipeline import json_text, read_records, setup_logging, write_files
+
+sm = snakemake  # noqa: F821
+log = setup_logging(sm.log[0])
+records = read_records(dict(sm.params.expected), log)
+write_files({str(sm.output[0]): json_text({p: r["checksum"] for p, r in records.items()})})
+log.info("%d run records checked", len(records))
