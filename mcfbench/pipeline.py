@@ -220,6 +220,11 @@ def mem_mb(level):
     return 500 + 100 * 4 ** max(int(level) - 5, 0)
 
 
+def alternatives(names):
+    """A wildcard constraint matching exactly ``names`` (longest first)."""
+    return "|".join(re.escape(n) for n in sorted(names, key=len, reverse=True))
+
+
 def check_keys(config, schema_path):
     """Refuse unknown top-level config keys in one line, naming them and the known
     ones (Snakemake's schema check would print the whole schema after it)."""
@@ -338,7 +343,7 @@ class Pipeline:
     @staticmethod
     def scheme_pattern():
         """Regular expression of the registry's names, longest first."""
-        return "|".join(re.escape(s) for s in sorted(SCHEMES, key=len, reverse=True))
+        return alternatives(SCHEMES)
 
     # -- resources of the jobs (minutes, MB)
     @staticmethod

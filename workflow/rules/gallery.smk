@@ -8,7 +8,8 @@
 # validated), tau = C * (mean edge length)^2, `steps` steps, the robust solver
 # (config key `gallery`). Without `meshes` the suite first writes its own
 # real-world-like meshes as OBJ to results/gallery/meshes/. Uses MATRIX_CODE
-# and _alternatives of workflow/rules/matrix.smk (included before).
+# and _alternatives (mcfbench.pipeline.alternatives) of workflow/rules/matrix.smk
+# (included before).
 #
 # Outputs under results/gallery/: runs/{mesh}/{scheme}.json,
 # frames/{mesh}/{scheme}.npz, table.md, table.csv, pictures.png, pictures.pdf.
@@ -59,6 +60,8 @@ if GALLERY["generated"]:
         resources:
             mem_mb=1000,
             runtime=10,
+        conda:
+            "../envs/ddfv.yaml"
         script:
             "../scripts/gallery_mesh.py"
 
@@ -83,6 +86,8 @@ rule gallery_run:
     resources:
         mem_mb=2000,
         runtime=60,
+    conda:
+        "../envs/ddfv.yaml"
     script:
         "../scripts/gallery_run.py"
 
@@ -104,6 +109,8 @@ rule gallery_table:
     resources:
         mem_mb=1000,
         runtime=5,
+    conda:
+        "../envs/ddfv.yaml"
     script:
         "../scripts/gallery_table.py"
 
@@ -126,5 +133,7 @@ rule gallery_pictures:
     resources:
         mem_mb=2000,
         runtime=10,
+    conda:
+        "../envs/ddfv.yaml"
     script:
         "../scripts/gallery_pictures.py"

@@ -17,9 +17,8 @@
 #   figures/errors, quality, pictures (.png, .pdf)
 #   findings.md                                  written from the numbers only
 
-import re as _re
-
 from mcfbench import matrix as _matrix
+from mcfbench.pipeline import alternatives as _alternatives
 from mcfbench.provenance import code_hash as _code_hash
 
 MATRIX = _matrix.matrix_plan(config.get("matrix"))
@@ -27,11 +26,6 @@ MATRIX = _matrix.matrix_plan(config.get("matrix"))
 MATRIX_CODE = _code_hash()
 # {record path: settings} of every run
 MATRIX_RUNS = _matrix.planned_runs(MATRIX, MATRIX_CODE)
-
-
-def _alternatives(names):
-    """A wildcard constraint matching exactly `names` (longest first)."""
-    return "|".join(_re.escape(n) for n in sorted(names, key=len, reverse=True))
 
 
 MATRIX_PROBLEM_TABLES = [
@@ -73,6 +67,8 @@ rule matrix_run:
         runtime=60,
     # the finest levels first: long jobs start early and the two cores stay busy
     priority: lambda wildcards: 1 + int(wildcards.level) - min(MATRIX["problems"][wildcards.problem])
+    conda:
+        "../envs/ddfv.yaml"
     script:
         "../scripts/matrix_run.py"
 
@@ -86,7 +82,6 @@ rule matrix_tables:
     params:
         expected=MATRIX_RUNS,
         plan=MATRIX,
-        out_dir="results/matrix/tables",
     log:
         "results/logs/matrix/tables.log",
     localrule: True
@@ -94,6 +89,8 @@ rule matrix_tables:
     resources:
         mem_mb=1500,
         runtime=10,
+    conda:
+        "../envs/ddfv.yaml"
     script:
         "../scripts/matrix_tables.py"
 
@@ -117,6 +114,8 @@ rule matrix_plots:
     resources:
         mem_mb=2000,
         runtime=10,
+    conda:
+        "../envs/ddfv.yaml"
     script:
         "../scripts/matrix_plots.py"
 
@@ -136,5 +135,7 @@ rule matrix_findings:
     resources:
         mem_mb=1000,
         runtime=5,
+    conda:
+        "../envs/ddfv.yaml"
     script:
         "../scripts/matrix_findings.py"

@@ -7,11 +7,12 @@ table per problem and the summary.
 """
 
 import logging
+from pathlib import Path
 
 from mcfbench.matrix import aggregate
 
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, force=True)  # noqa: F821
 table, summary = aggregate(snakemake.params.expected, snakemake.params.plan,  # noqa: F821
-                           snakemake.params.out_dir)  # noqa: F821
+                           Path(snakemake.output[0]).parent)  # noqa: F821
 logging.info("%d runs, %d rows; summary:\n%s", len(snakemake.params.expected),  # noqa: F821
              len(table), summary.to_string())
