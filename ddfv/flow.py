@@ -160,7 +160,11 @@ class Flow:
     @cached_property
     def covolumes(self):
         """(n_f + n_t,) covolume areas ``chi^n``, F-vertices first."""
-        return np.concatenate(covolume_areas(self.mesh, self.geometry))
+        chi_f, chi_t = covolume_areas(self.mesh, self.geometry)
+        chi = chi_f.base              # the two are views of one (n_f + n_t,) buffer
+        if chi is None or chi is not chi_t.base or chi.shape != (self.mesh.n_unknowns,):
+            chi = np.concatenate([chi_f, chi_t])
+        return chi
 
     @property
     def l2_weights(self):
@@ -172,11 +176,21 @@ class Flow:
     def barycentric(self):
         """(n_t, 3) barycentric coordinates of each T-vertex projected into
         its triangle (the T monitor; Section 3.2)."""
-        return t_barycentric(self.F, self.T, self.mesh.faces)
+        bary, low = t_barycentric(self.F, self.T, self.mesh.faces, return_min=True)
+        self.__dict__["_barycentric_min"] = (bary, low)
+        return bary
+
+    def _smallest_barycentric(self):
+        """``barycentric.min()``, as computed with it (or again if replaced)."""
+        bary = self.barycentric
+        cached = self.__dict__.get("_barycentric_min")
+        if cached is not None and cached[0] is bary:
+            return cached[1]
+        return float(bary.min())
 
     def t_min_barycentric(self):
         """Smallest barycentric coordinate of any T-vertex in its triangle."""
-        return float(self.barycentric.min())
+        return self._smallest_barycentric()
 
     def frame(self):
         """``{"F": (n_f, 3), "T": (n_t, 3)}`` copies of the current state."""
@@ -208,14 +222,20 @@ class Flow:
             N = vertex_normals(self.mesh, self.geometry)              # N^{n-1}
             rhs = self._X - self.tau * (h - (h * N).sum(axis=0) * N)  # (3.6)
         x0 = self._X
+        owned = False
         if self.warm_start == "extrapolate":
-            x0 = 2.0 * self._X - self._X_prev
+            x0 = np.multiply(self._X, 2.0)     # 2 X^{n-1} - X^{n-2} in one new buffer
+            x0 -= self._X_prev
+            owned = True
         clock = self._tick("assembly", clock)
-        X, info = solve(A, rhs, x0)
+        if owned and getattr(solve, "can_overwrite_x0", False):   # may iterate in x0
+            X, info = solve(A, rhs, x0, overwrite_x0=True)
+        else:
+            X, info = solve(A, rhs, x0)
         self._tick("solve", clock)
         self._X_prev, self._X = self._X, np.ascontiguousarray(X)
         self.n += 1
-        for name in ("geometry", "covolumes", "barycentric"):
+        for name in ("geometry", "covolumes", "barycentric", "_barycentric_min"):
             self.__dict__.pop(name, None)
         return info
 
@@ -238,11 +258,12 @@ class Flow:
             if not np.isfinite(self._X).all():
                 return [("degenerated", "non-finite coordinates")]
             J = self.geometry.J
-            threshold = max(1e-10 * J.mean(), 1e-12 * self._J0)
+            # J.mean() without its Python wrapper: the same pairwise sum and division
+            threshold = max(1e-10 * (np.add.reduce(J) / len(J)), 1e-12 * self._J0)
             if not J.min() > threshold:
                 return [("degenerated", collapsed_cells(J, threshold, "diamond cell"))]
             bary = self.barycentric
-            if not bary.min() >= 0.0:        # the rows only when one is outside
+            if not self._smallest_barycentric() >= 0.0:   # min from the kernel's pass
                 smallest = bary.min(axis=1)
                 worst = int(np.argmin(smallest))
                 count = int(np.count_nonzero(~(smallest >= 0.0)))

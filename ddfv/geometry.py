@@ -201,7 +201,7 @@ def triangle_areas(F, faces):
     return 0.5 * _norm(_cross(p1 - p0, p2 - p0))
 
 
-def t_barycentric(F, T, faces):
+def t_barycentric(F, T, faces, return_min=False):
     """Barycentric coordinates of each T-vertex projected into its triangle.
 
     ``(1/3, 1/3, 1/3)`` at the barycentre; a negative coordinate means the
@@ -216,10 +216,14 @@ def t_barycentric(F, T, faces):
     F : (n_f, 3) float array
     T : (n_t, 3) float array
     faces : (n_t, 3) int array
+    return_min : bool
+        Also return the smallest coordinate (``out.min()``, computed in the
+        same pass).
 
     Returns
     -------
     (n_t, 3) float array
+        With ``return_min``: ``(coordinates, smallest)``.
     """
     from .kernels import t_barycentric_kernel
 
@@ -228,9 +232,9 @@ def t_barycentric(F, T, faces):
         raise ValueError(f"faces must be an (n_t, 3) int array, got {faces.dtype} {faces.shape}")
     T = _coordinates(T, len(faces), "T")
     out = np.empty((len(faces), 3))
-    t_barycentric_kernel(_coordinates(F, None, "F"), T,
-                         faces.astype(np.int64, copy=False).view(np.uint64), out)
-    return out
+    low = t_barycentric_kernel(_coordinates(F, None, "F"), T,
+                               faces.astype(np.int64, copy=False).view(np.uint64), out)
+    return (out, float(low)) if return_min else out
 
 
 def _coordinates(X, n, name):

@@ -276,9 +276,12 @@ def system_kernel(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, indptr, d
         data[diag[i]] += shift
 
 
-@numba.njit("void(float64[:, :], float64[:, :], uint64[:, :], float64[:, ::1])", **_OPTIONS)
+@numba.njit("float64(float64[:, :], float64[:, :], uint64[:, :], float64[:, ::1])", **_OPTIONS)
 def t_barycentric_kernel(F, T, faces, out):
     """Barycentric coordinates of the projection of ``T_i`` into triangle ``i``.
+
+    Returns the smallest coordinate (the T monitor), NaN when one is NaN
+    (as ``out.min()``).
 
     Parameters
     ----------
@@ -288,6 +291,7 @@ def t_barycentric_kernel(F, T, faces, out):
     out : (n_t, 3) float64 array, output
     """
     n_f = np.uint64(F.shape[0])
+    low = np.inf
     for t in range(faces.shape[0]):
         i0, i1, i2 = faces[t, 0], faces[t, 1], faces[t, 2]
         if i0 >= n_f or i1 >= n_f or i2 >= n_f:
@@ -305,6 +309,14 @@ def t_barycentric_kernel(F, T, faces, out):
         det = g11 * g22 - g12 * g12
         l1 = (g22 * r1 - g12 * r2) / det
         l2 = (g11 * r2 - g12 * r1) / det
-        out[t, 0] = 1.0 - l1 - l2
+        l0 = 1.0 - l1 - l2
+        out[t, 0] = l0
         out[t, 1] = l1
         out[t, 2] = l2
+        if low == low:                      # the first NaN stays
+            smallest = min(l0, l1, l2)
+            if not (l0 == l0 and l1 == l1 and l2 == l2):
+                low = np.nan
+            elif smallest < low:
+                low = smallest
+    return low

@@ -11,7 +11,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from tqdm import tqdm
 
 from .flow import FlowBreakdown
 from .solver import Solver, SolverFailure
@@ -74,6 +73,19 @@ class Trajectory:
         """Time of the breakdown or first defect, NaN when ``ok``."""
         return float("nan") if self.ok else float(self.defects[0]["time"]) \
             if self.defects else float("nan")
+
+
+class _NoBar:
+    """The progress bar when there is none."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
+
+    def update(self, n=1):
+        pass
 
 
 def simulate(flow, steps, *, solver=None, save_every=1, observers=(), on_defect="stop",
@@ -147,8 +159,13 @@ def simulate(flow, steps, *, solver=None, save_every=1, observers=(), on_defect=
     except FlowBreakdown as err:
         broken = err
     save()
-    with tqdm(total=int(steps), delay=2.0, disable=not progress or broken is not None,
-              unit="step") as bar:
+    if progress and broken is None:
+        from tqdm import tqdm     # on first use: not paid at start-up without a bar
+
+        bar = tqdm(total=int(steps), delay=2.0, unit="step")
+    else:
+        bar = _NoBar()
+    with bar:
         for _ in range(int(steps) if broken is None else 0):
             try:
                 try:

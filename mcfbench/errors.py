@@ -2,6 +2,30 @@
 
 import numpy as np
 
+_KERNEL = None
+
+
+def _error_kernel():
+    """The compiled pass of :meth:`SphereL2Error.__call__` (numba imported on first use)."""
+    global _KERNEL
+    if _KERNEL is None:
+        import numba
+
+        @numba.njit(cache=True, nogil=True, error_model="numpy")
+        def sphere_error_sum(X, c0, c1, c2, r, w):
+            """``sum_i w_i (|X_i - c| - r)^2`` in one pass (no temporaries)."""
+            total = 0.0
+            for i in range(X.shape[1]):
+                x0 = X[0, i] - c0
+                x1 = X[1, i] - c1
+                x2 = X[2, i] - c2
+                dist = np.sqrt(x0 * x0 + x1 * x1 + x2 * x2) - r
+                total += dist * dist * w[i]
+            return total
+
+        _KERNEL = sphere_error_sum
+    return _KERNEL
+
 
 def sphere_radius(t, radius=1.0):
     """Exact radius ``r(t) = sqrt(R^2 - 4 t)`` of a sphere under MCF (Section 3.1)."""
@@ -34,10 +58,15 @@ class SphereL2Error:
     def __call__(self, flow):
         if flow.n == 0:
             return
-        r = sphere_radius(flow.n * flow.tau, self.radius)
-        X = flow.X - self.centre[:, None]
-        dist = np.sqrt(X[0] ** 2 + X[1] ** 2 + X[2] ** 2) - r
-        self.total += flow.tau * float(np.dot(dist**2, flow.l2_weights))  # (3.2)
+        r = float(sphere_radius(flow.n * flow.tau, self.radius))
+        X = np.asarray(flow.X, dtype=np.float64)
+        w = np.asarray(flow.l2_weights, dtype=np.float64)
+        if X.ndim != 2 or X.shape[0] != 3 or w.shape != (X.shape[1],):
+            raise ValueError(f"X must be (3, n) and l2_weights (n,), got {X.shape} and "
+                             f"{w.shape}")
+        c0, c1, c2 = (float(c) for c in self.centre)
+        # (3.2): one compiled pass over the points, no copy of flow.X
+        self.total += flow.tau * float(_error_kernel()(X, c0, c1, c2, r, w))
         self.levels += 1
 
     @property

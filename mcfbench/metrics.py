@@ -25,7 +25,6 @@ Problem metrics: :func:`catenoid_profile_error`, :func:`max_height`,
 """
 
 import numpy as np
-from scipy.optimize import brentq
 
 # ------------------------------------------------------------ measures
 
@@ -180,6 +179,8 @@ def catenoid_parameter(radius=1.0, half_height=0.5):
     """
     R, h = float(radius), float(half_height)
     # a cosh(h/a) is smallest where tanh(h/a) = a/h
+    from scipy.optimize import brentq   # on first use: importing it takes 0.3 s
+
     a_min = brentq(lambda a: np.tanh(h / a) - a / h, 1e-6 * h, h)
     if a_min * np.cosh(h / a_min) > R:
         raise ValueError(f"no catenoid spans circles of radius {R} at z = +-{h} "
@@ -272,17 +273,9 @@ def min_angle(vertices, faces):
     """Smallest interior angle of the mesh, in degrees (60 for equilateral triangles).
 
     The smallest angle of a triangle is the one opposite its shortest side:
-    one ``atan2(|u x v|, u . v)`` per triangle instead of three.
+    one ``atan2(|u x v|, u . v)`` per triangle (:func:`quality`).
     """
-    V, F = _mesh(vertices, faces)
-    P = V[F]                                   # (m, 3 corners, 3)
-    e = P[:, [1, 2, 0]] - P                    # e_k: corner k -> corner k + 1
-    shortest = np.argmin(np.einsum("ijk,ijk->ij", e, e), axis=1)
-    rows = np.arange(len(F))
-    u = e[rows, (shortest + 2) % 3]            # the two sides at the opposite corner
-    v = -e[rows, (shortest + 1) % 3]
-    angle = np.arctan2(np.linalg.norm(np.cross(u, v), axis=1), np.einsum("ij,ij->i", u, v))
-    return float(np.degrees(angle.min()))
+    return quality(vertices, faces)["min_angle"]
 
 
 def aspect_ratios(vertices, faces):
@@ -312,14 +305,12 @@ def aspect_ratios(vertices, faces):
 
 def max_aspect_ratio(vertices, faces):
     """Largest :func:`aspect_ratios` of the mesh (1 when all triangles are equilateral)."""
-    return float(aspect_ratios(vertices, faces).max())
+    return quality(vertices, faces)["max_aspect_ratio"]
 
 
 def area_ratio(vertices, faces):
     """Largest triangle area over the smallest (``inf`` if a triangle has zero area)."""
-    A = triangle_areas(vertices, faces)
-    with np.errstate(divide="ignore"):
-        return float(A.max() / A.min())
+    return quality(vertices, faces)["area_ratio"]
 
 
 def edge_neighbours(faces):
@@ -401,10 +392,116 @@ def quality(vertices, faces, neighbours=None):
         ``flipped_triangles``: :func:`min_angle`, :func:`max_aspect_ratio`,
         :func:`area_ratio`, :func:`flipped_triangles`.
     """
-    return {"min_angle": min_angle(vertices, faces),
-            "max_aspect_ratio": max_aspect_ratio(vertices, faces),
-            "area_ratio": area_ratio(vertices, faces),
-            "flipped_triangles": flipped_triangles(vertices, faces, neighbours=neighbours)}
+    V, F = _mesh(vertices, faces)
+    if len(F) == 0:
+        raise ValueError("a mesh without triangles has no quality")
+    t1, t2 = edge_neighbours(F) if neighbours is None else neighbours
+    t1, t2 = np.asarray(t1, dtype=np.int64), np.asarray(t2, dtype=np.int64)
+    if t1.shape != t2.shape or t1.ndim != 1 or (t1.size > 0 and (
+            min(t1.min(), t2.min()) < 0 or max(t1.max(), t2.max()) >= len(F))):
+        raise ValueError(f"neighbours must be two equally long arrays of triangle indices "
+                         f"in [0, {len(F)})")
+    # one compiled pass over the triangles and one over the neighbour pairs (checked
+    # against plain numpy evaluations of the same formulas in tests/test_metrics.py);
+    # the arctan2 of the smallest angles is numpy's
+    work = np.empty((4, len(F), 3))
+    aspect, a_min, a_max, flipped = _quality_kernel()(
+        V, F.astype(np.int64, copy=False), t1, t2, work)
+    angle = np.arctan2(work[0, :, 0], work[0, :, 1]).min()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = float(np.float64(a_max) / np.float64(a_min))
+    return {"min_angle": float(np.degrees(angle)), "max_aspect_ratio": float(aspect),
+            "area_ratio": ratio, "flipped_triangles": int(flipped)}
+
+
+_QUALITY = None
+
+
+def _quality_kernel():
+    """The compiled kernel of :func:`quality` (numba imported and the kernel loaded
+    from its cache on first use)."""
+    global _QUALITY
+    if _QUALITY is not None:
+        return _QUALITY
+    import numba
+
+    @numba.njit(cache=True, nogil=True, error_model="numpy")
+    def quality_kernel(V, F, t1, t2, work):
+        """Largest aspect ratio, smallest and largest area, flipped triangles;
+        ``work[0, t, :2]``: ``|u x v|`` and ``u . v`` of the smallest angle of
+        triangle ``t`` (``work[1]``, ``work[2]``: scratch). NaN propagates as in
+        numpy's min/max."""
+        m = F.shape[0]
+        out = work[0]
+        N = work[1]
+        R = work[2]
+        S = work[3]
+        asp = -np.inf
+        a_min = np.inf
+        a_max = -np.inf
+        for t in range(m):
+            i0, i1, i2 = F[t, 0], F[t, 1], F[t, 2]
+            # e_k: corner k -> corner k + 1
+            a0, a1, a2 = V[i1, 0] - V[i0, 0], V[i1, 1] - V[i0, 1], V[i1, 2] - V[i0, 2]
+            b0, b1, b2 = V[i2, 0] - V[i1, 0], V[i2, 1] - V[i1, 1], V[i2, 2] - V[i1, 2]
+            c0, c1, c2 = V[i0, 0] - V[i2, 0], V[i0, 1] - V[i2, 1], V[i0, 2] - V[i2, 2]
+            la = (a0 * a0 + a2 * a2) + a1 * a1
+            lb = (b0 * b0 + b2 * b2) + b1 * b1
+            lc = (c0 * c0 + c2 * c2) + c1 * c1
+            # the smallest angle is opposite the shortest side (the first one on ties):
+            # u = e_{s+2}, v = -e_{s+1}
+            if lb < la and lb <= lc:
+                u0, u1, u2, v0, v1, v2 = a0, a1, a2, -c0, -c1, -c2
+            elif lc < la and lc < lb:
+                u0, u1, u2, v0, v1, v2 = b0, b1, b2, -a0, -a1, -a2
+            else:
+                u0, u1, u2, v0, v1, v2 = c0, c1, c2, -b0, -b1, -b2
+            x0 = u1 * v2 - u2 * v1
+            x1 = u2 * v0 - u0 * v2
+            x2 = u0 * v1 - u1 * v0
+            out[t, 0] = np.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
+            out[t, 1] = (u0 * v0 + u2 * v2) + u1 * v1
+            # normal (b - a) x (c - a), area, aspect ratio
+            y0, y1, y2 = V[i2, 0] - V[i0, 0], V[i2, 1] - V[i0, 1], V[i2, 2] - V[i0, 2]
+            n0 = a1 * y2 - a2 * y1
+            n1 = a2 * y0 - a0 * y2
+            n2 = a0 * y1 - a1 * y0
+            N[t, 0] = n0
+            N[t, 1] = n1
+            N[t, 2] = n2
+            area = 0.5 * np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+            sa = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
+            sb = np.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
+            sc = np.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+            r = sa * sb * sc * (0.5 * (sa + sb + sc)) / (8.0 * (area * area))
+            if asp == asp and (r > asp or r != r):
+                asp = r
+            if a_min == a_min and (area < a_min or area != area):
+                a_min = area
+            if a_max == a_max and (area > a_max or area != area):
+                a_max = area
+        # flipped: n_t . (sum of the neighbours' normals) < 0, the sums accumulated
+        # like np.bincount(t1, N[t2]) + np.bincount(t2, N[t1])
+        R[:, :] = 0.0
+        S[:, :] = 0.0
+        for k in range(t1.shape[0]):
+            p, q = t1[k], t2[k]
+            R[p, 0] += N[q, 0]
+            R[p, 1] += N[q, 1]
+            R[p, 2] += N[q, 2]
+            S[q, 0] += N[p, 0]
+            S[q, 1] += N[p, 1]
+            S[q, 2] += N[p, 2]
+        flipped = 0
+        for t in range(m):
+            d = (N[t, 0] * (R[t, 0] + S[t, 0]) + N[t, 2] * (R[t, 2] + S[t, 2])) \
+                + N[t, 1] * (R[t, 1] + S[t, 1])
+            if d < 0:
+                flipped += 1
+        return asp, a_min, a_max, flipped
+
+    _QUALITY = quality_kernel
+    return _QUALITY
 
 
 # -------------------------------------------------------- steady state

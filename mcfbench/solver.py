@@ -107,7 +107,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from numba import njit
 
 METHODS = ("bicgstab", "jacobi-bicgstab", "ilu-bicgstab", "direct")
@@ -610,8 +609,10 @@ def _coupled(A, shape):
                      f"({n}, {n}) (shared by the rows) or ({k * n}, {k * n}) (coupled)")
 
 
-def _blocks(A, b, x0):
-    """``b``, a copy of ``x0``, ``c`` in the kernels' (k, m) layout.
+def _blocks(A, b, x0, overwrite_x0=False):
+    """``b``, a copy of ``x0`` (``x0`` itself with ``overwrite_x0`` when it is a
+    C-contiguous float64 array not sharing memory with ``b``), ``c`` in the
+    kernels' (k, m) layout.
 
     Returns ``(b, x, cmean, cfull, to_block)``: ``cmean`` the per-row means
     of ``x0``, ``cfull`` the broadcast ``c`` for a coupled matrix (empty for
@@ -620,14 +621,21 @@ def _blocks(A, b, x0):
     b = np.ascontiguousarray(b, dtype=float)
     if b.ndim != 2:
         raise ValueError(f"b must be a (k, n) block, got shape {b.shape}")
-    x = (np.zeros(b.shape) if x0 is None
-         else np.array(x0, dtype=float, order="C", copy=True))
+    if x0 is None:
+        x = np.zeros(b.shape)
+    elif (overwrite_x0 and isinstance(x0, np.ndarray) and x0.dtype == np.float64
+          and x0.flags.c_contiguous and x0.flags.writeable
+          and not np.shares_memory(x0, b)):
+        x = x0                       # the caller's buffer: no copy
+    else:
+        x = np.array(x0, dtype=float, order="C", copy=True)
     if x.shape != b.shape:
         raise ValueError(f"x0 has shape {x.shape}, b has {b.shape}")
     k, n = b.shape
     coupled = _coupled(A, b.shape)
     with np.errstate(all="ignore"):
-        cmean = x.mean(axis=1) if n else np.zeros(k)
+        # x.mean(axis=1) without its Python wrapper (the same sum and division)
+        cmean = np.add.reduce(x, axis=1) / n if n else np.zeros(k)
     if not coupled:
         return b, x, cmean, np.empty((k, 0)), lambda z: z
     cfull = np.repeat(cmean, n).reshape(1, k * n)
@@ -637,6 +645,8 @@ def _blocks(A, b, x0):
 
 def _factorize(A, ilu, drop_tol=1e-4, fill_factor=10.0):
     """SuperLU ``splu``/``spilu`` of ``A``: ``(lu, None)`` or ``(None, detail)``."""
+    import scipy.sparse.linalg as spla    # on first use (import cost at start-up)
+
     what = "ILU" if ilu else "LU"
     try:
         with np.errstate(all="ignore"):
@@ -663,7 +673,7 @@ def _failed(method, status, detail, residual=math.nan, iterations=0):
 
 
 def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
-          stagnation_window=50, ilu_drop_tol=1e-4, ilu_fill_factor=10.0):
+          stagnation_window=50, ilu_drop_tol=1e-4, ilu_fill_factor=10.0, overwrite_x0=False):
     """Solve ``A x = b`` for a (k, n) block ``b`` from ``x0``; reports failures in ``info``.
 
     Parameters
@@ -681,6 +691,10 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
         Stagnated after this many iterations without a new residual minimum.
     ilu_drop_tol, ilu_fill_factor : float
         ``spilu`` parameters of ``"ilu-bicgstab"``.
+    overwrite_x0 : bool
+        ``x0`` may be used as the iterate (no copy) when it is a C-contiguous,
+        writeable float64 array not sharing memory with ``b``; it then holds
+        the returned solution (or the last iterate).
 
     Returns
     -------
@@ -697,7 +711,7 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
     if method not in METHODS:
         raise ValueError(f"unknown solver method {method!r}; choose one of "
                          f"{', '.join(METHODS)}")
-    b, x, cmean, cfull, to_block = _blocks(A, b, x0)
+    b, x, cmean, cfull, to_block = _blocks(A, b, x0, overwrite_x0)
     csr = _csr(A)
     with np.errstate(all="ignore"):
         if method == "direct":
@@ -863,6 +877,9 @@ class Solver:
     ilu_drop_tol: float = 1e-4
     ilu_fill_factor: float = 10.0
 
+    #: ``solver(A, b, x0, overwrite_x0=True)`` iterates in ``x0`` (no copy), see :func:`solve`
+    can_overwrite_x0 = True
+
     def __post_init__(self):
         if self.method not in METHODS:
             raise ValueError(f"unknown solver method {self.method!r}; choose one of "
@@ -880,11 +897,11 @@ class Solver:
                 and self.ilu_fill_factor >= 1):
             raise ValueError(f"ilu_fill_factor must be >= 1, got {self.ilu_fill_factor!r}")
 
-    def __call__(self, A, b, x0):
+    def __call__(self, A, b, x0, *, overwrite_x0=False):
         x, info = solve(A, b, x0, method=self.method, rtol=self.rtol, maxiter=self.maxiter,
                         stagnation_window=self.stagnation_window,
                         ilu_drop_tol=self.ilu_drop_tol,
-                        ilu_fill_factor=self.ilu_fill_factor)
+                        ilu_fill_factor=self.ilu_fill_factor, overwrite_x0=overwrite_x0)
         if not info.converged:
             raise SolverFailure(info, self.rtol, self.maxiter)
         return x, info

@@ -17,7 +17,6 @@ import time
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
-import pandas as pd
 
 from . import metrics
 from .driver import simulate
@@ -246,6 +245,8 @@ def level_sweep(scheme, problem, levels=None, **options):
     """
     problem = get_problem(problem) if isinstance(problem, str) else problem
     levels = [int(level) for level in (problem.levels if levels is None else levels)]
+    import pandas as pd     # on first use: importing pandas takes 0.1-0.2 s
+
     results = [run(scheme, problem, level, **options)[0] for level in levels]
     table = pd.DataFrame([r.to_dict(series=False) for r in results])
     consecutive = np.r_[False, np.diff(levels) == 1]
@@ -288,6 +289,8 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
     RuntimeError
         The reference run broke down (its message).
     """
+    import pandas as pd
+
     def final(tau):
         result, traj = run(scheme, problem, level, tau=tau, t_final=t_final, solver=solver,
                            **options)

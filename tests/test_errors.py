@@ -51,3 +51,20 @@ def test_eoc():
 def test_sphere_radius():
     assert sphere_radius(0.0, 2.0) == 2.0
     assert sphere_radius(0.25) == 0.0
+
+
+def test_l2_error_kernel_matches_the_numpy_formula():
+    """The compiled pass of the observer is the sum of (3.2) up to round-off."""
+    rng = np.random.default_rng(5)
+
+    class State:
+        n, tau = 2, 0.01
+
+    state = State()
+    state.X = rng.standard_normal((3, 101))
+    state.l2_weights = rng.random(101)
+    error = SphereL2Error(radius=1.5, centre=(0.1, -0.2, 0.3))
+    error(state)
+    X = state.X - np.array([0.1, -0.2, 0.3])[:, None]
+    dist = np.sqrt((X**2).sum(axis=0)) - sphere_radius(0.02, 1.5)
+    assert error.total == pytest.approx(0.01 * np.dot(dist**2, state.l2_weights), rel=1e-13)

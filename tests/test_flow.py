@@ -234,3 +234,18 @@ def test_boundary_vertices_stay_fixed_without_elimination():
     traj = simulate(V, F, 0.0025, 40, save_every=20)
     for X in traj.F:
         np.testing.assert_array_equal(X[boundary], V[boundary])
+
+
+def test_t_monitor_and_state_checks_reuse_the_kernels_minimum():
+    """t_min_barycentric is barycentric.min() (taken in the kernel's pass), and the
+    warm start with the solver iterating in its own buffer keeps the states."""
+    V, F = icosphere(2)
+    flow = Flow(V, F, 0.001)
+    for _ in range(3):
+        flow.step(Solver())
+        assert flow.defects() == []
+        assert flow.t_min_barycentric() == float(flow.barycentric.min())
+    other = Flow(V, F, 0.001)
+    for _ in range(3):
+        other.step(lambda A, b, x0: Solver()(A, b, x0))      # a plain callable: copies
+    np.testing.assert_array_equal(flow.X, other.X)

@@ -224,3 +224,32 @@ def test_inputs_of_the_wrong_shape_are_refused():
         area(V, F.astype(float))
     with pytest.raises(ValueError, match="face indices"):
         volume(V[:5], F)
+
+
+def _numpy_quality(V, F):
+    """The monitors of :func:`quality` evaluated with plain numpy (the test oracle)."""
+    from mcfbench.metrics import aspect_ratios, flipped_triangles, triangle_areas
+
+    A = triangle_areas(V, F)
+    return {"min_angle": float(triangle_angles(V, F).min()),
+            "max_aspect_ratio": float(aspect_ratios(V, F).max()),
+            "area_ratio": float(A.max() / A.min()),
+            "flipped_triangles": flipped_triangles(V, F)}
+
+
+def test_quality_kernel_matches_a_numpy_evaluation():
+    from mcfbench.metrics import edge_neighbours
+    from mcfbench.surfaces import icosphere
+
+    rng = np.random.default_rng(3)
+    V, F = icosphere(3)
+    neighbours = edge_neighbours(F)
+    for noise in (0.0, 0.002, 0.05):
+        W = V + noise * rng.standard_normal(V.shape)
+        expected = _numpy_quality(W, F)
+        for got in (quality(W, F, neighbours), quality(W, F)):
+            assert got["flipped_triangles"] == expected["flipped_triangles"]
+            for key in ("min_angle", "max_aspect_ratio", "area_ratio"):
+                assert got[key] == pytest.approx(expected[key], rel=1e-12), key
+    with pytest.raises(ValueError):
+        quality(V, F, (np.array([0]), np.array([len(F)])))

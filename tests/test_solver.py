@@ -339,3 +339,23 @@ def test_solve_info_api():
     assert info.detail == ""
     with pytest.raises(AttributeError):
         info.iterations = 4
+
+
+def test_overwrite_x0_iterates_in_the_callers_buffer():
+    """overwrite_x0: no copy of a suitable x0, the same solution as with the copy."""
+    rng = np.random.default_rng(7)
+    n = 40
+    A = sp.csr_matrix(sp.eye(n) * 4.0 + sp.random(n, n, density=0.1, random_state=3))
+    b = rng.standard_normal((3, n))
+    x0 = rng.standard_normal((3, n))
+    kept = x0.copy()
+    x_copy, info_copy = solve(A, b, x0)
+    assert np.array_equal(x0, kept)                          # default: x0 untouched
+    x_own, info_own = solve(A, b, x0, overwrite_x0=True)
+    assert x_own is x0 and np.array_equal(x_own, x_copy)
+    assert info_own == info_copy
+    x1, _ = Solver()(A, b, kept.copy(), overwrite_x0=True)
+    assert np.array_equal(x1, x_copy) and Solver.can_overwrite_x0
+    view = kept.copy()[:, ::1].T.copy().T                    # not C-contiguous: copied
+    x2, _ = solve(A, b, view, overwrite_x0=True)
+    assert x2 is not view and np.array_equal(x2, x_copy)
