@@ -24,7 +24,7 @@ from .meshio import read_mesh
 from .problems import PROBLEMS, Problem, get_problem
 from .provenance import provenance
 from .schemes import SCHEMES, get_scheme
-from .solver import METHODS, Solver
+from .solver import METHODS, ROBUST, Solver
 from .studies import level_sweep, run
 from .tables import sphere_table
 
@@ -103,7 +103,7 @@ def build_parser():
     flow.add_argument("--save-every", type=_count, default=1,
                       help="keep every K-th step as a frame (0: first and last only)")
     flow.add_argument("--out", type=Path, required=True, help="output file (.npz)")
-    _common(flow, "direct")
+    _common(flow, ROBUST)
 
     commands.add_parser("schemes", help="list the schemes")
     commands.add_parser("problems", help="list the problems")
@@ -233,7 +233,7 @@ def _run(args):
     problem = Problem.user_mesh(args.mesh.name, args.steps, args.tau_edge or 1.0)
     tau = args.tau
     print(f"scheme {scheme.name}, solver {args.solver}"
-          f"{'' if args.solver == 'direct' else f' (rtol {args.rtol:g})'}, "
+          f"{' (the robust default)' if args.solver == ROBUST else f' (rtol {args.rtol:g})'}, "
           f"tau {tau if tau else problem.tau(0, (V, F)):.4g}, {args.steps} steps")
     result, traj = run(scheme, problem, 0, tau=tau, mesh=(V, F), save_every=args.save_every,
                        **options)

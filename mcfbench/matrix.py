@@ -88,19 +88,11 @@ class ConfigError(ValueError):
 # ---------------------------------------------------------------- config
 
 
-def robust_method(methods=None):
-    """The shared solver's robust method: ``mcfbench.solver.ROBUST`` if the
-    harness names one, else ``"direct"`` (sparse LU) when offered."""
-    from . import solver
+def robust_method():
+    """The shared solver's method for meshes of unknown quality (:data:`mcfbench.solver.ROBUST`)."""
+    from .solver import ROBUST
 
-    methods = solver.METHODS if methods is None else methods
-    named = getattr(solver, "ROBUST", None)
-    if named in methods:
-        return named
-    for method in ("direct", "ilu-bicgstab"):
-        if method in methods:
-            return method
-    return EXACT_SOLVER
+    return ROBUST
 
 
 def is_mesh_problem(problem):
