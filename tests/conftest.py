@@ -2,6 +2,7 @@
 
 import functools
 
+import numpy as np
 import pytest
 
 from mcfbench import surfaces
@@ -13,9 +14,31 @@ from mcfbench.surfaces import random_bumpy_sphere as bumpy_sphere
 # half_height = 0.5) are those of mcfbench.surfaces.cylinder.
 cylinder = functools.partial(surfaces.cylinder, diagonals="parallel")
 
-__all__ = ["bumpy_sphere", "cylinder", "flat_lattice"]
+__all__ = ["approaches_the_catenoid", "bumpy_sphere", "cylinder", "flat_lattice"]
 
 
 @pytest.fixture
 def bumpy():
     return bumpy_sphere()
+
+
+@pytest.fixture(scope="module")
+def noisy_sphere():
+    """A level-2 icosphere with radial noise: no symmetry hides index errors."""
+    V, F = surfaces.icosphere(2)
+    rng = np.random.default_rng(7)
+    return V * (1.0 + 0.1 * rng.random((len(V), 1))), F
+
+
+def approaches_the_catenoid(X, tol=0.004):
+    """Frames ``X`` (frames, n, 3) of the 24 x 8 cylinder (R = 1, h = 0.5): the neck
+    shrinks monotonically to ``a = 0.84834`` (1 %) and the last profile is
+    ``a cosh(z / a)`` to ``tol``."""
+    from mcfbench.metrics import catenoid_parameter
+
+    a = catenoid_parameter(1.0, 0.5)
+    r, z = np.hypot(X[..., 0], X[..., 1]), X[..., 2]
+    neck = np.array([r[k][np.abs(z[k]) < 0.07].mean() for k in range(len(X))])
+    assert np.all(np.diff(neck) < 0), neck
+    assert neck[-1] == pytest.approx(a, rel=0.01)
+    np.testing.assert_allclose(r[-1], a * np.cosh(z[-1] / a), atol=tol)
