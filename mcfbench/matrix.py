@@ -35,13 +35,13 @@ no exact value: no EOC. The *main metric* of a problem
 findings.
 """
 
-import logging
 import math
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
+
+from .pipeline import setup_logging
 
 TIMING_BASE = (
     "Timings compare schemes fairly only on the same footing: the same solver and "
@@ -304,16 +304,6 @@ def run_one(scheme, problem, level, *, solver, mesh=None, tau=None):
     return result, frames
 
 
-def _logger(log_path):
-    handlers = [logging.StreamHandler(sys.stderr)]
-    if log_path:
-        Path(log_path).parent.mkdir(parents=True, exist_ok=True)
-        handlers.append(logging.FileHandler(log_path, mode="w"))
-    logging.basicConfig(level=logging.INFO, handlers=handlers, force=True,
-                        format="%(asctime)s %(levelname)s %(message)s")
-    return logging.getLogger("mcfbench.matrix")
-
-
 def run_job(settings, record, frames, log_path=None):
     """One run of the matrix: the record (:func:`mcfbench.records.write_record`,
     with ``metric_names``) and the first and last frames (npz), both atomic."""
@@ -321,7 +311,7 @@ def run_job(settings, record, frames, log_path=None):
     from .records import write_record
     from .solver import Solver
 
-    log = _logger(log_path)
+    log = setup_logging(log_path)
     solver = Solver(method=settings["solver"]["method"], rtol=settings["solver"]["rtol"],
                     maxiter=settings["solver"]["maxiter"])
     log.info("%s on %s level %d, solver %s", settings["scheme"], settings["problem"],
@@ -600,38 +590,26 @@ def problem_table(table, problem, schemes=None, labels=None):
 
 
 def markdown(frame, notes=()):
-    """A pipe table, then ``notes`` as paragraphs."""
-    columns = [str(c) for c in frame.columns]
-    cells = [[str(v) for v in row] for row in frame.itertuples(index=False)]
-    lines = ["| " + " | ".join(c.replace("|", "\\|") for c in columns) + " |",
-             "|" + "|".join("---" if i == 0 else "--:" for i in range(len(columns))) + "|"]
-    lines += ["| " + " | ".join(c.replace("|", "\\|") for c in row) + " |" for row in cells]
-    for note in notes:
-        lines += ["", note]
+    """A pipe table (:func:`mcfbench.tables.md_table`), then ``notes`` as paragraphs."""
+    from .tables import md_table
+
+    lines = [md_table(list(frame.columns), frame.itertuples(index=False))]
+    lines += [f"\n{note}" for note in notes]
     return "\n".join(lines) + "\n"
 
 
-_TEX = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "_": r"\_", "#": r"\#",
-        "$": r"\$", "{": r"\{", "}": r"\}", "~": r"\~{}", "^": r"\^{}", "–": "--",
-        "·": r"$\cdot$", "|": r"$|$"}
-
-
-def _tex(text):
-    return "".join(_TEX.get(c, c) for c in str(text))
-
-
 def latex(frame, caption="", notes=()):
-    """A ``table`` with a ``tabular``, the notes below it (standalone-safe)."""
-    columns = list(frame.columns)
-    lines = [r"\begin{table}[ht]", r"\centering", r"\small",
-             r"\begin{tabular}{l" + "r" * (len(columns) - 1) + "}", r"\hline",
-             " & ".join(_tex(c) for c in columns) + r" \\", r"\hline"]
-    lines += [" & ".join(_tex(v) for v in row) + r" \\" for row in frame.itertuples(index=False)]
-    lines += [r"\hline", r"\end{tabular}"]
+    """A ``table`` with a booktabs ``tabular`` (:func:`mcfbench.tables.tex_tabular`),
+    the notes below it."""
+    from .tables import tex_escape, tex_tabular
+
+    lines = [r"\begin{table}[ht]",
+             tex_tabular([tex_escape(c) for c in frame.columns],
+                         [[tex_escape(v) for v in row] for row in frame.itertuples(index=False)],
+                         "l" + "r" * (len(frame.columns) - 1))]
     if caption:
-        lines.append(r"\caption{" + _tex(caption) + "}")
-    for note in notes:
-        lines.append(r"\par\smallskip{\footnotesize " + _tex(note) + "}")
+        lines.append(r"\caption{" + tex_escape(caption) + "}")
+    lines += [r"\par\smallskip{\footnotesize " + tex_escape(note) + "}" for note in notes]
     lines.append(r"\end{table}")
     return "\n".join(lines) + "\n"
 
@@ -1120,7 +1098,7 @@ def gallery_job(mesh_path, scheme, settings, record, frames, log_path=None):
     from .schemes import get_scheme
     from .solver import Solver
 
-    log = _logger(log_path)
+    log = setup_logging(log_path)
     solver = Solver(method=settings["solver"], rtol=settings["rtol"],
                     maxiter=settings["maxiter"])
     problem = _gallery_problem(settings["C"], settings["steps"])

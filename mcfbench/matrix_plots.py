@@ -20,6 +20,7 @@ import numpy as np  # noqa: E402
 
 from .atomic import save_figure  # noqa: E402
 from .matrix import is_error, main_metric  # noqa: E402
+from .plots import style as scheme_style  # noqa: E402
 
 T_FLOOR = -0.5
 """Lower limit of the T monitor axes (values below are clipped and noted)."""
@@ -29,14 +30,6 @@ DIAMONDS_UP_TO = 1500
 """Draw the DDFV diamond mesh (T-vertices) of meshes with at most this many triangles."""
 VIEWS = {"catenoid": (15.0, -60.0), "hemisphere": (25.0, -60.0)}
 """View (elev, azim) of the pictures per problem (default ``(20, -60)``)."""
-
-
-def _style(scheme):
-    from .schemes import SCHEMES
-
-    entry = SCHEMES.get(scheme)
-    style = dict(entry.style) if entry is not None else {}
-    return style, (entry.label if entry is not None else scheme)
 
 
 def _grid(n, width=3.4, height=3.0, rows=1):
@@ -53,7 +46,7 @@ def _legend(fig, schemes):
 
     handles = []
     for scheme in schemes:
-        style, label = _style(scheme)
+        label, style = scheme_style(scheme)
         handles.append(Line2D([], [], label=label, **style))
     fig.legend(handles=handles, loc="lower center", ncol=min(4, len(handles)), fontsize=8,
                frameon=False)
@@ -89,7 +82,7 @@ def error_figure(table, paths, problems=None, schemes=None):
             rows = runs[runs["scheme"] == scheme].sort_values("level")
             if not len(rows):
                 continue
-            style, label = _style(scheme)
+            label, style = scheme_style(scheme)
             if (rows["status"] != "ok").any():
                 broke.append(scheme)
             if error:
@@ -168,7 +161,7 @@ def quality_figure(records, paths, problems=None, schemes=None):
             if r is None or not r.get("series"):
                 continue
             levels.add(int(r["level"]))
-            style, label = _style(scheme)
+            label, style = scheme_style(scheme)
             style = {k: v for k, v in style.items() if k != "marker"}
             series = r["series"]
             t, angle = np.asarray(series.get("quality_t", []), float), \
@@ -305,7 +298,7 @@ def picture_grid(entries, paths, problems, schemes):
             if cells[0][j] is None:
                 F0, T0, _ = _surface(frames, 0)
                 cells[0][j] = (F0, None, faces, f"level {record['level']}, t = 0")
-    labels = ["initial"] + [_style(s)[1] for s in schemes]
+    labels = ["initial"] + [scheme_style(s)[0] for s in schemes]
     _draw_grid(cells, labels, problems, paths, "Final surfaces (coarsest level of each problem)",
                views=[VIEWS.get(p, (20.0, -60.0)) for p in problems])
 
@@ -330,6 +323,6 @@ def gallery_grid(entries, paths, meshes, schemes):
             if cells[i][0] is None:
                 F0, _, _ = _surface(frames, 0)
                 cells[i][0] = (F0, None, faces, f"{len(faces)} triangles")
-    labels = ["initial"] + [_style(s)[1] for s in schemes]
+    labels = ["initial"] + [scheme_style(s)[0] for s in schemes]
     _draw_grid(cells, list(meshes), labels, paths, "Gallery: first and last frame per scheme",
                share="row")
