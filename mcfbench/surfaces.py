@@ -40,7 +40,6 @@ surfaces (double ``resolution``).
 """
 
 import numpy as np
-from scipy.optimize import brentq
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, Delaunay, cKDTree
@@ -695,6 +694,8 @@ def dumbbell(level=1):
     if int(level) != level or level < 0:
         raise ValueError(f"level must be a whole number >= 0, got {level!r}")
     h = 0.2 / 2 ** int(level)
+    from scipy.optimize import brentq
+
     L = brentq(dumbbell_profile, 1.5, 4.0, xtol=1e-15)  # the top pole, 2.2 to rounding
     s = np.linspace(0.0, np.pi, 20001)
     z = L * np.cos(s)
@@ -773,7 +774,7 @@ def isosurface(field, lower, upper, resolution, weld=1e-3):
     # field > 0 inside: "ascent" orients the triangles with outward normals
     V, F, _, _ = marching_cubes(values, 0.0, spacing=(d, d, d), gradient_direction="ascent")
     V, F = _clean(V.astype(np.float64) + lower, F.astype(np.int64), weld * d)
-    _check_closed_manifold(F, len(V))
+    _check_closed_manifold(V, F)
     return V, F
 
 
@@ -1022,33 +1023,16 @@ def _clean(V, F, tol=0.0):
     return V[used], new[F].astype(np.int64)
 
 
-def _check_closed_manifold(F, n):
-    """Raise unless the triangles form a closed, consistently oriented 2-manifold.
+def _check_closed_manifold(V, F):
+    """Raise unless the triangles form a closed, consistently oriented 2-manifold
+    (:func:`mcfbench.mesh.summarize`, which validates first, and no boundary loop)."""
+    from .mesh import MeshError, summarize
 
-    Every undirected edge must lie in exactly two triangles that traverse
-    it in opposite directions, and the triangles at each vertex must form
-    one fan: the corners of a vertex, joined across the edges at it, one
-    connected component.
-    """
-    src, dst = F.ravel(), F[:, [1, 2, 0]].ravel()  # half-edge 3 t + k: corner k -> k + 1
-    key = src * n + dst
-    order = np.argsort(key)
-    twin_at = np.searchsorted(key[order], dst * n + src)
-    found = twin_at < len(key)
-    found[found] = key[order][twin_at[found]] == (dst * n + src)[found]
-    repeated = len(np.unique(key)) != len(key)
-    if repeated or not found.all():
-        raise ValueError("marching cubes gave an open or non-manifold mesh: "
-                         f"{int((~found).sum())} half-edge(s) without an opposite one, "
-                         f"repeated half-edges: {repeated}; enlarge the box or refine the grid")
-    # the corner of src in triangle t meets the corner of src in the twin's triangle
-    twin = order[twin_at]
-    corner_in_twin = 3 * (twin // 3) + (twin % 3 + 1) % 3
-    graph = coo_matrix((np.ones(len(key)), (np.arange(len(key)), corner_in_twin)),
-                       shape=(len(key), len(key)))
-    _, label = connected_components(graph, directed=False)
-    fans = np.bincount(np.unique(np.column_stack([src, label]), axis=0)[:, 0], minlength=n)
-    if (fans != 1).any():
-        raise ValueError(f"marching cubes gave a non-manifold mesh: vertex(es) "
-                         f"{np.flatnonzero(fans != 1)[:10].tolist()} join separate fans "
-                         "of triangles")
+    try:
+        loops = summarize(V, F).boundary_loops
+    except MeshError as err:
+        raise ValueError(f"marching cubes gave an open or non-manifold mesh: {err}; "
+                         "enlarge the box or refine the grid") from None
+    if loops:
+        raise ValueError(f"marching cubes gave an open or non-manifold mesh: {loops} "
+                         "boundary loop(s); enlarge the box or refine the grid")
