@@ -41,7 +41,7 @@ def triangle_areas(vertices, faces):
     -------
     (m,) float array
     """
-    return 0.5 * np.linalg.norm(_normals(*_mesh(vertices, faces)), axis=1)
+    return 0.5 * np.linalg.norm(triangle_normals(*_mesh(vertices, faces)), axis=1)
 
 
 def area(vertices, faces):
@@ -359,7 +359,7 @@ def flipped_triangles(vertices, faces, reference_normals=None, neighbours=None):
     int
     """
     V, F = _mesh(vertices, faces)
-    N = _normals(V, F)
+    N = triangle_normals(V, F)
     if reference_normals is None:
         t1, t2 = edge_neighbours(F) if neighbours is None else neighbours
         reference = np.column_stack([
@@ -550,6 +550,7 @@ def _mesh(vertices, faces):
     return V, F
 
 
-def _normals(V, F):
-    """(m, 3) normals ``(b - a) x (c - a)`` (length twice the area)."""
+def triangle_normals(V, F):
+    """(m, 3) normals ``(b - a) x (c - a)`` of the triangles ``(a, b, c)`` (length
+    twice the area; no validation of the arrays)."""
     return np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])

@@ -44,6 +44,8 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, Delaunay, cKDTree
 
+from .metrics import triangle_normals
+
 # ---------------------------------------------------------------- icosphere
 
 
@@ -972,21 +974,15 @@ def _zip_rings(s_in, m, s_out, M):
     return tri[(tri[:, 0] != tri[:, 2]) & (tri[:, 1] != tri[:, 2])]
 
 
-def _normals(V, F):
-    """(m, 3) area-weighted normals ``(b - a) x (c - a)``."""
-    a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
-    return np.cross(b - a, c - a)
-
-
 def _orient_away_from(V, F, centre):
     """Reverse the triangles whose normal points towards ``centre``."""
-    away = np.einsum("ij,ij->i", _normals(V, F), V[F].mean(axis=1) - centre)
+    away = np.einsum("ij,ij->i", triangle_normals(V, F), V[F].mean(axis=1) - centre)
     return np.where((away < 0)[:, None], F[:, ::-1], F)
 
 
 def _orient_along(V, F, direction):
     """Reverse the triangles whose normal points against ``direction``."""
-    return np.where((_normals(V, F) @ direction < 0)[:, None], F[:, ::-1], F)
+    return np.where((triangle_normals(V, F) @ direction < 0)[:, None], F[:, ::-1], F)
 
 
 def _clean(V, F, tol=0.0):
@@ -1012,7 +1008,7 @@ def _clean(V, F, tol=0.0):
     V = V.copy()
     V[first] = np.column_stack([np.bincount(cluster, weights=V[:, k]) / size for k in range(3)])
     F = first[cluster][F]
-    area2 = np.linalg.norm(_normals(V, F), axis=1)
+    area2 = np.linalg.norm(triangle_normals(V, F), axis=1)
     F = F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0]) & (area2 > 0)]
     _, triple, count = np.unique(np.sort(F, axis=1), axis=0,
                                  return_inverse=True, return_counts=True)
