@@ -380,9 +380,8 @@ def plot_levels(frames, title=""):
     bars(ax_b, y, [r["t_bary_min"] for r in rows], diamond_c, ".4f", "smallest")
     ax_b.plot([r["t_bary_median"] for r in rows], y, "k|", ms=14, label="median")
     ax_b.axvline(1 / 3, color="0.5", lw=0.8, ls="--")
-    ax_b.set_xlim(min(0.0, min(float(r["t_bary_min"]) for r in rows
-                               if not pd.isna(r["t_bary_min"])) if any(
-                  not pd.isna(r["t_bary_min"]) for r in rows) else 0.0), 0.5)
+    known = [float(r["t_bary_min"]) for r in rows if not pd.isna(r["t_bary_min"])]
+    ax_b.set_xlim(min([0.0, *known]), 0.5)
     ax_b.set_xlabel("T-vertex barycentric coordinate\n(1/3: barycentre, < 0: outside)")
     bars(ax_g, y + h / 2, [r["angle_min_deg"] for r in rows], diamond_c, ".1f",
          "diamond mesh (F, F, T)")
