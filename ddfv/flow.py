@@ -18,6 +18,13 @@ Warm start: ``X^n`` is predicted by linear extrapolation
 O(tau^2) instead of the O(tau) of ``X^{n-1}``; ``warm_start="previous"``
 starts from ``X^{n-1}`` (see ``ddfv/README.md``).
 
+Numbering: the flow stores its state in its own numbering of the vertices
+and triangles (:func:`ddfv.topology.locality_order`), in which neighbours
+are close in memory; every public array (``X``, ``F``, ``T``,
+``covolumes``, ``barycentric``, ``frame()``, the messages of
+``defects()``) is in the caller's numbering. The scheme does not depend
+on the numbering; only the order of floating-point sums does.
+
 Invalid states (:meth:`Flow.defects`): non-finite coordinates or collapsed
 diamond cells (``"degenerated"``), and a T-vertex whose projection left its
 triangle (``"t_escaped"``, Section 2.2.2: "the point T_i^n does not need to
@@ -32,13 +39,13 @@ import numpy as np
 from .assembly import Assembler
 from .geometry import covolume_areas, diamond_geometry, t_barycentric, vertex_normals
 from .t_vertices import initial_t_vertices
-from .topology import diamond_mesh
+from .topology import diamond_mesh, locality_order
 
 WARM_STARTS = ("extrapolate", "previous")
 TANGENTIAL = ("none", "eliminate")
 
 
-def collapsed_cells(measure, threshold, cell):
+def collapsed_cells(measure, threshold, cell, name=str):
     """Describe the cells whose ``measure`` is not above ``threshold``, or None.
 
     Parameters
@@ -48,11 +55,13 @@ def collapsed_cells(measure, threshold, cell):
     threshold : float
     cell : str
         Name of a cell in the message, e.g. ``"diamond cell"``.
+    name : callable
+        ``name(index)``: how the message names a cell (default its index).
     """
     collapsed = np.flatnonzero(~(measure > threshold))
     if len(collapsed) == 0:
         return None
-    return f"{len(collapsed)} {cell}(s) collapsed, e.g. {cell} {int(collapsed[0])}"
+    return f"{len(collapsed)} {cell}(s) collapsed, e.g. {cell} {name(int(collapsed[0]))}"
 
 
 class Flow:
@@ -82,7 +91,7 @@ class Flow:
     Attributes
     ----------
     F, T : float arrays
-        Current state ``F^n``, ``T^n``.
+        Current state ``F^n``, ``T^n`` (copies, caller's numbering).
     n : int
         Current time level.
     timings : dict
@@ -100,38 +109,53 @@ class Flow:
         if tangential not in TANGENTIAL:
             raise ValueError(f"unknown tangential {tangential!r}; choose one of "
                              f"{', '.join(TANGENTIAL)}")
-        self.mesh = diamond_mesh(faces, len(vertices))
-        F = np.asarray(vertices, dtype=float)
-        T = initial_t_vertices(F, self.mesh, t_init) if T0 is None \
-            else np.asarray(T0, dtype=float)
-        if T.shape != (self.mesh.n_t, 3):
-            raise ValueError(f"T0 must have shape {(self.mesh.n_t, 3)}, got {T.shape}")
+        self._faces = diamond_mesh(faces, len(vertices)).faces   # checked, as given
+        n_f, n_t = len(vertices), len(self._faces)
+        # the flow's own numbering (module docstring): position j holds the
+        # caller's vertex vertex_order[j] and triangle face_order[j]
+        vertex_order, self._face_order = locality_order(self._faces, n_f)
+        rank = np.empty(n_f, dtype=np.int64)
+        rank[vertex_order] = np.arange(n_f)
+        self._mesh = diamond_mesh(rank[self._faces[self._face_order]], n_f)
+        face_rank = np.empty(n_t, dtype=np.int64)
+        face_rank[self._face_order] = np.arange(n_t)
+        #: column of the flow's state that holds each caller's point (F, then T)
+        self._external = np.concatenate([rank, n_f + face_rank])
+        self._vertex_order = vertex_order
+        F = np.asarray(vertices, dtype=float)[vertex_order]
+        if T0 is None:
+            T = initial_t_vertices(F, self._mesh, t_init)
+        else:
+            T = np.asarray(T0, dtype=float)
+            if T.shape != (n_t, 3):
+                raise ValueError(f"T0 must have shape {(n_t, 3)}, got {T.shape}")
+            T = T[self._face_order]
         self.tau = float(tau)
         self.warm_start, self.tangential = warm_start, tangential
         self.dual_length = dual_length
         self.n = 0
         self._X = np.ascontiguousarray(np.concatenate([F, T]).T)
         self._X_prev = self._X
-        self._assembler = Assembler(self.mesh)
+        self._assembler = Assembler(self._mesh)
         self.timings = {"geometry": 0.0, "assembly": 0.0, "solve": 0.0}
-        self._J0 = self.geometry.J.mean()
+        self._J0 = self._geometry.J.mean()
 
     @property
     def X(self):
-        """(3, n_f + n_t) read-only view of ``[F^n; T^n]`` by components."""
-        view = self._X.view()
-        view.flags.writeable = False
-        return view
+        """(3, n_f + n_t) ``[F^n; T^n]`` by components, caller's numbering (read-only copy)."""
+        X = np.take(self._X, self._external, axis=1)
+        X.flags.writeable = False
+        return X
 
     @property
     def F(self):
-        """(n_f, 3) view of the F-vertices ``F^n``."""
-        return self._X[:, :self.mesh.n_f].T
+        """(n_f, 3) the F-vertices ``F^n`` (a copy)."""
+        return np.take(self._X, self._external[:self._mesh.n_f], axis=1).T
 
     @property
     def T(self):
-        """(n_t, 3) view of the T-vertices ``T^n``."""
-        return self._X[:, self.mesh.n_f:].T
+        """(n_t, 3) the T-vertices ``T^n`` (a copy)."""
+        return np.take(self._X, self._external[self._mesh.n_f:], axis=1).T
 
     @property
     def t(self):
@@ -139,62 +163,66 @@ class Flow:
 
     @property
     def vertices(self):
-        """(n_f, 3) the F-vertices (the mesh vertices)."""
+        """(n_f, 3) the F-vertices (the mesh vertices, a copy)."""
         return self.F
 
     @property
     def faces(self):
-        """(n_t, 3) the triangles."""
-        return self.mesh.faces
+        """(n_t, 3) the triangles, as given."""
+        return self._faces
 
     @property
     def fixed(self):
         """(n_f,) bool: the Dirichlet (boundary) F-vertices (1.2)."""
-        return self.mesh.boundary_vertices
+        return self._mesh.boundary_vertices[self._external[:self._mesh.n_f]]
 
     @cached_property
-    def geometry(self):
-        """:class:`~ddfv.geometry.DiamondGeometry` of the current state."""
-        return diamond_geometry(self.mesh, self.F, self.T, self.dual_length)
+    def _geometry(self):
+        """:class:`~ddfv.geometry.DiamondGeometry` of the current state (own numbering)."""
+        n_f = self._mesh.n_f
+        return diamond_geometry(self._mesh, self._X[:, :n_f].T, self._X[:, n_f:].T,
+                                self.dual_length)
 
     @cached_property
-    def covolumes(self):
-        """(n_f + n_t,) covolume areas ``chi^n``, F-vertices first."""
-        chi_f, chi_t = covolume_areas(self.mesh, self.geometry)
+    def _chi(self):
+        """(n_f + n_t,) covolume areas ``chi^n``, F-vertices first (own numbering)."""
+        chi_f, chi_t = covolume_areas(self._mesh, self._geometry)
         chi = chi_f.base              # the two are views of one (n_f + n_t,) buffer
-        if chi is None or chi is not chi_t.base or chi.shape != (self.mesh.n_unknowns,):
+        if chi is None or chi is not chi_t.base or chi.shape != (self._mesh.n_unknowns,):
             chi = np.concatenate([chi_f, chi_t])
         return chi
 
     @property
+    def covolumes(self):
+        """(n_f + n_t,) covolume areas ``chi^n``, F-vertices first, as ``X``."""
+        return self._chi[self._external]
+
+    @property
     def l2_weights(self):
-        """Quadrature weights of the L2 error (3.2): ``chi^n / 2`` (the F- and
-        the T-covolumes each tile the surface once)."""
+        """Quadrature weights of the points of ``X`` for the L2 error (3.2):
+        ``chi^n / 2`` (the F- and the T-covolumes each tile the surface once)."""
         return 0.5 * self.covolumes
 
     @cached_property
+    def _barycentric(self):
+        """(n_t, 3) barycentric coordinates and their minimum (own numbering)."""
+        n_f = self._mesh.n_f
+        return t_barycentric(self._X[:, :n_f].T, self._X[:, n_f:].T, self._mesh.faces,
+                             return_min=True)
+
+    @property
     def barycentric(self):
         """(n_t, 3) barycentric coordinates of each T-vertex projected into
         its triangle (the T monitor; Section 3.2)."""
-        bary, low = t_barycentric(self.F, self.T, self.mesh.faces, return_min=True)
-        self.__dict__["_barycentric_min"] = (bary, low)
-        return bary
-
-    def _smallest_barycentric(self):
-        """``barycentric.min()``, as computed with it (or again if replaced)."""
-        bary = self.barycentric
-        cached = self.__dict__.get("_barycentric_min")
-        if cached is not None and cached[0] is bary:
-            return cached[1]
-        return float(bary.min())
+        return self._barycentric[0][self._external[self._mesh.n_f:] - self._mesh.n_f]
 
     def t_min_barycentric(self):
         """Smallest barycentric coordinate of any T-vertex in its triangle."""
-        return self._smallest_barycentric()
+        return self._barycentric[1]
 
     def frame(self):
         """``{"F": (n_f, 3), "T": (n_t, 3)}`` copies of the current state."""
-        return {"F": self.F.copy(), "T": self.T.copy()}
+        return {"F": self.F, "T": self.T}
 
     def step(self, solve):
         """Advance one time step.
@@ -212,14 +240,14 @@ class Flow:
             What ``solve`` returned.
         """
         clock = time.perf_counter()
-        geometry, covolumes = self.geometry, self.covolumes
+        geometry, covolumes = self._geometry, self._chi
         self._tick("geometry", clock)
         clock = time.perf_counter()
         A = self._assembler.system(geometry, covolumes, self.tau)
         rhs = self._X
         if self.tangential == "eliminate":
             h = (self._X - (A @ self._X.T).T) / self.tau            # h^{n-1}
-            N = vertex_normals(self.mesh, self.geometry)              # N^{n-1}
+            N = vertex_normals(self._mesh, geometry)                  # N^{n-1}
             rhs = self._X - self.tau * (h - (h * N).sum(axis=0) * N)  # (3.6)
         x0 = self._X
         owned = False
@@ -235,7 +263,7 @@ class Flow:
         self._tick("solve", clock)
         self._X_prev, self._X = self._X, np.ascontiguousarray(X)
         self.n += 1
-        for name in ("geometry", "covolumes", "barycentric", "_barycentric_min"):
+        for name in ("_geometry", "_chi", "_barycentric"):
             self.__dict__.pop(name, None)
         return info
 
@@ -243,6 +271,12 @@ class Flow:
         now = time.perf_counter()
         self.timings[phase] += now - since
         return now
+
+    def _edge_name(self, d):
+        """``"of edge (a, b)"``, ``a < b``: diamond ``d`` named by its edge in the
+        caller's numbering."""
+        a, b = np.sort(self._vertex_order[self._mesh.diamonds[d, :2]])
+        return f"of edge ({a}, {b})"
 
     def defects(self):
         """What is wrong with the current state: ``[(status, description)]``.
@@ -257,14 +291,14 @@ class Flow:
         try:
             if not np.isfinite(self._X).all():
                 return [("degenerated", "non-finite coordinates")]
-            J = self.geometry.J
+            J = self._geometry.J
             # J.mean() without its Python wrapper: the same pairwise sum and division
             threshold = max(1e-10 * (np.add.reduce(J) / len(J)), 1e-12 * self._J0)
             if not J.min() > threshold:
-                return [("degenerated", collapsed_cells(J, threshold, "diamond cell"))]
-            bary = self.barycentric
-            if not self._smallest_barycentric() >= 0.0:   # min from the kernel's pass
-                smallest = bary.min(axis=1)
+                return [("degenerated", collapsed_cells(J, threshold, "diamond cell",
+                                                        self._edge_name))]
+            if not self.t_min_barycentric() >= 0.0:   # min from the kernel's pass
+                smallest = self.barycentric.min(axis=1)
                 worst = int(np.argmin(smallest))
                 count = int(np.count_nonzero(~(smallest >= 0.0)))
                 return [("t_escaped", f"the T-vertex of triangle {worst} left its triangle "

@@ -55,6 +55,7 @@ import numpy as np
 import pandas as pd
 
 from ddfv.geometry import diamond_corners, diamond_geometry, t_barycentric
+from ddfv.topology import diamond_mesh
 
 #: relative diamond area below which a diamond cell counts as collapsed
 COLLAPSE_AREA = 1e-8
@@ -184,11 +185,14 @@ class MeshQuality:
 
     def __init__(self):
         self.rows = []
+        self._mesh = None
 
     def __call__(self, flow):
         row = {"n": int(flow.n), "t": float(flow.n * flow.tau)}
-        if getattr(flow, "T", None) is not None and hasattr(flow, "mesh"):
-            row.update(mesh_quality(flow.mesh, flow.F, flow.T, flow.geometry))
+        if getattr(flow, "T", None) is not None:
+            if self._mesh is None:
+                self._mesh = diamond_mesh(flow.faces, len(flow.F))
+            row.update(mesh_quality(self._mesh, flow.F, flow.T))
         else:
             row.update(vertex_quality(flow.vertices, flow.faces))
         self.rows.append(row)

@@ -5,6 +5,7 @@ import pytest
 
 from conftest import cylinder
 from ddfv import Flow
+from ddfv.geometry import covolume_areas, diamond_geometry
 from ddfv.topology import diamond_mesh
 from mcfbench.driver import simulate as drive
 from mcfbench.solver import Solver
@@ -46,6 +47,22 @@ def test_trajectory_invariant_under_scaling_with_tau_times_s2(bumpy):
     ref, scaled = _run(V, F), _run(s * V, F, tau=0.002 * s**2)
     np.testing.assert_allclose(scaled.F, s * ref.F, atol=1e-10 * s)
     np.testing.assert_allclose(scaled.T, s * ref.T, atol=1e-10 * s)
+
+
+def test_public_arrays_are_in_the_callers_numbering(bumpy):
+    V, F = bumpy
+    T0 = V[F].mean(axis=1) + 1e-3 * np.arange(len(F))[:, None]
+    flow = Flow(V, F, 0.01, T0=T0)
+    np.testing.assert_array_equal(flow.F, V)
+    np.testing.assert_array_equal(flow.T, T0)
+    np.testing.assert_array_equal(flow.X, np.concatenate([V, T0]).T)
+    np.testing.assert_array_equal(flow.faces, F)
+    assert not flow.X.flags.writeable
+    frame = flow.frame()
+    np.testing.assert_array_equal(frame["F"], V)
+    mesh = diamond_mesh(F, len(V))
+    chi_f, chi_t = covolume_areas(mesh, diamond_geometry(mesh, V, T0))
+    np.testing.assert_allclose(flow.covolumes, np.r_[chi_f, chi_t], rtol=1e-13)
 
 
 def test_trajectory_invariant_under_relabelling(bumpy):
@@ -161,7 +178,8 @@ def test_degenerate_initial_t_vertices_are_a_defect_at_step_0(bumpy):
     T0 = V[F].mean(axis=1)
     T0[t1] = T0[t2] = (V[a] + V[b]) / 2          # v = 0: the diamond collapses
     assert Flow(V, F, 0.01, T0=T0).defects() == [
-        ("degenerated", "1 diamond cell(s) collapsed, e.g. diamond cell 0")]
+        ("degenerated", f"1 diamond cell(s) collapsed, e.g. diamond cell of edge "
+                        f"({min(a, b)}, {max(a, b)})")]
     traj = simulate(V, F, 0.01, 3, T0=T0)
     assert traj.status == "degenerated" and traj.failed_step == 0 and traj.steps_done == 0
 

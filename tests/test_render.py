@@ -18,7 +18,7 @@ PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 @pytest.fixture(scope="module")
 def sphere():
     flow = Flow(*icosphere(2), 0.01)
-    return flow.F.copy(), flow.T.copy(), flow.mesh.faces
+    return flow.F.copy(), flow.T.copy(), flow.faces
 
 
 def test_render_writes_non_empty_png_and_pdf(tmp_path, sphere):
@@ -41,7 +41,7 @@ def test_stem_writes_png_and_pdf(tmp_path, sphere):
 
 def test_open_surface_renders(tmp_path):
     flow = Flow(*cylinder(24, 8, 1.0, 0.55, "twisted"), 0.0025)
-    fig = panel_row([Panel(flow.F, flow.T, flow.mesh.faces, label="cylinder")], view=(12, -60))
+    fig = panel_row([Panel(flow.F, flow.T, flow.faces, label="cylinder")], view=(12, -60))
     (png,) = save_figure(fig, tmp_path / "cyl.png")
     assert png.stat().st_size > 10_000
 
