@@ -9,11 +9,15 @@ the blocks. Process-wide, so never done on import: the entry points (the
 command line, the pipeline's jobs, the benchmarks) call :func:`tune_malloc`.
 A no-op elsewhere than glibc; ``DDFV_MALLOC_TUNING=0`` leaves the allocator
 alone.
+
+:func:`peak_rss_mb` is the peak resident memory of the process, stored in
+every run record (:func:`mcfbench.records.write_record`).
 """
 
 import ctypes
 import ctypes.util
 import os
+import sys
 
 _M_TRIM_THRESHOLD = -1
 _M_MMAP_THRESHOLD = -3
@@ -32,3 +36,19 @@ def tune_malloc():
         return False
     return bool(mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD)
                 and mallopt(_M_TRIM_THRESHOLD, TRIM_THRESHOLD))
+
+
+def peak_rss_mb():
+    """Peak resident memory of this process so far, in MB (2**20 bytes).
+
+    ``getrusage(RUSAGE_SELF).ru_maxrss`` (kilobytes on Linux, bytes on
+    macOS): for a pipeline job, which writes its one record at its end, the
+    peak of the whole job (imports and compilation included). NaN where the
+    ``resource`` module does not exist (Windows).
+    """
+    try:
+        import resource
+    except ImportError:
+        return float("nan")
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return peak / (2**20 if sys.platform == "darwin" else 2**10)

@@ -151,23 +151,32 @@ def beyond_settings(config, problem):
     Returns
     -------
     dict
-        ``levels`` (sorted ints), ``schemes``, ``long_time`` (``level``,
-        ``t_final``, ``tau``, ``schemes``), ``time_study`` (``level``,
-        ``taus`` (descending), ``reference_factor``, ``t_final``,
-        ``schemes``) and ``space_study`` (``levels``, ``tau``, ``t_final``,
-        ``schemes``); times as floats.
+        ``levels`` (sorted ints), ``schemes``, ``finest`` (``level``,
+        ``schemes``: the schemes whose rows of the L2/EOC table go on to that
+        level; none by default), ``long_time`` (``level``, ``t_final``,
+        ``tau``, ``schemes``), ``time_study`` (``level``, ``taus``
+        (descending), ``reference_factor``, ``t_final``, ``schemes``) and
+        ``space_study`` (``levels``, ``tau``, ``t_final``, ``schemes``); times
+        as floats.
 
     Raises
     ------
     ConfigError
-        An unknown scheme, or a final time that is not a whole multiple of a
-        time step; the message names the key.
+        An unknown scheme, a final time that is not a whole multiple of a
+        time step, a scheme of ``beyond.finest`` that is not one of
+        ``beyond.schemes``, or a finest level that is not above
+        ``beyond.levels``; the message names the key.
     """
     beyond = config["beyond"]
     t_final = problem.t_final
     levels = sorted({int(level) for level in beyond["levels"]})
     for level in levels:
         _steps("'beyond.levels'", problem, problem.tau(level), t_final, f"the level-{level}")
+    schemes = check_schemes("beyond.schemes", beyond["schemes"])
+    finest = {"level": int(beyond["finest"]["level"]),
+              "schemes": check_schemes("beyond.finest.schemes", beyond["finest"]["schemes"])}
+    if finest["schemes"]:
+        _check_finest(finest, levels, schemes, problem)
     long, time_, space = beyond["long_time"], beyond["time_study"], beyond["space_study"]
     long_level, long_t = int(long["level"]), float(long["t_final"])
     _steps("'beyond.long_time.t_final'", problem, problem.tau(long_level), long_t,
@@ -183,7 +192,8 @@ def beyond_settings(config, problem):
     _steps("'beyond.space_study.tau'", problem, space_tau, space_t, "the")
     return {
         "levels": levels,
-        "schemes": check_schemes("beyond.schemes", beyond["schemes"]),
+        "schemes": schemes,
+        "finest": finest,
         "long_time": {"level": long_level, "t_final": long_t, "tau": problem.tau(long_level),
                       "schemes": check_schemes("beyond.long_time.schemes", long["schemes"])},
         "time_study": {"level": int(time_["level"]), "taus": taus, "reference_factor": factor,
@@ -195,6 +205,22 @@ def beyond_settings(config, problem):
                         "schemes": check_schemes("beyond.space_study.schemes",
                                                  space["schemes"])},
     }
+
+
+def _check_finest(finest, levels, schemes, problem):
+    """``beyond.finest`` extends rows of the L2/EOC table: its schemes are some of
+    ``schemes``, its level is above ``levels`` and its time step divides t_final."""
+    others = [s for s in finest["schemes"] if s not in schemes]
+    if others:
+        raise ConfigError(f"config key 'beyond.finest.schemes': {others} not in "
+                          f"'beyond.schemes' {schemes} (the finest level continues their "
+                          "rows of the L2/EOC table)")
+    level = finest["level"]
+    if level <= levels[-1]:
+        raise ConfigError(f"config key 'beyond.finest.level': {level} is not above the "
+                          f"levels of 'beyond.levels' {levels}")
+    _steps("'beyond.finest.level'", problem, problem.tau(level), problem.t_final,
+           f"the level-{level}")
 
 
 def used_schemes(beyond):
@@ -321,12 +347,19 @@ class Pipeline:
         return {self.run_record(s, lv): self.run_settings(s, lv)
                 for s in self.schemes for lv in self.levels}
 
+    def beyond_levels(self, scheme):
+        """Levels of ``scheme`` in the L2/EOC table: ``beyond.levels``, and
+        ``beyond.finest.level`` for the schemes of ``beyond.finest``."""
+        finest = self.beyond["finest"]
+        return self.beyond["levels"] + ([finest["level"]] if scheme in finest["schemes"]
+                                        else [])
+
     def beyond_runs(self):
         """``{study: {record path: settings}}`` of the beyond study."""
         b = self.beyond
         return {
             "levels": {self.run_record(s, lv): self.run_settings(s, lv)
-                       for s in b["schemes"] for lv in b["levels"]},
+                       for s in b["schemes"] for lv in self.beyond_levels(s)},
             "long_time": {
                 f"results/beyond/runs/long_time/{s}/level{b['long_time']['level']}.json":
                     self.beyond_run_settings("long_time", s, b["long_time"]["level"])
@@ -388,11 +421,11 @@ def run_job(settings, output, log):
              settings["tau"], settings["t_final"], settings["rtol"])
     result, _ = run(settings["scheme"], problem, settings["level"], tau=settings["tau"],
                     t_final=settings["t_final"], solver=solver_of(settings))
-    write_record(output, result, settings)
-    log.info("%s level %d: status %s, L2 error %.4e, %d iterations, %.3f s wall -> %s",
-             result.scheme, result.level, result.status,
+    record = write_record(output, result, settings)
+    log.info("%s level %d: status %s, L2 error %.4e, %d iterations, %.3f s wall, "
+             "%.0f MB peak memory -> %s", result.scheme, result.level, result.status,
              result.metrics.get("l2_error", math.nan), result.iterations, result.wall_seconds,
-             output)
+             record["peak_rss_mb"], output)
     if result.status != "ok":
         log.warning("%s", result.message)
     return result
@@ -400,7 +433,7 @@ def run_job(settings, output, log):
 
 TIME_FIELDS = {"scheme": str, "level": int, "reference_tau": float, "t_final": float,
                "outcome": str, "message": str, "rows": list, "wall_seconds": float,
-               "settings": dict, "provenance": dict, "checksum": str}
+               "peak_rss_mb": float, "settings": dict, "provenance": dict, "checksum": str}
 """Key -> type of a time-study record (:func:`time_job`)."""
 
 
@@ -427,12 +460,14 @@ def time_job(settings, output, log):
     except RuntimeError as err:
         rows, outcome, message = [], "reference_failed", str(err)
     wall = time.perf_counter() - wall
-    write_record(output, {"scheme": settings["scheme"], "level": settings["level"],
-                          "taus": taus, "reference_factor": factor,
-                          "reference_tau": min(taus) / factor, "t_final": settings["t_final"],
-                          "outcome": outcome, "message": message, "rows": rows,
-                          "wall_seconds": wall}, settings)
-    log.info("%s: %s in %.1f s -> %s", settings["scheme"], outcome, wall, output)
+    record = write_record(output, {"scheme": settings["scheme"], "level": settings["level"],
+                                   "taus": taus, "reference_factor": factor,
+                                   "reference_tau": min(taus) / factor,
+                                   "t_final": settings["t_final"], "outcome": outcome,
+                                   "message": message, "rows": rows, "wall_seconds": wall},
+                          settings)
+    log.info("%s: %s in %.1f s, %.0f MB peak memory -> %s", settings["scheme"], outcome, wall,
+             record["peak_rss_mb"], output)
     if outcome != "ok":
         log.warning("%s", message)
     for row in rows:

@@ -1,7 +1,9 @@
 """Run records: one JSON file per run, with a schema, a checksum and provenance.
 
 A record holds every field of :class:`mcfbench.studies.RunResult` (the
-problem's metrics as top-level keys), the settings that produced it and
+problem's metrics as top-level keys), ``peak_rss_mb`` (the peak resident
+memory of the process that wrote it, :func:`mcfbench.memory.peak_rss_mb`:
+each job writes one record, at its end), the settings that produced it and
 their provenance (:func:`mcfbench.provenance.provenance`), and a SHA-256
 ``checksum`` of everything else, so that a record edited by hand is refused
 instead of shown in a table. NaN is stored as ``null`` (standard JSON);
@@ -15,12 +17,13 @@ from pathlib import Path
 
 from .atomic import json_value, write_json
 from .flow import STATUSES
+from .memory import peak_rss_mb
 from .provenance import config_hash, provenance
 from .studies import RunResult
 
 # field -> type of the fixed part of a record; float fields may be null (NaN)
 FIELDS = {f.name: f.type for f in fields(RunResult) if f.name != "metrics"}
-FIELDS.update({"settings": dict, "provenance": dict, "checksum": str})
+FIELDS.update({"peak_rss_mb": float, "settings": dict, "provenance": dict, "checksum": str})
 RECOMPUTE = "delete it and run snakemake again to recompute it"
 
 
@@ -36,7 +39,8 @@ def checksum(record):
 
 
 def write_record(path, result, settings, **extra):
-    """Write the record of ``result`` (a :class:`RunResult` or a dict) atomically.
+    """Write the record of ``result`` (a :class:`RunResult` or a dict) atomically,
+    with the peak resident memory of this process so far (``peak_rss_mb``).
 
     Parameters
     ----------
@@ -53,8 +57,8 @@ def write_record(path, result, settings, **extra):
         The record as written.
     """
     row = result.to_dict() if isinstance(result, RunResult) else dict(result)
-    record = json_value({**row, **extra, "settings": settings,
-                         "provenance": provenance(settings)})
+    record = json_value({**row, **extra, "peak_rss_mb": peak_rss_mb(),
+                         "settings": settings, "provenance": provenance(settings)})
     record["checksum"] = checksum(record)
     write_json(path, record)
     return record

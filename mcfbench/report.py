@@ -1548,25 +1548,40 @@ def accuracy_section(levels, paper_schemes):
 
 
 def finest_section(levels, schemes):
-    """The finest level, beyond the paper: errors, orders and cost."""
-    finest = int(levels["level"].max())
-    rows = levels[levels["level"] == finest].set_index("scheme")
-    lines = [f"## Level {finest} (finest level run)", ""]
+    """The finest level every scheme ran, beyond the paper, and the finer levels
+    some schemes ran (``beyond.finest``): errors, orders and cost.
+
+    Returns
+    -------
+    lines : list of str
+    finest : int
+        The finest level every scheme of ``schemes`` ran.
+    """
+    finest = int(levels.groupby("scheme")["level"].max()[schemes].min())
+    deeper = levels[levels["level"] > finest]
+    lines = [f"## Level {finest} (finest level run" +
+             (f" by every scheme; level {_levels(deeper['level'].unique())} by "
+              f"{', '.join(label(s) for s in dict.fromkeys(deeper['scheme']))} only)"
+              if len(deeper) else ")"), ""]
     for scheme in schemes:
-        r = rows.loc[scheme]
-        if r.status == "ok":
-            eoc = f", EOC {r.eoc:.3f} against level {finest - 1}" if np.isfinite(r.eoc) else ""
-            lines.append(f"- **{label(scheme)}**: L2 {sci(r.l2_error, 4)}{eoc}; "
-                         f"{r.iterations} BiCGStab iterations, {r.wall_seconds:.0f} s wall.")
-        else:
-            lines.append(f"- **{label(scheme)}**: no error, the run broke down: {_breakdown(r)} "
-                         f"({r.wall_seconds:.0f} s wall until then).")
+        rows = levels[(levels["scheme"] == scheme) & (levels["level"] >= finest)]
+        for r in rows.itertuples():
+            name = f"**{label(scheme)}**" + (f" on level {r.level}" if r.level > finest else "")
+            cost = f"{r.wall_seconds:.0f} s wall, {r.peak_rss_mb:.0f} MB peak memory"
+            if r.status == "ok":
+                eoc = f", EOC {r.eoc:.3f} against level {r.level - 1}" \
+                    if np.isfinite(r.eoc) else ""
+                lines.append(f"- {name}: L2 {sci(r.l2_error, 4)}{eoc}; "
+                             f"{r.iterations} BiCGStab iterations, {cost}.")
+            else:
+                lines.append(f"- {name}: no error, the run broke down: {_breakdown(r)} "
+                             f"({cost} until then).")
     return lines + [""], finest
 
 
-def cost_section(levels, schemes, reference):
+def cost_section(levels, schemes, reference, finest):
     """CPU time and iterations of each scheme against ``reference`` on the finest
-    level where both finished, and on the finest level run."""
+    level where both finished, and on level ``finest`` (the finest every scheme ran)."""
     lines = ["## Cost", ""]
     ok = levels[levels["status"] == "ok"]
     cpu = ok.pivot(index="level", columns="scheme", values="cpu_seconds")
@@ -1583,11 +1598,11 @@ def cost_section(levels, schemes, reference):
                      f"{common.loc[level, scheme] / common.loc[level, reference]:.2f}), "
                      f"{iters.loc[level, scheme]:.0f} BiCGStab iterations against "
                      f"{iters.loc[level, reference]:.0f}.")
-    finest = levels[levels["level"] == levels["level"].max()]
-    lines.append(f"- level {int(finest['level'].iloc[0])}: " + ", ".join(
+    lines.append(f"- level {finest}: " + ", ".join(
         f"{label(r.scheme)} {r.cpu_seconds:.0f} CPU s"
         + ("" if r.status == "ok" else f" until it broke down at step "
-           f"{round(r.t_failed / r.tau)} of {r.N}") for r in finest.itertuples()) + ".")
+           f"{round(r.t_failed / r.tau)} of {r.N}")
+        for r in levels[levels["level"] == finest].itertuples()) + ".")
     lines.append("")
     lines.append("CPU seconds of the flow on one core, from the pipeline's run records "
                  "(wall seconds, in the tables, depend on the other jobs sharing the machine); "
@@ -1689,7 +1704,7 @@ def findings(levels, stability, time, space, schemes, paper_schemes, t_final, ta
     reference = paper_schemes[0] if paper_schemes else schemes[0]
     parts += summary(levels, stable, paper_schemes, finest)
     parts += stab + accuracy_section(levels, paper_schemes) + fine
-    parts += cost_section(levels, schemes, reference)
+    parts += cost_section(levels, schemes, reference, finest)
     parts += order_section(levels, time, space, paper_schemes)
     parts += ["## Figures and tables", "",
               "![L2 error per level](figures/levels.png)", "",

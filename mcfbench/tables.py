@@ -341,8 +341,12 @@ def level_table(records, schemes, levels, paper_schemes=(PAPER_SCHEME,), baselin
     ----------
     records : dict
         ``(scheme, level) -> run record``.
-    schemes, levels : list
+    schemes : list
         Row order.
+    levels : list or dict
+        Row order within a scheme: the levels of every scheme, or scheme ->
+        its levels (the beyond study runs its finest level for some schemes
+        only).
     paper_schemes : collection of str
         Schemes compared with the published Table 3.1 (default: the paper's
         scheme; the beyond study adds the other DDFV schemes).
@@ -358,7 +362,8 @@ def level_table(records, schemes, levels, paper_schemes=(PAPER_SCHEME,), baselin
     published = pd.DataFrame.from_dict(PUBLISHED, orient="index", columns=PUBLISHED_COLUMNS)
     parts = []
     for scheme in schemes:
-        part = record_rows(records, [scheme], levels)
+        part = record_rows(records, [scheme],
+                           levels[scheme] if isinstance(levels, dict) else levels)
         part["eoc"] = eoc_column(part["level"], part["l2_error"], part["status"])
         for column in ("l2_error", "eoc", "iterations", "cpu_seconds"):
             values = part["level"].map(published[column]) if scheme in paper_schemes \
@@ -471,7 +476,7 @@ def convergence_documents(table, schemes, settings):
 # -- beyond Table 3.1: the T monitor, stability, orders in time and space --------------
 
 MONITOR_COLUMNS = ["t_reached", "t_monitor_start", "t_monitor_end", "t_exit"]
-BEYOND_LEVEL_COLUMNS = LEVEL_COLUMNS[:-1] + MONITOR_COLUMNS + ["message"]
+BEYOND_LEVEL_COLUMNS = LEVEL_COLUMNS[:-1] + ["peak_rss_mb"] + MONITOR_COLUMNS + ["message"]
 STABILITY_COLUMNS = ["study", "scheme", "label", "level", "nT", "tau", "t_final", "N",
                      "status", "t_failed", "t_reached", "t_monitor_start",
                      "t_min_barycentric", "t_monitor_end", "t_exit", "l2_error",
@@ -525,11 +530,13 @@ def monitor_series(records, study):
         pd.DataFrame(columns=SERIES_COLUMNS)
 
 
-def beyond_level_table(records, schemes, levels, paper_schemes):
-    """:func:`level_table` of every scheme, with the T monitor (:func:`monitor_summary`)."""
-    table = level_table(records, schemes, levels, paper_schemes=set(paper_schemes))
-    summary = pd.DataFrame([monitor_summary(records[s, lv]) for s, lv in
-                            zip(table["scheme"], table["level"])])
+def beyond_level_table(records, levels, paper_schemes):
+    """:func:`level_table` of every scheme with the peak memory of each run and the
+    T monitor (:func:`monitor_summary`); ``levels``: scheme -> its levels."""
+    table = level_table(records, list(levels), levels, paper_schemes=set(paper_schemes))
+    summary = pd.DataFrame([{"peak_rss_mb": records[s, lv]["peak_rss_mb"],
+                             **monitor_summary(records[s, lv])}
+                            for s, lv in zip(table["scheme"], table["level"])])
     return pd.concat([table, summary], axis=1)[BEYOND_LEVEL_COLUMNS]
 
 
@@ -617,12 +624,13 @@ def beyond_tables(inputs, records, beyond, paper_schemes):
     """
     by_level = {(records[p]["scheme"], records[p]["level"]): records[p]
                 for p in inputs["levels"]}
-    levels = [by_level[s, lv] for s in beyond["schemes"] for lv in beyond["levels"]]
+    # the levels each scheme ran: beyond.levels, and beyond.finest.level for some
+    runs = {s: sorted(lv for scheme, lv in by_level if scheme == s) for s in beyond["schemes"]}
+    levels = [by_level[s, lv] for s, scheme_levels in runs.items() for lv in scheme_levels]
     long = [records[p] for p in inputs["long_time"]]
     space = {(records[p]["scheme"], records[p]["level"]): records[p] for p in inputs["space"]}
     tables = {
-        "levels": beyond_level_table(by_level, beyond["schemes"], beyond["levels"],
-                                     paper_schemes),
+        "levels": beyond_level_table(by_level, runs, paper_schemes),
         "stability": stability_table(levels, long),
         "time_convergence": time_table([records[p] for p in inputs["time"]]),
         "space_convergence": space_table(space, beyond["space_study"]["schemes"],
@@ -642,32 +650,39 @@ def beyond_levels_rows(table, schemes, paper_schemes):
     by = table.set_index(["scheme", "level"])
     rows = []
     for level in sorted(table["level"].unique()):
-        first = by.loc[(schemes[0], level)]
+        first = table[table["level"] == level].iloc[0]
         paper = table[(table["level"] == level) & table["paper_l2_error"].notna()]
         row = [str(level), f"{first.h:.4f}", f"{first.tau:g}", str(first.N),
                sci(paper["paper_l2_error"].iloc[0], 2) if len(paper) else MISSING,
                fix(paper["paper_eoc"].iloc[0], 2) if len(paper) else MISSING]
         for s in schemes:
+            width = 3 if s in paper_schemes else 2
+            if (s, level) not in by.index:          # a level this scheme did not run
+                row += [MISSING] * width
+                continue
             r = by.loc[(s, level)]
-            row += [l2_cell(r, 4), fix(r.eoc, 3)]
-            if s in paper_schemes:
-                row.append(fix(r.l2_ratio, 3))
+            row += [l2_cell(r, 4), fix(r.eoc, 3), fix(r.l2_ratio, 3)][:width]
         rows.append(row)
     return header, rows
 
 
 def cost_rows(table, schemes):
-    """Iterations, CPU and wall seconds per level and scheme."""
+    """Iterations, CPU and wall seconds and peak memory per level and scheme."""
     header = ["level", "N"]
     for s in schemes:
-        header += [f"{label(s)} iter", f"{label(s)} CPU s", f"{label(s)} wall s"]
+        header += [f"{label(s)} iter", f"{label(s)} CPU s", f"{label(s)} wall s",
+                   f"{label(s)} peak MB"]
     by = table.set_index(["scheme", "level"])
     rows = []
     for level in sorted(table["level"].unique()):
-        row = [str(level), str(by.loc[(schemes[0], level)].N)]
+        row = [str(level), str(table[table["level"] == level].iloc[0].N)]
         for s in schemes:
+            if (s, level) not in by.index:
+                row += [MISSING] * 4
+                continue
             r = by.loc[(s, level)]
-            row += [str(r.iterations), sig(r.cpu_seconds, 3), sig(r.wall_seconds, 3)]
+            row += [str(r.iterations), sig(r.cpu_seconds, 3), sig(r.wall_seconds, 3),
+                    int_or(r.peak_rss_mb)]
         rows.append(row)
     return header, rows
 
@@ -723,6 +738,7 @@ def space_rows(table, schemes):
 
 def _beyond_descriptions(beyond, settings):
     time, space, long = beyond["time_study"], beyond["space_study"], beyond["long_time"]
+    finest = beyond["finest"]
     return {
         "levels": (
             f"Shrinking unit sphere (Section 3.1), t_f = {settings['t_final']:g}, "
@@ -730,7 +746,11 @@ def _beyond_descriptions(beyond, settings):
             f"{settings['rtol']:g}. L2: space-time error (3.2) (vertex schemes: over the "
             "vertices, lumped-mass weights); EOC (3.1) against the next coarser level, only "
             "between runs that finished; /paper: ours over the published L2 of Table 3.1 "
-            "(levels 1-5). A run that broke down shows `failed (t = time of the breakdown)`."),
+            "(levels 1-5). A run that broke down shows `failed (t = time of the breakdown)`."
+            + (f" Level {finest['level']} ran for "
+               f"{', '.join(label(s) for s in finest['schemes'])} only (`beyond.finest`)."
+               if finest["schemes"] else "")
+            + " peak MB: peak resident memory of the run's job (ru_maxrss)."),
         "stability": (
             "T monitor: smallest barycentric coordinate of any T-vertex projected into "
             "its triangle (1/3 at the barycentre; below 0 a T-vertex is outside, and the "
@@ -792,7 +812,8 @@ def beyond_documents(tables, beyond, settings, paper_schemes):
                             desc["levels"], [
                                 ("L2 error and EOC", level_rows),
                                 ("Cost: BiCGStab iterations, CPU and wall seconds of the flow "
-                                 "(one core; wall seconds depend on the other jobs running)",
+                                 "(one core; wall seconds depend on the other jobs running), "
+                                 "peak memory of the job",
                                  cost_rows(levels, schemes))], notes["levels"]),
         "stability": _markdown("T-vertex stability: the T monitor of every run",
                                desc["stability"], [("", stability_rows(stability))],
@@ -808,7 +829,8 @@ def beyond_documents(tables, beyond, settings, paper_schemes):
     tex = {
         "levels": _latex(desc["levels"], [
             ("L2 error and EOC per level and scheme.", "tab:beyond-levels", level_rows),
-            ("Cost: BiCGStab iterations, CPU and wall seconds (one core).", "tab:beyond-cost",
+            ("Cost: BiCGStab iterations, CPU and wall seconds (one core), peak memory.",
+             "tab:beyond-cost",
              cost_rows(levels, schemes))], notes["levels"]),
         "stability": _latex(desc["stability"], [("T-vertex stability.", "tab:beyond-stability",
                                                  stability_rows(stability))],

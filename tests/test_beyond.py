@@ -22,7 +22,7 @@ import pytest
 import yaml
 
 from mcfbench.pipeline import (ConfigError, Pipeline, read_records, run_job, setup_logging,
-                               time_job, used_schemes)
+                               time_job, used_schemes, write_files)
 from mcfbench.plots import beyond_figures
 from mcfbench.provenance import config_hash
 from mcfbench.records import RecordError, read_record
@@ -57,7 +57,7 @@ def record(scheme, level, *, status="ok", l2=None, monitor=None, tau=None, t_fin
         "message": "" if ok else f"{status} at step {levels} (t = {levels * tau:g}): ...",
         "t_failed": float("nan") if ok else levels * tau, "t_end": (levels - 1) * tau,
         "steady": False, "iterations": 5 * steps, "solver": "bicgstab",
-        "cpu_seconds": 0.1 * level, "wall_seconds": 0.1 * level,
+        "cpu_seconds": 0.1 * level, "wall_seconds": 0.1 * level, "peak_rss_mb": 50.0 * level,
         "t_min_barycentric": float(np.min(monitor)) if ddfv else float("nan"),
         "min_angle": 0.5, "max_aspect": 2.0, "max_flipped": 0.0,
         "l2_error": (1.3e-2 / 4 ** (level - 1) if l2 is None else l2) if ok else float("nan"),
@@ -139,14 +139,15 @@ LEVELS = [1, 2, 3]
 PAPER = ["ddfv", "ddfv-chord"]
 
 
-def synthetic_inputs():
+def synthetic_inputs(finest=()):
     """Records of a small beyond study: the paper variant breaks down on level 3
     with a solver failure after its monitor went below 0, and in the long run
-    a T-vertex escapes (t_escaped); chord finishes."""
+    a T-vertex escapes (t_escaped); chord finishes. The schemes ``finest`` go on
+    to level 4 (``beyond.finest``)."""
     failing = [0.33, 0.2, 0.05, -0.5, -3.0]          # outside from n = 3
     records = {}
     for s in SCHEMES_USED:
-        for lv in LEVELS:
+        for lv in LEVELS + ([4] if s in finest else []):
             if (s, lv) == ("ddfv", 3):
                 records[f"runs/{s}/level{lv}.json"] = record(s, lv, status="solver_failed",
                                                              monitor=failing)
@@ -174,6 +175,7 @@ def synthetic_inputs():
             "beyond/time/cotan.json": {"scheme": "cotan", **base, "outcome": "ok",
                                        "message": "", "rows": time_rows}}
     beyond = {"levels": LEVELS, "schemes": SCHEMES_USED,
+              "finest": {"level": 4, "schemes": list(finest)},
               "long_time": {"level": 2, "t_final": 0.12, "tau": 0.01,
                             "schemes": ["ddfv", "ddfv-chord"]},
               "time_study": {"level": 2, "taus": [0.01, 0.005, 0.0025], "reference_factor": 8,
@@ -223,6 +225,52 @@ def test_stability_table_and_monitor_series(tables):
     np.testing.assert_allclose(run["t_monitor"], [0.33, 0.2, 0.05, -0.5, -3.0])
     np.testing.assert_allclose(run["t"], 0.0025 * np.arange(5))
     assert "cotan" not in set(series["scheme"])
+
+
+def test_finest_level_of_one_scheme_leaves_the_other_rows_alone(tables, tmp_path):
+    """beyond.finest: chord goes on to level 4 with its EOC against level 3; the
+    rows of every other scheme (and chord's own coarser rows) stay as they are."""
+    inputs, records, beyond = synthetic_inputs(finest=["ddfv-chord"])
+    tabs, series = beyond_tables(inputs, records, beyond, PAPER)
+    levels, plain = tabs["levels"], tables[0]["levels"]
+    assert levels[["scheme", "level"]].values.tolist() == [
+        *([s, lv] for s in ["ddfv", "ddfv-chord"] for lv in LEVELS), ["ddfv-chord", 4],
+        *(["cotan", lv] for lv in LEVELS)]
+    finest = levels.set_index(["scheme", "level"]).loc[("ddfv-chord", 4)]
+    assert finest["eoc"] == pytest.approx(2.0) and finest["peak_rss_mb"] == 200.0
+    assert finest["paper_l2_error"] == 1.95e-4        # published: levels 1-5
+    assert np.isnan(finest["wall_time_ratio"])         # no cotan run on level 4
+    kept = levels[levels["level"] < 4].reset_index(drop=True)
+    pd.testing.assert_frame_equal(kept, plain)
+    assert 4 in set(series[series["scheme"] == "ddfv-chord"]["level"])
+    docs = beyond_documents(tabs, beyond, SETTINGS, PAPER)
+    md = docs["levels"]["md"]
+    row = next(line for line in md.splitlines() if line.startswith("| 4 |"))
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    # level, h, tau, N, paper L2/EOC, then DDFV (L2, EOC, /paper), chord (same), cotan
+    assert cells[6:9] == ["–"] * 3 and cells[9:11] == ["2.1328e-04", "2.000"]
+    assert cells[12:] == ["–"] * 2
+    assert "Level 4 ran for DDFV, chord" in md and "peak MB" in md
+    cost = next(line for line in md.splitlines()[md.splitlines().index(row) + 1:]
+                if line.startswith("| 4 |"))
+    cells = [c.strip() for c in cost.strip("|").split("|")]
+    # level, N, then iter, CPU s, wall s, peak MB of DDFV, chord, cotan
+    assert cells[:2] == ["4", "128"] and cells[2:6] == ["–"] * 4 and cells[10:] == ["–"] * 4
+    assert cells[6:10] == ["640", "0.4", "0.4", "200"]
+    assert "\\ensuremath{|}gamma\\ensuremath{|} peak MB" in docs["levels"]["tex"]
+    for name, doc in docs.items():
+        (tmp_path / f"{name}.csv").write_text(doc["csv"])
+    read = [pd.read_csv(tmp_path / f"{n}.csv") for n in (
+        "levels", "stability", "time_convergence", "space_convergence")]
+    text = findings(*read, SCHEMES_USED, PAPER, 0.08, 0.04)
+    chord = SCHEMES["ddfv-chord"].label
+    assert f"## Level 3 (finest level run by every scheme; level 4 by {chord} only)" in text
+    assert (f"- **{chord}** on level 4: L2 2.1328e-04, EOC 2.000 against level 3; 640 "
+            "BiCGStab iterations, 0 s wall, 200 MB peak memory.") in text
+    assert f"- level 3: {SCHEMES['ddfv'].label} 0 CPU s until it broke down" in text
+    figures = beyond_figures(read[0], read[1], series, read[2], read[3], beyond, 0.08)
+    write_files({tmp_path / f"{name}.png": fig for name, fig in figures.items()})
+    assert (tmp_path / "levels.png").stat().st_size > 1000
 
 
 def test_time_and_space_tables(tables):
@@ -282,8 +330,6 @@ def test_plots_from_the_tables(tables, tmp_path):
     figures = beyond_figures(tabs["levels"], tabs["stability"], series,
                              tabs["time_convergence"], tabs["space_convergence"], beyond, 0.08)
     assert sorted(figures) == ["levels", "space_convergence", "t_monitor", "time_convergence"]
-    from mcfbench.pipeline import write_files
-
     paths = {tmp_path / f"{name}.{ext}": fig for name, fig in figures.items()
              for ext in ("png", "pdf")}
     write_files(paths)
@@ -313,6 +359,7 @@ def test_time_study_runs_for_a_vertex_scheme(tmp_path):
     time_job(settings, path, log)
     rec = read_records({path: settings}, log)[path]
     assert rec["outcome"] == "ok" and [r["status"] for r in rec["rows"]] == ["ok", "ok"]
+    assert rec["wall_seconds"] > 0 and rec["peak_rss_mb"] > 0
     assert rec["rows"][1]["error"] < rec["rows"][0]["error"]
 
 
@@ -332,10 +379,33 @@ def test_default_config_passes_the_schema_and_the_checks():
     assert settings["space_study"]["tau"] == pytest.approx(0.04 / 4 ** 6)
     assert used_schemes(settings)[-1] == "cotan"
     assert all(s in SCHEMES for s in used_schemes(settings))
+    # the level-7 run is off by default
+    assert settings["finest"] == {"level": 7, "schemes": []}
+    assert not [p for p in Pipeline(config).beyond_runs()["levels"] if "level7" in p]
+
+
+def test_finest_level_adds_its_runs_only():
+    config = json.loads(json.dumps(CONFIG))
+    config["beyond"]["finest"]["schemes"] = ["ddfv-chord"]
+    pipeline = Pipeline(config)
+    runs = pipeline.beyond_runs()["levels"]
+    default = Pipeline(json.loads(json.dumps(CONFIG))).beyond_runs()["levels"]
+    assert set(runs) - set(default) == {"results/runs/ddfv-chord/level7.json"}
+    assert all(runs[p] == settings for p, settings in default.items())
+    assert runs["results/runs/ddfv-chord/level7.json"] == pipeline.run_settings("ddfv-chord", 7)
+    assert pipeline.beyond_levels("ddfv-chord") == [1, 2, 3, 4, 5, 6, 7]
+    assert pipeline.beyond_levels("ddfv") == [1, 2, 3, 4, 5, 6]
+    assert pipeline.problem.time_steps(pipeline.problem.tau(7)) == 8192
+    # the job's Slurm resources cover the single-core estimate of an earlier session
+    # (about 630 MB and 860 s) twice over
+    assert pipeline.mem_mb(7) >= 2 * 630 and pipeline.run_runtime(7) * 60 >= 2 * 860
 
 
 @pytest.mark.parametrize("path, value", [
     (("beyond", "levels"), [8]),
+    (("beyond", "finest", "level"), 8),
+    (("beyond", "finest", "schemes"), "ddfv-chord"),
+    (("beyond", "finest", "extra"), 1),
     (("beyond", "schemes"), ["DDFV"]),
     (("beyond", "long_time", "t_final"), 0.3),
     (("beyond", "time_study", "taus"), [0.01]),
@@ -366,9 +436,17 @@ def test_schema_rejects_bad_beyond_values(path, value):
      "config key 'beyond.long_time.t_final': t_final = 0.1503 is not a whole multiple"),
     (("time_study", "taus"), [0.01, 0.03], "config key 'beyond.time_study.taus'"),
     (("space_study", "tau"), 3e-5, "config key 'beyond.space_study.tau'"),
+    (("finest", "schemes"), ["fem"],
+     "config key 'beyond.finest.schemes': unknown scheme(s) ['fem']; known schemes"),
+    (("finest", "schemes"), ["cotan-voronoi"],
+     "config key 'beyond.finest.schemes': ['cotan-voronoi'] not in 'beyond.schemes'"),
+    (("finest", "level"), 6,
+     "config key 'beyond.finest.level': 6 is not above the levels of 'beyond.levels'"),
 ])
 def test_checks_across_keys_name_the_key(path, value, message):
     config = json.loads(json.dumps(CONFIG))
+    if path[0] == "finest" and path[1] == "level":
+        config["beyond"]["finest"]["schemes"] = ["ddfv-chord"]   # checked when on
     config["beyond"][path[0]][path[1]] = value
     with pytest.raises(ConfigError) as err:
         Pipeline(config)
@@ -381,6 +459,15 @@ def test_time_study_takes_any_scheme():
     config = json.loads(json.dumps(CONFIG))
     config["beyond"]["time_study"]["schemes"] = ["cotan", "ddfv"]
     assert Pipeline(config).beyond["time_study"]["schemes"] == ["cotan", "ddfv"]
+
+
+FINEST = "beyond={finest: {schemes: [ddfv-chord]}}"   # the command line of config/README.md
+
+
+def jobs(out, rule):
+    """The number of jobs of ``rule`` in the job stats of a dry run."""
+    return next(int(line.split()[1]) for line in out.splitlines()
+                if line.split()[:1] == [rule])
 
 
 def test_dry_run_of_beyond_and_a_bad_value(tmp_path):
@@ -399,7 +486,11 @@ def test_dry_run_of_beyond_and_a_bad_value(tmp_path):
     env["PATH"] = os.pathsep.join([str(stub), env.get("PATH", "")])
     # the study's own outputs (`beyond` also rebuilds the report)
     targets = ["beyond_tables", "beyond_figures", "beyond_findings"]
-    runs = {"good": ["-n", *targets], "bad": ["-n", *targets, "--configfile", "bad.yaml"]}
+    runs = {"good": ["-n", *targets], "bad": ["-n", *targets, "--configfile", "bad.yaml"],
+            # --config merges into the config file's `beyond`: the level stays 7
+            "finest": ["-n", *targets, "--config", FINEST],
+            "bad_finest": ["-n", *targets, "--config",
+                           "beyond={finest: {level: 6, schemes: [ddfv-chord]}}"]}
     procs = {k: subprocess.Popen([sys.executable, "-m", "snakemake", *args], cwd=work, env=env,
                                  stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
              for k, args in runs.items()}
@@ -414,6 +505,16 @@ def test_dry_run_of_beyond_and_a_bad_value(tmp_path):
     assert procs["bad"].returncode != 0
     assert "config key 'beyond.time_study.schemes': unknown scheme(s) ['fem']" in out["bad"], \
         out["bad"][-2000:]
+    # the level-7 run: only with beyond.finest, one job more, sized for Slurm
+    level7 = "results/runs/ddfv-chord/level7.json"
+    assert level7 not in out["good"]
+    assert procs["finest"].returncode == 0, out["finest"][-3000:]
+    job = out["finest"].split(f"output: {level7}")[1].split("\n\n")[0]
+    pipeline = Pipeline(json.loads(json.dumps(CONFIG)))
+    assert f"runtime={pipeline.run_runtime(7)}, mem_mb={pipeline.mem_mb(7)}," in job, job
+    assert jobs(out["finest"], "run_scheme") == jobs(out["good"], "run_scheme") + 1
+    assert procs["bad_finest"].returncode != 0
+    assert "config key 'beyond.finest.level': 6 is not above" in out["bad_finest"]
     assert not (work / "results").exists()
 
 

@@ -131,6 +131,7 @@ def test_provenance(workdir, table):
         ("cotan", 2), "l2_error"]
     assert record["settings"]["code"].keys() == {"ddfv", "baselines", "mcfbench"}
     assert len(record["series"]["t_min_barycentric"]) == record["N"] + 1
+    assert record["wall_seconds"] > 0 and record["peak_rss_mb"] > 10   # the job's peak, MB
     assert record["checksum"] == checksum(record)
 
 

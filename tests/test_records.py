@@ -24,6 +24,8 @@ def test_record_round_trip(tmp_path, result):
     assert record["iterations"] == result.iterations and record["status"] == "ok"
     assert math.isnan(record["t_failed"]) and math.isnan(record["t_min_barycentric"])
     assert record["provenance"]["config"] == SETTINGS
+    # the peak memory of the process that wrote it (ru_maxrss), next to the run's times
+    assert record["wall_seconds"] > 0 and 10 < record["peak_rss_mb"] < 10_000
     assert json.loads(path.read_text())["t_failed"] is None       # standard JSON
 
 

@@ -2,14 +2,17 @@
 # study (issue #5). Not part of `rule all`:
 #
 #   snakemake --cores 2 beyond      # about 8 minutes on 2 cores
+#   # and level 7 of the chord variant in the L2/EOC table (config key beyond.finest):
+#   snakemake --cores 2 beyond --config 'beyond={finest: {schemes: [ddfv-chord]}}'
 #
 # Settings: the config key `beyond` (config/README.md), checked by
 # mcfbench.pipeline.beyond_settings. Four studies, all under results/beyond/
 # (results/README.md), for any scheme of the registry mcfbench.schemes.SCHEMES:
 #
-# - levels: every scheme on every level with tau ~ h^2 as in Table 3.1; the
-#   ordinary run records results/runs/{scheme}/level{k}.json of rule
-#   run_scheme (shared with the convergence study);
+# - levels: every scheme on every level with tau ~ h^2 as in Table 3.1, and
+#   the schemes of beyond.finest on one level more; the ordinary run records
+#   results/runs/{scheme}/level{k}.json of rule run_scheme (shared with the
+#   convergence study);
 # - long_time: one level continued past t_final (onset of the breakdown);
 # - space: refined meshes with one tiny time step (order 2 in space);
 # - time: one mesh, tau halved repeatedly (order 1 in time;
