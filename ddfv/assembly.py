@@ -134,6 +134,7 @@ class Assembler:
         slots[inner, k.SLOT_T1_T2], slots[inner, k.SLOT_T2_T1] = s_t12, s_t21
         slots[inner, k.SLOT_T2_T2] = s_diag[n_f + t2_i]
         self.shape = (n, n)
+        self._mesh = mesh
         self._slots = slots
         self._diag = np.ascontiguousarray(s_diag)
         self._indices = cols[perm].astype(np.int32)
@@ -147,9 +148,9 @@ class Assembler:
     def nnz(self):
         return len(self._indices)
 
-    def _matrix(self, geom, scale, shift):
+    def _matrix(self, geom, scale, shift, threads=1):
         """``diag(scale) K + shift I`` in CSR (:func:`ddfv.kernels.system_kernel`)."""
-        from .kernels import system_kernel
+        from .kernels import for_threads, system_kernel
 
         n_d = self._slots.shape[0]
         factors = []
@@ -160,8 +161,9 @@ class Assembler:
                                  f"the mesh needs ({n_d},)")
             factors.append(x)
         data = np.empty(self.nnz)
-        system_kernel(self._inner, *factors, self._slots, self._indptr.view(np.uint32),
-                      self._diag, scale, float(shift), data)
+        for_threads(system_kernel, threads)(
+            self._inner, *factors, self._slots, *self._mesh.diamond_blocks(threads),
+            self._indptr.view(np.uint32), self._diag, scale, float(shift), data)
         return sp.csr_matrix((data, self._indices, self._indptr), shape=self.shape)
 
     def stiffness(self, geom):
@@ -179,7 +181,7 @@ class Assembler:
         """
         return self._matrix(geom, (~self._dirichlet).astype(float), 0.0)
 
-    def system(self, geom, chi, tau):
+    def system(self, geom, chi, tau, threads=1):
         """System matrix ``I + tau diag(1/chi) K`` of (2.10)-(2.11), (2.13)-(2.14).
 
         Parameters
@@ -191,6 +193,8 @@ class Assembler:
             of the equation's own covolume scales each row (typo in (2.11)).
         tau : float
             Time step.
+        threads : int
+            Threads of the fill (:meth:`ddfv.topology.DiamondMesh.diamond_blocks`).
 
         Returns
         -------
@@ -203,4 +207,4 @@ class Assembler:
         scale = tau / chi
         if self._has_boundary:
             scale[self._dirichlet] = 0.0
-        return self._matrix(geom, scale, 1.0)
+        return self._matrix(geom, scale, 1.0, threads)

@@ -38,6 +38,7 @@ import numpy as np
 
 from .assembly import Assembler
 from .geometry import covolume_areas, diamond_geometry, t_barycentric, vertex_normals
+from .kernels import check_threads
 from .t_vertices import initial_t_vertices
 from .topology import diamond_mesh, locality_order
 
@@ -87,6 +88,9 @@ class Flow:
     dual_length : {"broken", "chord"}
         Length of the dual curves ``|gamma|``: the paper's broken line (2.5)
         or the chord (see :func:`ddfv.geometry.diamond_geometry`).
+    threads : int
+        Threads of the compiled passes (geometry, covolumes, matrix fill, T
+        monitor; :func:`ddfv.kernels.for_threads`).
 
     Attributes
     ----------
@@ -100,7 +104,7 @@ class Flow:
     """
 
     def __init__(self, vertices, faces, tau, *, T0=None, t_init="paper",
-                 warm_start="extrapolate", tangential="none", dual_length="broken"):
+                 warm_start="extrapolate", tangential="none", dual_length="broken", threads=1):
         if not (np.isfinite(tau) and tau > 0):
             raise ValueError(f"tau must be a positive number, got {tau!r}")
         if warm_start not in WARM_STARTS:
@@ -109,6 +113,8 @@ class Flow:
         if tangential not in TANGENTIAL:
             raise ValueError(f"unknown tangential {tangential!r}; choose one of "
                              f"{', '.join(TANGENTIAL)}")
+        check_threads(threads)
+        self.threads = threads
         self._faces = diamond_mesh(faces, len(vertices)).faces   # checked, as given
         n_f, n_t = len(vertices), len(self._faces)
         # the flow's own numbering (module docstring): position j holds the
@@ -181,12 +187,12 @@ class Flow:
         """:class:`~ddfv.geometry.DiamondGeometry` of the current state (own numbering)."""
         n_f = self._mesh.n_f
         return diamond_geometry(self._mesh, self._X[:, :n_f].T, self._X[:, n_f:].T,
-                                self.dual_length)
+                                self.dual_length, self.threads)
 
     @cached_property
     def _chi(self):
         """(n_f + n_t,) covolume areas ``chi^n``, F-vertices first (own numbering)."""
-        chi_f, chi_t = covolume_areas(self._mesh, self._geometry)
+        chi_f, chi_t = covolume_areas(self._mesh, self._geometry, self.threads)
         chi = chi_f.base              # the two are views of one (n_f + n_t,) buffer
         if chi is None or chi is not chi_t.base or chi.shape != (self._mesh.n_unknowns,):
             chi = np.concatenate([chi_f, chi_t])
@@ -208,7 +214,7 @@ class Flow:
         """(n_t, 3) barycentric coordinates and their minimum (own numbering)."""
         n_f = self._mesh.n_f
         return t_barycentric(self._X[:, :n_f].T, self._X[:, n_f:].T, self._mesh.faces,
-                             return_min=True)
+                             return_min=True, threads=self.threads)
 
     @property
     def barycentric(self):
@@ -243,7 +249,7 @@ class Flow:
         geometry, covolumes = self._geometry, self._chi
         self._tick("geometry", clock)
         clock = time.perf_counter()
-        A = self._assembler.system(geometry, covolumes, self.tau)
+        A = self._assembler.system(geometry, covolumes, self.tau, self.threads)
         rhs = self._X
         if self.tangential == "eliminate":
             h = (self._X - (A @ self._X.T).T) / self.tau            # h^{n-1}

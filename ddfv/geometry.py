@@ -93,7 +93,7 @@ def diamond_corners(mesh, F, T):
 DUAL_LENGTHS = ("broken", "chord")
 
 
-def diamond_geometry(mesh, F, T, dual_length="broken"):
+def diamond_geometry(mesh, F, T, dual_length="broken", threads=1):
     """Geometric factors of all diamonds, see :class:`DiamondGeometry`.
 
     One pass over the diamonds (:func:`ddfv.kernels.diamond_geometry_kernel`)
@@ -111,6 +111,8 @@ def diamond_geometry(mesh, F, T, dual_length="broken"):
     dual_length : {"broken", "chord"}
         ``|gamma|`` as the paper's broken line through ``S`` (2.5), or as the
         chord (``|gamma^T| = |v|``, ``|gamma^F| = |u|``).
+    threads : int
+        Threads of the pass (:func:`ddfv.kernels.threaded`).
 
     Returns
     -------
@@ -126,7 +128,7 @@ def diamond_geometry(mesh, F, T, dual_length="broken"):
     n_d = diamonds.shape[1]
     buf = np.empty((k.GEOMETRY_ROWS, k.padded_length(n_d)))
     broken = dual_length == "broken"
-    k.diamond_geometry_kernel(F, T, diamonds, broken, buf)
+    k.for_threads(k.diamond_geometry_kernel, threads)(F, T, diamonds, broken, buf)
     rows = buf[:, :n_d]
     len_u, len_v = rows[k.ROW_LEN_U], rows[k.ROW_LEN_V]
     return DiamondGeometry(
@@ -138,7 +140,7 @@ def diamond_geometry(mesh, F, T, dual_length="broken"):
         quarters=rows[k.ROW_QUARTERS:k.ROW_QUARTERS + 4])
 
 
-def covolume_areas(mesh, geom):
+def covolume_areas(mesh, geom, threads=1):
     """Areas ``chi(V_i^F)`` and ``chi(V_i^T)`` of the covolumes (Section 2.2.4).
 
     Each diamond is cut by its centre ``S`` into four triangles
@@ -151,6 +153,8 @@ def covolume_areas(mesh, geom):
     ----------
     mesh : DiamondMesh
     geom : DiamondGeometry
+    threads : int
+        Threads of the scatter (:meth:`DiamondMesh.diamond_blocks`).
 
     Returns
     -------
@@ -158,13 +162,14 @@ def covolume_areas(mesh, geom):
     chi_t : (n_t,) float array
         Views of one (n_f + n_t,) buffer, F-vertices first.
     """
-    from .kernels import covolume_kernel
+    from .kernels import covolume_kernel, for_threads
 
     diamonds = _diamond_indices(mesh)
     quarters = _diamond_array(geom.quarters, (4, diamonds.shape[1]), "quarters")
     chi = np.empty(mesh.n_unknowns)
     chi_f, chi_t = chi[:mesh.n_f], chi[mesh.n_f:]
-    covolume_kernel(diamonds, quarters, chi_f, chi_t)
+    for_threads(covolume_kernel, threads)(diamonds, quarters, *mesh.diamond_blocks(threads),
+                                         chi_f, chi_t)
     return chi_f, chi_t
 
 
@@ -201,7 +206,7 @@ def triangle_areas(F, faces):
     return 0.5 * _norm(_cross(p1 - p0, p2 - p0))
 
 
-def t_barycentric(F, T, faces, return_min=False):
+def t_barycentric(F, T, faces, return_min=False, threads=1):
     """Barycentric coordinates of each T-vertex projected into its triangle.
 
     ``(1/3, 1/3, 1/3)`` at the barycentre; a negative coordinate means the
@@ -219,21 +224,24 @@ def t_barycentric(F, T, faces, return_min=False):
     return_min : bool
         Also return the smallest coordinate (``out.min()``, computed in the
         same pass).
+    threads : int
+        Threads of the pass (:func:`ddfv.kernels.threaded`).
 
     Returns
     -------
     (n_t, 3) float array
         With ``return_min``: ``(coordinates, smallest)``.
     """
-    from .kernels import t_barycentric_kernel
+    from .kernels import for_threads, t_barycentric_kernel
 
     faces = np.asarray(faces)
     if faces.ndim != 2 or faces.shape[1] != 3 or not np.issubdtype(faces.dtype, np.integer):
         raise ValueError(f"faces must be an (n_t, 3) int array, got {faces.dtype} {faces.shape}")
     T = _coordinates(T, len(faces), "T")
     out = np.empty((len(faces), 3))
-    low = t_barycentric_kernel(_coordinates(F, None, "F"), T,
-                               faces.astype(np.int64, copy=False).view(np.uint64), out)
+    kernel = for_threads(t_barycentric_kernel, threads)
+    low = kernel(_coordinates(F, None, "F"), T,
+                 faces.astype(np.int64, copy=False).view(np.uint64), out)
     return (out, float(low)) if return_min else out
 
 

@@ -20,7 +20,13 @@ Conventions
 - ``error_model="numpy"``: a division by zero gives inf/nan as in numpy.
 - ``cache=True``: compiled once into numba's cache (``NUMBA_CACHE_DIR``, by
   default ``__pycache__`` next to this file) and loaded from it afterwards.
+- Loops over independent elements are ``prange`` loops: plain loops in
+  these kernels, split over numba's threads in their :func:`threaded`
+  copies (``threads > 1``).
 """
+
+import functools
+import types
 
 import numba
 import numpy as np
@@ -42,6 +48,62 @@ GEOMETRY_ROWS = 19
  SLOT_T1_A, SLOT_T1_B, SLOT_T2_A, SLOT_T2_B, SLOT_T1_T2, SLOT_T2_T1, SLOT_T1_T1,
  SLOT_T2_T2) = range(16)
 N_SLOTS = 16
+
+
+@functools.cache
+def threaded(kernel, **callees):
+    """``kernel`` compiled again with ``parallel=True``: its ``prange`` loops are
+    split into one block of iterations per thread, their sums and minima
+    reduced per block.
+
+    One source for both versions. The copy has its own name, hence its own
+    entry in numba's cache; it is built and compiled on first use, so a
+    one-thread run never compiles it. ``callees`` replace the compiled
+    functions the kernel calls, by name (their threaded copies).
+
+    Parameters
+    ----------
+    kernel : numba dispatcher
+    **callees : numba dispatchers
+
+    Returns
+    -------
+    numba dispatcher
+        Compiled lazily for the argument types of each call.
+    """
+    py = kernel.py_func
+    clone = types.FunctionType(py.__code__, {**py.__globals__, **callees},
+                               f"{py.__name__}_threaded", py.__defaults__, py.__closure__)
+    clone.__qualname__, clone.__doc__ = clone.__name__, py.__doc__
+    options = {k: v for k, v in kernel.targetoptions.items() if k != "nopython"}
+    return numba.njit(parallel=True, cache=True, **options)(clone)
+
+
+def check_threads(threads):
+    """Refuse a thread count that is not a whole number in ``[1, NUMBA_NUM_THREADS]``."""
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) \
+            or threads < 1:
+        raise ValueError(f"threads must be a whole number >= 1, got {threads!r}")
+    if threads > numba.config.NUMBA_NUM_THREADS:
+        raise ValueError(f"threads={threads} exceeds the {numba.config.NUMBA_NUM_THREADS} "
+                         "thread(s) numba was started with (NUMBA_NUM_THREADS, by default "
+                         "the number of cores)")
+
+
+def for_threads(kernel, threads, **callees):
+    """``kernel`` for one thread; else its :func:`threaded` copy (calling the
+    threaded copies of ``callees``), with numba set to ``threads`` threads.
+
+    Raises
+    ------
+    ValueError
+        ``threads`` is not a whole number in ``[1, NUMBA_NUM_THREADS]``.
+    """
+    check_threads(threads)
+    if threads == 1:
+        return kernel
+    numba.set_num_threads(threads)
+    return threaded(kernel, **{name: threaded(c) for name, c in callees.items()})
 
 
 def padded_length(n):
@@ -77,11 +139,13 @@ def diamond_geometry_kernel(F, T, diamonds, broken, out):
     """
     # uint64 sizes: a comparison of uint64 with int64 would go through float64
     n_f, n_t = np.uint64(F.shape[0]), np.uint64(T.shape[0])
-    for d in range(diamonds.shape[1]):
+    bad = 0
+    for d in numba.prange(diamonds.shape[1]):
         a, b, t1, t2 = diamonds[0, d], diamonds[1, d], diamonds[2, d], diamonds[3, d]
         inner = t2 != NO_T
         if a >= n_f or b >= n_f or t1 >= n_t or (inner and t2 >= n_t):
-            raise IndexError("diamond index out of range")
+            bad += 1            # raised after the loop (a raise would keep it serial)
+            continue
         uu = vv = ee = uv = ue = ve = 0.0
         for k in range(3):
             fa, fb, p = F[a, k], F[b, k], T[t1, k]
@@ -122,11 +186,39 @@ def diamond_geometry_kernel(F, T, diamonds, broken, out):
         if broken:
             out[ROW_GAMMA_T, d] = np.sqrt(p2) + np.sqrt(q2)    # (2.5)
             out[ROW_GAMMA_F, d] = np.sqrt(ra2) + np.sqrt(rb2)  # (2.15), Section 2.2.5
+    if bad > 0:
+        raise IndexError("diamond index out of range")
 
 
-@numba.njit("void(uint64[:, :], float64[:, :], float64[::1], float64[::1])", **_OPTIONS)
-def covolume_kernel(diamonds, quarters, chi_f, chi_t):
+@numba.njit(**_OPTIONS, inline="always")
+def _scatter_quarters(diamonds, quarters, order, lo, hi, chi_f, chi_t):
+    """The diamonds ``order[lo:hi]`` of :func:`covolume_kernel`; returns how many
+    had an index out of range (skipped)."""
+    n_f, n_t = np.uint64(chi_f.shape[0]), np.uint64(chi_t.shape[0])
+    bad = 0
+    for j in range(lo, hi):
+        d = order[j]
+        a, b, t1, t2 = diamonds[0, d], diamonds[1, d], diamonds[2, d], diamonds[3, d]
+        inner = t2 != NO_T
+        if a >= n_f or b >= n_f or t1 >= n_t or (inner and t2 >= n_t):
+            bad += 1
+            continue
+        q_a1, q_a2, q_b1, q_b2 = quarters[0, d], quarters[1, d], quarters[2, d], quarters[3, d]
+        chi_f[a] += q_a1 + q_a2
+        chi_f[b] += q_b1 + q_b2
+        chi_t[t1] += q_a1 + q_b1
+        if inner:
+            chi_t[t2] += q_a2 + q_b2
+    return bad
+
+
+@numba.njit("void(uint64[:, :], float64[:, :], uint64[::1], uint64[::1], float64[::1], "
+            "float64[::1])", **_OPTIONS)
+def covolume_kernel(diamonds, quarters, order, starts, chi_f, chi_t):
     """Scatter the quarters of each diamond into ``chi(V^F)``, ``chi(V^T)`` (Section 2.2.4).
+
+    The blocks of :meth:`ddfv.topology.DiamondMesh.diamond_blocks` one per
+    thread, then the diamonds across blocks.
 
     Parameters
     ----------
@@ -134,23 +226,22 @@ def covolume_kernel(diamonds, quarters, chi_f, chi_t):
     quarters : (4, n_d) float64 array
         Areas of ``(F_a, T_t1, S)``, ``(F_a, S, T_t2)``, ``(F_b, T_t1, S)``,
         ``(F_b, S, T_t2)``.
+    order, starts : uint64 arrays
+        The diamond blocks.
     chi_f : (n_f,) float64 array, output
     chi_t : (n_t,) float64 array, output
     """
-    n_f, n_t = np.uint64(chi_f.shape[0]), np.uint64(chi_t.shape[0])
     chi_f[:] = 0.0
     chi_t[:] = 0.0
-    for d in range(diamonds.shape[1]):
-        a, b, t1, t2 = diamonds[0, d], diamonds[1, d], diamonds[2, d], diamonds[3, d]
-        inner = t2 != NO_T
-        if a >= n_f or b >= n_f or t1 >= n_t or (inner and t2 >= n_t):
-            raise IndexError("diamond index out of range")
-        q_a1, q_a2, q_b1, q_b2 = quarters[0, d], quarters[1, d], quarters[2, d], quarters[3, d]
-        chi_f[a] += q_a1 + q_a2
-        chi_f[b] += q_b1 + q_b2
-        chi_t[t1] += q_a1 + q_b1
-        if inner:
-            chi_t[t2] += q_a2 + q_b2
+    parts = starts.shape[0] - 2
+    bad = np.zeros(parts + 1, dtype=np.int64)       # per block (no reduction across blocks)
+    for k in numba.prange(parts):
+        bad[k] = _scatter_quarters(diamonds, quarters, order, starts[k], starts[k + 1],
+                                   chi_f, chi_t)
+    bad[parts] = _scatter_quarters(diamonds, quarters, order, starts[parts],
+                                   starts[parts + 1], chi_f, chi_t)
+    if bad.any():
+        raise IndexError("diamond index out of range")
 
 
 @numba.njit("void(uint64[:, :], float64[:, :], float64[:, :], int64, float64[:, ::1])",
@@ -210,38 +301,11 @@ def flux_coefficients_kernel(gamma_t, gamma_f, J, len_u, len_v, uv):
             gf_J * uv / len_u)         # beta_hat = q_hat^F           (2.15)
 
 
-@numba.njit("void(boolean[::1], float64[:], float64[:], float64[:], float64[:], float64[:], "
-            "float64[:], uint32[:, ::1], uint32[::1], uint32[::1], float64[::1], float64, "
-            "float64[::1])", **_OPTIONS)
-def system_kernel(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, indptr, diag,
-                  scale, shift, data):
-    """Values of ``diag(scale) K + shift I`` in a fixed CSR pattern (2.10)-(2.15).
-
-    Each diamond scatters its entries of ``K`` (minus its fluxes, see
-    :mod:`ddfv.assembly`) into their CSR slots; one pass over the rows then
-    scales them and adds ``shift`` on the diagonal. The slots, ``indptr``
-    and ``diag`` come from :class:`ddfv.assembly.Assembler` (positions in
-    its CSR pattern, all below ``nnz`` by construction) and are not checked
-    here.
-
-    Parameters
-    ----------
-    inner : (n_d,) bool array
-        False on boundary diamonds (``t2 = -1``).
-    gamma_t, gamma_f, J, len_u, len_v, uv : (n_d,) float64 arrays
-        The geometric factors of :class:`ddfv.geometry.DiamondGeometry`.
-    slots : (n_d, N_SLOTS) uint32 array
-        CSR position of each entry of the diamond (``SLOT_*``); the ``t2``
-        slots of boundary diamonds are unused.
-    indptr : (n + 1,) uint32 array
-    diag : (n,) uint32 array
-        CSR position of the diagonal entry of each row.
-    scale : (n,) float64 array
-    shift : float
-    data : (nnz,) float64 array, output
-    """
-    data[:] = 0.0
-    for d in range(inner.shape[0]):
+@numba.njit(**_OPTIONS, inline="always")
+def _scatter_entries(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, order, lo, hi, data):
+    """The diamonds ``order[lo:hi]`` of :func:`system_kernel`."""
+    for j in range(lo, hi):
+        d = order[j]
         alpha, beta, alpha_hat, beta_hat = flux_coefficients_kernel(
             gamma_t[d], gamma_f[d], J[d], len_u[d], len_v[d], uv[d])
         s = slots[d]
@@ -269,7 +333,52 @@ def system_kernel(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, indptr, d
             data[s[SLOT_T1_A]] -= beta_hat + alpha_hat
             data[s[SLOT_T1_B]] += beta_hat - alpha_hat
             data[s[SLOT_T1_T1]] += 2.0 * alpha_hat
-    for i in range(diag.shape[0]):
+
+
+@numba.njit("void(boolean[::1], float64[:], float64[:], float64[:], float64[:], float64[:], "
+            "float64[:], uint32[:, ::1], uint64[::1], uint64[::1], uint32[::1], uint32[::1], "
+            "float64[::1], float64, float64[::1])", **_OPTIONS)
+def system_kernel(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, order, starts, indptr,
+                  diag, scale, shift, data):
+    """Values of ``diag(scale) K + shift I`` in a fixed CSR pattern (2.10)-(2.15).
+
+    Each diamond scatters its entries of ``K`` (minus its fluxes, see
+    :mod:`ddfv.assembly`) into their CSR slots, the blocks of
+    :meth:`ddfv.topology.DiamondMesh.diamond_blocks` one per thread, then
+    the diamonds across blocks; one pass over the rows then scales them and
+    adds ``shift`` on the diagonal. The slots, ``indptr`` and ``diag`` come
+    from :class:`ddfv.assembly.Assembler` (positions in its CSR pattern, all
+    below ``nnz`` by construction) and are not checked here.
+
+    Parameters
+    ----------
+    inner : (n_d,) bool array
+        False on boundary diamonds (``t2 = -1``).
+    gamma_t, gamma_f, J, len_u, len_v, uv : (n_d,) float64 arrays
+        The geometric factors of :class:`ddfv.geometry.DiamondGeometry`.
+    slots : (n_d, N_SLOTS) uint32 array
+        CSR position of each entry of the diamond (``SLOT_*``); the ``t2``
+        slots of boundary diamonds are unused.
+    order, starts : uint64 arrays
+        The diamond blocks.
+    indptr : (n + 1,) uint32 array
+    diag : (n,) uint32 array
+        CSR position of the diagonal entry of each row.
+    scale : (n,) float64 array
+    shift : float
+    data : (nnz,) float64 array, output
+    """
+    n = diag.shape[0]
+    for i in numba.prange(n):
+        for j in range(indptr[i], indptr[i + 1]):
+            data[j] = 0.0
+    parts = starts.shape[0] - 2
+    for k in numba.prange(parts):
+        _scatter_entries(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, order,
+                         starts[k], starts[k + 1], data)
+    _scatter_entries(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, order,
+                     starts[parts], starts[parts + 1], data)
+    for i in numba.prange(n):
         s_i = scale[i]
         for j in range(indptr[i], indptr[i + 1]):
             data[j] *= s_i
@@ -292,10 +401,13 @@ def t_barycentric_kernel(F, T, faces, out):
     """
     n_f = np.uint64(F.shape[0])
     low = np.inf
-    for t in range(faces.shape[0]):
+    nans = 0
+    bad = 0
+    for t in numba.prange(faces.shape[0]):
         i0, i1, i2 = faces[t, 0], faces[t, 1], faces[t, 2]
         if i0 >= n_f or i1 >= n_f or i2 >= n_f:
-            raise IndexError("face index out of range")
+            bad += 1            # raised after the loop (a raise would keep it serial)
+            continue
         g11 = g12 = g22 = r1 = r2 = 0.0
         for k in range(3):
             p0 = F[i0, k]
@@ -313,10 +425,10 @@ def t_barycentric_kernel(F, T, faces, out):
         out[t, 0] = l0
         out[t, 1] = l1
         out[t, 2] = l2
-        if low == low:                      # the first NaN stays
-            smallest = min(l0, l1, l2)
-            if not (l0 == l0 and l1 == l1 and l2 == l2):
-                low = np.nan
-            elif smallest < low:
-                low = smallest
-    return low
+        if l0 == l0 and l1 == l1 and l2 == l2:
+            low = min(low, min(l0, l1, l2))
+        else:
+            nans += 1
+    if bad > 0:
+        raise IndexError("face index out of range")
+    return np.nan if nans > 0 else low

@@ -73,6 +73,44 @@ class DiamondMesh:
         adj.sort_indices()
         return adj
 
+    def diamond_blocks(self, parts):
+        """The diamonds grouped so that ``parts`` threads can scatter into per-vertex
+        arrays (covolumes, matrix rows) without two of them writing one entry.
+
+        F-vertex ``i`` belongs to part ``i * parts // n_f`` and T-vertex ``t``
+        to part ``t * parts // n_t``; in the locality numbering
+        (:func:`locality_order`) both are contiguous regions of the surface.
+        Block ``k < parts`` holds the diamonds whose four vertices all lie in
+        part ``k``; the last block the diamonds across parts (to be done
+        after the others, on one thread). Each block keeps the diamonds in
+        their order; with ``parts = 1`` the one block is every diamond in
+        order.
+
+        Parameters
+        ----------
+        parts : int
+
+        Returns
+        -------
+        order : (n_d,) uint64 array
+            The diamonds, block by block.
+        starts : (parts + 2,) uint64 array
+            Block ``k`` is ``order[starts[k]:starts[k + 1]]``.
+        """
+        cache = self.__dict__.setdefault("_blocks", {})
+        if parts not in cache:
+            a, b, t1, t2 = self.diamonds.T
+            part_f = np.arange(self.n_f) * parts // self.n_f
+            part_t = np.arange(self.n_t) * parts // max(self.n_t, 1)
+            part = part_f[a]
+            across = (part_f[b] != part) | (part_t[t1] != part)
+            across |= (t2 >= 0) & (part_t[np.maximum(t2, 0)] != part)
+            block = np.where(across, parts, part)
+            order = np.argsort(block, kind="stable")
+            starts = np.searchsorted(block[order], np.arange(parts + 2))
+            cache[parts] = (order.astype(np.uint64), starts.astype(np.uint64))
+        return cache[parts]
+
     def one_ring(self, i):
         """Indices of the F-vertices adjacent to F-vertex ``i`` (sorted)."""
         adj = self.adjacency

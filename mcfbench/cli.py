@@ -71,6 +71,9 @@ def _common(parser, default_solver):
     parser.add_argument("--on-defect", choices=("stop", "record"), default="stop",
                         help="an invalid state (T-vertex escaped, triangle inverted, mesh "
                              "degenerated) ends the run (stop, default) or is recorded")
+    parser.add_argument("--threads", type=_level, default=1,
+                        help="threads of the solver and of DDFV's per-element passes "
+                             "(default: 1)")
 
 
 def build_parser():
@@ -129,8 +132,8 @@ def _scheme(args):
 
 def _options(args, scheme):
     """Run options: the solver and the DDFV-only settings that were given."""
-    options = {"solver": Solver(args.solver, args.rtol, args.maxiter),
-               "on_defect": args.on_defect}
+    options = {"solver": Solver(args.solver, args.rtol, args.maxiter, threads=args.threads),
+               "on_defect": args.on_defect, "threads": args.threads}
     ddfv_only = {"t_init": args.t_init, "warm_start": args.warm_start}
     given = {k: v for k, v in ddfv_only.items() if v is not None}
     if given and scheme.family != "ddfv":
@@ -142,7 +145,8 @@ def _options(args, scheme):
 def _settings(args, scheme):
     return {"command": args.command, "scheme": scheme.name, "solver": args.solver,
             "rtol": args.rtol, "maxiter": args.maxiter, "t_init": args.t_init,
-            "warm_start": args.warm_start, "on_defect": args.on_defect}
+            "warm_start": args.warm_start, "on_defect": args.on_defect,
+            "threads": args.threads}
 
 
 def _sphere_table(args):

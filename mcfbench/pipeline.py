@@ -287,6 +287,11 @@ class Pipeline:
         self.rtol = float(config["rtol"])
         if not 0 < self.rtol < 1:          # the schema lets NaN through
             raise ConfigError(f"config key 'rtol': must lie in (0, 1), got {config['rtol']!r}")
+        self.threads = config.get("threads", 1)
+        if isinstance(self.threads, bool) or not isinstance(self.threads, int) \
+                or self.threads < 1:
+            raise ConfigError(f"config key 'threads': a whole number >= 1, got "
+                              f"{self.threads!r}")
         self.problem = get_problem(PROBLEM).with_settings(
             tau_1=float(config["tau_level_1"]), t_final=float(config["t_final"]))
         for level in self.levels:
@@ -308,7 +313,7 @@ class Pipeline:
         settings = {"scheme": scheme, "problem": self.problem.name, "level": level,
                     "tau": self.problem.tau(level) if tau is None else float(tau),
                     "t_final": self.problem.t_final if t_final is None else float(t_final),
-                    "rtol": self.rtol, "code": self.code}
+                    "rtol": self.rtol, "threads": self.threads, "code": self.code}
         return settings if study is None else {"study": study, **settings}
 
     def beyond_run_settings(self, study, scheme, level):
@@ -326,7 +331,7 @@ class Pipeline:
         return {"study": "time", "scheme": scheme, "problem": self.problem.name,
                 "level": study["level"], "taus": study["taus"],
                 "reference_factor": study["reference_factor"], "t_final": study["t_final"],
-                "rtol": self.rtol, "code": self.code}
+                "rtol": self.rtol, "threads": self.threads, "code": self.code}
 
     def convergence_settings(self):
         """The config as far as Table 3.1 depends on it (not the other studies)."""
@@ -402,9 +407,9 @@ class Pipeline:
 # -- jobs --------------------------------------------------------------------------
 
 def solver_of(settings):
-    """The shared solver with the settings' tolerance (and ``maxiter`` if given)."""
-    return Solver(rtol=settings["rtol"], **({"maxiter": settings["maxiter"]}
-                                            if "maxiter" in settings else {}))
+    """The shared solver with the settings' tolerance (``maxiter``, ``threads`` if given)."""
+    return Solver(rtol=settings["rtol"], **{k: settings[k] for k in ("maxiter", "threads")
+                                            if k in settings})
 
 
 def run_job(settings, output, log):
@@ -420,7 +425,8 @@ def run_job(settings, output, log):
     log.info("%s level %d: tau %g, t_final %g, rtol %g", settings["scheme"], settings["level"],
              settings["tau"], settings["t_final"], settings["rtol"])
     result, _ = run(settings["scheme"], problem, settings["level"], tau=settings["tau"],
-                    t_final=settings["t_final"], solver=solver_of(settings))
+                    t_final=settings["t_final"], solver=solver_of(settings),
+                    threads=settings.get("threads", 1))
     record = write_record(output, result, settings)
     log.info("%s level %d: status %s, L2 error %.4e, %d iterations, %.3f s wall, "
              "%.0f MB peak memory -> %s", result.scheme, result.level, result.status,
@@ -455,7 +461,8 @@ def time_job(settings, output, log):
     try:
         table = time_convergence(settings["scheme"], problem, settings["level"], taus,
                                  reference_factor=factor, t_final=settings["t_final"],
-                                 solver=solver_of(settings))
+                                 solver=solver_of(settings),
+                                 threads=settings.get("threads", 1))
         rows, outcome, message = table.to_dict("records"), "ok", ""
     except RuntimeError as err:
         rows, outcome, message = [], "reference_failed", str(err)

@@ -11,6 +11,7 @@ of :data:`ddfv.variants.VARIANTS`.
 """
 
 import importlib
+import inspect
 from dataclasses import dataclass, field
 
 
@@ -50,12 +51,17 @@ class Scheme:
         module, _, cls = self.flow.partition(":")
         return getattr(importlib.import_module(module), cls)
 
-    def make(self, vertices, faces, tau, **options):
+    def make(self, vertices, faces, tau, *, threads=1, **options):
         """The flow of ``(vertices, faces)`` with time step ``tau``.
 
-        ``options`` override the entry's own.
+        ``options`` override the entry's own. ``threads`` goes to a flow
+        class that takes it (DDFV's per-element passes); the others run on
+        one thread (their linear solves take the solver's threads).
         """
-        return self.flow_class(vertices, faces, tau, **{**self.options, **options})
+        cls = self.flow_class
+        if "threads" in inspect.signature(cls).parameters:
+            options = {**options, "threads": threads}
+        return cls(vertices, faces, tau, **{**self.options, **options})
 
 
 def _ddfv(variant, label, color, marker, linestyle, description):

@@ -107,7 +107,9 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from numba import njit
+from numba import njit, prange
+
+from ddfv.kernels import check_threads, for_threads
 
 METHODS = ("bicgstab", "jacobi-bicgstab", "ilu-bicgstab", "direct")
 ROBUST = "direct"
@@ -193,7 +195,7 @@ def _spmv(indptr, indices, data, X, Y, R):
     ry = 0.0
     yy = 0.0
     if k == 3:
-        for i in range(m):
+        for i in prange(m):
             y0 = 0.0
             y1 = 0.0
             y2 = 0.0
@@ -209,7 +211,7 @@ def _spmv(indptr, indices, data, X, Y, R):
             ry += R[0, i] * y0 + R[1, i] * y1 + R[2, i] * y2
             yy += y0 * y0 + y1 * y1 + y2 * y2
     elif k == 1:
-        for i in range(m):
+        for i in prange(m):
             y0 = 0.0
             for jj in range(indptr[i], indptr[i + 1]):
                 y0 += data[jj] * X[0, indices[jj]]
@@ -217,7 +219,7 @@ def _spmv(indptr, indices, data, X, Y, R):
             ry += R[0, i] * y0
             yy += y0 * y0
     else:
-        for i in range(m):
+        for i in prange(m):
             for q in range(k):
                 Y[q, i] = 0.0
             for jj in range(indptr[i], indptr[i + 1]):
@@ -506,7 +508,7 @@ def _bicgstab(indptr, indices, data, b, x, cmean, cfull, rtol, maxiter, window, 
         if not math.isfinite(alpha):
             return _BREAKDOWN, 5, it, rnorm, ref
         ss = 0.0
-        for i in range(n):                  # s = r - alpha v
+        for i in prange(n):                  # s = r - alpha v
             si = rf[i] - vf[i] * alpha
             sf[i] = si
             ss += si * si
@@ -515,7 +517,7 @@ def _bicgstab(indptr, indices, data, b, x, cmean, cfull, rtol, maxiter, window, 
             return _BREAKDOWN, 7, it, snorm, ref
         if snorm <= tol:                    # half-step exit: still one iteration
             xx = 0.0
-            for i in range(n):
+            for i in prange(n):
                 xi = xf[i] + phf[i] * alpha
                 xf[i] = xi
                 xx += xi * xi
@@ -537,7 +539,7 @@ def _bicgstab(indptr, indices, data, b, x, cmean, cfull, rtol, maxiter, window, 
         rr = 0.0
         rho_new = 0.0
         xx = 0.0
-        for i in range(n):                  # x += alpha p + omega s; r = s - omega t
+        for i in prange(n):                  # x += alpha p + omega s; r = s - omega t
             xi = (xf[i] + phf[i] * alpha) + shf[i] * omega
             xf[i] = xi
             xx += xi * xi
@@ -569,7 +571,7 @@ def _bicgstab(indptr, indices, data, b, x, cmean, cfull, rtol, maxiter, window, 
         if not math.isfinite(beta):
             return _BREAKDOWN, 6, it, rnorm, ref
         rho = rho_new
-        for i in range(n):                  # p = r + beta (p - omega v)
+        for i in prange(n):                  # p = r + beta (p - omega v)
             pf[i] = (pf[i] - vf[i] * omega) * beta + rf[i]
     return _MAXITER, 0, it, rnorm, ref
 
@@ -676,7 +678,8 @@ def _failed(method, status, detail, residual=math.nan, iterations=0):
 
 
 def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
-          stagnation_window=50, ilu_drop_tol=1e-4, ilu_fill_factor=10.0, overwrite_x0=False):
+          stagnation_window=50, ilu_drop_tol=1e-4, ilu_fill_factor=10.0, overwrite_x0=False,
+          threads=1):
     """Solve ``A x = b`` for a (k, n) block ``b`` from ``x0``; reports failures in ``info``.
 
     Parameters
@@ -698,6 +701,12 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
         ``x0`` may be used as the iterate (no copy) when it is a C-contiguous,
         writeable float64 array not sharing memory with ``b``; it then holds
         the returned solution (or the last iterate).
+    threads : int
+        Threads of the BiCGStab methods' products and vector updates (row
+        blocks, :func:`ddfv.kernels.for_threads`), at most
+        ``numba.config.NUMBA_NUM_THREADS``. With more than one the inner
+        products are summed in another order: the iterates agree to
+        round-off, not bitwise.
 
     Returns
     -------
@@ -714,6 +723,7 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
     if method not in METHODS:
         raise ValueError(f"unknown solver method {method!r}; choose one of "
                          f"{', '.join(METHODS)}")
+    check_threads(threads)
     b, x, cmean, cfull, to_block = _blocks(A, b, x0, overwrite_x0)
     csr = _csr(A)
     with np.errstate(all="ignore"):
@@ -739,7 +749,7 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
                 if lu is None:
                     return to_block(x), _failed(method, "breakdown", detail)
             # else: kind 0, the kernel reports the non-finite input
-        code, dcode, it, rnorm, ref = _bicgstab(
+        code, dcode, it, rnorm, ref = for_threads(_bicgstab, threads, _spmv=_spmv)(
             *csr, b, x, cmean, cfull, float(rtol), int(maxiter), int(stagnation_window),
             kind, dinv, *_ilu_arrays(lu))
         residual = (rnorm / ref if ref > 0.0 else
@@ -871,6 +881,8 @@ class Solver:
         Iterations without a new residual minimum that count as stagnation.
     ilu_drop_tol, ilu_fill_factor : float
         ``scipy.sparse.linalg.spilu`` parameters of ``"ilu-bicgstab"``.
+    threads : int
+        Threads of the BiCGStab products and vector updates (see :func:`solve`).
     """
 
     method: str = "bicgstab"
@@ -879,6 +891,7 @@ class Solver:
     stagnation_window: int = 50
     ilu_drop_tol: float = 1e-4
     ilu_fill_factor: float = 10.0
+    threads: int = 1
 
     #: ``solver(A, b, x0, overwrite_x0=True)`` iterates in ``x0`` (no copy), see :func:`solve`
     can_overwrite_x0 = True
@@ -899,12 +912,14 @@ class Solver:
         if not (isinstance(self.ilu_fill_factor, (int, float))
                 and self.ilu_fill_factor >= 1):
             raise ValueError(f"ilu_fill_factor must be >= 1, got {self.ilu_fill_factor!r}")
+        check_threads(self.threads)
 
     def __call__(self, A, b, x0, *, overwrite_x0=False):
         x, info = solve(A, b, x0, method=self.method, rtol=self.rtol, maxiter=self.maxiter,
                         stagnation_window=self.stagnation_window,
                         ilu_drop_tol=self.ilu_drop_tol,
-                        ilu_fill_factor=self.ilu_fill_factor, overwrite_x0=overwrite_x0)
+                        ilu_fill_factor=self.ilu_fill_factor, overwrite_x0=overwrite_x0,
+                        threads=self.threads)
         if not info.converged:
             raise SolverFailure(info, self.rtol, self.maxiter)
         return x, info

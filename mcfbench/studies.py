@@ -14,7 +14,7 @@ solution: order 2 expected).
 """
 
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
@@ -165,7 +165,7 @@ class _Steady:
 
 
 def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defect="stop",
-        save_every=0, samples=20, mesh=None, **options):
+        save_every=0, samples=20, mesh=None, threads=1, **options):
     """Run ``scheme`` on ``problem`` at refinement ``level``.
 
     Parameters
@@ -185,6 +185,10 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defec
         About how many time levels the mesh quality is sampled at.
     mesh : (vertices, faces), optional
         Instead of the problem's generator (a user's mesh).
+    threads : int
+        Threads of the solver and of the scheme's compiled passes
+        (:meth:`mcfbench.schemes.Scheme.make`); ``solver.threads`` is
+        replaced by it when more than one.
     **options
         Options of the scheme's flow class (override the registry's).
 
@@ -199,11 +203,13 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defec
     tau = problem.tau(level, (V, F)) if tau is None else float(tau)
     steps = problem.time_steps(tau, t_final)
     solver = Solver() if solver is None else solver
+    if threads != 1:
+        solver = replace(solver, threads=threads)
     monitor = _Monitor(max(1, steps // max(1, samples)))
     observers = problem.observers()
     until = _Steady(problem.steady_speed) if problem.steady_speed else None
     cpu, wall = time.process_time(), time.perf_counter()
-    flow = scheme.make(V, F, tau, **options)
+    flow = scheme.make(V, F, tau, threads=threads, **options)
     traj = simulate(flow, steps, solver=solver, save_every=save_every,
                     observers=[monitor, *observers], on_defect=on_defect, until=until)
     monitor.final(flow)

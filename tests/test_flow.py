@@ -267,3 +267,30 @@ def test_t_monitor_and_state_checks_reuse_the_kernels_minimum():
     for _ in range(3):
         other.step(lambda A, b, x0: Solver()(A, b, x0))      # a plain callable: copies
     np.testing.assert_array_equal(flow.X, other.X)
+
+
+def test_threaded_passes_agree_with_one_thread(bumpy):
+    """threads=2: the per-diamond and per-triangle passes are the same
+    arithmetic; the scatters add the diamonds across blocks last (round-off)."""
+    V, F = bumpy
+    one, two = Flow(V, F, 0.002), Flow(V, F, 0.002, threads=2)
+    for name in ("J", "uv", "len_u", "gamma_t", "quarters"):
+        np.testing.assert_array_equal(getattr(two._geometry, name),
+                                      getattr(one._geometry, name))
+    np.testing.assert_allclose(two.covolumes, one.covolumes, rtol=1e-14)
+    np.testing.assert_array_equal(two.barycentric, one.barycentric)
+    assert two.t_min_barycentric() == one.t_min_barycentric()
+    A1 = one._assembler.system(one._geometry, one._chi, one.tau)
+    A2 = two._assembler.system(two._geometry, two._chi, two.tau, threads=2)
+    np.testing.assert_allclose(A2.toarray(), A1.toarray(), rtol=1e-13, atol=1e-15)
+    solve = Solver()
+    for _ in range(5):
+        one.step(solve)
+        two.step(solve)
+    np.testing.assert_allclose(two.X, one.X, atol=1e-12)
+
+
+@pytest.mark.parametrize("threads", [0, 1.5, True, 10**6])
+def test_bad_thread_counts_are_refused(bumpy, threads):
+    with pytest.raises(ValueError, match="threads"):
+        Flow(*bumpy, 0.01, threads=threads)

@@ -24,7 +24,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
 
+from mcfbench.pipeline import Pipeline, solver_of
 from mcfbench.records import checksum
 
 REPO = Path(__file__).resolve().parents[1]
@@ -204,6 +206,7 @@ BAD_CONFIGS = {  # --config value -> expected part of the message
     "t_final=nan": "config keys 't_final' and 'tau_level_1': t_final must be a positive number",
     "rtol=-1e-9": "schema['properties']['rtol']",
     "rtol=nan": "config key 'rtol': must lie in (0, 1), got nan",
+    "threads=0": "schema['properties']['threads']",
     "foo=1": "unknown config key(s) ['foo']; known keys: beyond, gallery,",
 }
 
@@ -219,6 +222,21 @@ def test_bad_config_stops_before_any_job(tmp_path, env):
         assert proc.returncode != 0, setting
         assert BAD_CONFIGS[setting] in out, (setting, out[-2000:])
     assert not (work / "results").exists()
+
+
+def test_threads_setting_reaches_the_rules_and_the_records(tmp_path, env):
+    work = copy_workflow(tmp_path / "work")
+    out = subprocess.run(
+        [sys.executable, "-m", "snakemake", "-n", "--cores", "2", "convergence", "--config",
+         "threads=2", "levels=[1,2]", "schemes=[ddfv]"],
+        cwd=work, env=env, capture_output=True, text=True, timeout=TIMEOUT)
+    assert out.returncode == 0, out.stderr[-2000:]
+    jobs = out.stdout.split("rule run_scheme:")[1:]
+    assert len(jobs) == 2 and all("threads: 2" in job.split("\n\n")[0] for job in jobs)
+    config = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+    settings = Pipeline({**config, "threads": 2}).run_settings("ddfv", 1)
+    assert settings["threads"] == 2 and solver_of(settings).threads == 2
+    assert Pipeline(config).run_settings("ddfv", 1)["threads"] == 1
 
 
 SCRIPTS = REPO / "workflow" / "scripts"

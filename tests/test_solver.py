@@ -359,3 +359,20 @@ def test_overwrite_x0_iterates_in_the_callers_buffer():
     view = kept.copy()[:, ::1].T.copy().T                    # not C-contiguous: copied
     x2, _ = solve(A, b, view, overwrite_x0=True)
     assert x2 is not view and np.array_equal(x2, x_copy)
+
+
+@pytest.mark.parametrize("system", [ring_system, nonsymmetric])
+def test_two_threads_give_the_same_solution_to_round_off(system):
+    A, b = system()
+    x1, info1 = solve(A, b, None, rtol=1e-10)
+    x2, info2 = solve(A, b, None, rtol=1e-10, threads=2)
+    assert info1.converged and info2.converged
+    assert abs(info2.iterations - info1.iterations) <= 1
+    np.testing.assert_allclose(x2, x1, atol=1e-8 * np.abs(x1).max())
+    assert residual(A, b, x2) <= 1e-10 * np.linalg.norm(b)
+
+
+@pytest.mark.parametrize("threads", [0, 2.5, True, 10**6])
+def test_bad_thread_counts_are_refused(threads):
+    with pytest.raises(ValueError, match="threads"):
+        Solver(threads=threads)

@@ -102,3 +102,31 @@ def test_locality_order_is_a_renumbering_that_narrows_the_band():
     assert _bandwidth(renumbered) < 2 * np.sqrt(len(V))
     # triangles sorted by their smallest new vertex number
     assert np.all(np.diff(renumbered.min(axis=1)) >= 0)
+
+
+@pytest.mark.parametrize("parts", [1, 2, 3])
+def test_diamond_blocks_never_share_a_vertex_across_threads(parts):
+    V, F = icosphere(3)
+    vertex_order, face_order = locality_order(F, len(V))
+    rank = np.empty_like(vertex_order)
+    rank[vertex_order] = np.arange(len(V))
+    mesh = diamond_mesh(rank[F[face_order]], len(V))
+    order, starts = mesh.diamond_blocks(parts)
+    assert len(starts) == parts + 2
+    np.testing.assert_array_equal(np.sort(order), np.arange(len(mesh.diamonds)))
+    d = mesh.diamonds[order.astype(np.int64)]
+    # block k < parts: all four vertices in part k (F-vertices and T-vertices
+    # each cut into `parts` consecutive ranges); the last block: the rest
+    part_f = np.arange(mesh.n_f) * parts // mesh.n_f
+    part_t = np.arange(mesh.n_t) * parts // mesh.n_t
+    parts_of = np.stack([part_f[d[:, 0]], part_f[d[:, 1]], part_t[d[:, 2]], part_t[d[:, 3]]])
+    for k in range(parts):
+        block = slice(int(starts[k]), int(starts[k + 1]))
+        assert (parts_of[:, block] == k).all()
+        assert np.all(np.diff(order[block].astype(np.int64)) > 0)   # in mesh order
+    across = parts_of[:, int(starts[parts]):]
+    assert (across.min(axis=0) != across.max(axis=0)).all()
+    if parts == 1:
+        np.testing.assert_array_equal(order, np.arange(len(mesh.diamonds)))
+    else:   # the RCM ranges meet along a short front: few diamonds across
+        assert 0 < starts[parts + 1] - starts[parts] < 0.15 * len(order)

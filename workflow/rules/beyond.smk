@@ -56,7 +56,7 @@ rule beyond_run:
         settings=beyond_run_settings,
     log:
         "results/logs/beyond/{study}/{scheme}/level{level}.log",
-    threads: 1
+    threads: THREADS
     resources:
         mem_mb=run_mem_mb,
         runtime=beyond_run_runtime,
@@ -75,7 +75,7 @@ rule beyond_time:
         settings=time_settings,
     log:
         "results/logs/beyond/time/{scheme}.log",
-    threads: 1
+    threads: THREADS
     resources:
         mem_mb=500,
         runtime=time_runtime,

@@ -10,6 +10,7 @@ LEVELS = PIPELINE.levels
 SCHEMES = PIPELINE.schemes
 # the config key `beyond`, checked and normalised
 BEYOND = PIPELINE.beyond
+THREADS = PIPELINE.threads
 # {study: {record path: settings}} of the beyond study (workflow/rules/beyond.smk)
 BEYOND_RUNS = PIPELINE.beyond_runs()
 # schemes of the beyond study compared with the published Table 3.1 (DDFV family)

@@ -20,7 +20,7 @@ rule run_scheme:
         settings=run_settings,
     log:
         "results/logs/runs/{scheme}/level{level}.log",
-    threads: 1
+    threads: THREADS
     resources:
         mem_mb=run_mem_mb,
         runtime=run_runtime,
