@@ -23,14 +23,22 @@ the peak above the warmed-up process, scaled with the unknowns).
     python benchmarks/bench_level6.py --level 7            # 491 522 unknowns, 8192 steps
     python benchmarks/bench_level6.py --scheme cotan --compare-levels
     python benchmarks/bench_level6.py --level 7 --steps 2  # smoke test: 2 steps only
+    python benchmarks/bench_level6.py --threads 1          # no two-thread run
+
+``--threads N`` (default 2) also runs the level with N threads (the
+``threads`` setting: solver and DDFV's compiled passes), in a fresh child
+on N cores with ``NUMBA_NUM_THREADS = N``, alternating with the one-thread
+runs; the target is a speed-up >= 1.5.
 
 The machine is shared and noisy: compare ratios, not absolute seconds.
 """
 
 import os
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"          # before numpy is imported
+# numba's threads: 1, or those of a threaded child (set by the parent)
+os.environ["NUMBA_NUM_THREADS"] = os.environ.get("BENCH_THREADS", "1")
 
 import argparse  # noqa: E402
 import gc  # noqa: E402
@@ -49,13 +57,17 @@ def child(scheme, level, steps):
     from mcfbench.memory import tune_malloc
 
     tune_malloc()
-    one_core()
-    harness_run(scheme, 1)                                  # JIT / cache loading
+    threads = int(os.environ["NUMBA_NUM_THREADS"])
+    if threads == 1:
+        one_core()
+    else:
+        os.sched_setaffinity(0, set(range(threads)))
+    harness_run(scheme, 1, threads=threads)                 # JIT / cache loading
     gc.collect()
     rss_warm = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    result, flow = harness_run(scheme, level, steps=steps)
+    result, flow = harness_run(scheme, level, steps=steps, threads=threads)
     print(json.dumps({
-        "scheme": scheme, "level": level, "nV": result.nV, "N": result.N,
+        "scheme": scheme, "level": level, "threads": threads, "nV": result.nV, "N": result.N,
         "steps_done": result.steps_done, "iterations": result.iterations,
         "status": result.status, "message": result.message,
         "l2_error": result.metrics.get("l2_error"), "wall": result.wall_seconds,
@@ -64,11 +76,12 @@ def child(scheme, level, steps):
         "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
 
 
-def run_child(scheme, level, steps):
+def run_child(scheme, level, steps, threads=1):
     command = [sys.executable, __file__, "--child", scheme, str(level)]
     if steps is not None:
         command += ["--steps", str(steps)]
-    out = subprocess.run(command, capture_output=True, text=True)
+    out = subprocess.run(command, capture_output=True, text=True,
+                         env={**os.environ, "BENCH_THREADS": str(threads)})
     if out.returncode:
         raise RuntimeError(f"level {level}: the child failed:\n{out.stderr}")
     return json.loads(out.stdout.strip().splitlines()[-1])
@@ -80,8 +93,8 @@ def summary(runs):
     wall = median(r["wall"] for r in runs)
     cpu = median(r["cpu"] for r in runs)
     work = first["nV"] * first["steps_done"]
-    return {**{k: first[k] for k in ("scheme", "level", "nV", "N", "steps_done", "iterations",
-                                     "status", "message", "l2_error")},
+    return {**{k: first[k] for k in ("scheme", "level", "threads", "nV", "N", "steps_done",
+                                     "iterations", "status", "message", "l2_error")},
             "runs": len(runs), "wall": wall, "cpu": cpu, "walls": [r["wall"] for r in runs],
             "phases": {k: median(r["phases"][k] for r in runs) for k in PHASES},
             "peak_rss_mb": max(r["peak_rss_mb"] for r in runs),
@@ -117,6 +130,8 @@ def main(argv=None):
                         "(smoke test; the targets then do not apply)")
     parser.add_argument("--target-seconds", type=float, default=35.0)
     parser.add_argument("--target-gb", type=float, default=1.0)
+    parser.add_argument("--threads", type=int, default=2,
+                        help="also run --level on this many threads (default 2; 1: not)")
     parser.add_argument("--json", help="also write the measurements to this file")
     parser.add_argument("--child", nargs=2, metavar=("SCHEME", "LEVEL"), help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -124,7 +139,7 @@ def main(argv=None):
         child(args.child[0], int(args.child[1]), args.steps)
         return 0
 
-    one_core()                                   # the children inherit the affinity
+    one_core()           # the one-thread children inherit the affinity
     compare = sorted(set(args.compare_levels) - {args.level})
     print(f"bench_level6: {machine_line()}")
     print(f"{args.scheme} on the sphere (Table 3.1 setting: t_f = 0.08, tau = 0.04/4^(k-1)), "
@@ -135,21 +150,26 @@ def main(argv=None):
         for level in compare:
             small[level].append(run_child(args.scheme, level, args.steps))
     results = [summary(small[lv]) for lv in compare]
-    results.append(summary([run_child(args.scheme, args.level, args.steps)
-                            for _ in range(args.repeats)]))
+    finest_runs, threaded_runs = [], []
+    for _ in range(args.repeats):                   # one and N threads alternating
+        finest_runs.append(run_child(args.scheme, args.level, args.steps))
+        if args.threads > 1:
+            threaded_runs.append(run_child(args.scheme, args.level, args.steps, args.threads))
+    results.append(summary(finest_runs))
+    threaded = summary(threaded_runs) if threaded_runs else None
 
-    head = (f"{'level':>5} {'unknowns':>8} {'steps':>5} {'iter':>5} {'runs':>4} {'wall s':>8} "
+    head = (f"{'level':>5} {'thr':>3} {'unknowns':>8} {'steps':>5} {'iter':>5} {'runs':>4} {'wall s':>8} "
             f"{'cpu s':>8} {'ms/step':>8} {'geom':>6} {'assem':>6} {'solve':>6} {'other':>6} "
             f"{'peak MB':>8} {'+MB':>6} {'ns/(unk*step)':>13} {'cpu ns':>7} {'growth':>6}")
     print(head)
     print("-" * len(head))
     previous = None
-    for m in sorted(results, key=lambda m: m["level"]):
+    for m in sorted(results, key=lambda m: m["level"]) + ([threaded] if threaded else []):
         growth = (m["ns_per_unknown_step"] / previous["ns_per_unknown_step"]
-                  if previous else float("nan"))
+                  if previous and m["threads"] == 1 else float("nan"))
         cells = " ".join(f"{m['phases'][k] / m['wall']:6.1%}" if m["phases"][k] == m["phases"][k]
                          else f"{'-':>6}" for k in PHASES)
-        print(f"{m['level']:5d} {m['nV']:8d} {m['steps_done']:5d} {m['iterations']:5d} "
+        print(f"{m['level']:5d} {m['threads']:3d} {m['nV']:8d} {m['steps_done']:5d} {m['iterations']:5d} "
               f"{m['runs']:4d} {m['wall']:8.2f} {m['cpu']:8.2f} "
               f"{1e3 * m['wall'] / max(1, m['steps_done']):8.2f} {cells} "
               f"{m['peak_rss_mb']:8.0f} {m['peak_rss_mb'] - m['warm_rss_mb']:6.0f} "
@@ -174,6 +194,13 @@ def main(argv=None):
         print(f"TARGET peak memory <= {args.target_gb:g} GB: {finest['peak_rss_mb']:.0f} MB: "
               f"{'met' if mem_ok else 'NOT met'}; L2 error {finest['l2_error']}, "
               f"{finest['iterations']} iterations")
+        if threaded:
+            speedup = finest["wall"] / threaded["wall"]
+            print(f"TARGET {args.threads} threads >= 1.5 x faster than one: wall "
+                  f"{threaded['wall']:.1f} s against {finest['wall']:.1f} s, x{speedup:.2f}: "
+                  f"{'met' if speedup >= 1.5 else 'NOT met'}; L2 error "
+                  f"{threaded['l2_error']}, {threaded['iterations']} iterations, peak "
+                  f"{threaded['peak_rss_mb']:.0f} MB")
     if compare:
         first = results[0]
         print(f"level {first['level']} -> {finest['level']}: unknowns x steps "
@@ -192,7 +219,7 @@ def main(argv=None):
               "scaled with the unknowns); the iteration count per step may grow too")
     if args.json:
         with open(args.json, "w") as out:
-            json.dump({"scheme": args.scheme, "levels": results,
+            json.dump({"scheme": args.scheme, "levels": results, "threaded": threaded,
                        "targets": {"seconds": args.target_seconds, "gb": args.target_gb}},
                       out, indent=2)
     return 0
