@@ -32,7 +32,7 @@ import sys
 import time
 from pathlib import Path
 
-from .atomic import _figure_metadata, atomic_path, json_value, save_npz
+from .atomic import _figure_metadata, atomic_path, json_value, save_npz, write_json
 from .problems import get_problem
 from .provenance import code_hash, provenance
 from .records import FIELDS, RecordError, read_record, write_record
@@ -435,6 +435,42 @@ def run_job(settings, output, log):
     if result.status != "ok":
         log.warning("%s", result.message)
     return result
+
+
+def compile_job(threads, output, log):
+    """Compile every kernel into numba's cache once, before the run jobs start.
+
+    One level-1 sphere step of every scheme of the registry (on one thread,
+    and on ``threads`` when more: the threaded copies) and one small solve
+    with every solver method. The run jobs then load the kernels from the
+    cache instead of each compiling them (numba writes its cache files by
+    rename: jobs that start together on an empty cache would each compile,
+    never corrupt it; ``tests/test_pipeline.py``). Writes the seconds it
+    took (compiling, or loading when the cache was warm) to ``output``.
+    """
+    import numpy as np
+    import scipy.sparse as sp
+
+    from .solver import METHODS, solve
+    from .studies import run
+
+    start = time.perf_counter()
+    problem = get_problem(PROBLEM)
+    for name in SCHEMES:
+        for n in sorted({1, threads}):
+            run(name, problem, 1, t_final=problem.tau(1), threads=n)
+    n = 30
+    A = sp.diags([-np.ones(n - 1), 4.0 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1],
+                 format="csr")
+    b = np.ones((3, n))
+    for method in METHODS:
+        solve(A, b, None, method=method)
+        solve(sp.kron(sp.eye(3), A, format="csr"), b, None, method=method)
+    seconds = time.perf_counter() - start
+    write_json(output, {"seconds": seconds, "threads": threads, "schemes": list(SCHEMES),
+                        "methods": list(METHODS)})
+    log.info("kernels of %d schemes and %d solver methods compiled or loaded in %.1f s -> %s",
+             len(SCHEMES), len(METHODS), seconds, output)
 
 
 TIME_FIELDS = {"scheme": str, "level": int, "reference_tau": float, "t_final": float,

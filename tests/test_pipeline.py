@@ -239,8 +239,41 @@ def test_threads_setting_reaches_the_rules_and_the_records(tmp_path, env):
     assert Pipeline(config).run_settings("ddfv", 1)["threads"] == 1
 
 
+_ONE_STEP = ("import json; from mcfbench.studies import run; "
+             "r, _ = run('ddfv', 'sphere', 1, t_final=0.04); print(json.dumps(r.metrics))")
+
+
+def test_jobs_starting_together_on_an_empty_kernel_cache(tmp_path):
+    """Two jobs on one empty numba cache: both compile, neither breaks the
+    cache or the other's numbers; a later job only loads the kernels."""
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    procs = [subprocess.Popen([sys.executable, "-c", _ONE_STEP], env=env, text=True,
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+             for _ in range(2)]
+    outs = [proc.communicate(timeout=TIMEOUT) for proc in procs]
+    assert [proc.returncode for proc in procs] == [0, 0], outs
+    assert outs[0][0] == outs[1][0] and "l2_error" in outs[0][0]
+    later = subprocess.run([sys.executable, "-c", _ONE_STEP], capture_output=True, text=True,
+                           env={**env, "NUMBA_DEBUG_CACHE": "1"}, timeout=TIMEOUT)
+    assert later.returncode == 0, later.stderr
+    assert "data loaded from" in later.stdout and "data saved to" not in later.stdout
+    assert later.stdout.splitlines()[-1] == outs[0][0].strip()
+
+
+def test_run_jobs_wait_for_one_kernel_compilation(tmp_path, env):
+    work = copy_workflow(tmp_path / "work")
+    out = subprocess.run([sys.executable, "-m", "snakemake", "-n", "--cores", "2",
+                          "convergence"],
+                         cwd=work, env=env, capture_output=True, text=True, timeout=TIMEOUT)
+    assert out.returncode == 0, out.stdout[-2000:]
+    assert out.stdout.count("rule compile_kernels:") == 1
+    jobs = [job.split("\n\n")[0] for job in out.stdout.split("rule run_scheme:")[1:]]
+    assert len(jobs) == 10
+    assert all("input: results/logs/kernels.json" in job for job in jobs), jobs[0]
+
+
 SCRIPTS = REPO / "workflow" / "scripts"
-OWN_SCRIPTS = ["run_scheme", "beyond_time", "figure", "convergence_table", "plot_convergence",
+OWN_SCRIPTS = ["compile_kernels", "run_scheme", "beyond_time", "figure", "convergence_table", "plot_convergence",
                "beyond_tables", "beyond_plots", "beyond_findings", "report", "report_pdf",
                "check_records"]
 

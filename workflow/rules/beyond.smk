@@ -50,6 +50,8 @@ wildcard_constraints:
 
 rule beyond_run:
     """One scheme on one sphere level with the settings of a beyond study."""
+    input:
+        kernels=ancient(KERNELS),
     output:
         "results/beyond/runs/{study}/{scheme}/level{level}.json",
     params:
@@ -69,6 +71,8 @@ rule beyond_run:
 
 rule beyond_time:
     """Time convergence of one scheme on one mesh (mcfbench.studies.time_convergence)."""
+    input:
+        kernels=ancient(KERNELS),
     output:
         "results/beyond/runs/time/{scheme}.json",
     params:

@@ -15,6 +15,8 @@ THREADS = PIPELINE.threads
 BEYOND_RUNS = PIPELINE.beyond_runs()
 # schemes of the beyond study compared with the published Table 3.1 (DDFV family)
 BEYOND_PAPER_SCHEMES = PIPELINE.paper_schemes()
+# every compiled kernel in numba's cache before the run jobs (rule compile_kernels)
+KERNELS = "results/logs/kernels.json"
 
 
 def run_settings(wildcards):

@@ -13,6 +13,8 @@ rule convergence:
 
 rule run_scheme:
     """One scheme on one sphere level: results/runs/{scheme}/level{level}.json."""
+    input:
+        kernels=ancient(KERNELS),
     output:
         "results/runs/{scheme}/level{level}.json",
     params:

@@ -35,6 +35,8 @@ rule figure:
     that breaks down keeps its frames and the job still succeeds; the
     record and a note in the figure say what happened.
     """
+    input:
+        kernels=ancient(KERNELS),
     output:
         png=report(
             "results/figures/{figure}.png",

@@ -69,6 +69,7 @@ if GALLERY["generated"]:
 rule gallery_run:
     """One scheme on one mesh file."""
     input:
+        kernels=ancient(KERNELS),
         mesh=lambda wildcards: GALLERY["meshes"][wildcards.mesh],
     output:
         record="results/gallery/runs/{mesh}/{scheme}.json",

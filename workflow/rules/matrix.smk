@@ -48,6 +48,8 @@ MATRIX_TARGETS = [*MATRIX_TABLES, *MATRIX_FIGURES.values(), "results/matrix/find
 
 rule matrix_run:
     """One scheme on one problem at one level: record and first/last frame."""
+    input:
+        kernels=ancient(KERNELS),
     output:
         record="results/matrix/runs/{problem}/{scheme}/level{level}.json",
         frames="results/matrix/frames/{problem}/{scheme}/level{level}.npz",
