@@ -17,7 +17,7 @@ run(scheme, problem, level, ...) -> (RunResult, Trajectory)
     One scheme on one problem.
 simulate(flow, steps, solver=..., ...) -> Trajectory
     The driver.
-Solver(method, rtol, maxiter)
+Solver(method, rtol, maxiter, threads=1)
     The shared linear solver.
 SCHEMES, PROBLEMS, get_scheme(name), get_problem(name)
     The registries.
