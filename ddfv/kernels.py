@@ -59,7 +59,9 @@ def threaded(kernel, **callees):
     One source for both versions. The copy has its own name, hence its own
     entry in numba's cache; it is built and compiled on first use, so a
     one-thread run never compiles it. ``callees`` replace the compiled
-    functions the kernel calls, by name (their threaded copies).
+    functions the kernel calls, by name (their threaded copies); numba's
+    cache does not key on them, so each kernel has one set of callees (one
+    call site).
 
     Parameters
     ----------

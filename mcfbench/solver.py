@@ -259,7 +259,7 @@ def _residual(indptr, indices, data, b, x, cmean, cfull, r):
         c0 = cmean[0]
         c1 = cmean[1]
         c2 = cmean[2]
-        for i in range(m):
+        for i in prange(m):
             a0 = 0.0
             a1 = 0.0
             a2 = 0.0
@@ -274,8 +274,7 @@ def _residual(indptr, indices, data, b, x, cmean, cfull, r):
                 rs += a
                 ra += abs(a)
             nan_a += ra * 0.0
-            if ra > norm_a:
-                norm_a = ra
+            norm_a = max(norm_a, ra)
             width = max(width, np.int64(indptr[i + 1] - indptr[i]))
             b0 = b[0, i]
             b1 = b[1, i]
@@ -749,7 +748,8 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
                 if lu is None:
                     return to_block(x), _failed(method, "breakdown", detail)
             # else: kind 0, the kernel reports the non-finite input
-        code, dcode, it, rnorm, ref = for_threads(_bicgstab, threads, _spmv=_spmv)(
+        code, dcode, it, rnorm, ref = for_threads(_bicgstab, threads, _spmv=_spmv,
+                                                   _residual=_residual)(
             *csr, b, x, cmean, cfull, float(rtol), int(maxiter), int(stagnation_window),
             kind, dinv, *_ilu_arrays(lu))
         residual = (rnorm / ref if ref > 0.0 else
