@@ -38,7 +38,7 @@ import numpy as np
 
 from .assembly import Assembler
 from .geometry import covolume_areas, diamond_geometry, t_barycentric, vertex_normals
-from .kernels import check_threads
+from .kernels import check_threads, extrapolate_kernel, for_threads
 from .t_vertices import initial_t_vertices
 from .topology import diamond_mesh, locality_order
 
@@ -201,7 +201,7 @@ class Flow:
     @property
     def covolumes(self):
         """(n_f + n_t,) covolume areas ``chi^n``, F-vertices first, as ``X``."""
-        return self._chi[self._external]
+        return np.take(self._chi, self._external)
 
     @property
     def l2_weights(self):
@@ -258,8 +258,8 @@ class Flow:
         x0 = self._X
         owned = False
         if self.warm_start == "extrapolate":
-            x0 = np.multiply(self._X, 2.0)     # 2 X^{n-1} - X^{n-2} in one new buffer
-            x0 -= self._X_prev
+            x0 = np.empty_like(self._X)        # 2 X^{n-1} - X^{n-2} in one new buffer
+            for_threads(extrapolate_kernel, self.threads)(self._X, self._X_prev, x0)
             owned = True
         clock = self._tick("assembly", clock)
         if owned and getattr(solve, "can_overwrite_x0", False):   # may iterate in x0
