@@ -152,8 +152,8 @@ def beyond_settings(config, problem):
     -------
     dict
         ``levels`` (sorted ints), ``schemes``, ``finest`` (``level``,
-        ``schemes``: the schemes whose rows of the L2/EOC table go on to that
-        level; none by default), ``long_time`` (``level``, ``t_final``,
+        ``rtol`` of its runs, ``schemes``: the schemes whose rows of the
+        L2/EOC table go on to that level; none by default), ``long_time`` (``level``, ``t_final``,
         ``tau``, ``schemes``), ``time_study`` (``level``, ``taus``
         (descending), ``reference_factor``, ``t_final``, ``schemes``) and
         ``space_study`` (``levels``, ``tau``, ``t_final``, ``schemes``); times
@@ -174,7 +174,11 @@ def beyond_settings(config, problem):
         _steps("'beyond.levels'", problem, problem.tau(level), t_final, f"the level-{level}")
     schemes = check_schemes("beyond.schemes", beyond["schemes"])
     finest = {"level": int(beyond["finest"]["level"]),
+              "rtol": float(beyond["finest"].get("rtol", config["rtol"])),
               "schemes": check_schemes("beyond.finest.schemes", beyond["finest"]["schemes"])}
+    if not 0 < finest["rtol"] < 1:          # the schema lets NaN through
+        raise ConfigError(f"config key 'beyond.finest.rtol': must lie in (0, 1), got "
+                          f"{beyond['finest']['rtol']!r}")
     if finest["schemes"]:
         _check_finest(finest, levels, schemes, problem)
     long, time_, space = beyond["long_time"], beyond["time_study"], beyond["space_study"]
@@ -310,10 +314,14 @@ class Pipeline:
         and so the hash, are those of Table 3.1.
         """
         level = int(level)
+        finest = self.beyond["finest"]
+        # the finest level's runs of beyond.finest: their own tolerance (config/README.md)
+        rtol = finest["rtol"] if study is None and level == finest["level"] \
+            and scheme in finest["schemes"] else self.rtol
         settings = {"scheme": scheme, "problem": self.problem.name, "level": level,
                     "tau": self.problem.tau(level) if tau is None else float(tau),
                     "t_final": self.problem.t_final if t_final is None else float(t_final),
-                    "rtol": self.rtol, "threads": self.threads, "code": self.code}
+                    "rtol": rtol, "threads": self.threads, "code": self.code}
         return settings if study is None else {"study": study, **settings}
 
     def beyond_run_settings(self, study, scheme, level):

@@ -748,7 +748,8 @@ def _beyond_descriptions(beyond, settings):
             "between runs that finished; /paper: ours over the published L2 of Table 3.1 "
             "(levels 1-5). A run that broke down shows `failed (t = time of the breakdown)`."
             + (f" Level {finest['level']} ran for "
-               f"{', '.join(label(s) for s in finest['schemes'])} only (`beyond.finest`)."
+               f"{', '.join(label(s) for s in finest['schemes'])} only (`beyond.finest`), "
+               f"at BiCGStab rtol = {finest['rtol']:g} (`beyond.finest.rtol`)."
                if finest["schemes"] else "")
             + " peak MB: peak resident memory of the run's job (ru_maxrss)."),
         "stability": (

@@ -175,7 +175,7 @@ def synthetic_inputs(finest=()):
             "beyond/time/cotan.json": {"scheme": "cotan", **base, "outcome": "ok",
                                        "message": "", "rows": time_rows}}
     beyond = {"levels": LEVELS, "schemes": SCHEMES_USED,
-              "finest": {"level": 4, "schemes": list(finest)},
+              "finest": {"level": 4, "rtol": 1e-11, "schemes": list(finest)},
               "long_time": {"level": 2, "t_final": 0.12, "tau": 0.01,
                             "schemes": ["ddfv", "ddfv-chord"]},
               "time_study": {"level": 2, "taus": [0.01, 0.005, 0.0025], "reference_factor": 8,
@@ -380,7 +380,7 @@ def test_default_config_passes_the_schema_and_the_checks():
     assert used_schemes(settings)[-1] == "cotan"
     assert all(s in SCHEMES for s in used_schemes(settings))
     # the level-7 run is off by default
-    assert settings["finest"] == {"level": 7, "schemes": []}
+    assert settings["finest"] == {"level": 7, "rtol": 1e-11, "schemes": []}
     assert not [p for p in Pipeline(config).beyond_runs()["levels"] if "level7" in p]
 
 
@@ -393,6 +393,9 @@ def test_finest_level_adds_its_runs_only():
     assert set(runs) - set(default) == {"results/runs/ddfv-chord/level7.json"}
     assert all(runs[p] == settings for p, settings in default.items())
     assert runs["results/runs/ddfv-chord/level7.json"] == pipeline.run_settings("ddfv-chord", 7)
+    # the finest level's own tolerance; every other run keeps the top-level one
+    assert runs["results/runs/ddfv-chord/level7.json"]["rtol"] == 1e-11
+    assert {s["rtol"] for p, s in runs.items() if "level7" not in p} == {1e-9}
     assert pipeline.beyond_levels("ddfv-chord") == [1, 2, 3, 4, 5, 6, 7]
     assert pipeline.beyond_levels("ddfv") == [1, 2, 3, 4, 5, 6]
     assert pipeline.problem.time_steps(pipeline.problem.tau(7)) == 8192
@@ -442,6 +445,7 @@ def test_schema_rejects_bad_beyond_values(path, value):
      "config key 'beyond.finest.schemes': ['cotan-voronoi'] not in 'beyond.schemes'"),
     (("finest", "level"), 6,
      "config key 'beyond.finest.level': 6 is not above the levels of 'beyond.levels'"),
+    (("finest", "rtol"), float("nan"), "config key 'beyond.finest.rtol': must lie in (0, 1)"),
 ])
 def test_checks_across_keys_name_the_key(path, value, message):
     config = json.loads(json.dumps(CONFIG))
