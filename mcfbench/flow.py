@@ -58,7 +58,9 @@ class Flow(Protocol):
         Time step.
     X : (3, n_points) float array
         The state by components (DDFV: F- then T-vertices; the
-        triangle-based schemes: the mesh vertices). Read-only view.
+        triangle-based schemes: the mesh vertices), in the numbering of the
+        input mesh. Read-only (a view, or a copy for a scheme that stores
+        its state in its own numbering).
     vertices : (n, 3) float array
         The mesh vertices of the current state (DDFV: the F-vertices).
     faces : (m, 3) int array
