@@ -187,7 +187,8 @@ class Flow:
         """:class:`~ddfv.geometry.DiamondGeometry` of the current state (own numbering)."""
         n_f = self._mesh.n_f
         return diamond_geometry(self._mesh, self._X[:, :n_f].T, self._X[:, n_f:].T,
-                                self.dual_length, self.threads)
+                                self.dual_length, self.threads,
+                                vectors=self.tangential == "eliminate")   # normals (3.6)
 
     @cached_property
     def _chi(self):

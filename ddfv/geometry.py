@@ -23,9 +23,10 @@ class DiamondGeometry:
 
     Attributes
     ----------
-    u, v : (3, n_d) float arrays
-        The diagonals ``F_b - F_a`` and ``T_t2 - T_t1`` (2.3).
-    e : (3, n_d) float array
+    u, v : (3, n_d) float arrays, or None
+        The diagonals ``F_b - F_a`` and ``T_t2 - T_t1`` (2.3) (None when
+        not asked for, :func:`diamond_geometry`).
+    e : (3, n_d) float array, or None
         ``(F_a + F_b - T_t1 - T_t2) / 4``: with ``S`` the centre
         ``bar-phi(C)`` (Section 2.2.2), ``F_a - S = e - u/2``,
         ``F_b - S = e + u/2``, ``T_t1 - S = -e - v/2``, ``T_t2 - S = -e + v/2``.
@@ -93,7 +94,7 @@ def diamond_corners(mesh, F, T):
 DUAL_LENGTHS = ("broken", "chord")
 
 
-def diamond_geometry(mesh, F, T, dual_length="broken", threads=1):
+def diamond_geometry(mesh, F, T, dual_length="broken", threads=1, vectors=True):
     """Geometric factors of all diamonds, see :class:`DiamondGeometry`.
 
     One pass over the diamonds (:func:`ddfv.kernels.diamond_geometry_kernel`)
@@ -113,6 +114,9 @@ def diamond_geometry(mesh, F, T, dual_length="broken", threads=1):
         chord (``|gamma^T| = |v|``, ``|gamma^F| = |u|``).
     threads : int
         Threads of the pass (:func:`ddfv.kernels.threaded`).
+    vectors : bool
+        Also keep ``u``, ``v``, ``e`` (otherwise None: the scheme needs
+        them only for the vertex normals of (3.6)).
 
     Returns
     -------
@@ -128,12 +132,13 @@ def diamond_geometry(mesh, F, T, dual_length="broken", threads=1):
     n_d = diamonds.shape[1]
     buf = np.empty((k.GEOMETRY_ROWS, k.padded_length(n_d)))
     broken = dual_length == "broken"
-    k.for_threads(k.diamond_geometry_kernel, threads)(F, T, diamonds, broken, buf)
+    k.for_threads(k.diamond_geometry_kernel, threads)(F, T, diamonds, broken, vectors, buf)
     rows = buf[:, :n_d]
     len_u, len_v = rows[k.ROW_LEN_U], rows[k.ROW_LEN_V]
+    u, v, e = ((rows[k.ROW_U:k.ROW_U + 3], rows[k.ROW_V:k.ROW_V + 3],
+                rows[k.ROW_E:k.ROW_E + 3]) if vectors else (None, None, None))
     return DiamondGeometry(
-        u=rows[k.ROW_U:k.ROW_U + 3], v=rows[k.ROW_V:k.ROW_V + 3],
-        e=rows[k.ROW_E:k.ROW_E + 3], len_u=len_u, len_v=len_v,
+        u=u, v=v, e=e, len_u=len_u, len_v=len_v,
         J=rows[k.ROW_J], uv=rows[k.ROW_UV],
         gamma_t=rows[k.ROW_GAMMA_T] if broken else len_v,
         gamma_f=rows[k.ROW_GAMMA_F] if broken else len_u,

@@ -120,9 +120,9 @@ def padded_length(n):
     return n + (24 - n) % 512
 
 
-@numba.njit("void(float64[:, :], float64[:, :], uint64[:, :], boolean, float64[:, ::1])",
-            **_OPTIONS)
-def diamond_geometry_kernel(F, T, diamonds, broken, out):
+@numba.njit("void(float64[:, :], float64[:, :], uint64[:, :], boolean, boolean, "
+            "float64[:, ::1])", **_OPTIONS)
+def diamond_geometry_kernel(F, T, diamonds, broken, vectors, out):
     """Per-diamond geometry in one pass, see :func:`ddfv.geometry.diamond_geometry`.
 
     Parameters
@@ -135,6 +135,9 @@ def diamond_geometry_kernel(F, T, diamonds, broken, out):
         Write ``|gamma^T|``, ``|gamma^F|`` as broken lines (2.5), (2.15);
         otherwise the rows ``ROW_GAMMA_T``, ``ROW_GAMMA_F`` are left alone
         (the chord is ``|v|``, ``|u|``).
+    vectors : bool
+        Write the rows ``u``, ``v``, ``e``; otherwise they are left alone
+        (9 of the 19 rows: on large meshes the pass is bound by its writes).
     out : (GEOMETRY_ROWS, >= n_d) float64 array
         Rows ``u`` (3), ``v`` (3), ``e`` (3), ``|u|``, ``|v|``, ``J``,
         ``u.v``, ``|gamma^T|``, ``|gamma^F|``, the four quarters.
@@ -155,9 +158,10 @@ def diamond_geometry_kernel(F, T, diamonds, broken, out):
             q = T[t2, k] if inner else (fa + fb) - p
             u, v = fb - fa, q - p                          # diagonals (2.3)
             e = (((fa + fb) - p) - q) * 0.25               # F_a - S = e - u/2 etc.
-            out[ROW_U + k, d] = u
-            out[ROW_V + k, d] = v
-            out[ROW_E + k, d] = e
+            if vectors:
+                out[ROW_U + k, d] = u
+                out[ROW_V + k, d] = v
+                out[ROW_E + k, d] = e
             uu += u * u
             vv += v * v
             ee += e * e
