@@ -37,7 +37,7 @@ from functools import cached_property
 import numpy as np
 
 from .assembly import Assembler
-from .geometry import covolume_areas, diamond_geometry, t_barycentric, vertex_normals
+from .geometry import diamond_geometry, t_barycentric, vertex_normals
 from .kernels import check_threads, extrapolate_kernel, for_threads
 from .t_vertices import initial_t_vertices
 from .topology import diamond_mesh, locality_order
@@ -183,21 +183,25 @@ class Flow:
         return self._mesh.boundary_vertices[self._external[:self._mesh.n_f]]
 
     @cached_property
-    def _geometry(self):
-        """:class:`~ddfv.geometry.DiamondGeometry` of the current state (own numbering)."""
+    def _state(self):
+        """``(geometry, chi)`` of the current state in one pass (own numbering): the
+        :class:`~ddfv.geometry.DiamondGeometry` and the (n_f + n_t,) covolume
+        areas ``chi^n``, F-vertices first."""
         n_f = self._mesh.n_f
-        return diamond_geometry(self._mesh, self._X[:, :n_f].T, self._X[:, n_f:].T,
-                                self.dual_length, self.threads,
-                                vectors=self.tangential == "eliminate")   # normals (3.6)
+        chi = np.empty(self._mesh.n_unknowns)
+        geometry = diamond_geometry(self._mesh, self._X[:, :n_f].T, self._X[:, n_f:].T,
+                                    self.dual_length, self.threads,
+                                    vectors=self.tangential == "eliminate",  # normals (3.6)
+                                    covolumes=chi)
+        return geometry, chi
 
-    @cached_property
+    @property
+    def _geometry(self):
+        return self._state[0]
+
+    @property
     def _chi(self):
-        """(n_f + n_t,) covolume areas ``chi^n``, F-vertices first (own numbering)."""
-        chi_f, chi_t = covolume_areas(self._mesh, self._geometry, self.threads)
-        chi = chi_f.base              # the two are views of one (n_f + n_t,) buffer
-        if chi is None or chi is not chi_t.base or chi.shape != (self._mesh.n_unknowns,):
-            chi = np.concatenate([chi_f, chi_t])
-        return chi
+        return self._state[1]
 
     @property
     def covolumes(self):
@@ -270,7 +274,7 @@ class Flow:
         self._tick("solve", clock)
         self._X_prev, self._X = self._X, np.ascontiguousarray(X)
         self.n += 1
-        for name in ("_geometry", "_chi", "_barycentric"):
+        for name in ("_state", "_barycentric"):
             self.__dict__.pop(name, None)
         return info
 

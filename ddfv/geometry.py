@@ -42,7 +42,7 @@ class DiamondGeometry:
     gamma_f : (n_d,) float array
         ``|gamma^F| = |F_a - S| + |F_b - S|``, the dual curve crossing
         ``v`` (2.15).
-    quarters : (4, n_d) float array
+    quarters : (4, n_d) float array, or None
         Areas of the triangles ``(F_a, T_t1, S)``, ``(F_a, S, T_t2)``,
         ``(F_b, T_t1, S)``, ``(F_b, S, T_t2)`` that cut the diamond at
         ``S`` (Section 2.2.4), see :func:`covolume_areas`; zero on the
@@ -94,7 +94,8 @@ def diamond_corners(mesh, F, T):
 DUAL_LENGTHS = ("broken", "chord")
 
 
-def diamond_geometry(mesh, F, T, dual_length="broken", threads=1, vectors=True):
+def diamond_geometry(mesh, F, T, dual_length="broken", threads=1, vectors=True,
+                     covolumes=None):
     """Geometric factors of all diamonds, see :class:`DiamondGeometry`.
 
     One pass over the diamonds (:func:`ddfv.kernels.diamond_geometry_kernel`)
@@ -117,6 +118,10 @@ def diamond_geometry(mesh, F, T, dual_length="broken", threads=1, vectors=True):
     vectors : bool
         Also keep ``u``, ``v``, ``e`` (otherwise None: the scheme needs
         them only for the vertex normals of (3.6)).
+    covolumes : (n_f + n_t,) float array, optional
+        Filled with the covolume areas in the same pass (as
+        :func:`covolume_areas`, bitwise on one thread); ``quarters`` is then
+        None.
 
     Returns
     -------
@@ -132,7 +137,13 @@ def diamond_geometry(mesh, F, T, dual_length="broken", threads=1, vectors=True):
     n_d = diamonds.shape[1]
     buf = np.empty((k.GEOMETRY_ROWS, k.padded_length(n_d)))
     broken = dual_length == "broken"
-    k.for_threads(k.diamond_geometry_kernel, threads)(F, T, diamonds, broken, vectors, buf)
+    scatter = covolumes is not None
+    if scatter and (covolumes.shape != (mesh.n_unknowns,) or covolumes.dtype != np.float64):
+        raise ValueError(f"covolumes must be a ({mesh.n_unknowns},) float64 array")
+    chi = covolumes if scatter else np.empty(0)
+    k.for_threads(k.diamond_geometry_kernel, threads)(
+        F, T, diamonds, *mesh.diamond_blocks(threads), broken, vectors, scatter,
+        chi[:mesh.n_f], chi[mesh.n_f:], buf)
     rows = buf[:, :n_d]
     len_u, len_v = rows[k.ROW_LEN_U], rows[k.ROW_LEN_V]
     u, v, e = ((rows[k.ROW_U:k.ROW_U + 3], rows[k.ROW_V:k.ROW_V + 3],
@@ -142,7 +153,7 @@ def diamond_geometry(mesh, F, T, dual_length="broken", threads=1, vectors=True):
         J=rows[k.ROW_J], uv=rows[k.ROW_UV],
         gamma_t=rows[k.ROW_GAMMA_T] if broken else len_v,
         gamma_f=rows[k.ROW_GAMMA_F] if broken else len_u,
-        quarters=rows[k.ROW_QUARTERS:k.ROW_QUARTERS + 4])
+        quarters=None if scatter else rows[k.ROW_QUARTERS:k.ROW_QUARTERS + 4])
 
 
 def covolume_areas(mesh, geom, threads=1):

@@ -120,36 +120,20 @@ def padded_length(n):
     return n + (24 - n) % 512
 
 
-@numba.njit("void(float64[:, :], float64[:, :], uint64[:, :], boolean, boolean, "
-            "float64[:, ::1])", **_OPTIONS)
-def diamond_geometry_kernel(F, T, diamonds, broken, vectors, out):
-    """Per-diamond geometry in one pass, see :func:`ddfv.geometry.diamond_geometry`.
-
-    Parameters
-    ----------
-    F : (n_f, 3) float64 array
-    T : (n_t, 3) float64 array
-    diamonds : (4, n_d) uint64 array
-        Rows ``a, b, t1, t2``; ``t2 = NO_T`` on boundary diamonds.
-    broken : bool
-        Write ``|gamma^T|``, ``|gamma^F|`` as broken lines (2.5), (2.15);
-        otherwise the rows ``ROW_GAMMA_T``, ``ROW_GAMMA_F`` are left alone
-        (the chord is ``|v|``, ``|u|``).
-    vectors : bool
-        Write the rows ``u``, ``v``, ``e``; otherwise they are left alone
-        (9 of the 19 rows: on large meshes the pass is bound by its writes).
-    out : (GEOMETRY_ROWS, >= n_d) float64 array
-        Rows ``u`` (3), ``v`` (3), ``e`` (3), ``|u|``, ``|v|``, ``J``,
-        ``u.v``, ``|gamma^T|``, ``|gamma^F|``, the four quarters.
-    """
+@numba.njit(**_OPTIONS, inline="always")
+def _geometry_block(F, T, diamonds, order, lo, hi, broken, vectors, scatter, chi_f, chi_t,
+                    out):
+    """The diamonds ``order[lo:hi]`` of :func:`diamond_geometry_kernel`; returns how
+    many had an index out of range (skipped)."""
     # uint64 sizes: a comparison of uint64 with int64 would go through float64
     n_f, n_t = np.uint64(F.shape[0]), np.uint64(T.shape[0])
     bad = 0
-    for d in numba.prange(diamonds.shape[1]):
+    for j in range(lo, hi):
+        d = order[j]
         a, b, t1, t2 = diamonds[0, d], diamonds[1, d], diamonds[2, d], diamonds[3, d]
         inner = t2 != NO_T
         if a >= n_f or b >= n_f or t1 >= n_t or (inner and t2 >= n_t):
-            bad += 1            # raised after the loop (a raise would keep it serial)
+            bad += 1
             continue
         uu = vv = ee = uv = ue = ve = 0.0
         for k in range(3):
@@ -177,14 +161,23 @@ def diamond_geometry_kernel(F, T, diamonds, broken, vectors, out):
         ra_p, rb_q = c_minus + d_minus, c_minus - d_minus
         ra_q, rb_p = d_plus - c_plus, d_plus + c_plus      # rb_p up to its sign
         # area = |x| |y| sin / 2 = sqrt(|x|^2 |y|^2 - (x.y)^2) / 2
-        out[ROW_QUARTERS, d] = 0.5 * np.sqrt(max(ra2 * p2 - ra_p * ra_p, 0.0))
-        out[ROW_QUARTERS + 2, d] = 0.5 * np.sqrt(max(rb2 * p2 - rb_p * rb_p, 0.0))
+        q_a1 = 0.5 * np.sqrt(max(ra2 * p2 - ra_p * ra_p, 0.0))
+        q_b1 = 0.5 * np.sqrt(max(rb2 * p2 - rb_p * rb_p, 0.0))
+        q_a2 = q_b2 = 0.0          # a boundary diamond: only the side of T_t1
         if inner:
-            out[ROW_QUARTERS + 1, d] = 0.5 * np.sqrt(max(ra2 * q2 - ra_q * ra_q, 0.0))
-            out[ROW_QUARTERS + 3, d] = 0.5 * np.sqrt(max(rb2 * q2 - rb_q * rb_q, 0.0))
-        else:  # only the two triangles on the side of T_t1
-            out[ROW_QUARTERS + 1, d] = 0.0
-            out[ROW_QUARTERS + 3, d] = 0.0
+            q_a2 = 0.5 * np.sqrt(max(ra2 * q2 - ra_q * ra_q, 0.0))
+            q_b2 = 0.5 * np.sqrt(max(rb2 * q2 - rb_q * rb_q, 0.0))
+        if scatter:                # the covolumes (Section 2.2.4), see covolume_kernel
+            chi_f[a] += q_a1 + q_a2
+            chi_f[b] += q_b1 + q_b2
+            chi_t[t1] += q_a1 + q_b1
+            if inner:
+                chi_t[t2] += q_a2 + q_b2
+        else:
+            out[ROW_QUARTERS, d] = q_a1
+            out[ROW_QUARTERS + 1, d] = q_a2
+            out[ROW_QUARTERS + 2, d] = q_b1
+            out[ROW_QUARTERS + 3, d] = q_b2
         out[ROW_LEN_U, d] = np.sqrt(uu)
         out[ROW_LEN_V, d] = np.sqrt(vv)                    # d^T (2.8)
         out[ROW_J, d] = np.sqrt(max(0.0, uu * vv - uv * uv))   # |u x v| = 2 chi(V^D) (2.8)
@@ -192,7 +185,57 @@ def diamond_geometry_kernel(F, T, diamonds, broken, vectors, out):
         if broken:
             out[ROW_GAMMA_T, d] = np.sqrt(p2) + np.sqrt(q2)    # (2.5)
             out[ROW_GAMMA_F, d] = np.sqrt(ra2) + np.sqrt(rb2)  # (2.15), Section 2.2.5
-    if bad > 0:
+    return bad
+
+
+@numba.njit("void(float64[:, :], float64[:, :], uint64[:, :], uint64[::1], uint64[::1], "
+            "boolean, boolean, boolean, float64[::1], float64[::1], float64[:, ::1])",
+            **_OPTIONS)
+def diamond_geometry_kernel(F, T, diamonds, order, starts, broken, vectors, scatter, chi_f,
+                            chi_t, out):
+    """Per-diamond geometry in one pass, see :func:`ddfv.geometry.diamond_geometry`.
+
+    The blocks of :meth:`ddfv.topology.DiamondMesh.diamond_blocks` one per
+    thread, then the diamonds across blocks.
+
+    Parameters
+    ----------
+    F : (n_f, 3) float64 array
+    T : (n_t, 3) float64 array
+    diamonds : (4, n_d) uint64 array
+        Rows ``a, b, t1, t2``; ``t2 = NO_T`` on boundary diamonds.
+    order, starts : uint64 arrays
+        The diamond blocks.
+    broken : bool
+        Write ``|gamma^T|``, ``|gamma^F|`` as broken lines (2.5), (2.15);
+        otherwise the rows ``ROW_GAMMA_T``, ``ROW_GAMMA_F`` are left alone
+        (the chord is ``|v|``, ``|u|``).
+    vectors : bool
+        Write the rows ``u``, ``v``, ``e``; otherwise they are left alone.
+    scatter : bool
+        Add the quarters into the covolumes ``chi_f``, ``chi_t`` (as
+        :func:`covolume_kernel`) instead of writing their rows.
+    chi_f : (n_f,) float64 array, output (any length when not ``scatter``)
+    chi_t : (n_t,) float64 array, output (any length when not ``scatter``)
+    out : (GEOMETRY_ROWS, >= n_d) float64 array
+        Rows ``u`` (3), ``v`` (3), ``e`` (3), ``|u|``, ``|v|``, ``J``,
+        ``u.v``, ``|gamma^T|``, ``|gamma^F|``, the four quarters. On large
+        meshes the pass is bound by its writes: the rows not asked for are
+        left alone.
+    """
+    if scatter:
+        if chi_f.shape[0] != F.shape[0] or chi_t.shape[0] != T.shape[0]:
+            raise ValueError("covolume arrays do not fit F and T")
+        chi_f[:] = 0.0
+        chi_t[:] = 0.0
+    parts = starts.shape[0] - 2
+    bad = np.zeros(parts + 1, dtype=np.int64)       # per block (no reduction across blocks)
+    for k in numba.prange(parts):
+        bad[k] = _geometry_block(F, T, diamonds, order, starts[k], starts[k + 1], broken,
+                                 vectors, scatter, chi_f, chi_t, out)
+    bad[parts] = _geometry_block(F, T, diamonds, order, starts[parts], starts[parts + 1],
+                                 broken, vectors, scatter, chi_f, chi_t, out)
+    if bad.any():
         raise IndexError("diamond index out of range")
 
 

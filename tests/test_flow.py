@@ -274,7 +274,7 @@ def test_threaded_passes_agree_with_one_thread(bumpy):
     arithmetic; the scatters add the diamonds across blocks last (round-off)."""
     V, F = bumpy
     one, two = Flow(V, F, 0.002), Flow(V, F, 0.002, threads=2)
-    for name in ("J", "uv", "len_u", "gamma_t", "quarters"):
+    for name in ("J", "uv", "len_u", "gamma_t"):
         np.testing.assert_array_equal(getattr(two._geometry, name),
                                       getattr(one._geometry, name))
     np.testing.assert_allclose(two.covolumes, one.covolumes, rtol=1e-14)

@@ -211,3 +211,22 @@ def test_out_of_range_indices_raise_instead_of_reading_memory():
         t_barycentric(F, T[:2], np.array([[0, 1, 2], [0, -1, 2]]))
     with pytest.raises(ValueError, match="T must have shape"):
         diamond_geometry(mesh, F, T[:-1])
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_covolumes_in_the_geometry_pass_are_those_of_covolume_areas(threads):
+    V, F = icosphere(3)
+    mesh = diamond_mesh(F)
+    T = V[F].mean(axis=1) + np.random.default_rng(5).normal(scale=0.01, size=(len(F), 3))
+    separate = diamond_geometry(mesh, V, T)
+    chi = np.empty(mesh.n_unknowns)
+    fused = diamond_geometry(mesh, V, T, threads=threads, vectors=False, covolumes=chi)
+    chi_f, chi_t = covolume_areas(mesh, separate)
+    if threads == 1:       # the same sums in the same order
+        np.testing.assert_array_equal(chi, np.r_[chi_f, chi_t])
+    np.testing.assert_allclose(chi, np.r_[chi_f, chi_t], rtol=1e-14)
+    assert fused.quarters is None and fused.u is None and fused.e is None
+    for name in ("J", "uv", "len_u", "len_v", "gamma_t", "gamma_f"):
+        np.testing.assert_array_equal(getattr(fused, name), getattr(separate, name))
+    with pytest.raises(ValueError, match="covolumes"):
+        diamond_geometry(mesh, V, T, covolumes=np.empty(3))
