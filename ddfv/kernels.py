@@ -121,18 +121,38 @@ def padded_length(n):
 
 
 @numba.njit(**_OPTIONS, inline="always")
+def _diamond(diamonds, d, n_f, n_t):
+    """``a, b, t1, t2`` of diamond ``d``, whether it is inner (``t2 != NO_T``) and
+    whether its indices are below ``n_f``, ``n_t`` (uint64: a comparison of
+    uint64 with int64 would go through float64)."""
+    a, b, t1, t2 = diamonds[0, d], diamonds[1, d], diamonds[2, d], diamonds[3, d]
+    inner = t2 != NO_T
+    valid = a < n_f and b < n_f and t1 < n_t and (not inner or t2 < n_t)
+    return a, b, t1, t2, inner, valid
+
+
+@numba.njit(**_OPTIONS, inline="always")
+def _add_quarters(chi_f, chi_t, a, b, t1, t2, inner, q_a1, q_a2, q_b1, q_b2):
+    """Add the quarters ``(F_a, T_t1, S)``, ``(F_a, S, T_t2)``, ``(F_b, T_t1, S)``,
+    ``(F_b, S, T_t2)`` of one diamond to its covolumes (Section 2.2.4)."""
+    chi_f[a] += q_a1 + q_a2
+    chi_f[b] += q_b1 + q_b2
+    chi_t[t1] += q_a1 + q_b1
+    if inner:
+        chi_t[t2] += q_a2 + q_b2
+
+
+@numba.njit(**_OPTIONS, inline="always")
 def _geometry_block(F, T, diamonds, order, lo, hi, broken, vectors, scatter, chi_f, chi_t,
                     out):
     """The diamonds ``order[lo:hi]`` of :func:`diamond_geometry_kernel`; returns how
     many had an index out of range (skipped)."""
-    # uint64 sizes: a comparison of uint64 with int64 would go through float64
     n_f, n_t = np.uint64(F.shape[0]), np.uint64(T.shape[0])
     bad = 0
     for j in range(lo, hi):
         d = order[j]
-        a, b, t1, t2 = diamonds[0, d], diamonds[1, d], diamonds[2, d], diamonds[3, d]
-        inner = t2 != NO_T
-        if a >= n_f or b >= n_f or t1 >= n_t or (inner and t2 >= n_t):
+        a, b, t1, t2, inner, valid = _diamond(diamonds, d, n_f, n_t)
+        if not valid:
             bad += 1
             continue
         uu = vv = ee = uv = ue = ve = 0.0
@@ -167,12 +187,8 @@ def _geometry_block(F, T, diamonds, order, lo, hi, broken, vectors, scatter, chi
         if inner:
             q_a2 = 0.5 * np.sqrt(max(ra2 * q2 - ra_q * ra_q, 0.0))
             q_b2 = 0.5 * np.sqrt(max(rb2 * q2 - rb_q * rb_q, 0.0))
-        if scatter:                # the covolumes (Section 2.2.4), see covolume_kernel
-            chi_f[a] += q_a1 + q_a2
-            chi_f[b] += q_b1 + q_b2
-            chi_t[t1] += q_a1 + q_b1
-            if inner:
-                chi_t[t2] += q_a2 + q_b2
+        if scatter:                # the covolumes, as covolume_kernel
+            _add_quarters(chi_f, chi_t, a, b, t1, t2, inner, q_a1, q_a2, q_b1, q_b2)
         else:
             out[ROW_QUARTERS, d] = q_a1
             out[ROW_QUARTERS + 1, d] = q_a2
@@ -247,17 +263,12 @@ def _scatter_quarters(diamonds, quarters, order, lo, hi, chi_f, chi_t):
     bad = 0
     for j in range(lo, hi):
         d = order[j]
-        a, b, t1, t2 = diamonds[0, d], diamonds[1, d], diamonds[2, d], diamonds[3, d]
-        inner = t2 != NO_T
-        if a >= n_f or b >= n_f or t1 >= n_t or (inner and t2 >= n_t):
+        a, b, t1, t2, inner, valid = _diamond(diamonds, d, n_f, n_t)
+        if not valid:
             bad += 1
             continue
-        q_a1, q_a2, q_b1, q_b2 = quarters[0, d], quarters[1, d], quarters[2, d], quarters[3, d]
-        chi_f[a] += q_a1 + q_a2
-        chi_f[b] += q_b1 + q_b2
-        chi_t[t1] += q_a1 + q_b1
-        if inner:
-            chi_t[t2] += q_a2 + q_b2
+        _add_quarters(chi_f, chi_t, a, b, t1, t2, inner,
+                      quarters[0, d], quarters[1, d], quarters[2, d], quarters[3, d])
     return bad
 
 
@@ -323,9 +334,8 @@ def vertex_normals_kernel(diamonds, u, v, n_f, out):
     nf = np.uint64(n_f)    # uint64 + int64 would be float64 in numba
     out[:, :] = 0.0
     for d in range(diamonds.shape[1]):
-        a, b, t1, t2 = diamonds[0, d], diamonds[1, d], diamonds[2, d], diamonds[3, d]
-        inner = t2 != NO_T
-        if a >= nf or b >= nf or t1 >= n_t or (inner and t2 >= n_t):
+        a, b, t1, t2, inner, valid = _diamond(diamonds, d, nf, n_t)
+        if not valid:
             raise IndexError("diamond index out of range")
         # u x v = 2 chi(V^D) N^D
         c0 = u[1, d] * v[2, d] - u[2, d] * v[1, d]
