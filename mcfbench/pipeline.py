@@ -445,16 +445,12 @@ def run_job(settings, output, log):
     return result
 
 
-def compile_job(threads, output, log):
-    """Compile every kernel into numba's cache once, before the run jobs start.
+def warm_kernels(threads=1):
+    """Compile every kernel, or load it from numba's cache when it is there.
 
-    One level-1 sphere step of every scheme of the registry (on one thread,
-    and on ``threads`` when more: the threaded copies) and one small solve
-    with every solver method. The run jobs then load the kernels from the
-    cache instead of each compiling them (numba writes its cache files by
-    rename: jobs that start together on an empty cache would each compile,
-    never corrupt it; ``tests/test_pipeline.py``). Writes the seconds it
-    took (compiling, or loading when the cache was warm) to ``output``.
+    One level-1 sphere step of every scheme of the registry, on one thread
+    and on ``threads`` when more (the threaded copies), and one small solve
+    with every solver method, for a shared and a coupled matrix.
     """
     import numpy as np
     import scipy.sparse as sp
@@ -462,7 +458,6 @@ def compile_job(threads, output, log):
     from .solver import METHODS, solve
     from .studies import run
 
-    start = time.perf_counter()
     problem = get_problem(PROBLEM)
     for name in SCHEMES:
         for n in sorted({1, threads}):
@@ -474,6 +469,22 @@ def compile_job(threads, output, log):
     for method in METHODS:
         solve(A, b, None, method=method)
         solve(sp.kron(sp.eye(3), A, format="csr"), b, None, method=method)
+
+
+def compile_job(threads, output, log):
+    """Compile every kernel into numba's cache once, before the run jobs start
+    (:func:`warm_kernels`).
+
+    The run jobs then load the kernels from the cache instead of each
+    compiling them (numba writes its cache files by rename: jobs that start
+    together on an empty cache would each compile, never corrupt it;
+    ``tests/test_pipeline.py``). Writes the seconds it took (compiling, or
+    loading when the cache was warm) to ``output``.
+    """
+    from .solver import METHODS
+
+    start = time.perf_counter()
+    warm_kernels(threads)
     seconds = time.perf_counter() - start
     write_json(output, {"seconds": seconds, "threads": threads, "schemes": list(SCHEMES),
                         "methods": list(METHODS)})
