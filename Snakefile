@@ -7,7 +7,7 @@
 #
 # Settings: config/config.yaml (documented in config/README.md), validated
 # against workflow/schemas/config.schema.yaml and across keys (scheme names
-# against the registry mcfbench.schemes.SCHEMES, time steps; mcfbench.pipeline)
+# against the registry mcfbench.running.schemes.SCHEMES, time steps; mcfbench.pipeline)
 # before any job runs. The logic of the rules is in the harness (mcfbench);
 # workflow/scripts/*.py are thin adapters. Needs the packages installed:
 # `pip install -e .` in the repository.
@@ -20,7 +20,7 @@ from mcfbench.pipeline import check_keys
 
 # One BLAS thread per job, set once here: every job inherits it (local or
 # Slurm), before any of them imports numpy. The jobs' run records store these
-# variables (mcfbench.provenance.BLAS_THREAD_VARIABLES).
+# variables (mcfbench.storage.provenance.BLAS_THREAD_VARIABLES).
 os.environ.update(dict.fromkeys(("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"), "1"))
 
 min_version("9.0")

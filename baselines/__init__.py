@@ -1,9 +1,9 @@
 """Schemes compared with the DDFV scheme, on the mesh vertices only.
 
-Every scheme is one class following the contract of ``mcfbench.flow.Flow``
+Every scheme is one class following the contract of ``mcfbench.running.flow.Flow``
 (constructor ``(vertices, faces, tau, **options)``, ``step(solve)``,
 ``defects()``, ``frame()``, ...) and is registered in
-``mcfbench/schemes.py``; this package imports nothing from ``ddfv`` or
+``mcfbench/running/schemes.py``; this package imports nothing from ``ddfv`` or
 ``mcfbench`` (see ``baselines/README.md``).
 
 cotan (:class:`baselines.cotan.CotanFlow`)

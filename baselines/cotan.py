@@ -45,7 +45,7 @@ Assembly (``assembly=``):
     the matrices agree with ``"cached"`` to rounding).
 
 This module also holds :class:`VertexFlow`, what every vertex-based
-baseline shares: the state, the contract of ``mcfbench.flow.Flow``, the
+baseline shares: the state, the contract of ``mcfbench.running.flow.Flow``, the
 warm start and the checks of a state (:meth:`VertexFlow.defects`).
 """
 
@@ -240,7 +240,7 @@ def dirichlet_rows(A, fixed):
 
 
 class VertexFlow:
-    """What every vertex-based baseline shares (the ``mcfbench.flow.Flow`` contract).
+    """What every vertex-based baseline shares (the ``mcfbench.running.flow.Flow`` contract).
 
     The state is the mesh vertices, stored by components ``X`` (3, n).
     Subclasses implement :meth:`system`, the linear system of one step at

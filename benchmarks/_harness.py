@@ -2,8 +2,8 @@
 
 * :func:`one_core`: pin this process (and so its children) to one core;
   the scripts set the BLAS thread variables themselves, before numpy is
-  imported, and call :func:`mcfbench.memory.tune_malloc` first.
-* :func:`harness_run`: :func:`mcfbench.studies.run` exactly as the command
+  imported, and call :func:`mcfbench.storage.memory.tune_malloc` first.
+* :func:`harness_run`: :func:`mcfbench.running.run.run` exactly as the command
   line runs it, keeping the flow so that its ``timings`` can be read.
 * :class:`OldWorker`: the previous numpy implementation (commit ``6cc720c``,
   ``git archive`` into a temporary directory) in a persistent child
@@ -64,7 +64,7 @@ class _Capture:
     """A registry scheme whose ``make`` keeps the flow it built (for ``timings``)."""
 
     def __init__(self, scheme):
-        from mcfbench.schemes import get_scheme
+        from mcfbench.running.schemes import get_scheme
 
         self._scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
         self.flow = None
@@ -78,15 +78,15 @@ class _Capture:
 
 
 def harness_run(scheme, level, *, problem="sphere", solver=None, steps=None, **options):
-    """:func:`mcfbench.studies.run` of ``scheme`` on ``problem`` at ``level``.
+    """:func:`mcfbench.running.run.run` of ``scheme`` on ``problem`` at ``level``.
 
     ``steps`` (optional) stops after that many steps (``t_final = steps tau``,
     for smoke tests). Returns ``(result, flow)``: the run's
-    :class:`~mcfbench.studies.RunResult` and the flow it stepped.
+    :class:`~mcfbench.storage.records.RunResult` and the flow it stepped.
     """
-    from mcfbench.problems import get_problem
-    from mcfbench.solver import Solver
-    from mcfbench.studies import run
+    from mcfbench.running.problems import get_problem
+    from mcfbench.running.solver import Solver
+    from mcfbench.running.run import run
 
     capture = _Capture(scheme)
     t_final = None

@@ -58,7 +58,7 @@ def numpy_reference(rev, tmp):
 def icosphere(level):
     """The icosphere of Table 3.1 (the harness's generator if there is one)."""
     try:
-        from mcfbench.surfaces import icosphere as harness_icosphere
+        from mcfbench.geometry.surfaces import icosphere as harness_icosphere
         return harness_icosphere(level)
     except ImportError:
         pass
@@ -186,7 +186,7 @@ def main():
     if hasattr(os, "sched_setaffinity"):
         os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})   # one core
     try:
-        from mcfbench.memory import tune_malloc
+        from mcfbench.storage.memory import tune_malloc
         tuned = tune_malloc()
     except ImportError:
         tuned = False

@@ -3,7 +3,7 @@
 The paper's DDFV variant breaks down on level 6 (ddfv/README.md,
 results/beyond/), so the scheme timed by default is one that completes,
 ``ddfv-chord``; any scheme of the registry can be given. Each run is
-``mcfbench.studies.run(scheme, "sphere", level)`` as on the command line
+``mcfbench.running.run.run(scheme, "sphere", level)`` as on the command line
 (flow construction, every step, the error (3.2), the T monitor, quality
 samples), in a FRESH child process pinned to one core with one BLAS thread
 and glibc's malloc tuned, after a warm-up on level 1 in that process (no
@@ -54,7 +54,7 @@ PHASES = ("geometry", "assembly", "solve", "other")
 
 def child(scheme, level, steps):
     """One run in this process; prints a JSON line with its measurements."""
-    from mcfbench.memory import tune_malloc
+    from mcfbench.storage.memory import tune_malloc
 
     tune_malloc()
     threads = int(os.environ["NUMBA_NUM_THREADS"])
@@ -104,8 +104,8 @@ def summary(runs):
 
 def size(scheme, level):
     """``(unknowns, steps)`` of the sphere at ``level`` for ``scheme`` (without running)."""
-    from mcfbench.problems import get_problem
-    from mcfbench.schemes import get_scheme
+    from mcfbench.running.problems import get_problem
+    from mcfbench.running.schemes import get_scheme
 
     problem = get_problem("sphere")
     n_f, n_t = 10 * 4 ** level + 2, 20 * 4 ** level            # icosphere
@@ -114,7 +114,7 @@ def size(scheme, level):
 
 
 def main(argv=None):
-    from mcfbench.schemes import SCHEMES
+    from mcfbench.running.schemes import SCHEMES
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--level", type=int, default=6, help="the level timed (default 6)")

@@ -1,4 +1,4 @@
-"""Time the shared linear solver (mcfbench.solver) against the former numpy BiCGStab.
+"""Time the shared linear solver (mcfbench.running.solver) against the former numpy BiCGStab.
 
 The systems are those of the first two time steps of the sphere experiment
 (Table 3.1) at one level (default 5: 30722 unknowns, 276482 entries),
@@ -35,7 +35,7 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from mcfbench.solver import METHODS, Solver, apply_block, solve  # noqa: E402
+from mcfbench.running.solver import METHODS, Solver, apply_block, solve  # noqa: E402
 
 
 # --- the former implementation (ddfv/solver.py at 6cc720c), for comparison ---
@@ -101,7 +101,7 @@ def old_bicgstab(A, b, x0, rtol=1e-10, maxiter=1000):
 def sphere_systems(level):
     """``[(A, b, x0)]`` of the first two steps of the Table 3.1 run at ``level``."""
     from ddfv import Flow
-    from mcfbench.surfaces import icosphere
+    from mcfbench.geometry.surfaces import icosphere
 
     V, F = icosphere(level)
     flow = Flow(V, F, 0.04 / 4.0 ** (level - 1))
@@ -142,7 +142,7 @@ _COMPILE = """
 import time
 t = time.perf_counter()
 import numpy as np, scipy.sparse as sp
-from mcfbench.solver import solve, apply_block
+from mcfbench.running.solver import solve, apply_block
 t_import = time.perf_counter() - t
 A = sp.eye(6, format="csr") * 2.0
 b = np.arange(18.0).reshape(3, 6)
@@ -217,7 +217,7 @@ def main():
         (imp, cold), (imp2, cached) = compile_times()
         print(f"first calls in a fresh interpreter: cold cache {cold - imp:.2f} s, "
               f"cached {cached - imp2:.2f} s (plus {imp2:.2f} s to import numpy, scipy, "
-              "numba and mcfbench.solver)")
+              "numba and mcfbench.running.solver)")
 
 
 if __name__ == "__main__":

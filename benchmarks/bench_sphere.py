@@ -1,6 +1,6 @@
 """Time the sphere experiment of Table 3.1 on the harness, every scheme on the same footing.
 
-Per scheme and level, each run is ``mcfbench.studies.run(scheme, "sphere",
+Per scheme and level, each run is ``mcfbench.running.run.run(scheme, "sphere",
 level)`` exactly as the command line does it (flow construction, every
 step, the error (3.2), the T monitor and the mesh-quality samples), after
 a warm-up on level 1 so that no JIT compilation or cache loading is timed.
@@ -59,7 +59,7 @@ from pathlib import Path  # noqa: E402
 from _harness import (OLD_REV, ROOT, OldWorker, footing, harness_run, machine_line,  # noqa: E402
                       median, one_core, split)
 
-from mcfbench.memory import tune_malloc  # noqa: E402
+from mcfbench.storage.memory import tune_malloc  # noqa: E402
 
 TARGET_L5_SECONDS = 2.0
 TARGET_L5_RATIO = 0.4
@@ -203,7 +203,7 @@ def profile(level, solver, runs, repeats=30):
 
     import numpy as np
 
-    from mcfbench.solver import apply_block
+    from mcfbench.running.solver import apply_block
 
     rs = runs["ddfv"][level]
     N, nV, iterations = rs[0]["N"], rs[0]["nV"], rs[0]["iterations"]
@@ -272,7 +272,7 @@ def _kernel_codes():
     """``(file name, first line, name)`` of every compiled kernel, as cProfile keys them."""
     import baselines.kernels
     import ddfv.kernels
-    from mcfbench import solver as solver_module
+    from mcfbench.running import solver as solver_module
     from numba.core.registry import CPUDispatcher
 
     codes = set()
@@ -290,13 +290,13 @@ _STARTUP = r'''
 import time
 t0 = time.perf_counter()
 import json, sys
-import mcfbench.studies
-from mcfbench.memory import tune_malloc
+import mcfbench.running.run
+from mcfbench.storage.memory import tune_malloc
 tune_malloc()
 t1 = time.perf_counter()
 scheme, level = sys.argv[1], int(sys.argv[2])
-tau = mcfbench.studies.get_problem("sphere").tau(level)
-r, _ = mcfbench.studies.run(scheme, "sphere", level, t_final=tau)     # one step
+tau = mcfbench.running.run.get_problem("sphere").tau(level)
+r, _ = mcfbench.running.run.run(scheme, "sphere", level, t_final=tau)     # one step
 t2 = time.perf_counter()
 print(json.dumps({"import": t1 - t0, "first_step": t2 - t0, "status": r.status}))
 '''
@@ -306,8 +306,8 @@ import time
 t0 = time.perf_counter()
 import json
 from numba.core.registry import CPUDispatcher
-import mcfbench.studies
-from mcfbench import solver as S
+import mcfbench.running.run
+from mcfbench.running import solver as S
 from mcfbench.pipeline import warm_kernels
 import ddfv.kernels, baselines.kernels
 t1 = time.perf_counter()
@@ -343,8 +343,8 @@ def _child(code, args, env=None):
 
 
 def jit_section(schemes, levels, repeats):
-    print("\nStart-up with a warm numba cache: fresh interpreter, `import mcfbench.studies`, "
-          "then mcfbench.studies.run(scheme, 'sphere', level) for one step "
+    print("\nStart-up with a warm numba cache: fresh interpreter, `import mcfbench.running.run`, "
+          "then mcfbench.running.run.run(scheme, 'sphere', level) for one step "
           f"(min / median of {repeats}, interleaved)")
     head = f"{'scheme':>8} {'level':>5} {'import s':>8} {'1st step s':>10} {'process s':>9}"
     print(head)
@@ -394,8 +394,8 @@ def jit_section(schemes, levels, repeats):
 # --- main -----------------------------------------------------------------------------
 
 def main(argv=None):
-    from mcfbench.schemes import SCHEMES
-    from mcfbench.solver import METHODS, Solver
+    from mcfbench.running.schemes import SCHEMES
+    from mcfbench.running.solver import METHODS, Solver
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5])

@@ -2,7 +2,7 @@
 
 A variant is a set of options of :class:`ddfv.Flow`; adding one is one
 entry in :data:`VARIANTS` (and a line in ``ddfv/README.md``); the harness's
-scheme registry (``mcfbench/schemes.py``) names each one ``ddfv-<variant>``.
+scheme registry (``mcfbench/running/schemes.py``) names each one ``ddfv-<variant>``.
 
 ``paper``
     The scheme as published: broken-line ``|gamma|`` (2.5), no tangential

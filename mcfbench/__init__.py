@@ -1,15 +1,23 @@
 """mcfbench: the benchmark harness for mean curvature flow schemes.
 
 The neutral package between the schemes (``ddfv``, ``baselines``) and the
-pipeline: the only place that imports both. It holds what every scheme
-shares: the flow contract (:mod:`mcfbench.flow`), the linear solver
-(:mod:`mcfbench.solver`), the driver (:mod:`mcfbench.driver`), mesh intake
-and validation (:mod:`mcfbench.meshio`, :mod:`mcfbench.mesh`), surfaces
-(:mod:`mcfbench.surfaces`), exact solutions, errors and metrics
-(:mod:`mcfbench.errors`, :mod:`mcfbench.metrics`), the registries of
-schemes and problems (:mod:`mcfbench.schemes`, :mod:`mcfbench.problems`),
-the studies (:mod:`mcfbench.studies`), tables, plots, records with
-provenance, and the command line (``python -m mcfbench``).
+pipeline: the only place that imports both. Five layers, imports flowing
+one way (``studies -> presentation -> storage``, ``studies -> running ->
+geometry -> storage``):
+
+``storage``
+    run records, statuses, provenance, atomic writes.
+``geometry``
+    surfaces, mesh intake and validation, metrics, exact solutions, monitors.
+``running``
+    flow contract, registries, solver, driver, the one ``run``.
+``presentation``
+    number formats, tables, plots, pictures, the report.
+``studies``
+    one module per study with the same protocol.
+
+plus the command line (:mod:`mcfbench.cli`) and the Snakemake glue
+(:mod:`mcfbench.pipeline`).
 
 Public API
 ----------
@@ -26,12 +34,13 @@ SCHEMES, PROBLEMS, get_scheme(name), get_problem(name)
 import importlib
 
 _EXPORTS = {
-    "Trajectory": "driver", "simulate": "driver",
-    "STATUSES": "flow", "Flow": "flow", "FlowBreakdown": "flow",
-    "PROBLEMS": "problems", "get_problem": "problems",
-    "SCHEMES": "schemes", "get_scheme": "schemes",
-    "Solver": "solver", "SolverFailure": "solver",
-    "RunResult": "studies", "run": "studies",
+    "Trajectory": "running.driver", "simulate": "running.driver",
+    "Flow": "running.flow", "FlowBreakdown": "running.flow",
+    "STATUSES": "storage.statuses",
+    "PROBLEMS": "running.problems", "get_problem": "running.problems",
+    "SCHEMES": "running.schemes", "get_scheme": "running.schemes",
+    "Solver": "running.solver", "SolverFailure": "running.solver",
+    "RunResult": "storage.records", "run": "running.run",
 }
 __all__ = sorted(_EXPORTS)
 

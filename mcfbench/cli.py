@@ -17,16 +17,16 @@ from pathlib import Path
 
 import numpy as np
 
-from .atomic import check_writable, save_npz, write_json
-from .memory import tune_malloc
-from .mesh import summarize
-from .meshio import read_mesh
-from .problems import PROBLEMS, Problem, get_problem
-from .provenance import provenance
-from .schemes import SCHEMES, get_scheme
-from .solver import METHODS, ROBUST, Solver
-from .studies import level_sweep, run
-from .tables import sphere_table
+from mcfbench.storage.atomic import check_writable, save_npz, write_json
+from mcfbench.storage.memory import tune_malloc
+from mcfbench.geometry.mesh import summarize
+from mcfbench.geometry.mesh_files import read_mesh
+from mcfbench.running.problems import PROBLEMS, Problem, get_problem
+from mcfbench.storage.provenance import provenance
+from mcfbench.running.schemes import SCHEMES, get_scheme
+from mcfbench.running.solver import METHODS, ROBUST, Solver
+from mcfbench.running.run import level_sweep, run
+from mcfbench.presentation.tables import sphere_table
 
 
 def _positive_float(text):
@@ -186,7 +186,7 @@ _NOT_METRICS = {"scheme", "problem", "level", "nV", "nF", "nT", "h", "tau", "N",
 
 
 def _write_csv(path, table, config):
-    from .atomic import atomic_path
+    from mcfbench.storage.atomic import atomic_path
 
     with atomic_path(path) as tmp:
         table.to_csv(tmp, index=False)

@@ -3,19 +3,19 @@
 The workflow (``Snakefile``, ``workflow/rules/*.smk``) holds target lists
 and input functions only; its scripts (``workflow/scripts/*.py``) are thin
 adapters that read Snakemake's inputs and params and call this module (or
-:mod:`mcfbench.tables`, :mod:`mcfbench.plots`, :mod:`mcfbench.report`).
+:mod:`mcfbench.presentation.tables`, :mod:`mcfbench.presentation.plots`, :mod:`mcfbench.presentation.report`).
 
 Config
     :class:`Pipeline` checks the config (after the schema,
     ``workflow/schemas/config.schema.yaml``) across keys while Snakemake
     reads the workflow: every scheme name is one of the registry
-    :data:`mcfbench.schemes.SCHEMES`, every final time a whole multiple of
+    :data:`mcfbench.running.schemes.SCHEMES`, every final time a whole multiple of
     its time steps. A bad value raises :class:`ConfigError` naming the key.
 Settings
     Everything that determines one run record (scheme, problem, level, tau,
     t_final, solver tolerance, the source hash of every package): passed to
     the job, stored and hashed in the record, and recomputed by the
-    aggregation to refuse stale records (:func:`mcfbench.records.read_record`).
+    aggregation to refuse stale records (:func:`mcfbench.storage.records.read_record`).
 Jobs
     :func:`run_job`, :func:`time_job`, :func:`figure_job` run flows;
     :func:`read_records` checks records for the aggregations;
@@ -32,12 +32,12 @@ import sys
 import time
 from pathlib import Path
 
-from .atomic import _figure_metadata, atomic_path, json_value, save_npz, write_json
-from .problems import get_problem
-from .provenance import code_hash, provenance
-from .records import FIELDS, RecordError, read_record, write_record
-from .schemes import SCHEMES, get_scheme
-from .solver import Solver
+from mcfbench.storage.atomic import _figure_metadata, atomic_path, json_value, save_npz, write_json
+from mcfbench.running.problems import get_problem
+from mcfbench.storage.provenance import code_hash, provenance
+from mcfbench.storage.records import FIELDS, RecordError, read_record, write_record
+from mcfbench.running.schemes import SCHEMES, get_scheme
+from mcfbench.running.solver import Solver
 
 PROBLEM = "sphere"        # the problem of Table 3.1 and of the beyond study
 FIGURE_DPI = 200
@@ -94,7 +94,7 @@ def write_files(files):
 
 
 def json_text(data):
-    """``data`` as indented standard JSON text (NaN as null), as :mod:`mcfbench.atomic`."""
+    """``data`` as indented standard JSON text (NaN as null), as :mod:`mcfbench.storage.atomic`."""
     return json.dumps(json_value(data), indent=2, allow_nan=False) + "\n"
 
 
@@ -125,7 +125,7 @@ def check_schemes(key, names):
     unknown = [s for s in names if s not in SCHEMES]
     if unknown:
         raise ConfigError(f"config key {key!r}: unknown scheme(s) {unknown}; known schemes "
-                          f"(mcfbench.schemes.SCHEMES): {', '.join(SCHEMES)}")
+                          f"(mcfbench.running.schemes.SCHEMES): {', '.join(SCHEMES)}")
     return names
 
 
@@ -145,7 +145,7 @@ def beyond_settings(config, problem):
     ----------
     config : dict
         The whole config, already checked against the schema.
-    problem : mcfbench.problems.Problem
+    problem : mcfbench.running.problems.Problem
         The sphere with the config's ``tau_level_1`` and ``t_final``.
 
     Returns
@@ -425,9 +425,9 @@ def run_job(settings, output, log):
 
     Returns
     -------
-    mcfbench.studies.RunResult
+    mcfbench.storage.records.RunResult
     """
-    from .studies import run
+    from mcfbench.running.run import run
 
     problem = get_problem(settings["problem"]).with_settings(t_final=settings["t_final"])
     log.info("%s level %d: tau %g, t_final %g, rtol %g", settings["scheme"], settings["level"],
@@ -455,8 +455,8 @@ def warm_kernels(threads=1):
     import numpy as np
     import scipy.sparse as sp
 
-    from .solver import METHODS, solve
-    from .studies import run
+    from mcfbench.running.solver import METHODS, solve
+    from mcfbench.running.run import run
 
     problem = get_problem(PROBLEM)
     for name in SCHEMES:
@@ -481,7 +481,7 @@ def compile_job(threads, output, log):
     ``tests/test_pipeline.py``). Writes the seconds it took (compiling, or
     loading when the cache was warm) to ``output``.
     """
-    from .solver import METHODS
+    from mcfbench.running.solver import METHODS
 
     start = time.perf_counter()
     warm_kernels(threads)
@@ -499,13 +499,13 @@ TIME_FIELDS = {"scheme": str, "level": int, "reference_tau": float, "t_final": f
 
 
 def time_job(settings, output, log):
-    """Time convergence of one scheme on one mesh (:func:`mcfbench.studies.time_convergence`).
+    """Time convergence of one scheme on one mesh (:func:`mcfbench.running.run.time_convergence`).
 
     A reference run that breaks down does not fail the job: the record has
     ``outcome = "reference_failed"``, the message and no rows; single runs
     that break down are rows with their status.
     """
-    from .studies import time_convergence
+    from mcfbench.running.run import time_convergence
 
     problem = get_problem(settings["problem"]).with_settings(t_final=settings["t_final"])
     taus, factor = settings["taus"], settings["reference_factor"]
@@ -579,7 +579,7 @@ def figure_outputs(name, results="results"):
 
 
 def figure_job(name, outputs, log):
-    """Run the experiment of one figure (:mod:`mcfbench.figures`) and draw it.
+    """Run the experiment of one figure (:mod:`mcfbench.studies.figures`) and draw it.
 
     Writes the figure (PNG + PDF), the kept frames of every run (npz, keys
     ``<run>.F``, ``<run>.T``, ``<run>.steps``, ``<run>.faces``,
@@ -590,9 +590,9 @@ def figure_job(name, outputs, log):
     """
     import pandas as pd
 
-    from .figures import EXPERIMENTS, draw_experiment, experiment_status, run_experiment
-    from .quality import COLUMNS, plot_quality
-    from .render import DPI
+    from mcfbench.studies.figures import EXPERIMENTS, draw_experiment, experiment_status, run_experiment
+    from mcfbench.geometry.quality import COLUMNS, plot_quality
+    from mcfbench.presentation.render import DPI
 
     experiment = EXPERIMENTS[name]
     wall = time.perf_counter()

@@ -1,17 +1,17 @@
-"""Shared meshes for the tests: the generators of :mod:`mcfbench.surfaces`."""
+"""Shared meshes for the tests: the generators of :mod:`mcfbench.geometry.surfaces`."""
 
 import functools
 
 import numpy as np
 import pytest
 
-from mcfbench import surfaces
-from mcfbench.surfaces import flat_lattice
-from mcfbench.surfaces import random_bumpy_sphere as bumpy_sphere
+from mcfbench.geometry import surfaces
+from mcfbench.geometry.surfaces import flat_lattice
+from mcfbench.geometry.surfaces import random_bumpy_sphere as bumpy_sphere
 
 # The tests that import ``cylinder`` from here were written for quads all cut
 # along the same diagonal; the positional parameters (around, along, radius,
-# half_height = 0.5) are those of mcfbench.surfaces.cylinder.
+# half_height = 0.5) are those of mcfbench.geometry.surfaces.cylinder.
 cylinder = functools.partial(surfaces.cylinder, diagonals="parallel")
 
 __all__ = ["approaches_the_catenoid", "bumpy_sphere", "cylinder", "flat_lattice"]
@@ -34,7 +34,7 @@ def approaches_the_catenoid(X, tol=0.004):
     """Frames ``X`` (frames, n, 3) of the 24 x 8 cylinder (R = 1, h = 0.5): the neck
     shrinks monotonically to ``a = 0.84834`` (1 %) and the last profile is
     ``a cosh(z / a)`` to ``tol``."""
-    from mcfbench.metrics import catenoid_parameter
+    from mcfbench.geometry.metrics import catenoid_parameter
 
     a = catenoid_parameter(1.0, 0.5)
     r, z = np.hypot(X[..., 0], X[..., 1]), X[..., 2]

@@ -8,7 +8,7 @@ from ddfv.assembly import Assembler, flux_coefficients
 from ddfv.geometry import covolume_areas, diamond_geometry
 from ddfv.t_vertices import initial_t_vertices
 from ddfv.topology import diamond_mesh
-from mcfbench.surfaces import icosphere
+from mcfbench.geometry.surfaces import icosphere
 
 
 def _state(V, F, t_init="paper", noise=0.0, seed=0):

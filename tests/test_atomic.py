@@ -1,4 +1,4 @@
-"""Atomic output (mcfbench/atomic.py): a kill at any moment leaves the old file or the new one."""
+"""Atomic output (mcfbench/storage/atomic.py): a kill at any moment leaves the old file or the new one."""
 
 import signal
 import subprocess
@@ -9,12 +9,12 @@ import zipfile
 import numpy as np
 import pytest
 
-from mcfbench.atomic import check_writable, save_npz, write_json, write_text
+from mcfbench.storage.atomic import check_writable, save_npz, write_json, write_text
 
 WRITER = """
 import sys
 import numpy as np
-from mcfbench.atomic import save_npz
+from mcfbench.storage.atomic import save_npz
 data = np.random.default_rng(int(sys.argv[2])).random((500_000,))   # 4 MB
 save_npz(sys.argv[1], data=data, tag=np.array(int(sys.argv[2])))
 print("ready", flush=True)

@@ -23,13 +23,13 @@ import yaml
 
 from mcfbench.pipeline import (ConfigError, Pipeline, read_records, run_job, setup_logging,
                                time_job, used_schemes, write_files)
-from mcfbench.plots import beyond_figures
-from mcfbench.provenance import config_hash
-from mcfbench.records import RecordError, read_record
-from mcfbench.report import findings
-from mcfbench.schemes import SCHEMES
-from mcfbench.studies import space_convergence
-from mcfbench.tables import (beyond_documents, beyond_tables, convergence_documents,
+from mcfbench.presentation.plots import beyond_figures
+from mcfbench.storage.provenance import config_hash
+from mcfbench.storage.records import RecordError, read_record
+from mcfbench.presentation.report import findings
+from mcfbench.running.schemes import SCHEMES
+from mcfbench.running.run import space_convergence
+from mcfbench.presentation.tables import (beyond_documents, beyond_tables, convergence_documents,
                              eoc_column, level_table, monitor_summary, space_table,
                              time_order)
 
@@ -41,7 +41,7 @@ SETTINGS = {"t_final": 0.08, "tau_level_1": 0.04, "rtol": 1e-9}
 # -- synthetic records ----------------------------------------------------------
 
 def record(scheme, level, *, status="ok", l2=None, monitor=None, tau=None, t_final=0.08):
-    """A run record as mcfbench.records.read_record returns it (without the file)."""
+    """A run record as mcfbench.storage.records.read_record returns it (without the file)."""
     tau = 0.04 / 4 ** (level - 1) if tau is None else tau
     steps = round(t_final / tau)
     ok = status == "ok"

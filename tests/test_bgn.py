@@ -9,10 +9,10 @@ from scipy.sparse.linalg import spsolve
 
 from baselines.bgn import BGNFlow
 from baselines.cotan import cotangent_laplacian
-from mcfbench.driver import simulate
-from mcfbench.errors import SphereL2Error, eoc
-from mcfbench.solver import Solver
-from mcfbench.surfaces import icosphere
+from mcfbench.running.driver import simulate
+from mcfbench.geometry.exact import SphereL2Error, eoc
+from mcfbench.running.solver import Solver
+from mcfbench.geometry.surfaces import icosphere
 
 EXACT = Solver(method="direct", rtol=1e-12)
 
@@ -165,7 +165,7 @@ def test_bad_parameters():
 
 
 def test_registry_entry():
-    from mcfbench.schemes import get_scheme
+    from mcfbench.running.schemes import get_scheme
 
     V, F = icosphere(1)
     flow = get_scheme("bgn").make(V, F, 0.01)

@@ -6,10 +6,10 @@ from conftest import cylinder
 
 from baselines.cmcf import CMCFFlow
 from baselines.cotan import CotanFlow, cotangent_laplacian, lumped_mass
-from mcfbench.driver import simulate
-from mcfbench.errors import SphereL2Error, eoc, sphere_radius
-from mcfbench.solver import Solver
-from mcfbench.surfaces import icosphere
+from mcfbench.running.driver import simulate
+from mcfbench.geometry.exact import SphereL2Error, eoc, sphere_radius
+from mcfbench.running.solver import Solver
+from mcfbench.geometry.surfaces import icosphere
 
 EXACT = Solver(method="direct", rtol=1e-12)
 
@@ -116,7 +116,7 @@ def test_bad_parameters():
 
 
 def test_registry_entry():
-    from mcfbench.schemes import get_scheme
+    from mcfbench.running.schemes import get_scheme
 
     V, F = icosphere(1)
     assert isinstance(get_scheme("cmcf").make(V, F, 0.01), CMCFFlow)

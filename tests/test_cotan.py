@@ -8,10 +8,10 @@ from conftest import approaches_the_catenoid, cylinder, flat_lattice
 from baselines import cotan
 from baselines.cotan import CotanAssembler, CotanFlow, cotangent_laplacian, lumped_mass
 from baselines.mesh import edge_mesh
-from mcfbench.driver import simulate
-from mcfbench.errors import SphereL2Error, eoc
-from mcfbench.solver import Solver
-from mcfbench.surfaces import icosphere
+from mcfbench.running.driver import simulate
+from mcfbench.geometry.exact import SphereL2Error, eoc
+from mcfbench.running.solver import Solver
+from mcfbench.geometry.surfaces import icosphere
 
 EXACT = Solver(method="direct", rtol=1e-12)
 
@@ -227,7 +227,7 @@ def test_bad_parameters(options, message):
 
 
 def test_registry_entries():
-    from mcfbench.schemes import get_scheme
+    from mcfbench.running.schemes import get_scheme
 
     V, F = icosphere(1)
     for name, mass in (("cotan", "barycentric"), ("cotan-voronoi", "voronoi")):

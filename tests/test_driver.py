@@ -1,4 +1,4 @@
-"""The shared driver (mcfbench/driver.py) on a flow whose answer is known exactly.
+"""The shared driver (mcfbench/running/driver.py) on a flow whose answer is known exactly.
 
 ``Decay`` is implicit Euler for ``x' = -x`` on n points: each step solves
 ``(1 + tau) x^n = x^{n-1}``, so ``x^n = x^0 / (1 + tau)^n``.
@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from mcfbench.driver import simulate
-from mcfbench.flow import Flow
-from mcfbench.solver import Solver
+from mcfbench.running.driver import simulate
+from mcfbench.running.flow import Flow
+from mcfbench.running.solver import Solver
 
 
 class Decay:
-    """A minimal :class:`mcfbench.flow.Flow`: implicit Euler for x' = -x."""
+    """A minimal :class:`mcfbench.running.flow.Flow`: implicit Euler for x' = -x."""
 
     def __init__(self, vertices, faces, tau, *, defect_at=None, status="t_escaped"):
         self.tau, self.n = float(tau), 0

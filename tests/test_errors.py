@@ -2,9 +2,9 @@ import numpy as np
 import pytest
 
 from ddfv import Flow
-from mcfbench.driver import simulate
-from mcfbench.errors import SphereL2Error, eoc, sphere_radius
-from mcfbench.surfaces import icosphere
+from mcfbench.running.driver import simulate
+from mcfbench.geometry.exact import SphereL2Error, eoc, sphere_radius
+from mcfbench.geometry.surfaces import icosphere
 
 
 def test_l2_error_vanishes_on_the_exact_solution():

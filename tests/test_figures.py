@@ -1,4 +1,4 @@
-"""The experiments of Figs. 3.1-3.8 (mcfbench/figures.py): definitions, tracked
+"""The experiments of Figs. 3.1-3.8 (mcfbench/studies/figures.py): definitions, tracked
 cells, panels and the diagnostics of their runs."""
 
 import dataclasses
@@ -10,12 +10,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from mcfbench.figures import (EXPERIMENTS, LABEL, PAPER_FIGURES, Experiment, Run, Shot, Track,
+from mcfbench.studies.figures import (EXPERIMENTS, LABEL, PAPER_FIGURES, Experiment, Run, Shot, Track,
                               Zoom, draw_experiment, experiment_panels, run_experiment,
                               tracked, validate)
-from mcfbench.render import cells_centre, cells_points, project
-from mcfbench.schemes import SCHEMES, get_scheme
-from mcfbench.surfaces import make_surface
+from mcfbench.presentation.render import cells_centre, cells_points, project
+from mcfbench.running.schemes import SCHEMES, get_scheme
+from mcfbench.geometry.surfaces import make_surface
 
 
 def n_vertices(run):

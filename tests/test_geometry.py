@@ -6,7 +6,7 @@ from ddfv.geometry import (covolume_areas, diamond_corners, diamond_geometry,
                            t_barycentric, triangle_areas, vertex_normals)
 from ddfv.t_vertices import initial_t_vertices
 from ddfv.topology import DiamondMesh, diamond_mesh
-from mcfbench.surfaces import icosphere
+from mcfbench.geometry.surfaces import icosphere
 
 
 def _random_state(seed=1):

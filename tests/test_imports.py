@@ -52,7 +52,7 @@ def test_importing_a_scheme_package_loads_nothing_of_the_others(package):
 def test_import_ddfv_has_no_process_wide_side_effect():
     """The glibc malloc tuning is an explicit call of the entry points."""
     code = ("import sys, ddfv\n"
-            "print('mcfbench.memory' in sys.modules)")
+            "print('mcfbench.storage.memory' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          cwd=ROOT, check=True).stdout.strip()
     assert out == "False"

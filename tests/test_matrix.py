@@ -1,4 +1,4 @@
-"""The benchmark matrix (mcfbench.matrix, workflow/rules/matrix.smk): the config
+"""The benchmark matrix (mcfbench.studies.matrix, workflow/rules/matrix.smk): the config
 check against the registries, one tiny matrix run for real (2 schemes x 2
 problems at level 1) through the job function, records, tables, findings and
 plots, the EOC and summary logic on records with known numbers, and the
@@ -13,11 +13,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mcfbench import matrix
-from mcfbench.flow import STATUSES
-from mcfbench.problems import PROBLEMS
-from mcfbench.records import FIELDS, read_record, write_record
-from mcfbench.schemes import SCHEMES
+from mcfbench.studies import matrix
+from mcfbench.storage.statuses import STATUSES
+from mcfbench.running.problems import PROBLEMS
+from mcfbench.storage.records import FIELDS, read_record, write_record
+from mcfbench.running.schemes import SCHEMES
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -124,7 +124,7 @@ def test_tiny_tables_and_findings(tiny):
 
 
 def test_tiny_plots(tiny):
-    from mcfbench.matrix_plots import error_figure, picture_grid, quality_figure
+    from mcfbench.presentation.matrix_plots import error_figure, picture_grid, quality_figure
 
     root, plan, runs, table, _ = tiny
     problems, schemes = list(plan["problems"]), plan["schemes"]
@@ -233,7 +233,7 @@ def test_snakemake_dry_run(tmp_path):
 
 
 def test_gallery_runs_every_scheme_on_every_file(tmp_path):
-    from mcfbench.surfaces import make_surface
+    from mcfbench.geometry.surfaces import make_surface
 
     meshes = tmp_path / "meshes"
     matrix.write_obj(meshes / "ball.obj", *make_surface("sphere", level=2))

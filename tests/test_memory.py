@@ -1,9 +1,9 @@
-"""The glibc malloc tuning (mcfbench/memory.py): an explicit call, with an opt-out."""
+"""The glibc malloc tuning (mcfbench/storage/memory.py): an explicit call, with an opt-out."""
 
 import subprocess
 import sys
 
-CODE = "from mcfbench.memory import tune_malloc; print(tune_malloc())"
+CODE = "from mcfbench.storage.memory import tune_malloc; print(tune_malloc())"
 
 
 def _run(env_value=None):

@@ -1,10 +1,10 @@
-"""The harness's validation and summary of input surfaces (mcfbench.mesh)."""
+"""The harness's validation and summary of input surfaces (mcfbench.geometry.mesh)."""
 
 import numpy as np
 import pytest
 
 from conftest import cylinder, flat_lattice
-from mcfbench.mesh import MeshError, MeshSummary, summarize, validate_mesh
+from mcfbench.geometry.mesh import MeshError, MeshSummary, summarize, validate_mesh
 
 
 def icosahedron():

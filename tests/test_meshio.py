@@ -1,10 +1,10 @@
-"""Reading mesh files: errors, intake repairs and numbering (mcfbench.meshio)."""
+"""Reading mesh files: errors, intake repairs and numbering (mcfbench.geometry.mesh_files)."""
 
 import numpy as np
 import pytest
 
-from mcfbench.mesh import summarize
-from mcfbench.meshio import read_mesh
+from mcfbench.geometry.mesh import summarize
+from mcfbench.geometry.mesh_files import read_mesh
 
 TET_V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=float)
 TET_F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])

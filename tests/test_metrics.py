@@ -1,14 +1,14 @@
-"""Problem metrics and mesh-quality monitors (mcfbench/metrics.py)."""
+"""Problem metrics and mesh-quality monitors (mcfbench/geometry/metrics.py)."""
 
 import numpy as np
 import pytest
 
-from mcfbench.metrics import (
+from mcfbench.geometry.metrics import (
     area, area_ratio, aspect_ratios, catenoid_parameter, catenoid_profile_error,
     flipped_triangles, l2_height, lumped_mass, max_aspect_ratio, max_height, max_speed,
     mean_edge_length, min_angle, quality, triangle_angles, triangle_areas, volume,
 )
-from mcfbench.surfaces import cylinder, flat_lattice, hemisphere, icosahedron
+from mcfbench.geometry.surfaces import cylinder, flat_lattice, hemisphere, icosahedron
 
 # a* of R = 1, h = 0.5 to 21 digits (mpmath.findroot at 30 digits)
 A_CATENOID = 0.848337938094979002054
@@ -228,7 +228,7 @@ def test_inputs_of_the_wrong_shape_are_refused():
 
 def _numpy_quality(V, F):
     """The monitors of :func:`quality` evaluated with plain numpy (the test oracle)."""
-    from mcfbench.metrics import aspect_ratios, flipped_triangles, triangle_areas
+    from mcfbench.geometry.metrics import aspect_ratios, flipped_triangles, triangle_areas
 
     A = triangle_areas(V, F)
     return {"min_angle": float(triangle_angles(V, F).min()),
@@ -238,8 +238,8 @@ def _numpy_quality(V, F):
 
 
 def test_quality_kernel_matches_a_numpy_evaluation():
-    from mcfbench.metrics import edge_neighbours
-    from mcfbench.surfaces import icosphere
+    from mcfbench.geometry.metrics import edge_neighbours
+    from mcfbench.geometry.surfaces import icosphere
 
     rng = np.random.default_rng(3)
     V, F = icosphere(3)

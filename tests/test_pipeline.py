@@ -27,7 +27,7 @@ import pytest
 import yaml
 
 from mcfbench.pipeline import Pipeline, solver_of
-from mcfbench.records import checksum
+from mcfbench.storage.records import checksum
 
 REPO = Path(__file__).resolve().parents[1]
 # the study's own target (rule all also builds the figures of another rule
@@ -239,7 +239,7 @@ def test_threads_setting_reaches_the_rules_and_the_records(tmp_path, env):
     assert Pipeline(config).run_settings("ddfv", 1)["threads"] == 1
 
 
-_ONE_STEP = ("import json; from mcfbench.studies import run; "
+_ONE_STEP = ("import json; from mcfbench.running.run import run; "
              "r, _ = run('ddfv', 'sphere', 1, t_final=0.04); print(json.dumps(r.metrics))")
 
 

@@ -1,14 +1,14 @@
-"""The problem registry (mcfbench/problems.py): meshes, time rules, metrics."""
+"""The problem registry (mcfbench/running/problems.py): meshes, time rules, metrics."""
 
 import numpy as np
 import pytest
 
-from mcfbench.flow import STATUSES
-from mcfbench.mesh import summarize
-from mcfbench.metrics import catenoid_parameter
-from mcfbench.problems import PROBLEMS, Problem, get_problem, time_steps
-from mcfbench.schemes import SCHEMES
-from mcfbench.studies import run
+from mcfbench.storage.statuses import STATUSES
+from mcfbench.geometry.mesh import summarize
+from mcfbench.geometry.metrics import catenoid_parameter
+from mcfbench.running.problems import PROBLEMS, Problem, get_problem, time_steps
+from mcfbench.running.schemes import SCHEMES
+from mcfbench.running.run import run
 
 CLOSED = {"sphere": 0, "torus": 1, "dumbbell": 0, "perturbed_sphere": 0, "remeshed_sphere": 0,
           "anisotropic_sphere": 0, "blobby": 0, "marching_torus": 1}
@@ -33,7 +33,7 @@ def test_every_problem_has_a_valid_mesh_and_time_rule(name):
 
 
 def test_refinement_series_halves_h_and_quarters_tau():
-    from mcfbench.metrics import mean_edge_length
+    from mcfbench.geometry.metrics import mean_edge_length
 
     for name in ("sphere", "catenoid", "hemisphere", "torus"):
         problem = get_problem(name)
@@ -71,7 +71,7 @@ def test_time_steps_refuse_what_is_not_a_multiple():
 def test_user_mesh_problem_uses_the_mesh_size():
     problem = Problem.user_mesh("my.obj", steps=7, tau_edge=0.5)
     V, F = get_problem("sphere").mesh(2)
-    from mcfbench.metrics import mean_edge_length
+    from mcfbench.geometry.metrics import mean_edge_length
 
     assert problem.tau(0, (V, F)) == pytest.approx(0.5 * mean_edge_length(V, F) ** 2)
     assert problem.time_steps(0.01) == 7

@@ -1,11 +1,11 @@
-"""Provenance (mcfbench/provenance.py): the code is identified from anywhere."""
+"""Provenance (mcfbench/storage/provenance.py): the code is identified from anywhere."""
 
 import json
 import subprocess
 import sys
 from pathlib import Path
 
-from mcfbench.provenance import config_hash, dependency_versions, provenance, source_hash
+from mcfbench.storage.provenance import config_hash, dependency_versions, provenance, source_hash
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -23,7 +23,7 @@ def test_provenance_names_code_dependencies_and_settings():
 def test_git_commit_is_found_from_outside_the_repository(tmp_path):
     commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True,
                             text=True)
-    code = "import json; from mcfbench.provenance import provenance; " \
+    code = "import json; from mcfbench.storage.provenance import provenance; " \
            "print(json.dumps(provenance({})))"
     out = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
                          text=True, check=True).stdout

@@ -1,4 +1,4 @@
-"""Mesh-quality diagnostics (mcfbench/quality.py)."""
+"""Mesh-quality diagnostics (mcfbench/geometry/quality.py)."""
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -8,11 +8,11 @@ import pytest
 from baselines.cotan import CotanFlow
 from ddfv import Flow
 from ddfv.topology import diamond_mesh
-from mcfbench.driver import simulate
-from mcfbench.quality import (COLUMNS, DIAMOND_COLUMNS, MeshQuality, describe_violation,
+from mcfbench.running.driver import simulate
+from mcfbench.geometry.quality import (COLUMNS, DIAMOND_COLUMNS, MeshQuality, describe_violation,
                               diamond_min_angles, first_violation, mesh_quality, plot_quality,
                               primal_quality, vertex_quality)
-from mcfbench.surfaces import cylinder, icosphere
+from mcfbench.geometry.surfaces import cylinder, icosphere
 
 
 @pytest.fixture(scope="module")

@@ -1,12 +1,12 @@
-"""Run records (mcfbench/records.py): schema, checksum, stale settings, atomic write."""
+"""Run records (mcfbench/storage/records.py): schema, checksum, stale settings, atomic write."""
 
 import json
 import math
 
 import pytest
 
-from mcfbench.records import RecordError, read_record, write_record
-from mcfbench.studies import run
+from mcfbench.storage.records import RecordError, read_record, write_record
+from mcfbench.running.run import run
 
 SETTINGS = {"scheme": "cotan", "problem": "sphere", "level": 1}
 

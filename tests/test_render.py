@@ -1,4 +1,4 @@
-"""Pictures of the diamond mesh (mcfbench/render.py)."""
+"""Pictures of the diamond mesh (mcfbench/presentation/render.py)."""
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -7,10 +7,10 @@ from matplotlib.collections import PolyCollection
 
 from ddfv import Flow
 from ddfv.topology import diamond_mesh
-from mcfbench.render import (HIGHLIGHT_COLOR, Panel, cells_centre, cells_points, diamond_faces,
+from mcfbench.presentation.render import (HIGHLIGHT_COLOR, Panel, cells_centre, cells_points, diamond_faces,
                              draw_mesh, element_centre, legend_handles, panel_row, project,
                              save_figure, tracked_cells, view_frame, worst_element)
-from mcfbench.surfaces import cylinder, icosphere
+from mcfbench.geometry.surfaces import cylinder, icosphere
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

@@ -1,11 +1,11 @@
-"""The reproduction report (mcfbench/report.py, workflow/scripts/report*.py, paper/).
+"""The reproduction report (mcfbench/presentation/report.py, workflow/scripts/report*.py, paper/).
 
 Built from small synthetic result files in a temporary folder (the layout
 of results/, three levels, three figures), with the real paper/ sources and
 ddfv/README.md. Checked: every output is written; the HTML needs nothing
 but itself and embeds every image; a changed table value or run record
 changes the report, and values outside the tolerances are flagged; the
-published Table 3.1 equals mcfbench.tables.PUBLISHED exactly; the beyond study
+published Table 3.1 equals mcfbench.presentation.tables.PUBLISHED exactly; the beyond study
 is included when present; the deviations come from ddfv/README.md.
 """
 
@@ -23,10 +23,10 @@ import pandas as pd
 import pytest
 import yaml
 
-from mcfbench import report
-from mcfbench.figures import EXPERIMENTS, PAPER_FIGURES
-from mcfbench.schemes import SCHEMES
-from mcfbench.tables import PUBLISHED
+from mcfbench.presentation import report
+from mcfbench.studies.figures import EXPERIMENTS, PAPER_FIGURES
+from mcfbench.running.schemes import SCHEMES
+from mcfbench.presentation.tables import PUBLISHED
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -466,7 +466,7 @@ def test_pdf_builds_when_tex_is_installed(results, tmp_path, monkeypatch):
 
 
 def test_rule_declares_every_output_of_the_script():
-    """workflow/rules/report.smk lists the LaTeX fragments mcfbench.report writes."""
+    """workflow/rules/report.smk lists the LaTeX fragments mcfbench.presentation.report writes."""
     rules = (REPO / "workflow" / "rules" / "report.smk").read_text()
     block = re.search(r"REPORT_TEX_FRAGMENTS = \[(.*?)\]", rules, re.S)[1]
     assert tuple(re.findall(r'"(\w+)"', block)) == report.TEX_FRAGMENTS

@@ -1,12 +1,12 @@
-"""The scheme registry (mcfbench/schemes.py): every entry is a working flow."""
+"""The scheme registry (mcfbench/running/schemes.py): every entry is a working flow."""
 
 import numpy as np
 import pytest
 
-from mcfbench.driver import simulate
-from mcfbench.flow import Flow
-from mcfbench.schemes import SCHEMES, get_scheme
-from mcfbench.surfaces import icosphere, random_bumpy_sphere
+from mcfbench.running.driver import simulate
+from mcfbench.running.flow import Flow
+from mcfbench.running.schemes import SCHEMES, get_scheme
+from mcfbench.geometry.surfaces import icosphere, random_bumpy_sphere
 
 
 @pytest.mark.parametrize("name", sorted(SCHEMES))

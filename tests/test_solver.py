@@ -1,4 +1,4 @@
-"""The shared linear solver (mcfbench.solver): methods, failures, invariances.
+"""The shared linear solver (mcfbench.running.solver): methods, failures, invariances.
 
 The oracle is a literal copy of the former numpy BiCGStab (ddfv/solver.py at
 6cc720c): the compiled kernel must reproduce its iteration counts and its
@@ -10,7 +10,7 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from mcfbench.solver import (METHODS, SolveInfo, Solver, SolverFailure, apply_block,
+from mcfbench.running.solver import (METHODS, SolveInfo, Solver, SolverFailure, apply_block,
                              solve)
 
 pytestmark = pytest.mark.filterwarnings("error")   # no arithmetic warning may escape

@@ -1,10 +1,10 @@
-"""Studies for any scheme on any problem (mcfbench/studies.py)."""
+"""Studies for any scheme on any problem (mcfbench/running/run.py)."""
 
 import numpy as np
 import pytest
 
-from mcfbench.studies import level_sweep, run, space_convergence, time_convergence
-from mcfbench.surfaces import icosphere
+from mcfbench.running.run import level_sweep, run, space_convergence, time_convergence
+from mcfbench.geometry.surfaces import icosphere
 
 
 @pytest.mark.parametrize("scheme", ["ddfv", "cotan"])

@@ -1,4 +1,4 @@
-"""Initial surfaces (mcfbench/surfaces.py)."""
+"""Initial surfaces (mcfbench/geometry/surfaces.py)."""
 
 import hashlib
 
@@ -6,8 +6,8 @@ import igl
 import numpy as np
 import pytest
 
-from mcfbench.metrics import area, mean_edge_length, triangle_areas, volume
-from mcfbench.surfaces import (
+from mcfbench.geometry.metrics import area, mean_edge_length, triangle_areas, volume
+from mcfbench.geometry.surfaces import (
     SURFACES, anisotropic_sphere, blobby, bumpy_sphere, cylinder, dumbbell, dumbbell_profile,
     flat_lattice, flat_patch, hemisphere, icosahedron, icosphere, implicit_torus, isosurface,
     make_surface, perturbed_sphere, random_bumpy_sphere, remeshed_sphere, subdivide, torus,

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from conftest import cylinder, flat_lattice
-from mcfbench.surfaces import icosphere
+from mcfbench.geometry.surfaces import icosphere
 from ddfv.t_vertices import cotangent_mean_curvature_vector, initial_t_vertices
 from ddfv.topology import diamond_mesh
 

@@ -1,12 +1,12 @@
-"""Acceptance: Table 3.1 of the paper (Section 3.1), mcfbench/tables.py."""
+"""Acceptance: Table 3.1 of the paper (Section 3.1), mcfbench/presentation/tables.py."""
 
 import numpy as np
 import pytest
 
-from mcfbench.problems import get_problem
-from mcfbench.solver import Solver
-from mcfbench.studies import run
-from mcfbench.tables import PUBLISHED, sphere_table
+from mcfbench.running.problems import get_problem
+from mcfbench.running.solver import Solver
+from mcfbench.running.run import run
+from mcfbench.presentation.tables import PUBLISHED, sphere_table
 
 
 def sphere_run(level, scheme="ddfv", rtol=1e-9, **options):

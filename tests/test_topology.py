@@ -3,7 +3,7 @@ import pytest
 
 from conftest import flat_lattice
 from ddfv.topology import diamond_mesh, locality_order
-from mcfbench.surfaces import icosphere
+from mcfbench.geometry.surfaces import icosphere
 
 
 @pytest.mark.parametrize("level", [0, 1, 2, 3])

@@ -7,7 +7,7 @@
 #
 # Settings: the config key `beyond` (config/README.md), checked by
 # mcfbench.pipeline.beyond_settings. Four studies, all under results/beyond/
-# (results/README.md), for any scheme of the registry mcfbench.schemes.SCHEMES:
+# (results/README.md), for any scheme of the registry mcfbench.running.schemes.SCHEMES:
 #
 # - levels: every scheme on every level with tau ~ h^2 as in Table 3.1, and
 #   the schemes of beyond.finest on one level more; the ordinary run records
@@ -16,7 +16,7 @@
 # - long_time: one level continued past t_final (onset of the breakdown);
 # - space: refined meshes with one tiny time step (order 2 in space);
 # - time: one mesh, tau halved repeatedly (order 1 in time;
-#   mcfbench.studies.time_convergence).
+#   mcfbench.running.run.time_convergence).
 #
 # Runs that break down are records like any other (status, t_failed, the T
 # monitor of every time level reached); the tables show them as such.
@@ -70,7 +70,7 @@ rule beyond_run:
 
 
 rule beyond_time:
-    """Time convergence of one scheme on one mesh (mcfbench.studies.time_convergence)."""
+    """Time convergence of one scheme on one mesh (mcfbench.running.run.time_convergence)."""
     input:
         kernels=ancient(KERNELS),
     output:

@@ -4,7 +4,7 @@
 #   snakemake --cores 2 gallery                       # the suite's own meshes
 #   snakemake --cores 2 gallery --config meshes=DIR   # every .obj .off .ply .stl in DIR
 #
-# Each run: the mesh read by mcfbench.meshio.read_mesh (repaired and
+# Each run: the mesh read by mcfbench.geometry.mesh_files.read_mesh (repaired and
 # validated), tau = C * (mean edge length)^2, `steps` steps, the robust solver
 # (config key `gallery`). Without `meshes` the suite first writes its own
 # real-world-like meshes as OBJ to results/gallery/meshes/. Uses MATRIX_CODE

@@ -4,12 +4,12 @@
 #   snakemake --cores 2 matrix      # the default matrix: about 15 minutes on 2 cores
 #
 # Settings: the config key `matrix` (config/config.yaml), checked against the
-# registries mcfbench.schemes.SCHEMES and mcfbench.problems.PROBLEMS by
-# mcfbench.matrix.matrix_plan before any job runs. Everything but the rules
-# is in mcfbench/matrix.py (tables, findings) and mcfbench/matrix_plots.py.
+# registries mcfbench.running.schemes.SCHEMES and mcfbench.running.problems.PROBLEMS by
+# mcfbench.studies.matrix.matrix_plan before any job runs. Everything but the rules
+# is in mcfbench/studies/matrix.py (tables, findings) and mcfbench/presentation/matrix_plots.py.
 #
 # Outputs under results/matrix/:
-#   runs/{problem}/{scheme}/level{level}.json    one record per run (mcfbench.records)
+#   runs/{problem}/{scheme}/level{level}.json    one record per run (mcfbench.storage.records)
 #   frames/{problem}/{scheme}/level{level}.npz   its first and last frame
 #   tables/matrix.csv                            the long table (one row per metric)
 #   tables/{problem}.md, .tex                    one table per problem, schemes as rows
@@ -17,9 +17,9 @@
 #   figures/errors, quality, pictures (.png, .pdf)
 #   findings.md                                  written from the numbers only
 
-from mcfbench import matrix as _matrix
+from mcfbench.studies import matrix as _matrix
 from mcfbench.pipeline import alternatives as _alternatives
-from mcfbench.provenance import code_hash as _code_hash
+from mcfbench.storage.provenance import code_hash as _code_hash
 
 MATRIX = _matrix.matrix_plan(config.get("matrix"))
 # a run is redone when the code that computes it changes (not the tables or plots)

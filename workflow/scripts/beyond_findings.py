@@ -1,4 +1,4 @@
-"""Rule beyond_findings: the findings of the beyond study in words (mcfbench.report.findings).
+"""Rule beyond_findings: the findings of the beyond study in words (mcfbench.presentation.report.findings).
 
 Every number and verdict is read from the tables: nothing is typed by hand.
 """
@@ -6,7 +6,7 @@ Every number and verdict is read from the tables: nothing is typed by hand.
 import pandas as pd
 
 from mcfbench.pipeline import setup_logging, write_files
-from mcfbench.report import findings
+from mcfbench.presentation.report import findings
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

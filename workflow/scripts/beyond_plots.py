@@ -1,9 +1,9 @@
-"""Rule beyond_figures: the figures of the beyond study from its tables (mcfbench.plots)."""
+"""Rule beyond_figures: the figures of the beyond study from its tables (mcfbench.presentation.plots)."""
 
 import pandas as pd
 
 from mcfbench.pipeline import setup_logging, write_files
-from mcfbench.plots import beyond_figures
+from mcfbench.presentation.plots import beyond_figures
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

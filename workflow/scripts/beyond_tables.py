@@ -2,13 +2,13 @@
 
 Every record is checked first (:func:`mcfbench.pipeline.read_records`). Writes
 ``levels``, ``stability``, ``time_convergence``, ``space_convergence`` (CSV,
-Markdown, LaTeX each; :func:`mcfbench.tables.beyond_tables`,
-:func:`mcfbench.tables.beyond_documents`), ``t_monitor.csv`` (the T monitor
+Markdown, LaTeX each; :func:`mcfbench.presentation.tables.beyond_tables`,
+:func:`mcfbench.presentation.tables.beyond_documents`), ``t_monitor.csv`` (the T monitor
 at every time level) and ``beyond.json`` (provenance), all together.
 """
 
 from mcfbench.pipeline import json_text, read_records, setup_logging, sidecar, write_files
-from mcfbench.tables import beyond_documents, beyond_tables, csv_text
+from mcfbench.presentation.tables import beyond_documents, beyond_tables, csv_text
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

@@ -1,11 +1,11 @@
 """Rule beyond_time: time convergence of one scheme on one mesh -> a JSON record.
 
 ``params.settings``: :meth:`mcfbench.pipeline.Pipeline.time_settings`; the job
-is :func:`mcfbench.pipeline.time_job` (:func:`mcfbench.studies.time_convergence`,
+is :func:`mcfbench.pipeline.time_job` (:func:`mcfbench.running.run.time_convergence`,
 any scheme of the registry).
 """
 
-from mcfbench.memory import tune_malloc
+from mcfbench.storage.memory import tune_malloc
 from mcfbench.pipeline import setup_logging, time_job
 
 tune_malloc()  # before any flow allocates

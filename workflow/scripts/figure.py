@@ -1,4 +1,4 @@
-"""Rule figure: run the experiment of one figure (mcfbench.figures) and draw it.
+"""Rule figure: run the experiment of one figure (mcfbench.studies.figures) and draw it.
 
 Writes the figure (PNG, PDF), the kept frames (npz), the per-step mesh
 diagnostics (CSV, plot) and the figure's record (JSON): see
@@ -6,7 +6,7 @@ diagnostics (CSV, plot) and the figure's record (JSON): see
 frames; the job still succeeds.
 """
 
-from mcfbench.memory import tune_malloc
+from mcfbench.storage.memory import tune_malloc
 from mcfbench.pipeline import FIGURE_OUTPUTS, figure_job, setup_logging
 
 tune_malloc()  # before any flow allocates

@@ -1,4 +1,4 @@
-"""The figures of the benchmark matrix (mcfbench.matrix_plots).
+"""The figures of the benchmark matrix (mcfbench.presentation.matrix_plots).
 
 Called by rule ``matrix_plots`` (workflow/rules/matrix.smk): error against h
 from the long table, mesh quality over time from the records' series, and
@@ -7,9 +7,9 @@ the picture grid of final surfaces from the saved frames.
 
 import logging
 
-from mcfbench.matrix import load_frames, read_long_table, read_runs
-from mcfbench.matrix_plots import error_figure, picture_grid, quality_figure
-from mcfbench.records import read_record
+from mcfbench.studies.matrix import load_frames, read_long_table, read_runs
+from mcfbench.presentation.matrix_plots import error_figure, picture_grid, quality_figure
+from mcfbench.storage.records import read_record
 
 sm = snakemake  # noqa: F821
 logging.basicConfig(filename=sm.log[0], level=logging.INFO, force=True)

@@ -2,14 +2,14 @@
 
 Called by rule ``matrix_tables`` (workflow/rules/matrix.smk): every record is
 read and checked against the settings of its run (stale or edited records are
-refused), then :func:`mcfbench.matrix.aggregate` writes ``matrix.csv``, one
+refused), then :func:`mcfbench.studies.matrix.aggregate` writes ``matrix.csv``, one
 table per problem and the summary.
 """
 
 import logging
 from pathlib import Path
 
-from mcfbench.matrix import aggregate
+from mcfbench.studies.matrix import aggregate
 
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, force=True)  # noqa: F821
 table, summary = aggregate(snakemake.params.expected, snakemake.params.plan,  # noqa: F821

@@ -1,9 +1,9 @@
-"""Rule convergence_figure: L2 error against h for every scheme (mcfbench.plots)."""
+"""Rule convergence_figure: L2 error against h for every scheme (mcfbench.presentation.plots)."""
 
 import pandas as pd
 
 from mcfbench.pipeline import setup_logging, write_files
-from mcfbench.plots import convergence_figure
+from mcfbench.presentation.plots import convergence_figure
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

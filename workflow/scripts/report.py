@@ -1,15 +1,15 @@
-"""Rule reproduction_report: the report from the result files (mcfbench.report.build).
+"""Rule reproduction_report: the report from the result files (mcfbench.presentation.report.build).
 
 Writes ``reproduction.md``, ``.html`` (self-contained), ``.json`` (every check)
 and the LaTeX fragments under ``tex/``. Sources: the inputs of the rule
 (results/, paper/, ddfv/README.md) and whatever results/beyond/ holds. By
-hand: ``python -m mcfbench.report``.
+hand: ``python -m mcfbench.presentation.report``.
 """
 
 from pathlib import Path
 
 from mcfbench.pipeline import setup_logging
-from mcfbench.report import Sources, build, default_outputs
+from mcfbench.presentation.report import Sources, build, default_outputs
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

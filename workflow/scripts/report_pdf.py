@@ -1,11 +1,11 @@
 """Rule report_pdf: ``paper/reproduction.tex`` with the report's fragments as a PDF.
 
 Needs pdflatex (booktabs, graphicx, amssymb, hyperref); see
-:func:`mcfbench.report.build_pdf`.
+:func:`mcfbench.presentation.report.build_pdf`.
 """
 
 from mcfbench.pipeline import setup_logging
-from mcfbench.report import build_pdf
+from mcfbench.presentation.report import build_pdf
 
 sm = snakemake  # noqa: F821
 build_pdf(sm.output.pdf, sm.input.template, setup_logging(sm.log[0]))

@@ -2,11 +2,11 @@
 
 ``params.settings``: :meth:`mcfbench.pipeline.Pipeline.run_settings` (scheme,
 problem, level, tau, t_final, rtol, source hashes); the record is written by
-:func:`mcfbench.records.write_record` (fields of
-:class:`mcfbench.studies.RunResult`, settings, provenance, checksum).
+:func:`mcfbench.storage.records.write_record` (fields of
+:class:`mcfbench.storage.records.RunResult`, settings, provenance, checksum).
 """
 
-from mcfbench.memory import tune_malloc
+from mcfbench.storage.memory import tune_malloc
 from mcfbench.pipeline import run_job, setup_logging
 
 tune_malloc()  # before any flow allocates: halves the wall time of level 5

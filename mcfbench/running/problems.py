@@ -1,22 +1,22 @@
 """The registry of problems: initial surface, refinement series, time rule, metrics.
 
 A problem is one entry of :data:`PROBLEMS`: a surface generator of
-:mod:`mcfbench.surfaces` with its parameters per refinement level, the time
+:mod:`mcfbench.geometry.surfaces` with its parameters per refinement level, the time
 step of each level, the final time, an optional steady-state threshold and
-the metrics (observers of :mod:`mcfbench.metrics` and
-:mod:`mcfbench.errors`) measured on every run. Table 3.1 of the paper is
+the metrics (observers of :mod:`mcfbench.geometry.metrics` and
+:mod:`mcfbench.geometry.exact`) measured on every run. Table 3.1 of the paper is
 the problem ``sphere`` run by the scheme ``ddfv``.
 
 A new problem is one entry here (and, if it needs one, a generator in
-:mod:`mcfbench.surfaces` or a metric in :mod:`mcfbench.metrics`).
+:mod:`mcfbench.geometry.surfaces` or a metric in :mod:`mcfbench.geometry.metrics`).
 """
 
 import math
 from dataclasses import dataclass, field, replace
 
-from . import metrics as _metrics
-from .errors import SphereL2Error
-from .surfaces import make_surface
+from mcfbench.geometry import metrics as _metrics
+from mcfbench.geometry.exact import SphereL2Error
+from mcfbench.geometry.surfaces import make_surface
 
 
 @dataclass(frozen=True)
@@ -27,7 +27,7 @@ class Problem:
     ----------
     name, label : str
     surface : str
-        A name of :data:`mcfbench.surfaces.SURFACES`.
+        A name of :data:`mcfbench.geometry.surfaces.SURFACES`.
     params : callable
         ``params(level) -> dict`` of the generator's keyword arguments.
     levels : tuple of int
@@ -100,7 +100,7 @@ class Problem:
     @classmethod
     def user_mesh(cls, label, steps, tau_edge=0.1):
         """The problem of a user's mesh: ``tau = tau_edge h^2``, ``steps`` steps, no
-        exact answer (the mesh is passed to :func:`mcfbench.studies.run`)."""
+        exact answer (the mesh is passed to :func:`mcfbench.running.run.run`)."""
         return cls("user", label, "", lambda level: {}, levels=(0,), tau_1=tau_edge,
                    t_final=0.0, metrics=(), tau_rule="mesh", steps=int(steps),
                    exact="no exact solution: a user's mesh")

@@ -2,7 +2,7 @@
 
 :func:`read_mesh` reads a file, repairs what can be repaired without
 changing the surface, validates the result with
-:func:`mcfbench.mesh.validate_mesh` and says what it did in an
+:func:`mcfbench.geometry.mesh.validate_mesh` and says what it did in an
 :class:`IntakeReport`.
 
 Errors
@@ -12,7 +12,7 @@ file: a directory, an empty file, an extension other than ``.obj .off .ply
 .stl``, content libigl cannot read (its message is quoted), NaN/inf
 coordinates (the vertex is named, with its line for OBJ and OFF), a face
 with fewer than 3 corners, no faces, or an invalid surface
-(:class:`mcfbench.mesh.MeshError`, vertices and triangles named in the
+(:class:`mcfbench.geometry.mesh.MeshError`, vertices and triangles named in the
 file's numbering). libigl reads in a forked child process where the
 platform has ``fork``, so a crash of the reader (libigl aborts on a PLY
 with faces of different sizes) becomes a ``ValueError`` too.
@@ -52,7 +52,7 @@ from pathlib import Path
 import igl
 import numpy as np
 
-from .mesh import MeshError, _count, _few, validate_mesh
+from mcfbench.geometry.mesh import MeshError, _count, _few, validate_mesh
 
 SUPPORTED = (".obj", ".off", ".ply", ".stl")
 
@@ -134,7 +134,7 @@ def read_mesh(path):
     -------
     V : (n, 3) float64 array
     F : (m, 3) int64 array
-        A valid surface (:func:`mcfbench.mesh.validate_mesh`).
+        A valid surface (:func:`mcfbench.geometry.mesh.validate_mesh`).
     report : IntakeReport
 
     Raises

@@ -14,102 +14,18 @@ solution: order 2 expected).
 """
 
 import time
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import replace
 
 import numpy as np
 
-from . import metrics
-from .driver import simulate
-from .errors import eoc
-from .mesh import validate_mesh
-from .problems import get_problem
-from .schemes import get_scheme
-from .solver import Solver
-
-
-@dataclass
-class RunResult:
-    """One scheme on one problem at one level.
-
-    Attributes
-    ----------
-    scheme, problem : str
-    level : int
-    nV : int
-        Points of the state (DDFV: F- plus T-vertices).
-    nF, nT : int
-        Mesh vertices and triangles.
-    h : float
-        Mean edge length of the initial mesh.
-    tau : float
-    N : int
-        Steps asked for.
-    steps_done : int
-        Steps completed.
-    status, message : str
-        ``"ok"`` or the breakdown (:data:`mcfbench.flow.STATUSES`).
-    t_failed : float
-        Time of the breakdown or first defect, NaN when ``ok``.
-    t_end : float
-        Time of the last state reached (earlier than ``N tau`` at a
-        breakdown or when the steady state was reached).
-    steady : bool
-        The run stopped at the problem's steady state.
-    iterations : int
-        Total solver iterations.
-    solver : str
-        The solver's method.
-    cpu_seconds, wall_seconds : float
-        Flow construction (T-vertex initialisation included), stepping and
-        metrics.
-    t_min_barycentric : float
-        DDFV: the T monitor, smallest barycentric coordinate of a T-vertex
-        over all time levels reached (NaN for the other schemes).
-    min_angle, max_aspect, max_flipped : float
-        Worst mesh quality over the sampled time levels
-        (:func:`mcfbench.metrics.quality`).
-    metrics : dict
-        The problem's metrics (e.g. ``l2_error``); NaN when the run did not
-        finish.
-    series : dict of lists
-        ``t``, ``t_min_barycentric`` (every level), ``quality_t``,
-        ``min_angle``, ``max_aspect``, ``flipped`` (sampled levels).
-    """
-
-    scheme: str
-    problem: str
-    level: int
-    nV: int
-    nF: int
-    nT: int
-    h: float
-    tau: float
-    N: int
-    steps_done: int
-    status: str
-    message: str
-    t_failed: float
-    t_end: float
-    steady: bool
-    iterations: int
-    solver: str
-    cpu_seconds: float
-    wall_seconds: float
-    t_min_barycentric: float
-    min_angle: float
-    max_aspect: float
-    max_flipped: float
-    metrics: dict = field(default_factory=dict)
-    series: dict = field(default_factory=dict, repr=False)
-
-    def to_dict(self, series=True):
-        """Fields as a flat dict: the metrics as top-level keys; ``series=False``
-        leaves out the time series."""
-        row = asdict(self)
-        row.update(row.pop("metrics"))
-        if not series:
-            del row["series"]
-        return row
+from mcfbench.geometry import metrics
+from mcfbench.running.driver import simulate
+from mcfbench.geometry.exact import eoc
+from mcfbench.geometry.mesh import validate_mesh
+from mcfbench.running.problems import get_problem
+from mcfbench.running.schemes import get_scheme
+from mcfbench.running.solver import Solver
+from mcfbench.storage.records import RunResult
 
 
 class _Monitor:
@@ -170,15 +86,15 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defec
 
     Parameters
     ----------
-    scheme : str or mcfbench.schemes.Scheme
-    problem : str or mcfbench.problems.Problem
+    scheme : str or mcfbench.running.schemes.Scheme
+    problem : str or mcfbench.running.problems.Problem
     level : int
     tau, t_final : float, optional
         Override the problem's time rule.
-    solver : mcfbench.solver.Solver, optional
+    solver : mcfbench.running.solver.Solver, optional
         Default: BiCGStab, rtol 1e-9 (the paper's).
     on_defect : {"stop", "record"}
-        See :func:`mcfbench.driver.simulate`.
+        See :func:`mcfbench.running.driver.simulate`.
     save_every : int
         Frames kept in the returned trajectory (``0``: first and last).
     samples : int
@@ -187,7 +103,7 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defec
         Instead of the problem's generator (a user's mesh).
     threads : int
         Threads of the solver and of the scheme's compiled passes
-        (:meth:`mcfbench.schemes.Scheme.make`); ``solver.threads`` is
+        (:meth:`mcfbench.running.schemes.Scheme.make`); ``solver.threads`` is
         replaced by it when more than one.
     **options
         Options of the scheme's flow class (override the registry's).
@@ -195,7 +111,7 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defec
     Returns
     -------
     result : RunResult
-    trajectory : mcfbench.driver.Trajectory
+    trajectory : mcfbench.running.driver.Trajectory
     """
     scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
     problem = get_problem(problem) if isinstance(problem, str) else problem
@@ -277,7 +193,7 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
         The reference uses ``min(taus) / reference_factor``.
     t_final : float, optional
         Default: the problem's.
-    solver : mcfbench.solver.Solver, optional
+    solver : mcfbench.running.solver.Solver, optional
     **options
         Options of the scheme's flow (passed to :func:`run`).
 

@@ -11,7 +11,7 @@ A no-op elsewhere than glibc; ``DDFV_MALLOC_TUNING=0`` leaves the allocator
 alone.
 
 :func:`peak_rss_mb` is the peak resident memory of the process, stored in
-every run record (:func:`mcfbench.records.write_record`).
+every run record (:func:`mcfbench.storage.records.write_record`).
 """
 
 import ctypes

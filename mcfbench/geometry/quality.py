@@ -37,9 +37,9 @@ pipeline adds a first column ``run``, the run's key in its experiment):
     diamond with the smallest area (empty for ``vertex`` runs).
 ``primal_angle_min_deg``, ``primal_area_min_rel``, ``primal_flipped``, ``worst_triangle``
     The primal triangle mesh (the F-vertices; every scheme): smallest
-    interior angle in degrees (:func:`mcfbench.metrics.min_angle`),
+    interior angle in degrees (:func:`mcfbench.geometry.metrics.min_angle`),
     smallest triangle area over the mean, number of triangles folded over
-    against their neighbours (:func:`mcfbench.metrics.flipped_triangles`)
+    against their neighbours (:func:`mcfbench.geometry.metrics.flipped_triangles`)
     and the triangle with the smallest area.
 
 A ``ddfv`` row violates when a T-vertex has left its triangle or a
@@ -47,7 +47,7 @@ diamond cell collapsed; a ``vertex`` row when a triangle collapsed or
 folded over (:func:`first_violation`).
 
 Use :class:`MeshQuality` as an observer of
-:func:`mcfbench.driver.simulate`, then :meth:`MeshQuality.frame`,
+:func:`mcfbench.running.driver.simulate`, then :meth:`MeshQuality.frame`,
 :func:`first_violation` and :func:`plot_quality`.
 """
 
@@ -90,7 +90,7 @@ def mesh_quality(mesh, F, T, geometry=None):
     Examples
     --------
     >>> from ddfv.topology import diamond_mesh
-    >>> from mcfbench.surfaces import icosphere
+    >>> from mcfbench.geometry.surfaces import icosphere
     >>> V, faces = icosphere(2)
     >>> T = V[faces].mean(axis=1)
     >>> q = mesh_quality(diamond_mesh(faces), V, T)
@@ -133,12 +133,12 @@ def primal_quality(vertices, faces):
 
     Examples
     --------
-    >>> from mcfbench.surfaces import icosphere
+    >>> from mcfbench.geometry.surfaces import icosphere
     >>> q = primal_quality(*icosphere(1))
     >>> round(q["primal_angle_min_deg"], 1), q["primal_flipped"]
     (55.6, 0)
     """
-    from .metrics import flipped_triangles, min_angle, triangle_areas
+    from mcfbench.geometry.metrics import flipped_triangles, min_angle, triangle_areas
 
     V = np.asarray(vertices, dtype=float)
     areas = triangle_areas(V, faces)
@@ -157,7 +157,7 @@ def vertex_quality(vertices, faces):
     """The row of a state of a vertex scheme (``family = "vertex"``): the
     primal monitors, ``area`` and ``volume`` of the triangle mesh, NaN
     diamond monitors."""
-    from .metrics import area, volume
+    from mcfbench.geometry.metrics import area, volume
 
     row = {key: float("nan") for key in DIAMOND_COLUMNS}
     row.update(area=area(vertices, faces), volume=volume(vertices, faces), family="vertex")
@@ -175,8 +175,8 @@ class MeshQuality:
     Examples
     --------
     >>> from ddfv import Flow
-    >>> from mcfbench.driver import simulate
-    >>> from mcfbench.surfaces import icosphere
+    >>> from mcfbench.running.driver import simulate
+    >>> from mcfbench.geometry.surfaces import icosphere
     >>> quality = MeshQuality()
     >>> _ = simulate(Flow(*icosphere(1), 0.01), 3, observers=[quality])
     >>> quality.frame()["n"].tolist()

@@ -1,7 +1,7 @@
 """Plots of the pipeline's tables: the convergence figure and the beyond figures.
 
 Every scheme is drawn with the label and the line style of its registry
-entry (:data:`mcfbench.schemes.SCHEMES`), so a new scheme needs no entry
+entry (:data:`mcfbench.running.schemes.SCHEMES`), so a new scheme needs no entry
 here. A run that broke down has no error: it is marked by a cross at the
 bottom of the axes, at its mesh size, in the colour of its scheme.
 
@@ -23,7 +23,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import FixedFormatter, FixedLocator, NullFormatter  # noqa: E402
 
-from .schemes import SCHEMES  # noqa: E402
+from mcfbench.running.schemes import SCHEMES  # noqa: E402
 
 EDGE = 1.0 / 3.0   # 1/3 - monitor at which a T-vertex reaches an edge of its triangle
 UNREGISTERED = {"color": "k", "marker": "x", "linestyle": "-"}

@@ -1,7 +1,7 @@
 """Problem metrics and mesh-quality monitors: pure functions of a triangle mesh.
 
 Every function takes ``vertices``, an ``(n, 3)`` float array (one row per
-vertex, as the generators of :mod:`mcfbench.surfaces` return them), and,
+vertex, as the generators of :mod:`mcfbench.geometry.surfaces` return them), and,
 where it needs them, ``faces``, an ``(m, 3)`` int array of consistently
 oriented triangles; none keeps state. All are vectorized over vertices
 and triangles.
@@ -10,7 +10,7 @@ Exact answers of the problems (``NOTES.md``, "Exact and reference answers
 beyond the sphere"):
 
 * sphere of radius ``R``: ``r(t) = sqrt(R^2 - 4t)``
-  (:func:`mcfbench.errors.sphere_radius`);
+  (:func:`mcfbench.geometry.exact.sphere_radius`);
 * cylinder between the circles of radius ``R`` at ``z = +-h``: the
   catenoid ``r(z) = a cosh(z/a)``, ``a cosh(h/a) = R``
   (:func:`catenoid_parameter`, :func:`catenoid_profile_error`);
@@ -201,7 +201,7 @@ def catenoid_profile_error(vertices, a, fixed_mask=None, neck_band=None):
     ``neck_radius``
         The mean of ``rho_i / cosh(z_i/a)`` over the neck ring: the free
         vertices whose ``|z_i|`` is within ``neck_band`` of the smallest
-        ``|z|`` (for :func:`mcfbench.surfaces.cylinder` with even ``along``
+        ``|z|`` (for :func:`mcfbench.geometry.surfaces.cylinder` with even ``along``
         the middle ring, on ``z = 0``, where this is the mean radius).
         Dividing by ``cosh(z_i/a)`` makes each term exactly ``a`` on the
         catenoid, so a ring slightly off ``z = 0`` still measures the neck.

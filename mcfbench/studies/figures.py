@@ -16,7 +16,7 @@ What a figure shows, so that its PNG can be read alone:
   of a ``tau``;
 * a legend below the panels names the primal edges (blue), the diamond
   edges (red), the tracked cells and the detail region where drawn
-  (:func:`mcfbench.render.legend_handles`);
+  (:func:`mcfbench.presentation.render.legend_handles`);
 * :class:`Track` (Fig. 3.4): a few diamond cells, chosen once, are filled
   in amber in every panel of their run, and the details follow them
   (``Zoom(at="tracked")``) with one half-width for all detail panels.
@@ -24,7 +24,7 @@ What a figure shows, so that its PNG can be read alone:
 Choices not stated in the paper (it gives only ``n_V``, ``tau`` for
 Figs. 3.2 and 3.5, and the time levels shown):
 
-* shapes and their parameters: see :mod:`mcfbench.surfaces` (bumpy sphere
+* shapes and their parameters: see :mod:`mcfbench.geometry.surfaces` (bumpy sphere
   with eight Gaussian bumps; cymling with flattening 0.4, 9 scallops of
   10 %; cylinder ``R = 1``, ``h = 0.55``, 24 x 8 twisted quads; hemisphere
   of radius 1 with 10 rings);
@@ -47,11 +47,11 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from .driver import simulate
-from .mesh import validate_mesh
-from .quality import MeshQuality, describe_violation, first_violation
-from .schemes import get_scheme
-from .surfaces import make_surface
+from mcfbench.running.driver import simulate
+from mcfbench.geometry.mesh import validate_mesh
+from mcfbench.geometry.quality import MeshQuality, describe_violation, first_violation
+from mcfbench.running.schemes import get_scheme
+from mcfbench.geometry.surfaces import make_surface
 
 TAU = 0.0025
 
@@ -69,7 +69,7 @@ class Run:
     key : str
         Name of the run inside its experiment.
     shape : str
-        A name of :data:`mcfbench.surfaces.SURFACES`.
+        A name of :data:`mcfbench.geometry.surfaces.SURFACES`.
     params : dict
         Parameters of the shape generator.
     tau : float
@@ -77,7 +77,7 @@ class Run:
     save_every : int
         Frames kept (every panel's time level must be a multiple).
     scheme : str
-        A name of :data:`mcfbench.schemes.SCHEMES` (``ddfv-eliminate``: the
+        A name of :data:`mcfbench.running.schemes.SCHEMES` (``ddfv-eliminate``: the
         elimination (3.6)).
     t_init : str
         T-vertex initialisation (Section 3), DDFV schemes only.
@@ -104,7 +104,7 @@ class Zoom:
     """A detail of half-width ``half`` (in length units of the surface).
 
     ``at`` is a 3-D point; ``"worst"``: the visible element worst by the
-    measure ``by`` (:func:`mcfbench.render.worst_element`: the diamond
+    measure ``by`` (:func:`mcfbench.presentation.render.worst_element`: the diamond
     with the smallest angle, or the T-vertex with the smallest barycentric
     coordinate) at time level ``step`` (by default the panel's own),
     followed to the panel's time level; or ``"tracked"``: the centre of the
@@ -122,9 +122,9 @@ class Track:
     """Diamond cells of run ``run`` marked in every panel of that run.
 
     At time level ``step`` the visible element worst by ``by`` is taken
-    (:func:`mcfbench.render.worst_element`): for ``"angle"`` the diamond
+    (:func:`mcfbench.presentation.render.worst_element`): for ``"angle"`` the diamond
     with the smallest angle, and the cells tracked are the diamonds of its
-    two triangles (:func:`mcfbench.render.tracked_cells`); for
+    two triangles (:func:`mcfbench.presentation.render.tracked_cells`); for
     ``"barycentric"`` the three diamonds of the triangle whose T-vertex is
     nearest to leaving it. The same diamond indices are then filled in
     every panel of the run.
@@ -342,7 +342,7 @@ def validate(experiment):
     ------
     ValueError
     """
-    from .render import WORST_MEASURES
+    from mcfbench.presentation.render import WORST_MEASURES
 
     def kept(run, step, what):
         if step > run.steps or (step % run.save_every and step != run.steps):
@@ -389,7 +389,7 @@ class RunResult:
     message: str
     failed_step: int
     wall_seconds: float
-    quality: object = None  # pandas.DataFrame of mcfbench.quality.MeshQuality
+    quality: object = None  # pandas.DataFrame of mcfbench.geometry.quality.MeshQuality
 
     def frame(self, step):
         """Index of the last kept frame at or before ``step``."""
@@ -419,7 +419,7 @@ def run_one(run):
     figures show what happens after a T-vertex leaves its triangle), and
     its status says what went wrong first; a breakdown of the solver ends
     it, keeping the frames computed before. The mesh quality of every time
-    level is recorded (:class:`mcfbench.quality.MeshQuality`: diamond and
+    level is recorded (:class:`mcfbench.geometry.quality.MeshQuality`: diamond and
     primal monitors for DDFV, primal ones for the other schemes). A scheme that refuses the
     surface (ValueError) gives ``status = "unsupported"`` with the initial
     surface as the only frame.
@@ -469,7 +469,7 @@ def tracked(experiment, results):
         ``{run key: (k,) int array}`` of diamond indices (empty without a
         track or when the run has no frame at the track's time level).
     """
-    from .render import tracked_cells, worst_element
+    from mcfbench.presentation.render import tracked_cells, worst_element
 
     track = experiment.track
     if track is None:
@@ -490,7 +490,7 @@ def tracked(experiment, results):
 
 
 def experiment_panels(experiment, results):
-    """The :class:`mcfbench.render.Panel` of every shot, in order.
+    """The :class:`mcfbench.presentation.render.Panel` of every shot, in order.
 
     A panel whose time level was not reached shows the last frame of its
     run, labelled with the level shown and a note. Panels of a tracked run
@@ -498,7 +498,7 @@ def experiment_panels(experiment, results):
     on their centre in the panel's own frame, with the half-width of its
     :class:`Zoom` (one for all panels that share it).
     """
-    from .render import Panel, cells_centre, element_centre, worst_element
+    from mcfbench.presentation.render import Panel, cells_centre, element_centre, worst_element
 
     cells = tracked(experiment, results)
 
@@ -554,7 +554,7 @@ def draw_experiment(experiment, results):
     -------
     matplotlib.figure.Figure
     """
-    from .render import panel_row
+    from mcfbench.presentation.render import panel_row
 
     return panel_row(experiment_panels(experiment, results), view=experiment.view,
                      rows=experiment.rows, size=experiment.size, aspect=experiment.aspect,

@@ -279,7 +279,7 @@ def worst_element(F, T, faces, view=None, by="angle", max_tilt=60.0):
         shows the front of the surface.
     by : {"angle", "barycentric"}
         ``"angle"``: the diamond with the smallest angle
-        (:func:`mcfbench.quality.diamond_min_angles`); ``"barycentric"``:
+        (:func:`mcfbench.geometry.quality.diamond_min_angles`); ``"barycentric"``:
         the T-vertex with the smallest barycentric coordinate in its
         triangle (the first to leave it).
 
@@ -289,7 +289,7 @@ def worst_element(F, T, faces, view=None, by="angle", max_tilt=60.0):
         Diamond index (``"angle"``) or triangle index (``"barycentric"``);
         see :func:`element_centre`.
     """
-    from .quality import diamond_min_angles
+    from mcfbench.geometry.quality import diamond_min_angles
     from ddfv.geometry import t_barycentric
 
     if by not in WORST_MEASURES:

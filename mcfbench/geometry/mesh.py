@@ -13,7 +13,7 @@ several connected components:
   every index in ``[0, n)``; ``m >= 1``.
 * No triangle repeats a vertex; no two triangles use the same three
   vertices (in any order); every vertex is used by a triangle
-  (:func:`mcfbench.meshio.read_mesh` drops unused ones before).
+  (:func:`mcfbench.geometry.mesh_files.read_mesh` drops unused ones before).
 * Every edge has one (boundary) or two (inner) triangles, and two
   triangles traverse their common edge in opposite directions (consistent
   orientation). The triangles around a vertex form one fan (no two
@@ -70,7 +70,7 @@ def validate_mesh(vertices, faces, *, vertex_ids=None, face_ids=None):
         Triangles as indices into ``vertices``.
     vertex_ids, face_ids : (n,) and (m,) array_like of int, optional
         Numbers by which messages name vertices and triangles (e.g. their
-        numbers in the file, see :func:`mcfbench.meshio.read_mesh`);
+        numbers in the file, see :func:`mcfbench.geometry.mesh_files.read_mesh`);
         default: their indices in ``vertices`` and ``faces``.
 
     Returns
@@ -96,7 +96,7 @@ def validate_mesh(vertices, faces, *, vertex_ids=None, face_ids=None):
     >>> validate_mesh(V, [[0, 1, 1]])
     Traceback (most recent call last):
     ...
-    mcfbench.mesh.MeshError: triangle(s) [0] repeat a vertex, e.g. triangle 0 = (0, 1, 1)
+    mcfbench.geometry.mesh.MeshError: triangle(s) [0] repeat a vertex, e.g. triangle 0 = (0, 1, 1)
     """
     V, F = _arrays(vertices, faces)
     n, m = len(V), len(F)

@@ -9,37 +9,14 @@ scheme reports what is wrong with a state as plain ``(status, description)``
 pairs (:meth:`Flow.defects`), which the driver turns into one
 :class:`FlowBreakdown` with one message format.
 
-Statuses
---------
-``ok``
-    Every step done and every state valid.
-``solver_failed``
-    The iteration limit was reached without meeting the tolerance.
-``solver_breakdown``
-    A Krylov breakdown (``rho = 0``, ``(r_hat, v) = 0`` or ``omega = 0``).
-``solver_stagnated``
-    The residual stopped decreasing above the tolerance.
-``degenerated``
-    Non-finite coordinates or collapsed cells (diamonds, triangles).
-``t_escaped``
-    A T-vertex left its triangle (DDFV, Section 2.2.2 of the paper): its
-    projection onto the plane of the triangle has a negative barycentric
-    coordinate.
-``inverted``
-    A triangle's normal flipped against its neighbours (the surface folded).
-``unsupported``
-    The scheme refused the input (e.g. a surface with boundary for a scheme
-    that has none); nothing was computed.
+The statuses a run can end with are :data:`mcfbench.storage.statuses.STATUSES`.
 """
 
 from typing import Callable, Protocol, runtime_checkable
 
 import numpy as np
 
-STATUSES = ("ok", "solver_failed", "solver_breakdown", "solver_stagnated", "degenerated",
-            "t_escaped", "inverted", "unsupported")
-SOLVER_STATUSES = ("solver_failed", "solver_breakdown", "solver_stagnated")
-STATE_STATUSES = ("degenerated", "t_escaped", "inverted")
+
 
 
 @runtime_checkable
@@ -48,7 +25,7 @@ class Flow(Protocol):
 
     Built as ``scheme_class(vertices, faces, tau, **options)`` with
     ``vertices`` (n, 3) float and ``faces`` (m, 3) int arrays of a
-    validated manifold mesh (:func:`mcfbench.mesh.validate_mesh`).
+    validated manifold mesh (:func:`mcfbench.geometry.mesh.validate_mesh`).
 
     Attributes
     ----------
@@ -99,7 +76,7 @@ class Flow(Protocol):
     def defects(self) -> list:
         """What is wrong with the current state: ``[(status, description)]``.
 
-        ``status`` is one of :data:`STATE_STATUSES`; ``description`` names
+        ``status`` is one of :data:`mcfbench.storage.statuses.STATE_STATUSES`; ``description`` names
         the offending element and the measure (``"T-vertex of triangle 12:
         barycentric coordinate -0.031"``). Empty for a valid state.
         """
@@ -115,7 +92,7 @@ class FlowBreakdown(RuntimeError):
     Attributes
     ----------
     status : str
-        One of :data:`STATUSES` other than ``ok``.
+        One of :data:`mcfbench.storage.statuses.STATUSES` other than ``ok``.
     step : int
         The time step ``n`` at which it happened.
     time : float

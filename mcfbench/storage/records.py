@@ -1,25 +1,109 @@
 """Run records: one JSON file per run, with a schema, a checksum and provenance.
 
-A record holds every field of :class:`mcfbench.studies.RunResult` (the
+A record holds every field of :class:`mcfbench.storage.records.RunResult` (the
 problem's metrics as top-level keys), ``peak_rss_mb`` (the peak resident
-memory of the process that wrote it, :func:`mcfbench.memory.peak_rss_mb`:
+memory of the process that wrote it, :func:`mcfbench.storage.memory.peak_rss_mb`:
 each job writes one record, at its end), the settings that produced it and
-their provenance (:func:`mcfbench.provenance.provenance`), and a SHA-256
+their provenance (:func:`mcfbench.storage.provenance.provenance`), and a SHA-256
 ``checksum`` of everything else, so that a record edited by hand is refused
 instead of shown in a table. NaN is stored as ``null`` (standard JSON);
-records are written atomically (:mod:`mcfbench.atomic`).
+records are written atomically (:mod:`mcfbench.storage.atomic`).
 """
 
 import hashlib
 import json
-from dataclasses import fields
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
-from .atomic import json_value, write_json
-from .flow import STATUSES
-from .memory import peak_rss_mb
-from .provenance import config_hash, provenance
-from .studies import RunResult
+from mcfbench.storage.atomic import json_value, write_json
+from mcfbench.storage.statuses import STATUSES
+from mcfbench.storage.memory import peak_rss_mb
+from mcfbench.storage.provenance import config_hash, provenance
+
+@dataclass
+class RunResult:
+    """One scheme on one problem at one level.
+
+    Attributes
+    ----------
+    scheme, problem : str
+    level : int
+    nV : int
+        Points of the state (DDFV: F- plus T-vertices).
+    nF, nT : int
+        Mesh vertices and triangles.
+    h : float
+        Mean edge length of the initial mesh.
+    tau : float
+    N : int
+        Steps asked for.
+    steps_done : int
+        Steps completed.
+    status, message : str
+        ``"ok"`` or the breakdown (:data:`mcfbench.storage.statuses.STATUSES`).
+    t_failed : float
+        Time of the breakdown or first defect, NaN when ``ok``.
+    t_end : float
+        Time of the last state reached (earlier than ``N tau`` at a
+        breakdown or when the steady state was reached).
+    steady : bool
+        The run stopped at the problem's steady state.
+    iterations : int
+        Total solver iterations.
+    solver : str
+        The solver's method.
+    cpu_seconds, wall_seconds : float
+        Flow construction (T-vertex initialisation included), stepping and
+        metrics.
+    t_min_barycentric : float
+        DDFV: the T monitor, smallest barycentric coordinate of a T-vertex
+        over all time levels reached (NaN for the other schemes).
+    min_angle, max_aspect, max_flipped : float
+        Worst mesh quality over the sampled time levels
+        (:func:`mcfbench.geometry.metrics.quality`).
+    metrics : dict
+        The problem's metrics (e.g. ``l2_error``); NaN when the run did not
+        finish.
+    series : dict of lists
+        ``t``, ``t_min_barycentric`` (every level), ``quality_t``,
+        ``min_angle``, ``max_aspect``, ``flipped`` (sampled levels).
+    """
+
+    scheme: str
+    problem: str
+    level: int
+    nV: int
+    nF: int
+    nT: int
+    h: float
+    tau: float
+    N: int
+    steps_done: int
+    status: str
+    message: str
+    t_failed: float
+    t_end: float
+    steady: bool
+    iterations: int
+    solver: str
+    cpu_seconds: float
+    wall_seconds: float
+    t_min_barycentric: float
+    min_angle: float
+    max_aspect: float
+    max_flipped: float
+    metrics: dict = field(default_factory=dict)
+    series: dict = field(default_factory=dict, repr=False)
+
+    def to_dict(self, series=True):
+        """Fields as a flat dict: the metrics as top-level keys; ``series=False``
+        leaves out the time series."""
+        row = asdict(self)
+        row.update(row.pop("metrics"))
+        if not series:
+            del row["series"]
+        return row
+
 
 # field -> type of the fixed part of a record; float fields may be null (NaN)
 FIELDS = {f.name: f.type for f in fields(RunResult) if f.name != "metrics"}

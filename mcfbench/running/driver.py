@@ -1,9 +1,9 @@
 """The time-stepping driver shared by every scheme.
 
-:func:`simulate` steps a :class:`~mcfbench.flow.Flow` with the shared
+:func:`simulate` steps a :class:`~mcfbench.running.flow.Flow` with the shared
 linear solver, checks every state it reaches (the initial one included)
 through :meth:`Flow.defects`, calls observers at every time level and keeps
-frames. Every way a run can end is one :class:`~mcfbench.flow.FlowBreakdown`
+frames. Every way a run can end is one :class:`~mcfbench.running.flow.FlowBreakdown`
 with one message format, ``"{status} at step {n} (t = {t}): {detail}"``.
 """
 
@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .flow import FlowBreakdown
-from .solver import Solver, SolverFailure
+from mcfbench.running.flow import FlowBreakdown
+from mcfbench.running.solver import Solver, SolverFailure
 
 ON_DEFECT = ("stop", "record")
 
@@ -36,7 +36,7 @@ class Trajectory:
         Solver iterations of each completed step.
     status : str
         ``"ok"`` or the status of the first breakdown or defect
-        (:data:`mcfbench.flow.STATUSES`).
+        (:data:`mcfbench.storage.statuses.STATUSES`).
     message : str
         Empty when ``status == "ok"``.
     failed_step : int
@@ -94,9 +94,9 @@ def simulate(flow, steps, *, solver=None, save_every=1, observers=(), on_defect=
 
     Parameters
     ----------
-    flow : mcfbench.flow.Flow
+    flow : mcfbench.running.flow.Flow
     steps : int
-    solver : mcfbench.solver.Solver, optional
+    solver : mcfbench.running.solver.Solver, optional
         Default ``Solver()`` (BiCGStab, rtol 1e-9).
     save_every : int
         Keep every ``save_every``-th time level as a frame (the first and

@@ -7,7 +7,7 @@
   time per problem (finest level of each scheme, from the records'
   ``series``);
 * :func:`picture_grid`: the final surfaces, scheme x problem, from the
-  saved frames (:mod:`mcfbench.render`);
+  saved frames (:mod:`mcfbench.presentation.render`);
 * :func:`gallery_grid`: per mesh the initial surface and every scheme's
   last frame.
 """
@@ -18,9 +18,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .atomic import save_figure  # noqa: E402
-from .matrix import is_error, main_metric  # noqa: E402
-from .plots import style as scheme_style  # noqa: E402
+from mcfbench.storage.atomic import save_figure  # noqa: E402
+from mcfbench.studies.matrix import is_error, main_metric  # noqa: E402
+from mcfbench.presentation.plots import style as scheme_style  # noqa: E402
 
 T_FLOOR = -0.5
 """Lower limit of the T monitor axes (values below are clipped and noted)."""
@@ -210,7 +210,7 @@ def _draw_grid(cells, row_labels, col_labels, paths, title, views=None, share="c
                size=1.9):
     """Draw ``cells[i][j] = (F, T, faces, note)`` or None; one length scale per
     column (``share="column"``) or per row (``"row"``)."""
-    from .render import draw_mesh, project
+    from mcfbench.presentation.render import draw_mesh, project
 
     rows, cols = len(row_labels), len(col_labels)
     fig, axes = plt.subplots(rows, cols, figsize=(size * cols + 1.2, size * rows + 0.5),

@@ -44,7 +44,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, Delaunay, cKDTree
 
-from .metrics import triangle_normals
+from mcfbench.geometry.metrics import triangle_normals
 
 # ---------------------------------------------------------------- icosphere
 
@@ -453,7 +453,7 @@ def cylinder(around=24, along=8, radius=1.0, half_height=0.5, diagonals="alterna
     Both boundary circles are Dirichlet boundaries (1.2). Normals point
     away from the axis. The steady state of the flow is the catenoid
     ``r(z) = a cosh(z / a)`` with ``a cosh(h / a) = R``
-    (:func:`mcfbench.metrics.catenoid_parameter`), which exists for ``h / R``
+    (:func:`mcfbench.geometry.metrics.catenoid_parameter`), which exists for ``h / R``
     below about 0.663; ``R = 1, h = 0.5`` gives ``a = 0.848337938094979``.
 
     Parameters
@@ -733,7 +733,7 @@ def isosurface(field, lower, upper, resolution, weld=1e-3):
     below 0.1 degree), as in scanned meshes. Over 36 meshes tried
     (resolutions 20-88, :func:`blobby` and :func:`implicit_torus`) the
     default weld folded no triangle; welds of ``3e-3`` and more sometimes
-    fold a sliver (see :func:`mcfbench.metrics.flipped_triangles`).
+    fold a sliver (see :func:`mcfbench.geometry.metrics.flipped_triangles`).
 
     Parameters
     ----------
@@ -1021,8 +1021,8 @@ def _clean(V, F, tol=0.0):
 
 def _check_closed_manifold(V, F):
     """Raise unless the triangles form a closed, consistently oriented 2-manifold
-    (:func:`mcfbench.mesh.summarize`, which validates first, and no boundary loop)."""
-    from .mesh import MeshError, summarize
+    (:func:`mcfbench.geometry.mesh.summarize`, which validates first, and no boundary loop)."""
+    from mcfbench.geometry.mesh import MeshError, summarize
 
     try:
         loops = summarize(V, F).boundary_loops

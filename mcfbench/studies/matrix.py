@@ -1,6 +1,6 @@
 """The benchmark matrix: every scheme on every problem over its refinement series.
 
-One run is :func:`mcfbench.studies.run` of one (scheme, problem, level)
+One run is :func:`mcfbench.running.run.run` of one (scheme, problem, level)
 with the problem's own time rule and the shared solver: BiCGStab (the
 paper's) on the problems with a refinement series, the robust method
 (:func:`robust_method`) on the real-world-like meshes (``tau_rule =
@@ -21,7 +21,7 @@ Snakemake rule (``workflow/rules/matrix.smk``):
 * the gallery of user meshes (:func:`gallery_plan`, :func:`gallery_job`,
   :func:`gallery_table`).
 
-The plots are in :mod:`mcfbench.matrix_plots`.
+The plots are in :mod:`mcfbench.presentation.matrix_plots`.
 
 Errors and EOC
 --------------
@@ -41,7 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .pipeline import setup_logging
+from mcfbench.pipeline import setup_logging
 
 TIMING_BASE = (
     "Timings compare schemes fairly only on the same footing: the same solver and "
@@ -89,8 +89,8 @@ class ConfigError(ValueError):
 
 
 def robust_method():
-    """The shared solver's method for meshes of unknown quality (:data:`mcfbench.solver.ROBUST`)."""
-    from .solver import ROBUST
+    """The shared solver's method for meshes of unknown quality (:data:`mcfbench.running.solver.ROBUST`)."""
+    from mcfbench.running.solver import ROBUST
 
     return ROBUST
 
@@ -103,7 +103,7 @@ def is_mesh_problem(problem):
 
 REAL_WORLD_SURFACES = ("blobby", "implicit_torus", "perturbed_sphere", "remeshed_sphere",
                        "anisotropic_sphere", "flat_patch")
-"""Surfaces of :mod:`mcfbench.surfaces` that imitate meshes from the real world."""
+"""Surfaces of :mod:`mcfbench.geometry.surfaces` that imitate meshes from the real world."""
 
 
 def is_real_world(problem):
@@ -134,15 +134,15 @@ def matrix_plan(section=None, schemes=None, problems=None):
     Parameters
     ----------
     section : dict, optional
-        ``schemes`` ("all" or a list of :data:`mcfbench.schemes.SCHEMES`
+        ``schemes`` ("all" or a list of :data:`mcfbench.running.schemes.SCHEMES`
         names), ``problems`` (problem -> levels; a problem of the registry
         not named runs at its registry levels, ``[]`` leaves it out),
         ``rtol``, ``maxiter``, ``solver`` (method of the refinement series),
         ``mesh_solver`` (method of the real-world-like meshes, ``"robust"``
         = :func:`robust_method`).
     schemes, problems : dict, optional
-        The registries (default :data:`~mcfbench.schemes.SCHEMES`,
-        :data:`~mcfbench.problems.PROBLEMS`).
+        The registries (default :data:`~mcfbench.running.schemes.SCHEMES`,
+        :data:`~mcfbench.running.problems.PROBLEMS`).
 
     Returns
     -------
@@ -155,12 +155,12 @@ def matrix_plan(section=None, schemes=None, problems=None):
     ConfigError
         An unknown scheme, problem or solver, or bad levels, naming the key.
     """
-    from . import solver as _solver
+    from mcfbench.running import solver as _solver
 
     if schemes is None:
-        from .schemes import SCHEMES as schemes
+        from mcfbench.running.schemes import SCHEMES as schemes
     if problems is None:
-        from .problems import PROBLEMS as problems
+        from mcfbench.running.problems import PROBLEMS as problems
     section = dict(section or {})
     chosen = section.get("schemes", "all")
     if chosen in ("all", None):
@@ -170,12 +170,12 @@ def matrix_plan(section=None, schemes=None, problems=None):
     unknown = [s for s in chosen if s not in schemes]
     if unknown:
         raise ConfigError(f"config key 'matrix.schemes': unknown scheme(s) {unknown}; the "
-                          f"registry mcfbench.schemes.SCHEMES has {list(schemes)}")
+                          f"registry mcfbench.running.schemes.SCHEMES has {list(schemes)}")
     overrides = section.get("problems") or {}
     unknown = [p for p in overrides if p not in problems]
     if unknown:
         raise ConfigError(f"config key 'matrix.problems': unknown problem(s) {unknown}; the "
-                          f"registry mcfbench.problems.PROBLEMS has {list(problems)}")
+                          f"registry mcfbench.running.problems.PROBLEMS has {list(problems)}")
     plan_problems = {}
     for name, problem in problems.items():
         levels = _levels(overrides[name], f"matrix.problems.{name}") if name in overrides \
@@ -204,7 +204,7 @@ def matrix_plan(section=None, schemes=None, problems=None):
 
 def solver_method(plan, problem):
     """The method of ``problem``'s runs: robust on real-world-like meshes."""
-    from .problems import get_problem
+    from mcfbench.running.problems import get_problem
 
     problem = get_problem(problem) if isinstance(problem, str) else problem
     return plan["mesh_solver"] if is_mesh_problem(problem) else plan["solver"]
@@ -255,8 +255,8 @@ class _Guarded:
 
 
 def _nan_result(scheme, problem, level, mesh, tau, steps, status, message, method, seconds):
-    from . import metrics
-    from .studies import RunResult
+    from mcfbench.geometry import metrics
+    from mcfbench.storage.records import RunResult
 
     V, F = mesh
     nan = float("nan")
@@ -269,7 +269,7 @@ def _nan_result(scheme, problem, level, mesh, tau, steps, status, message, metho
 
 
 def run_one(scheme, problem, level, *, solver, mesh=None, tau=None):
-    """:func:`mcfbench.studies.run` with ``save_every=0``; a scheme that refuses
+    """:func:`mcfbench.running.run.run` with ``save_every=0``; a scheme that refuses
     the surface gives status ``unsupported`` (the initial surface as both frames).
 
     Returns
@@ -278,10 +278,10 @@ def run_one(scheme, problem, level, *, solver, mesh=None, tau=None):
     frames : dict of arrays
         The trajectory's frames (first and last), ``faces``, ``steps``, ``t``.
     """
-    from .mesh import validate_mesh
-    from .problems import get_problem
-    from .schemes import get_scheme
-    from .studies import run
+    from mcfbench.geometry.mesh import validate_mesh
+    from mcfbench.running.problems import get_problem
+    from mcfbench.running.schemes import get_scheme
+    from mcfbench.running.run import run
 
     scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
     problem = get_problem(problem) if isinstance(problem, str) else problem
@@ -305,11 +305,11 @@ def run_one(scheme, problem, level, *, solver, mesh=None, tau=None):
 
 
 def run_job(settings, record, frames, log_path=None):
-    """One run of the matrix: the record (:func:`mcfbench.records.write_record`,
+    """One run of the matrix: the record (:func:`mcfbench.storage.records.write_record`,
     with ``metric_names``) and the first and last frames (npz), both atomic."""
-    from .atomic import save_npz
-    from .records import write_record
-    from .solver import Solver
+    from mcfbench.storage.atomic import save_npz
+    from mcfbench.storage.records import write_record
+    from mcfbench.running.solver import Solver
 
     log = setup_logging(log_path)
     solver = Solver(method=settings["solver"]["method"], rtol=settings["solver"]["rtol"],
@@ -343,7 +343,7 @@ def main_metric(problem, available=()):
     :data:`MAIN_METRICS` of its observers found in ``available``, else the
     first error among ``available``, else the first of ``available``.
     """
-    from .problems import get_problem
+    from mcfbench.running.problems import get_problem
 
     problem = get_problem(problem) if isinstance(problem, str) else problem
     available = list(available)
@@ -361,7 +361,7 @@ def main_metric(problem, available=()):
 def _metric_names(record):
     names = record.get("metric_names")
     if names is None:
-        from .records import FIELDS
+        from mcfbench.storage.records import FIELDS
 
         names = [k for k in record if k not in FIELDS and k != "metric_names"]
     return list(names)
@@ -373,7 +373,7 @@ def long_table(records, schemes=None, problems=None):
     Parameters
     ----------
     records : iterable of dict
-        Run records (:func:`mcfbench.records.read_record`).
+        Run records (:func:`mcfbench.storage.records.read_record`).
     schemes, problems : list of str, optional
         Row order (default: order of first appearance).
 
@@ -590,8 +590,8 @@ def problem_table(table, problem, schemes=None, labels=None):
 
 
 def markdown(frame, notes=()):
-    """A pipe table (:func:`mcfbench.tables.md_table`), then ``notes`` as paragraphs."""
-    from .tables import md_table
+    """A pipe table (:func:`mcfbench.presentation.tables.md_table`), then ``notes`` as paragraphs."""
+    from mcfbench.presentation.tables import md_table
 
     lines = [md_table(list(frame.columns), frame.itertuples(index=False))]
     lines += [f"\n{note}" for note in notes]
@@ -599,9 +599,9 @@ def markdown(frame, notes=()):
 
 
 def latex(frame, caption="", notes=()):
-    """A ``table`` with a booktabs ``tabular`` (:func:`mcfbench.tables.tex_tabular`),
+    """A ``table`` with a booktabs ``tabular`` (:func:`mcfbench.presentation.tables.tex_tabular`),
     the notes below it."""
-    from .tables import tex_escape, tex_tabular
+    from mcfbench.presentation.tables import tex_escape, tex_tabular
 
     lines = [r"\begin{table}[ht]",
              tex_tabular([tex_escape(c) for c in frame.columns],
@@ -616,7 +616,7 @@ def latex(frame, caption="", notes=()):
 
 def problem_notes(problem, plan=None):
     """Lines under a problem's table: what it is, the exact answer, the solver."""
-    from .problems import get_problem
+    from mcfbench.running.problems import get_problem
 
     p = get_problem(problem)
     notes = [f"Problem `{p.name}`: {p.label}. {p.description}".strip()]
@@ -629,8 +629,8 @@ def problem_notes(problem, plan=None):
 
 def write_tables(table, out_dir, plan):
     """Write ``matrix.csv``, ``{problem}.md/.tex`` and ``summary.md/.tex/.csv``."""
-    from .atomic import write_text
-    from .schemes import SCHEMES
+    from mcfbench.storage.atomic import write_text
+    from mcfbench.running.schemes import SCHEMES
 
     out = Path(out_dir)
     labels = {s: SCHEMES[s].label if s in SCHEMES else s for s in plan["schemes"]}
@@ -658,8 +658,8 @@ def write_tables(table, out_dir, plan):
 
 def read_runs(expected):
     """Read and check the records ``{path: settings}`` (stale or edited ones are
-    refused, :func:`mcfbench.records.read_record`)."""
-    from .records import read_record
+    refused, :func:`mcfbench.storage.records.read_record`)."""
+    from mcfbench.storage.records import read_record
 
     return [read_record(path, settings=settings) for path, settings in expected.items()]
 
@@ -697,15 +697,15 @@ def read_long_table(path):
 
 def mesh_problems(plan):
     """The real-world-like problems of the plan (:func:`is_real_world`)."""
-    from .problems import get_problem
+    from mcfbench.running.problems import get_problem
 
     return [p for p in plan["problems"] if is_real_world(get_problem(p))]
 
 
 def write_findings(summary_csv, out, plan):
     """``findings.md`` from ``summary.csv`` (numbers from the table only)."""
-    from .atomic import write_text
-    from .schemes import SCHEMES
+    from mcfbench.storage.atomic import write_text
+    from mcfbench.running.schemes import SCHEMES
 
     summary = read_summary(summary_csv)
     labels = {s: SCHEMES[s].label for s in plan["schemes"] if s in SCHEMES}
@@ -771,7 +771,7 @@ def findings(summary, labels=None, mesh_problems=(), source="tables/summary.csv"
     problems = list(dict.fromkeys(summary["problem"]))
     schemes = list(dict.fromkeys(summary["scheme"]))
     lines = ["# Findings of the benchmark matrix", "",
-             f"Written by `mcfbench.matrix.findings` from `{source}`: every number below "
+             f"Written by `mcfbench.studies.matrix.findings` from `{source}`: every number below "
              "is read from the tables, none typed by hand. Order ~2 means an EOC between "
              f"the two finest finished levels in [{ORDER_BAND[0]}, {ORDER_BAND[1]}]; an "
              f"error with EOC below {CONVERGING_EOC} is not decreasing.", ""]
@@ -1002,10 +1002,10 @@ def gallery_plan(section=None, meshes=None, schemes=None):
         ``C, steps, solver, rtol, maxiter, schemes, meshes`` (file name ->
         path), ``generated`` (file name -> (surface or problem, params)).
     """
-    from . import solver as _solver
+    from mcfbench.running import solver as _solver
 
     if schemes is None:
-        from .schemes import SCHEMES as schemes
+        from mcfbench.running.schemes import SCHEMES as schemes
     section = dict(section or {})
     chosen = section.get("schemes", "all")
     chosen = list(schemes) if chosen in ("all", None) else \
@@ -1013,7 +1013,7 @@ def gallery_plan(section=None, meshes=None, schemes=None):
     unknown = [s for s in chosen if s not in schemes]
     if unknown:
         raise ConfigError(f"config key 'gallery.schemes': unknown scheme(s) {unknown}; the "
-                          f"registry mcfbench.schemes.SCHEMES has {list(schemes)}")
+                          f"registry mcfbench.running.schemes.SCHEMES has {list(schemes)}")
     method = section.get("solver", "robust")
     method = robust_method() if method == "robust" else method
     if method not in _solver.METHODS:
@@ -1050,8 +1050,8 @@ def generated_meshes():
     real-world-like problems of the registry (:func:`is_real_world`) at the
     middle level of their refinement series, or (when there are none) the surfaces
     :data:`GALLERY_SURFACES` at their defaults."""
-    from .problems import PROBLEMS
-    from .surfaces import SURFACES
+    from mcfbench.running.problems import PROBLEMS
+    from mcfbench.geometry.surfaces import SURFACES
 
     mesh_problems = [p for p in PROBLEMS.values() if is_real_world(p)]
     if mesh_problems:
@@ -1062,7 +1062,7 @@ def generated_meshes():
 
 def write_obj(path, vertices, faces):
     """A triangle mesh as Wavefront OBJ (atomic, 17 significant digits)."""
-    from .atomic import write_text
+    from mcfbench.storage.atomic import write_text
 
     lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in np.asarray(vertices, float).tolist()]
     lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in np.asarray(faces, int).tolist()]
@@ -1071,8 +1071,8 @@ def write_obj(path, vertices, faces):
 
 def write_generated_mesh(entry, path):
     """Write one mesh of :func:`generated_meshes` (``entry`` = its value)."""
-    from .problems import get_problem
-    from .surfaces import make_surface
+    from mcfbench.running.problems import get_problem
+    from mcfbench.geometry.surfaces import make_surface
 
     kind, name, level = entry
     V, F = get_problem(name).mesh(level) if kind == "problem" else make_surface(name)
@@ -1080,7 +1080,7 @@ def write_generated_mesh(entry, path):
 
 
 def _gallery_problem(C, steps):
-    from .problems import Problem
+    from mcfbench.running.problems import Problem
 
     return Problem("gallery", "a user's mesh", "", lambda level: {}, levels=(1,), tau_1=C,
                    t_final=1.0, metrics=(), tau_rule="mesh", steps=int(steps),
@@ -1091,12 +1091,12 @@ def gallery_job(mesh_path, scheme, settings, record, frames, log_path=None):
     """One scheme on one mesh file: ``tau = C h^2``, ``steps`` steps; record and
     first and last frames. A file the reader refuses gives status
     ``unsupported`` with the reader's message."""
-    from . import metrics
-    from .atomic import save_npz
-    from .meshio import read_mesh
-    from .records import write_record
-    from .schemes import get_scheme
-    from .solver import Solver
+    from mcfbench.geometry import metrics
+    from mcfbench.storage.atomic import save_npz
+    from mcfbench.geometry.mesh_files import read_mesh
+    from mcfbench.storage.records import write_record
+    from mcfbench.running.schemes import get_scheme
+    from mcfbench.running.solver import Solver
 
     log = setup_logging(log_path)
     solver = Solver(method=settings["solver"], rtol=settings["rtol"],
@@ -1118,7 +1118,7 @@ def gallery_job(mesh_path, scheme, settings, record, frames, log_path=None):
         result, arrays = run_one(scheme, problem, 1, solver=solver, mesh=(V, F), tau=tau)
         save_npz(frames, **arrays)
     if result is None:
-        from .studies import RunResult
+        from mcfbench.storage.records import RunResult
 
         nan = float("nan")
         result = RunResult(scheme=scheme.name, problem="gallery", level=1, nV=0, nF=0, nT=0,

@@ -35,7 +35,7 @@ def sphere_radius(t, radius=1.0):
 class SphereL2Error:
     """Space-time L2 error (3.2) of a flow started from a sphere.
 
-    Use as an observer of :func:`mcfbench.driver.simulate`; the sum runs over the
+    Use as an observer of :func:`mcfbench.running.driver.simulate`; the sum runs over the
     time levels ``n = 1 ... N`` and the points of ``flow.X`` with the
     weights ``flow.l2_weights`` of level ``n``: for DDFV the covolume
     areas ``chi^n / 2`` of F- and T-vertices (each family tiles the surface

@@ -1,0 +1,29 @@
+"""The ways a run can end: part of the flow contract and of every run record.
+
+Statuses
+--------
+``ok``
+    Every step done and every state valid.
+``solver_failed``
+    The iteration limit was reached without meeting the tolerance.
+``solver_breakdown``
+    A Krylov breakdown (``rho = 0``, ``(r_hat, v) = 0`` or ``omega = 0``).
+``solver_stagnated``
+    The residual stopped decreasing above the tolerance.
+``degenerated``
+    Non-finite coordinates or collapsed cells (diamonds, triangles).
+``t_escaped``
+    A T-vertex left its triangle (DDFV, Section 2.2.2 of the paper): its
+    projection onto the plane of the triangle has a negative barycentric
+    coordinate.
+``inverted``
+    A triangle's normal flipped against its neighbours (the surface folded).
+``unsupported``
+    The scheme refused the input (e.g. a surface with boundary for a scheme
+    that has none); nothing was computed.
+"""
+
+STATUSES = ("ok", "solver_failed", "solver_breakdown", "solver_stagnated", "degenerated",
+            "t_escaped", "inverted", "unsupported")
+SOLVER_STATUSES = ("solver_failed", "solver_breakdown", "solver_stagnated")
+STATE_STATUSES = ("degenerated", "t_escaped", "inverted")
