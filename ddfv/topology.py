@@ -193,7 +193,7 @@ def locality_order(faces, n_vertices):
     its neighbours from nearby addresses: the band of the system matrix
     shrinks from the whole matrix to a few hundred rows. Not part of the
     scheme: the scheme is invariant under any renumbering
-    (``tests/test_flow.py``).
+    (``tests/ddfv/test_flow.py``).
 
     Parameters
     ----------

@@ -478,7 +478,7 @@ def compile_job(threads, output, log):
     The run jobs then load the kernels from the cache instead of each
     compiling them (numba writes its cache files by rename: jobs that start
     together on an empty cache would each compile, never corrupt it;
-    ``tests/test_pipeline.py``). Writes the seconds it took (compiling, or
+    ``tests/workflow/test_pipeline.py``). Writes the seconds it took (compiling, or
     loading when the cache was warm) to ``output``.
     """
     from mcfbench.running.solver import METHODS

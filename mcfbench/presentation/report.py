@@ -197,7 +197,7 @@ def _check_paper_columns(conv, published, path):
                 raise ReportError(
                     f"{path}: paper_{column} of level {r.level} is {ours}, but "
                     f"paper/published/table_3_1.csv has {theirs}: mcfbench.presentation.tables.PUBLISHED and "
-                    "the published table have drifted apart (tests/test_report.py checks them)")
+                    "the published table have drifted apart (tests/harness/test_report.py checks them)")
 
 
 def table_3_1(conv, published, checks):

@@ -30,7 +30,7 @@ def test_every_scheme_follows_the_contract_and_runs(name):
     assert scheme.label and scheme.description and {"color", "marker"} <= set(scheme.style)
 
 
-# conformalized MCF keeps the initial stiffness: another rate (tests/test_cmcf.py)
+# conformalized MCF keeps the initial stiffness: another rate (tests/baselines/test_cmcf.py)
 @pytest.mark.parametrize("name", sorted(set(SCHEMES) - {"cmcf"}))
 def test_every_scheme_shrinks_the_sphere_at_the_exact_rate(name):
     """r(t) = sqrt(1 - 4t) on the level-3 icosphere to 1 % at t = 0.05 (r = 0.894)."""

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from mcfbench.storage.provenance import config_hash, dependency_versions, provenance, source_hash
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_provenance_names_code_dependencies_and_settings():

@@ -29,7 +29,9 @@ import yaml
 from mcfbench.pipeline import Pipeline, solver_of
 from mcfbench.storage.records import checksum
 
-REPO = Path(__file__).resolve().parents[1]
+pytestmark = pytest.mark.e2e
+
+REPO = Path(__file__).resolve().parents[2]
 # the study's own target (rule all also builds the figures of another rule
 # file); targets before --config, which takes every following word
 RUN = ["--cores", "2", "convergence", "--config", "levels=[1,2]"]

@@ -33,7 +33,7 @@ from mcfbench.presentation.tables import (beyond_documents, beyond_tables, conve
                              eoc_column, level_table, monitor_summary, space_table,
                              time_order)
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 CONFIG = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
 SETTINGS = {"t_final": 0.08, "tau_level_1": 0.04, "rtol": 1e-9}
 
@@ -474,6 +474,7 @@ def jobs(out, rule):
                 if line.split()[:1] == [rule])
 
 
+@pytest.mark.e2e
 def test_dry_run_of_beyond_and_a_bad_value(tmp_path):
     work = tmp_path / "work"
     work.mkdir()

@@ -19,7 +19,7 @@ from mcfbench.running.problems import PROBLEMS
 from mcfbench.storage.records import FIELDS, read_record, write_record
 from mcfbench.running.schemes import SCHEMES
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 
 # ------------------------------------------------------------ config
@@ -203,6 +203,7 @@ def test_recommendation_when_one_scheme_wins():
 # ------------------------------------------------------------ the Snakemake DAG
 
 
+@pytest.mark.e2e
 def test_snakemake_dry_run(tmp_path):
     """Both targets resolve to the planned jobs, in a copy of the repository."""
     work = tmp_path / "work"

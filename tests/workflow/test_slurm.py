@@ -48,9 +48,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-pytestmark = pytest.mark.slurm
+pytestmark = [pytest.mark.slurm, pytest.mark.e2e]
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 TABLE = Path("results") / "tables" / "convergence.csv"
 CONFIG = ["--config", "levels=[1,2]"]
 # without git (e.g. an unpacked source archive): the whole tree minus these

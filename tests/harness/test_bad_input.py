@@ -1,6 +1,6 @@
 """The bad-input sweep: every kind of bad input gets an exit status and a message
 naming the problem and the offending element or key (``python -m mcfbench run``
-and ``sphere-table``; the pipeline's config in tests/test_pipeline.py)."""
+and ``sphere-table``; the pipeline's config in tests/workflow/test_pipeline.py)."""
 
 import numpy as np
 import pytest

@@ -28,7 +28,7 @@ from mcfbench.studies.figures import EXPERIMENTS, PAPER_FIGURES
 from mcfbench.running.schemes import SCHEMES
 from mcfbench.presentation.tables import PUBLISHED
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 LEVELS = (1, 2, 3)
 FIGURES = ("fig_3_2", "fig_3_6", "fig_3_6_cotan", "fig_3_7")

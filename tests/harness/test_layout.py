@@ -1,0 +1,110 @@
+"""The harness's layout: layers import one way, modules stay small, names are unique.
+
+Rules (``mcfbench/<layer>/__init__.py`` states each in one sentence):
+``storage`` imports no other layer; ``geometry`` imports ``storage`` at most;
+``running`` never ``presentation`` or ``studies``; ``presentation`` never
+``studies`` and of ``running`` only the scheme registry (names, labels,
+styles); and importing any presentation module loads no solver, driver,
+flow, compiled kernel or numba.
+"""
+
+import ast
+import subprocess
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+HARNESS = ROOT / "mcfbench"
+LAYERS = ("storage", "geometry", "running", "presentation", "studies")
+# layer -> the mcfbench modules (prefixes) it may import
+ALLOWED = {
+    "storage": ("mcfbench.storage",),
+    "geometry": ("mcfbench.storage", "mcfbench.geometry"),
+    "running": ("mcfbench.storage", "mcfbench.geometry", "mcfbench.running"),
+    "presentation": ("mcfbench.storage", "mcfbench.geometry", "mcfbench.presentation",
+                     "mcfbench.running.schemes"),
+    "studies": ("mcfbench.",),
+}
+MAX_LINES = 600
+
+
+def _modules():
+    return sorted(p for p in HARNESS.rglob("*.py"))
+
+
+def _imports(path):
+    """Every module imported anywhere in a file (function-level imports too)."""
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            assert node.level == 0, f"{path}: relative import (the harness imports absolutely)"
+            names.add(node.module)
+            names.update(f"{node.module}.{alias.name}" for alias in node.names)
+    return names
+
+
+@pytest.mark.parametrize("layer", LAYERS)
+def test_each_layer_imports_only_the_layers_below(layer):
+    offending = {}
+    for path in sorted((HARNESS / layer).rglob("*.py")):
+        bad = sorted(n for n in _imports(path) if n.startswith("mcfbench.")
+                     and not any(n == a or n.startswith(a if a.endswith(".") else a + ".")
+                                 or (a.endswith(".") and n.startswith(a)) for a in ALLOWED[layer])
+                     and not any(n.startswith(a + ".") or n == a for a in ALLOWED[layer]))
+        if bad:
+            offending[str(path.relative_to(ROOT))] = bad
+    assert offending == {}
+
+
+def test_importing_presentation_loads_no_solver_driver_or_numba():
+    modules = sorted(f"mcfbench.presentation.{p.stem}" for p in (HARNESS / "presentation").glob("*.py")
+                     if p.stem != "__init__")
+    code = (f"import sys\nfor m in {modules!r}: __import__(m)\n"
+            "bad = sorted(m for m in sys.modules if m == 'numba' or m.startswith(("
+            "'mcfbench.running.solver', 'mcfbench.running.driver', 'mcfbench.running.run', "
+            "'mcfbench.studies', 'ddfv.kernels', 'ddfv.flow', 'baselines')))\n"
+            "print(','.join(bad))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
+                         check=True).stdout.strip()
+    assert out == ""
+
+
+def test_storage_loads_nothing_of_the_other_layers():
+    code = ("import sys, mcfbench.storage.records, mcfbench.storage.atomic, "
+            "mcfbench.storage.provenance\n"
+            "print(','.join(sorted(m for m in sys.modules if m.startswith(('mcfbench.running', "
+            "'mcfbench.geometry', 'mcfbench.presentation', 'mcfbench.studies', 'numba', 'ddfv', "
+            "'baselines')))))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
+                         check=True).stdout.strip()
+    assert out == ""
+
+
+def test_no_harness_module_is_over_600_lines():
+    long = {str(p.relative_to(ROOT)): n for p in _modules()
+            if (n := len(p.read_text().splitlines())) > MAX_LINES}
+    assert long == {}
+
+
+def test_no_class_or_public_function_is_defined_twice():
+    where = defaultdict(list)
+    for path in _modules():
+        for node in ast.parse(path.read_text()).body:
+            if isinstance(node, (ast.FunctionDef, ast.ClassDef)) and not node.name.startswith("_"):
+                where[node.name].append(str(path.relative_to(ROOT)))
+    assert {name: paths for name, paths in where.items() if len(paths) > 1} == {}
+
+
+def test_no_private_name_is_used_outside_its_module():
+    offending = []
+    for path in _modules():
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("mcfbench"):
+                offending += [f"{path.relative_to(ROOT)}: {node.module}.{a.name}"
+                              for a in node.names if a.name.startswith("_")]
+    assert offending == []
