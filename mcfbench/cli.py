@@ -26,7 +26,7 @@ from mcfbench.storage.provenance import provenance
 from mcfbench.running.schemes import SCHEMES, get_scheme
 from mcfbench.running.solver import METHODS, ROBUST, Solver
 from mcfbench.running.run import level_sweep, run
-from mcfbench.presentation.tables import sphere_table
+from mcfbench.studies.convergence import sphere_table
 
 
 def _positive_float(text):

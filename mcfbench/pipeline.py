@@ -3,7 +3,7 @@
 The workflow (``Snakefile``, ``workflow/rules/*.smk``) holds target lists
 and input functions only; its scripts (``workflow/scripts/*.py``) are thin
 adapters that read Snakemake's inputs and params and call this module (or
-:mod:`mcfbench.presentation.tables`, :mod:`mcfbench.presentation.plots`, :mod:`mcfbench.presentation.report`).
+:mod:`mcfbench.presentation.formats`, :mod:`mcfbench.presentation.plots`, :mod:`mcfbench.presentation.report`).
 
 Config
     :class:`Pipeline` checks the config (after the schema,

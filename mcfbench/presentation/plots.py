@@ -37,7 +37,7 @@ def style(scheme):
     return entry.label, {**UNREGISTERED, **entry.style}
 
 
-def tex_number(x):
+def mathtext_number(x):
     """``9.765625e-06`` as mathtext ``9.77 \\cdot 10^{-6}`` (from 1e-3 up: ``%g``)."""
     if x >= 1e-3:
         return f"{x:g}"
@@ -230,7 +230,7 @@ def time_figure(table):
     ax.set_xlabel(r"time step $\tau$")
     ax.set_ylabel(r"error at $t_f$ against a fine-$\tau$ reference")
     ax.text(0.97, 0.04, f"icosphere level {first.level} (fixed mesh), "
-            f"$t_f = {first.t_final:g}$\nreference $\\tau = {tex_number(first.reference_tau)}$",
+            f"$t_f = {first.t_final:g}$\nreference $\\tau = {mathtext_number(first.reference_tau)}$",
             transform=ax.transAxes, ha="right", va="bottom", fontsize=8)
     ax.grid(True, which="major", linewidth=0.5, alpha=0.5)
     ax.legend(fontsize=8, loc="upper left", frameon=False)
@@ -243,7 +243,7 @@ def space_figure(table):
     fig, ax = plt.subplots(figsize=(5.2, 4.0), layout="constrained")
     first = table.iloc[0]
     draw_convergence(ax, table.assign(paper_l2_error=np.nan), first.t_final,
-                     note=f"shrinking unit sphere\n$\\tau = {tex_number(first.tau)}$ on every "
+                     note=f"shrinking unit sphere\n$\\tau = {mathtext_number(first.tau)}$ on every "
                           f"level, $t_f = {first.t_final:g}$")
     ax.set_title("Convergence in space", fontsize=10)
     return fig

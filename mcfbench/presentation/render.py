@@ -289,8 +289,8 @@ def worst_element(F, T, faces, view=None, by="angle", max_tilt=60.0):
         Diamond index (``"angle"``) or triangle index (``"barycentric"``);
         see :func:`element_centre`.
     """
-    from mcfbench.geometry.quality import diamond_min_angles
     from ddfv.geometry import t_barycentric
+    from mcfbench.geometry.quality import diamond_min_angles
 
     if by not in WORST_MEASURES:
         raise ValueError(f"unknown measure {by!r}; choose one of {', '.join(WORST_MEASURES)}")

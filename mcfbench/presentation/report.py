@@ -27,7 +27,7 @@ Nothing here is a hand-typed result: the published values come from
 :func:`findings` writes the findings of the beyond study in words, every
 number and verdict read from its tables. Scheme names in the text are the
 registry's labels (:data:`mcfbench.running.schemes.SCHEMES`); numbers are formatted
-and escaped by :mod:`mcfbench.presentation.tables`.
+and escaped by :mod:`mcfbench.presentation.formats`.
 
 By hand, from the repository root: ``python -m mcfbench.presentation.report`` (results/
 -> results/paper/).
@@ -59,14 +59,14 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from mcfbench.studies.figures import EXPERIMENTS
-from mcfbench.storage.statuses import STATE_STATUSES
 from mcfbench.pipeline import setup_logging, write_files
-from mcfbench.storage.provenance import provenance
+from mcfbench.presentation.convergence_tables import BASELINE, PAPER_SCHEME, PUBLISHED_COLUMNS, label
+from mcfbench.presentation.formats import MISSING, finite_value, fix, int_or, md_cell, num, pct, pct0, sci, sig, signed, tex_escape, tex_inline, tex_tabular
+from mcfbench.presentation.formats import tex_number
 from mcfbench.running.schemes import get_scheme
-from mcfbench.presentation.tables import (BASELINE, MISSING, PAPER_SCHEME, PUBLISHED_COLUMNS, _value, fix, int_or,
-                     label, md_cell, num, pct, pct0, sci, sig, signed, tex_escape, tex_inline,
-                     tex_number, tex_tabular)
+from mcfbench.storage.provenance import provenance
+from mcfbench.storage.statuses import STATE_STATUSES
+from mcfbench.studies.figures import EXPERIMENTS
 
 TABLE_COLUMNS = ("level", "nV", "nF", "nT", "tau", "N", "l2_error", "iterations", "eoc",
                  "cpu_seconds")
@@ -78,7 +78,7 @@ MARKDOWN_EXTENSIONS = ["tables", "md_in_html", "attr_list", "fenced_code", "sane
 
 
 def _int(x):
-    value = _value(x)
+    value = finite_value(x)
     return None if value is None else int(round(value))
 
 
@@ -163,7 +163,7 @@ def load_published(paper):
 
 
 def published_as_tuples(paper):
-    """Table 3.1 of ``paper/`` in the layout of :data:`mcfbench.presentation.tables.PUBLISHED`."""
+    """Table 3.1 of ``paper/`` in the layout of :data:`mcfbench.presentation.convergence_tables.PUBLISHED`."""
     table = load_published(paper)
     out = {}
     for level, row in table.iterrows():
@@ -184,7 +184,7 @@ def l2_tolerance(checks, level):
 
 
 def _check_paper_columns(conv, published, path):
-    """The ``paper_*`` columns of convergence.csv (from mcfbench.presentation.tables.PUBLISHED)
+    """The ``paper_*`` columns of convergence.csv (from mcfbench.presentation.convergence_tables.PUBLISHED)
     must equal paper/published/table_3_1.csv: the two copies may not drift."""
     rows = conv[conv["scheme"] == PAPER_SCHEME]
     for r in rows.itertuples():
@@ -192,11 +192,11 @@ def _check_paper_columns(conv, published, path):
             continue
         p = published.loc[r.level]
         for column in ("l2_error", "eoc", "iterations", "cpu_seconds"):
-            ours, theirs = _value(getattr(r, f"paper_{column}")), _value(p[column])
+            ours, theirs = finite_value(getattr(r, f"paper_{column}")), finite_value(p[column])
             if ours != theirs:
                 raise ReportError(
                     f"{path}: paper_{column} of level {r.level} is {ours}, but "
-                    f"paper/published/table_3_1.csv has {theirs}: mcfbench.presentation.tables.PUBLISHED and "
+                    f"paper/published/table_3_1.csv has {theirs}: mcfbench.presentation.convergence_tables.PUBLISHED and "
                     "the published table have drifted apart (tests/harness/test_report.py checks them)")
 
 
@@ -220,8 +220,8 @@ def table_3_1(conv, published, checks):
     for level in sorted(set(published.index) | set(ours_rows.index)):
         p = published.loc[level] if level in published.index else None
         o = ours_rows.loc[level] if level in ours_rows.index else None
-        paper = {c: (_value(p[c]) if p is not None else None) for c in TABLE_COLUMNS}
-        ours = {c: (_value(o[c]) if o is not None else None) for c in TABLE_COLUMNS}
+        paper = {c: (finite_value(p[c]) if p is not None else None) for c in TABLE_COLUMNS}
+        ours = {c: (finite_value(o[c]) if o is not None else None) for c in TABLE_COLUMNS}
         for d in (paper, ours):
             for c in ("level", "nV", "nF", "nT", "N", "iterations"):
                 d[c] = _int(d[c])
@@ -275,7 +275,7 @@ def scheme_comparison(conv):
     for level in sorted(conv["level"].unique()):
         at = conv[conv["level"] == level].set_index("scheme")
         first = at.iloc[0]
-        row = {"level": int(level), "h": _value(first["h"]), "tau": _value(first["tau"]),
+        row = {"level": int(level), "h": finite_value(first["h"]), "tau": finite_value(first["tau"]),
                "N": _int(first["N"]), "by_scheme": {}}
         for s in schemes:
             if s not in at.index:
@@ -283,9 +283,9 @@ def scheme_comparison(conv):
                 continue
             r = at.loc[s]
             row["by_scheme"][s] = {"nV": _int(r["nV"]), "nF": _int(r["nF"]),
-                                   "l2_error": _value(r["l2_error"]), "eoc": _value(r["eoc"]),
+                                   "l2_error": finite_value(r["l2_error"]), "eoc": finite_value(r["eoc"]),
                                    "iterations": _int(r["iterations"]),
-                                   "wall_seconds": _value(r["wall_seconds"]),
+                                   "wall_seconds": finite_value(r["wall_seconds"]),
                                    "status": str(r["status"])}
         a, b = row["by_scheme"].get(PAPER_SCHEME), row["by_scheme"].get(BASELINE)
         row["l2_baseline_over_paper"] = (b["l2_error"] / a["l2_error"]
@@ -315,7 +315,7 @@ def run_records(results, conv):
             if key == "status":
                 same = str(a) == str(b)
             else:
-                fa, fb = _value(a), _value(b)
+                fa, fb = finite_value(a), finite_value(b)
                 same = (fa is None and fb is None) or (
                     fa is not None and fb is not None and math.isclose(fa, fb, rel_tol=1e-9))
             if not same:
@@ -909,8 +909,8 @@ def collect(sources):
             entries.append((f["record"], f["provenance"]))
     entries += beyond_data["provenance"]
     summary = provenance_summary(entries)
-    run_seconds = [_value(r.get("wall_seconds")) for r in records.values() if r]
-    fig_seconds = [_value(f["seconds"]) for f in figs]
+    run_seconds = [finite_value(r.get("wall_seconds")) for r in records.values() if r]
+    fig_seconds = [finite_value(f["seconds"]) for f in figs]
     summary["job_seconds"] = (sum(x for x in run_seconds + fig_seconds if x is not None)
                               if any(x is not None for x in run_seconds + fig_seconds)
                               else None)
@@ -1692,7 +1692,7 @@ def summary(levels, stable, paper_schemes, finest):
 
 def findings(levels, stability, time, space, schemes, paper_schemes, t_final, tau_1):
     """The findings of the beyond study (Markdown) from its tables (DataFrames of
-    :func:`mcfbench.presentation.tables.beyond_tables`); ``schemes``: those of the level table,
+    :func:`mcfbench.presentation.beyond_tables.beyond_tables`); ``schemes``: those of the level table,
     ``paper_schemes``: those compared with the published values."""
     parts = ["# Beyond Table 3.1: findings", "",
              "Generated by `mcfbench.presentation.report.findings` from the tables in "

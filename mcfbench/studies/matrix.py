@@ -590,8 +590,8 @@ def problem_table(table, problem, schemes=None, labels=None):
 
 
 def markdown(frame, notes=()):
-    """A pipe table (:func:`mcfbench.presentation.tables.md_table`), then ``notes`` as paragraphs."""
-    from mcfbench.presentation.tables import md_table
+    """A pipe table (:func:`mcfbench.presentation.formats.md_table`), then ``notes`` as paragraphs."""
+    from mcfbench.presentation.formats import md_table
 
     lines = [md_table(list(frame.columns), frame.itertuples(index=False))]
     lines += [f"\n{note}" for note in notes]
@@ -599,9 +599,9 @@ def markdown(frame, notes=()):
 
 
 def latex(frame, caption="", notes=()):
-    """A ``table`` with a booktabs ``tabular`` (:func:`mcfbench.presentation.tables.tex_tabular`),
+    """A ``table`` with a booktabs ``tabular`` (:func:`mcfbench.presentation.formats.tex_tabular`),
     the notes below it."""
-    from mcfbench.presentation.tables import tex_escape, tex_tabular
+    from mcfbench.presentation.formats import tex_escape, tex_tabular
 
     lines = [r"\begin{table}[ht]",
              tex_tabular([tex_escape(c) for c in frame.columns],

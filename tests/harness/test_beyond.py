@@ -29,9 +29,8 @@ from mcfbench.storage.records import RecordError, read_record
 from mcfbench.presentation.report import findings
 from mcfbench.running.schemes import SCHEMES
 from mcfbench.running.run import space_convergence
-from mcfbench.presentation.tables import (beyond_documents, beyond_tables, convergence_documents,
-                             eoc_column, level_table, monitor_summary, space_table,
-                             time_order)
+from mcfbench.presentation.beyond_tables import beyond_documents, beyond_tables, monitor_summary, space_table, time_order
+from mcfbench.presentation.convergence_tables import convergence_documents, eoc_column, level_table
 
 REPO = Path(__file__).resolve().parents[2]
 CONFIG = yaml.safe_load((REPO / "config" / "config.yaml").read_text())

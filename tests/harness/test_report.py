@@ -5,7 +5,7 @@ of results/, three levels, three figures), with the real paper/ sources and
 ddfv/README.md. Checked: every output is written; the HTML needs nothing
 but itself and embeds every image; a changed table value or run record
 changes the report, and values outside the tolerances are flagged; the
-published Table 3.1 equals mcfbench.presentation.tables.PUBLISHED exactly; the beyond study
+published Table 3.1 equals mcfbench.presentation.convergence_tables.PUBLISHED exactly; the beyond study
 is included when present; the deviations come from ddfv/README.md.
 """
 
@@ -26,7 +26,7 @@ import yaml
 from mcfbench.presentation import report
 from mcfbench.studies.figures import EXPERIMENTS, PAPER_FIGURES
 from mcfbench.running.schemes import SCHEMES
-from mcfbench.presentation.tables import PUBLISHED
+from mcfbench.presentation.convergence_tables import PUBLISHED
 
 REPO = Path(__file__).resolve().parents[2]
 

@@ -6,7 +6,8 @@ import pytest
 from mcfbench.running.problems import get_problem
 from mcfbench.running.solver import Solver
 from mcfbench.running.run import run
-from mcfbench.presentation.tables import PUBLISHED, sphere_table
+from mcfbench.presentation.convergence_tables import PUBLISHED
+from mcfbench.studies.convergence import sphere_table
 
 
 def sphere_run(level, scheme="ddfv", rtol=1e-9, **options):

@@ -2,13 +2,14 @@
 
 Every record is checked first (:func:`mcfbench.pipeline.read_records`). Writes
 ``levels``, ``stability``, ``time_convergence``, ``space_convergence`` (CSV,
-Markdown, LaTeX each; :func:`mcfbench.presentation.tables.beyond_tables`,
-:func:`mcfbench.presentation.tables.beyond_documents`), ``t_monitor.csv`` (the T monitor
+Markdown, LaTeX each; :func:`mcfbench.presentation.beyond_tables.beyond_tables`,
+:func:`mcfbench.presentation.beyond_tables.beyond_documents`), ``t_monitor.csv`` (the T monitor
 at every time level) and ``beyond.json`` (provenance), all together.
 """
 
 from mcfbench.pipeline import json_text, read_records, setup_logging, sidecar, write_files
-from mcfbench.presentation.tables import beyond_documents, beyond_tables, csv_text
+from mcfbench.presentation.beyond_tables import beyond_documents, beyond_tables
+from mcfbench.presentation.formats import csv_text
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

@@ -2,13 +2,13 @@
 
 Every record is checked first (:func:`mcfbench.pipeline.read_records`: checksum,
 schema, stale settings); one bad record stops the aggregation with a message
-naming the file. The tables are :func:`mcfbench.presentation.tables.level_table` and
-:func:`mcfbench.presentation.tables.convergence_documents`; all four files are written
+naming the file. The tables are :func:`mcfbench.presentation.convergence_tables.level_table` and
+:func:`mcfbench.presentation.convergence_tables.convergence_documents`; all four files are written
 together (:func:`mcfbench.pipeline.write_files`).
 """
 
 from mcfbench.pipeline import json_text, read_records, setup_logging, sidecar, write_files
-from mcfbench.presentation.tables import convergence_documents, level_table
+from mcfbench.presentation.convergence_tables import convergence_documents, level_table
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])
