@@ -22,25 +22,21 @@ Jobs
     :func:`write_files` writes every output of a job at once.
 """
 
-import contextlib
 import hashlib
 import json
-import logging
 import math
 import re
-import sys
 import time
 from pathlib import Path
 
-from mcfbench.storage.atomic import _figure_metadata, atomic_path, json_value, save_npz, write_json
 from mcfbench.running.problems import get_problem
-from mcfbench.storage.provenance import code_hash, provenance
-from mcfbench.storage.records import FIELDS, RecordError, read_record, write_record
 from mcfbench.running.schemes import SCHEMES, get_scheme
 from mcfbench.running.solver import Solver
+from mcfbench.storage.atomic import json_value, save_npz, write_files, write_json
+from mcfbench.storage.provenance import code_hash, provenance
+from mcfbench.storage.records import FIELDS, RecordError, read_record, write_record
 
 PROBLEM = "sphere"        # the problem of Table 3.1 and of the beyond study
-FIGURE_DPI = 200
 
 
 class ConfigError(ValueError):
@@ -48,49 +44,6 @@ class ConfigError(ValueError):
 
 
 # -- logging and output ---------------------------------------------------------------
-
-def setup_logging(log_file=None):
-    """Log to the job's log file (if given) and to stderr (shown by Snakemake)."""
-    handlers = [logging.StreamHandler(sys.stderr)]
-    if log_file:
-        Path(log_file).parent.mkdir(parents=True, exist_ok=True)
-        handlers.insert(0, logging.FileHandler(log_file, mode="w"))
-    logging.basicConfig(level=logging.INFO, handlers=handlers, force=True,
-                        format="%(asctime)s %(levelname)s %(message)s")
-    return logging.getLogger("pipeline")
-
-
-def write_files(files):
-    """Write every output of a job, all or nothing.
-
-    ``files`` maps a path to its content: text, bytes, a matplotlib figure
-    (saved in the format of the suffix at :data:`FIGURE_DPI`, without dates)
-    or ``(figure, savefig keyword arguments)``. Every content goes to a
-    temporary file next to its target first; only when all are written are
-    they renamed over the targets, so a failure leaves every previous output
-    in place. The figures are closed.
-    """
-    figures = []
-    try:
-        with contextlib.ExitStack() as stack:
-            for path, content in files.items():
-                tmp = stack.enter_context(atomic_path(path))
-                if isinstance(content, str):
-                    tmp.write_text(content)
-                elif isinstance(content, bytes):
-                    tmp.write_bytes(content)
-                else:
-                    fig, options = content if isinstance(content, tuple) else (content, {})
-                    figures.append(fig)
-                    suffix = Path(path).suffix
-                    fig.savefig(tmp, **{"dpi": FIGURE_DPI, "format": suffix.lstrip("."),
-                                        "metadata": _figure_metadata(suffix), **options})
-    finally:
-        if figures:
-            import matplotlib.pyplot as plt
-
-            for fig in set(figures):
-                plt.close(fig)
 
 
 def json_text(data):
@@ -455,8 +408,8 @@ def warm_kernels(threads=1):
     import numpy as np
     import scipy.sparse as sp
 
-    from mcfbench.running.solver import METHODS, solve
     from mcfbench.running.run import run
+    from mcfbench.running.solver import METHODS, solve
 
     problem = get_problem(PROBLEM)
     for name in SCHEMES:
@@ -590,9 +543,14 @@ def figure_job(name, outputs, log):
     """
     import pandas as pd
 
-    from mcfbench.studies.figures import EXPERIMENTS, draw_experiment, experiment_status, run_experiment
     from mcfbench.geometry.quality import COLUMNS, plot_quality
-    from mcfbench.presentation.render import DPI
+    from mcfbench.presentation.render import DPI, rasterize_meshes
+    from mcfbench.studies.figures import (
+        EXPERIMENTS,
+        draw_experiment,
+        experiment_status,
+        run_experiment,
+    )
 
     experiment = EXPERIMENTS[name]
     wall = time.perf_counter()
@@ -614,9 +572,7 @@ def figure_job(name, outputs, log):
     draw = time.perf_counter()
     figure = draw_experiment(experiment, results)
     draw = time.perf_counter() - draw
-    for ax in figure.axes:          # meshes rasterised in the PDF, as render.save_figure
-        for collection in ax.collections:
-            collection.set_rasterized(True)
+    rasterize_meshes(figure)
     status = experiment_status(results)
     record = {
         "experiment": experiment.name, "title": experiment.title, "status": status,

@@ -5,12 +5,12 @@ import pandas as pd
 
 from mcfbench.presentation.convergence_tables import (
     LEVEL_COLUMNS,
-    notes_markdown,
-    notes_latex,
     eoc_column,
     l2_cell,
     label,
     level_table,
+    notes_latex,
+    notes_markdown,
     record_rows,
 )
 from mcfbench.presentation.formats import (

@@ -26,11 +26,11 @@ Typical use::
 
     panels = [Panel(F, T, faces, label="n = 0"), ...]
     fig = panel_row(panels, view=(20, -60))
-    save_figure(fig, "results/figures/fig_3_2.png", "results/figures/fig_3_2.pdf")
+    write_files({"fig_3_2.png": (fig, {"dpi": DPI}),
+                 "fig_3_2.pdf": (rasterize_meshes(fig), {"dpi": 2 * DPI})})  # mcfbench.storage.atomic
 """
 
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import matplotlib
 
@@ -493,34 +493,10 @@ def panel_row(panels, *, view=(20.0, -60.0), size=2.6, aspect=1.0, rows=1,
     return fig
 
 
-def save_figure(fig, png, pdf=None, dpi=DPI):
-    """Write the figure as PNG (``dpi``) and optionally PDF, and close it.
-
-    The meshes are rasterised (at ``2 dpi``) inside the PDF to keep it
-    small; labels and frames stay vector.
-
-    Parameters
-    ----------
-    fig : matplotlib.figure.Figure
-    png : str or Path
-        The PNG file; if it has no suffix it is a stem and both
-        ``stem.png`` and ``stem.pdf`` are written.
-    pdf : str or Path, optional
-
-    Returns
-    -------
-    list of Path
-        The files written.
-    """
-    png = Path(png)
-    if not png.suffix:
-        png, pdf = png.with_name(png.name + ".png"), png.with_name(png.name + ".pdf")
-    paths = [png] + ([Path(pdf)] if pdf is not None else [])
+def rasterize_meshes(fig):
+    """Draw the meshes of ``fig`` as images inside a PDF (labels and frames stay
+    vector), which keeps a figure of thousands of cells small; returns ``fig``."""
     for ax in fig.axes:
         for coll in ax.collections:
             coll.set_rasterized(True)
-    for path in paths:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(path, dpi=dpi if path.suffix == ".png" else 2 * dpi)
-    plt.close(fig)
-    return paths
+    return fig

@@ -59,11 +59,32 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from mcfbench.pipeline import setup_logging, write_files
-from mcfbench.presentation.convergence_tables import BASELINE, PAPER_SCHEME, PUBLISHED_COLUMNS, label
-from mcfbench.presentation.formats import MISSING, finite_value, fix, int_or, md_cell, num, pct, pct0, sci, sig, signed, tex_escape, tex_inline, tex_tabular
-from mcfbench.presentation.formats import tex_number
+from mcfbench.presentation.convergence_tables import (
+    BASELINE,
+    PAPER_SCHEME,
+    PUBLISHED_COLUMNS,
+    label,
+)
+from mcfbench.presentation.formats import (
+    MISSING,
+    finite_value,
+    fix,
+    int_or,
+    md_cell,
+    num,
+    pct,
+    pct0,
+    sci,
+    sig,
+    signed,
+    tex_escape,
+    tex_inline,
+    tex_number,
+    tex_tabular,
+)
 from mcfbench.running.schemes import get_scheme
+from mcfbench.storage.atomic import write_files
+from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.provenance import provenance
 from mcfbench.storage.statuses import STATE_STATUSES
 from mcfbench.studies.figures import EXPERIMENTS

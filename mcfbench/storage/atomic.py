@@ -74,18 +74,9 @@ def save_npz(path, **arrays):
 
 
 def save_figure(fig, *paths, dpi=150):
-    """Save a matplotlib figure to each path atomically and close it."""
-    import matplotlib.pyplot as plt
-
-    try:
-        for path in paths:
-            if path is None:
-                continue
-            with atomic_path(path) as tmp:
-                fig.savefig(tmp, dpi=dpi, format=Path(path).suffix.lstrip("."),
-                            metadata=_figure_metadata(Path(path).suffix))
-    finally:
-        plt.close(fig)
+    """Save a matplotlib figure to each path (``None`` skipped) at once, as
+    :func:`write_files`, and close it."""
+    write_files({path: fig for path in paths if path is not None}, dpi=dpi)
 
 
 def _figure_metadata(suffix):
@@ -117,3 +108,36 @@ def check_writable(path):
             if not os.access(ancestor, os.W_OK | os.X_OK):
                 raise ValueError(f"cannot write {path}: directory {ancestor} is not writable")
             break
+
+
+def write_files(files, dpi=200):
+    """Write every output of a job, all or nothing.
+
+    ``files`` maps a path to its content: text, bytes, a matplotlib figure
+    (saved in the format of the suffix at ``dpi``, without dates)
+    or ``(figure, savefig keyword arguments)``. Every content goes to a
+    temporary file next to its target first; only when all are written are
+    they renamed over the targets, so a failure leaves every previous output
+    in place. The figures are closed.
+    """
+    figures = []
+    try:
+        with contextlib.ExitStack() as stack:
+            for path, content in files.items():
+                tmp = stack.enter_context(atomic_path(path))
+                if isinstance(content, str):
+                    tmp.write_text(content)
+                elif isinstance(content, bytes):
+                    tmp.write_bytes(content)
+                else:
+                    fig, options = content if isinstance(content, tuple) else (content, {})
+                    figures.append(fig)
+                    suffix = Path(path).suffix
+                    fig.savefig(tmp, **{"dpi": dpi, "format": suffix.lstrip("."),
+                                        "metadata": _figure_metadata(suffix), **options})
+    finally:
+        if figures:
+            import matplotlib.pyplot as plt
+
+            for fig in set(figures):
+                plt.close(fig)

@@ -16,9 +16,10 @@ from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
 from mcfbench.storage.atomic import json_value, write_json
-from mcfbench.storage.statuses import STATUSES
 from mcfbench.storage.memory import peak_rss_mb
 from mcfbench.storage.provenance import config_hash, provenance
+from mcfbench.storage.statuses import STATUSES
+
 
 @dataclass
 class RunResult:

@@ -47,11 +47,11 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from mcfbench.running.driver import simulate
 from mcfbench.geometry.mesh import validate_mesh
 from mcfbench.geometry.quality import MeshQuality, describe_violation, first_violation
-from mcfbench.running.schemes import get_scheme
 from mcfbench.geometry.surfaces import make_surface
+from mcfbench.running.driver import simulate
+from mcfbench.running.schemes import get_scheme
 
 TAU = 0.0025
 
@@ -498,7 +498,12 @@ def experiment_panels(experiment, results):
     on their centre in the panel's own frame, with the half-width of its
     :class:`Zoom` (one for all panels that share it).
     """
-    from mcfbench.presentation.render import Panel, cells_centre, element_centre, worst_element
+    from mcfbench.presentation.render import (
+        Panel,
+        cells_centre,
+        element_centre,
+        worst_element,
+    )
 
     cells = tracked(experiment, results)
 

@@ -41,7 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mcfbench.pipeline import setup_logging
+from mcfbench.storage.logs import setup_logging
 
 TIMING_BASE = (
     "Timings compare schemes fairly only on the same footing: the same solver and "
@@ -280,8 +280,8 @@ def run_one(scheme, problem, level, *, solver, mesh=None, tau=None):
     """
     from mcfbench.geometry.mesh import validate_mesh
     from mcfbench.running.problems import get_problem
-    from mcfbench.running.schemes import get_scheme
     from mcfbench.running.run import run
+    from mcfbench.running.schemes import get_scheme
 
     scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
     problem = get_problem(problem) if isinstance(problem, str) else problem
@@ -307,9 +307,9 @@ def run_one(scheme, problem, level, *, solver, mesh=None, tau=None):
 def run_job(settings, record, frames, log_path=None):
     """One run of the matrix: the record (:func:`mcfbench.storage.records.write_record`,
     with ``metric_names``) and the first and last frames (npz), both atomic."""
+    from mcfbench.running.solver import Solver
     from mcfbench.storage.atomic import save_npz
     from mcfbench.storage.records import write_record
-    from mcfbench.running.solver import Solver
 
     log = setup_logging(log_path)
     solver = Solver(method=settings["solver"]["method"], rtol=settings["solver"]["rtol"],
@@ -629,8 +629,8 @@ def problem_notes(problem, plan=None):
 
 def write_tables(table, out_dir, plan):
     """Write ``matrix.csv``, ``{problem}.md/.tex`` and ``summary.md/.tex/.csv``."""
-    from mcfbench.storage.atomic import write_text
     from mcfbench.running.schemes import SCHEMES
+    from mcfbench.storage.atomic import write_text
 
     out = Path(out_dir)
     labels = {s: SCHEMES[s].label if s in SCHEMES else s for s in plan["schemes"]}
@@ -704,8 +704,8 @@ def mesh_problems(plan):
 
 def write_findings(summary_csv, out, plan):
     """``findings.md`` from ``summary.csv`` (numbers from the table only)."""
-    from mcfbench.storage.atomic import write_text
     from mcfbench.running.schemes import SCHEMES
+    from mcfbench.storage.atomic import write_text
 
     summary = read_summary(summary_csv)
     labels = {s: SCHEMES[s].label for s in plan["schemes"] if s in SCHEMES}
@@ -1050,8 +1050,8 @@ def generated_meshes():
     real-world-like problems of the registry (:func:`is_real_world`) at the
     middle level of their refinement series, or (when there are none) the surfaces
     :data:`GALLERY_SURFACES` at their defaults."""
-    from mcfbench.running.problems import PROBLEMS
     from mcfbench.geometry.surfaces import SURFACES
+    from mcfbench.running.problems import PROBLEMS
 
     mesh_problems = [p for p in PROBLEMS.values() if is_real_world(p)]
     if mesh_problems:
@@ -1071,8 +1071,8 @@ def write_obj(path, vertices, faces):
 
 def write_generated_mesh(entry, path):
     """Write one mesh of :func:`generated_meshes` (``entry`` = its value)."""
-    from mcfbench.running.problems import get_problem
     from mcfbench.geometry.surfaces import make_surface
+    from mcfbench.running.problems import get_problem
 
     kind, name, level = entry
     V, F = get_problem(name).mesh(level) if kind == "problem" else make_surface(name)
@@ -1092,11 +1092,11 @@ def gallery_job(mesh_path, scheme, settings, record, frames, log_path=None):
     first and last frames. A file the reader refuses gives status
     ``unsupported`` with the reader's message."""
     from mcfbench.geometry import metrics
-    from mcfbench.storage.atomic import save_npz
     from mcfbench.geometry.mesh_files import read_mesh
-    from mcfbench.storage.records import write_record
     from mcfbench.running.schemes import get_scheme
     from mcfbench.running.solver import Solver
+    from mcfbench.storage.atomic import save_npz
+    from mcfbench.storage.records import write_record
 
     log = setup_logging(log_path)
     solver = Solver(method=settings["solver"], rtol=settings["rtol"],

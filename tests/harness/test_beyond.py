@@ -21,16 +21,34 @@ import pandas as pd
 import pytest
 import yaml
 
-from mcfbench.pipeline import (ConfigError, Pipeline, read_records, run_job, setup_logging,
-                               time_job, used_schemes, write_files)
+from mcfbench.pipeline import (
+    ConfigError,
+    Pipeline,
+    read_records,
+    run_job,
+    time_job,
+    used_schemes,
+)
+from mcfbench.presentation.beyond_tables import (
+    beyond_documents,
+    beyond_tables,
+    monitor_summary,
+    space_table,
+    time_order,
+)
+from mcfbench.presentation.convergence_tables import (
+    convergence_documents,
+    eoc_column,
+    level_table,
+)
 from mcfbench.presentation.plots import beyond_figures
+from mcfbench.presentation.report import findings
+from mcfbench.running.run import space_convergence
+from mcfbench.running.schemes import SCHEMES
+from mcfbench.storage.atomic import write_files
+from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.provenance import config_hash
 from mcfbench.storage.records import RecordError, read_record
-from mcfbench.presentation.report import findings
-from mcfbench.running.schemes import SCHEMES
-from mcfbench.running.run import space_convergence
-from mcfbench.presentation.beyond_tables import beyond_documents, beyond_tables, monitor_summary, space_table, time_order
-from mcfbench.presentation.convergence_tables import convergence_documents, eoc_column, level_table
 
 REPO = Path(__file__).resolve().parents[2]
 CONFIG = yaml.safe_load((REPO / "config" / "config.yaml").read_text())

@@ -7,10 +7,25 @@ from matplotlib.collections import PolyCollection
 
 from ddfv import Flow
 from ddfv.topology import diamond_mesh
-from mcfbench.presentation.render import (HIGHLIGHT_COLOR, Panel, cells_centre, cells_points, diamond_faces,
-                             draw_mesh, element_centre, legend_handles, panel_row, project,
-                             save_figure, tracked_cells, view_frame, worst_element)
 from mcfbench.geometry.surfaces import cylinder, icosphere
+from mcfbench.presentation.render import (
+    DPI,
+    HIGHLIGHT_COLOR,
+    Panel,
+    cells_centre,
+    cells_points,
+    diamond_faces,
+    draw_mesh,
+    element_centre,
+    legend_handles,
+    panel_row,
+    project,
+    rasterize_meshes,
+    tracked_cells,
+    view_frame,
+    worst_element,
+)
+from mcfbench.storage.atomic import write_files
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -27,22 +42,27 @@ def test_render_writes_non_empty_png_and_pdf(tmp_path, sphere):
               Panel(0.8 * F, 0.8 * T, faces, label="n = 1", zoom_box=(F[0], 0.2)),
               Panel(F, T, faces, label="detail", zoom=(F[0], 0.2)),
               Panel(F, None, faces, label="primal only", note="a note")]
-    png, pdf = save_figure(panel_row(panels), tmp_path / "fig.png", tmp_path / "fig.pdf")
+    png, pdf = tmp_path / "fig.png", tmp_path / "fig.pdf"
+    fig = panel_row(panels)
+    write_files({png: (fig, {"dpi": DPI}), pdf: (rasterize_meshes(fig), {"dpi": 2 * DPI})})
     assert png.read_bytes()[:8] == PNG_MAGIC and png.stat().st_size > 20_000
     assert pdf.read_bytes()[:5] == b"%PDF-" and pdf.stat().st_size > 20_000
 
 
-def test_stem_writes_png_and_pdf(tmp_path, sphere):
+def test_rasterized_meshes_are_images_in_the_pdf(tmp_path, sphere):
     F, T, faces = sphere
-    paths = save_figure(panel_row([Panel(F, T, faces)]), tmp_path / "sub" / "fig_3_1")
-    assert [p.name for p in paths] == ["fig_3_1.png", "fig_3_1.pdf"]
-    assert all(p.stat().st_size > 0 for p in paths)
+    vector, raster = tmp_path / "vector.pdf", tmp_path / "raster.pdf"
+    write_files({vector: panel_row([Panel(F, T, faces)])})
+    write_files({raster: rasterize_meshes(panel_row([Panel(F, T, faces)]))})
+    assert b"/Subtype /Image" in raster.read_bytes()
+    assert b"/Subtype /Image" not in vector.read_bytes()
 
 
 def test_open_surface_renders(tmp_path):
     flow = Flow(*cylinder(24, 8, 1.0, 0.55, "twisted"), 0.0025)
     fig = panel_row([Panel(flow.F, flow.T, flow.faces, label="cylinder")], view=(12, -60))
-    (png,) = save_figure(fig, tmp_path / "cyl.png")
+    png = tmp_path / "cyl.png"
+    write_files({png: (fig, {"dpi": DPI})})
     assert png.stat().st_size > 10_000
 
 

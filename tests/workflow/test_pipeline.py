@@ -305,7 +305,7 @@ def test_rules_use_the_registry_and_one_code_digest():
 
 
 def test_failed_output_leaves_every_previous_output_in_place(tmp_path):
-    from mcfbench.pipeline import write_files
+    from mcfbench.storage.atomic import write_files
 
     first, second = tmp_path / "table.csv", tmp_path / "table.md"
     write_files({first: "old csv\n", second: "old md\n"})

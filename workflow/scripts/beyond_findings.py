@@ -5,8 +5,9 @@ Every number and verdict is read from the tables: nothing is typed by hand.
 
 import pandas as pd
 
-from mcfbench.pipeline import setup_logging, write_files
 from mcfbench.presentation.report import findings
+from mcfbench.storage.atomic import write_files
+from mcfbench.storage.logs import setup_logging
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

@@ -7,9 +7,11 @@ Markdown, LaTeX each; :func:`mcfbench.presentation.beyond_tables.beyond_tables`,
 at every time level) and ``beyond.json`` (provenance), all together.
 """
 
-from mcfbench.pipeline import json_text, read_records, setup_logging, sidecar, write_files
+from mcfbench.pipeline import json_text, read_records, sidecar
 from mcfbench.presentation.beyond_tables import beyond_documents, beyond_tables
 from mcfbench.presentation.formats import csv_text
+from mcfbench.storage.atomic import write_files
+from mcfbench.storage.logs import setup_logging
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

@@ -5,8 +5,9 @@ is :func:`mcfbench.pipeline.time_job` (:func:`mcfbench.running.run.time_converge
 any scheme of the registry).
 """
 
+from mcfbench.pipeline import time_job
+from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.memory import tune_malloc
-from mcfbench.pipeline import setup_logging, time_job
 
 tune_malloc()  # before any flow allocates
 

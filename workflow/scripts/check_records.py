@@ -6,7 +6,9 @@ job before it runs it). Writes the checksum of every record
 (:func:`mcfbench.pipeline.read_records`: checksum, schema, stale settings).
 """
 
-from mcfbench.pipeline import json_text, read_records, setup_logging, write_files
+from mcfbench.pipeline import json_text, read_records
+from mcfbench.storage.atomic import write_files
+from mcfbench.storage.logs import setup_logging
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

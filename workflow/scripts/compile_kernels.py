@@ -5,7 +5,8 @@ output as an ``ancient`` input, so they start after it and load the
 kernels instead of each compiling them.
 """
 
-from mcfbench.pipeline import compile_job, setup_logging
+from mcfbench.pipeline import compile_job
+from mcfbench.storage.logs import setup_logging
 
 sm = snakemake  # noqa: F821
 compile_job(sm.params.threads, str(sm.output[0]), setup_logging(sm.log[0]))

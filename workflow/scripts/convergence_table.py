@@ -7,8 +7,10 @@ naming the file. The tables are :func:`mcfbench.presentation.convergence_tables.
 together (:func:`mcfbench.pipeline.write_files`).
 """
 
-from mcfbench.pipeline import json_text, read_records, setup_logging, sidecar, write_files
+from mcfbench.pipeline import json_text, read_records, sidecar
 from mcfbench.presentation.convergence_tables import convergence_documents, level_table
+from mcfbench.storage.atomic import write_files
+from mcfbench.storage.logs import setup_logging
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

@@ -6,8 +6,9 @@ diagnostics (CSV, plot) and the figure's record (JSON): see
 frames; the job still succeeds.
 """
 
+from mcfbench.pipeline import FIGURE_OUTPUTS, figure_job
+from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.memory import tune_malloc
-from mcfbench.pipeline import FIGURE_OUTPUTS, figure_job, setup_logging
 
 tune_malloc()  # before any flow allocates
 

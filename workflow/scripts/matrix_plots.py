@@ -7,9 +7,13 @@ the picture grid of final surfaces from the saved frames.
 
 import logging
 
-from mcfbench.studies.matrix import load_frames, read_long_table, read_runs
-from mcfbench.presentation.matrix_plots import error_figure, picture_grid, quality_figure
+from mcfbench.presentation.matrix_plots import (
+             error_figure,
+             picture_grid,
+             quality_figure,
+)
 from mcfbench.storage.records import read_record
+from mcfbench.studies.matrix import load_frames, read_long_table, read_runs
 
 sm = snakemake  # noqa: F821
 logging.basicConfig(filename=sm.log[0], level=logging.INFO, force=True)

@@ -2,8 +2,9 @@
 
 import pandas as pd
 
-from mcfbench.pipeline import setup_logging, write_files
 from mcfbench.presentation.plots import convergence_figure
+from mcfbench.storage.atomic import write_files
+from mcfbench.storage.logs import setup_logging
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

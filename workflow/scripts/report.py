@@ -8,8 +8,8 @@ hand: ``python -m mcfbench.presentation.report``.
 
 from pathlib import Path
 
-from mcfbench.pipeline import setup_logging
 from mcfbench.presentation.report import Sources, build, default_outputs
+from mcfbench.storage.logs import setup_logging
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

@@ -4,8 +4,8 @@ Needs pdflatex (booktabs, graphicx, amssymb, hyperref); see
 :func:`mcfbench.presentation.report.build_pdf`.
 """
 
-from mcfbench.pipeline import setup_logging
 from mcfbench.presentation.report import build_pdf
+from mcfbench.storage.logs import setup_logging
 
 sm = snakemake  # noqa: F821
 build_pdf(sm.output.pdf, sm.input.template, setup_logging(sm.log[0]))

@@ -6,8 +6,9 @@ problem, level, tau, t_final, rtol, source hashes); the record is written by
 :class:`mcfbench.storage.records.RunResult`, settings, provenance, checksum).
 """
 
+from mcfbench.pipeline import run_job
+from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.memory import tune_malloc
-from mcfbench.pipeline import run_job, setup_logging
 
 tune_malloc()  # before any flow allocates: halves the wall time of level 5
 
