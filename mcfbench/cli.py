@@ -17,15 +17,15 @@ from pathlib import Path
 
 import numpy as np
 
-from mcfbench.storage.atomic import check_writable, save_npz, write_json
-from mcfbench.storage.memory import tune_malloc
 from mcfbench.geometry.mesh import summarize
 from mcfbench.geometry.mesh_files import read_mesh
 from mcfbench.running.problems import PROBLEMS, Problem, get_problem
-from mcfbench.storage.provenance import provenance
+from mcfbench.running.run import level_sweep, run
 from mcfbench.running.schemes import SCHEMES, get_scheme
 from mcfbench.running.solver import METHODS, ROBUST, Solver
-from mcfbench.running.run import level_sweep, run
+from mcfbench.storage.atomic import check_writable, save_npz, write_json
+from mcfbench.storage.memory import tune_malloc
+from mcfbench.storage.provenance import provenance
 from mcfbench.studies.convergence import sphere_table
 
 
@@ -107,6 +107,16 @@ def build_parser():
                       help="keep every K-th step as a frame (0: first and last only)")
     flow.add_argument("--out", type=Path, required=True, help="output file (.npz)")
     _common(flow, ROBUST)
+
+    report = commands.add_parser("report", help="the reproduction report from the result "
+                                 "files (what the pipeline's rule reproduction_report does)")
+    report.add_argument("--results", type=Path, default=Path("results"))
+    report.add_argument("--paper", type=Path, default=Path("paper"))
+    report.add_argument("--readme", type=Path, default=Path("ddfv/README.md"))
+    report.add_argument("--out", type=Path, help="report folder (default: RESULTS/paper)")
+    report.add_argument("--beyond", type=Path,
+                        help="beyond-the-paper folder (default: RESULTS/beyond)")
+    report.add_argument("--log", type=Path, help="default: OUT/report.log")
 
     commands.add_parser("schemes", help="list the schemes")
     commands.add_parser("problems", help="list the problems")
@@ -261,6 +271,23 @@ def _run(args):
     return 0
 
 
+def _report(args):
+    from mcfbench.presentation.report import ReportError, Sources, build
+    from mcfbench.storage.logs import setup_logging
+    from mcfbench.studies.figures import EXPERIMENTS
+
+    sources = Sources(results=args.results, paper=args.paper, readme=args.readme,
+                      out=args.out or args.results / "paper",
+                      beyond=args.beyond or args.results / "beyond", experiments=EXPERIMENTS)
+    log = setup_logging(args.log or sources.out / "report.log")
+    try:
+        build(sources, log=log)
+    except ReportError as err:
+        log.error("%s", err)
+        return 1
+    return 0
+
+
 def _schemes(args):
     for scheme in SCHEMES.values():
         print(f"{scheme.name:22s} {scheme.description}")
@@ -274,4 +301,4 @@ def _problems(args):
 
 
 COMMANDS = {"sphere-table": _sphere_table, "study": _study, "run": _run,
-            "schemes": _schemes, "problems": _problems}
+            "report": _report, "schemes": _schemes, "problems": _problems}

@@ -1,5 +1,5 @@
 """The study beyond Table 3.1 (workflow/rules/beyond.smk; mcfbench.pipeline, .tables,
-.plots, .report.findings).
+.plots, .beyond_findings).
 
 Runs that break down must end up as rows with their status, the time of
 the breakdown, an empty L2 error and no EOC against them; the aggregation
@@ -42,7 +42,7 @@ from mcfbench.presentation.convergence_tables import (
     level_table,
 )
 from mcfbench.presentation.plots import beyond_figures
-from mcfbench.presentation.report import findings
+from mcfbench.presentation.beyond_findings import beyond_findings as findings
 from mcfbench.running.run import space_convergence
 from mcfbench.running.schemes import SCHEMES
 from mcfbench.storage.atomic import write_files

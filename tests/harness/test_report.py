@@ -23,7 +23,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from mcfbench.presentation import report
+from mcfbench.presentation import documents, report, report_inputs
 from mcfbench.studies.figures import EXPERIMENTS, PAPER_FIGURES
 from mcfbench.running.schemes import SCHEMES
 from mcfbench.presentation.convergence_tables import PUBLISHED
@@ -146,9 +146,10 @@ def results(tmp_path):
 
 
 def sources(results, **kw):
-    return report.Sources(results=results, paper=REPO / "paper",
+    return report_inputs.Sources(results=results, paper=REPO / "paper",
                                readme=REPO / "ddfv" / "README.md", out=results / "paper",
-                               beyond=results / "beyond", figures=FIGURES, **kw)
+                               beyond=results / "beyond", figures=FIGURES,
+                               experiments=EXPERIMENTS, **kw)
 
 
 def build(results, **kw):
@@ -161,7 +162,7 @@ def build(results, **kw):
 
 
 def b64(path):
-    return report.data_uri(path).split(",", 1)[1]
+    return documents.data_uri(path).split(",", 1)[1]
 
 
 class References(HTMLParser):
@@ -196,7 +197,7 @@ def test_html_is_self_contained(results):
     outside = [(tag, name, url) for tag, name, url in parser.urls
                if not (url.startswith("data:") or url.startswith("#"))]
     assert outside == []
-    assert report.external_references(html) == []
+    assert documents.external_references(html) == []
     assert "url(" not in html.split("<style>")[1].split("</style>")[0]
 
 
@@ -296,7 +297,7 @@ def test_published_values_and_table_may_not_drift(results):
     table = pd.read_csv(path)
     table.loc[table["scheme"] == "ddfv", "paper_l2_error"] *= 1.01
     table.to_csv(path, index=False)
-    with pytest.raises(report.ReportError, match="drifted"):
+    with pytest.raises(report_inputs.ReportError, match="drifted"):
         build(results)
 
 
@@ -305,7 +306,7 @@ def test_missing_figure_is_reported(results):
     _, md, html, checks = build(results)
     assert any("Figure 3.2" in item and "not built" in item
                for item in checks["differences"]["outside"])
-    assert report.external_references(html) == []
+    assert documents.external_references(html) == []
 
 
 def test_figure_checks_compare_with_the_captions(results):
@@ -339,7 +340,7 @@ def _same(a, b):
 
 
 def test_published_table_equals_mcfbench_tables_published():
-    published = report.published_as_tuples(REPO / "paper")
+    published = report_inputs.published_as_tuples(REPO / "paper")
     assert sorted(published) == sorted(PUBLISHED)
     for level, values in PUBLISHED.items():
         assert len(published[level]) == len(values)
@@ -391,7 +392,7 @@ def test_beyond_is_included_when_present(results):
     assert md.count("| 6 | 1.2e-05 |") == 1                       # CSV with a twin: once
     for seed_file in ("levels.png", "t_monitor.png"):
         assert b64(beyond / "figures" / seed_file) in html
-    assert report.external_references(html) == []
+    assert documents.external_references(html) == []
     assert "snakemake --cores 2 results/beyond/findings.md" in md
     beyond_tex = (results / "paper" / "tex" / "beyond.tex").read_text()
     assert "% the study's own fragment: \\input{results/beyond/tables/levels.tex}" in beyond_tex
@@ -437,7 +438,7 @@ def test_latex_fragments_are_balanced(results):
 
 
 def test_markdown_to_tex_escapes_the_readme():
-    tex = report.markdown_to_tex(report.deviations(REPO / "ddfv" / "README.md"))
+    tex = documents.markdown_to_tex(report_inputs.deviations(REPO / "ddfv" / "README.md"))
     assert _balanced(tex)
     assert "\\begin{enumerate}" in tex and "\\item \\textbf{" in tex
     prose = re.sub(r"\\texttt\{(?:[^{}]|\{[^{}]*\})*\}", "", tex)
@@ -460,7 +461,7 @@ def test_pdf_builds_when_tex_is_installed(results, tmp_path, monkeypatch):
     root = results.parent
     shutil.copytree(REPO / "paper", root / "paper")
     monkeypatch.chdir(root)
-    pdf = report.build_pdf(root / "results" / "paper" / "reproduction.pdf",
+    pdf = documents.build_pdf(root / "results" / "paper" / "reproduction.pdf",
                                Path("paper/reproduction.tex"))
     assert pdf.read_bytes().startswith(b"%PDF")
 

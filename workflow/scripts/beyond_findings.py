@@ -1,11 +1,11 @@
-"""Rule beyond_findings: the findings of the beyond study in words (mcfbench.presentation.report.findings).
+"""Rule beyond_findings: the findings of the beyond study in words (mcfbench.presentation.beyond_findings).
 
 Every number and verdict is read from the tables: nothing is typed by hand.
 """
 
 import pandas as pd
 
-from mcfbench.presentation.report import findings
+from mcfbench.presentation.beyond_findings import beyond_findings as findings
 from mcfbench.storage.atomic import write_files
 from mcfbench.storage.logs import setup_logging
 

@@ -1,10 +1,10 @@
 """Rule report_pdf: ``paper/reproduction.tex`` with the report's fragments as a PDF.
 
 Needs pdflatex (booktabs, graphicx, amssymb, hyperref); see
-:func:`mcfbench.presentation.report.build_pdf`.
+:func:`mcfbench.presentation.documents.build_pdf`.
 """
 
-from mcfbench.presentation.report import build_pdf
+from mcfbench.presentation.documents import build_pdf
 from mcfbench.storage.logs import setup_logging
 
 sm = snakemake  # noqa: F821

@@ -1,0 +1,264 @@
+"""The findings of the beyond study in words, from its tables (rule beyond_findings): every number is read from the tables."""
+
+import numpy as np
+
+from mcfbench.presentation.convergence_tables import (
+    label,
+)
+from mcfbench.presentation.formats import (
+    pct,
+    sci,
+)
+
+
+def _levels(values):
+    values = sorted(int(v) for v in values)
+    if not values:
+        return ""
+    if values == list(range(values[0], values[-1] + 1)) and len(values) > 2:
+        return f"{values[0]}-{values[-1]}"
+    return ", ".join(str(v) for v in values)
+
+
+def _breakdown(r):
+    text = (f"{r.status} at t = {r.t_failed:.4g} (step {round(r.t_failed / r.tau)} of {r.N})")
+    if np.isfinite(r.t_monitor_end):
+        text += f", T monitor {r.t_monitor_end:.3g} at the last time level computed"
+    if np.isfinite(r.t_exit):
+        text += f"; a T-vertex was outside its triangle from t = {r.t_exit:.4g} on"
+    return text
+
+
+def stability_section(levels, stability, schemes, t_final):
+    """Which schemes finished every run, and where the others broke down."""
+    lines, stable = ["## Which schemes stay stable", ""], []
+    for scheme in schemes:
+        runs = stability[stability["scheme"] == scheme]
+        plain = levels[levels["scheme"] == scheme]
+        has_t = len(runs) > 0
+        if not has_t:
+            runs = plain.assign(study="levels", t_final=t_final)
+        failed = runs[runs["status"] != "ok"]
+        finished = runs[runs["status"] == "ok"]
+        outside = runs[np.isfinite(runs["t_exit"])] if has_t else runs.iloc[:0]
+        head = f"- **{label(scheme)}** (`{scheme}`): "
+        where = []
+        for study, part in finished.groupby("study", sort=False):
+            t = part["t_final"].iloc[0]
+            where.append(f"level{'s' if len(part) > 1 else ''} {_levels(part['level'])} "
+                         f"to t = {t:g}")
+        if len(failed) == 0:
+            if len(outside) == 0:
+                stable.append(scheme)
+            text = head + "every run finished (" + "; ".join(where) + ")"
+            if has_t:
+                text += (f"; the T monitor stayed at or above "
+                         f"{runs['t_min_barycentric'].min():.3f}")
+                text += (", no T-vertex left its triangle." if len(outside) == 0 else
+                         f", but T-vertices left their triangles ({len(outside)} run(s)).")
+            else:
+                text += "; no T-vertices."
+        else:
+            parts = [f"level {r.level}" + (f" continued to t = {r.t_final:g}"
+                                           if r.study == "long_time" else
+                                           f" (t_f = {r.t_final:g})") + ": " + _breakdown(r)
+                     for r in failed.itertuples()]
+            text = head + f"broke down in {len(failed)} of {len(runs)} runs: " + \
+                "; ".join(parts) + "."
+            if where:
+                text += " Finished: " + "; ".join(where)
+                if has_t:
+                    text += f" (smallest T monitor {finished['t_min_barycentric'].min():.3f})"
+                text += "."
+        lines.append(text)
+    return lines + [""], stable
+
+
+def accuracy_section(levels, paper_schemes):
+    """L2 ours/paper and EOC on the levels of Table 3.1, per DDFV scheme."""
+    lines = ["## Accuracy against the published Table 3.1", ""]
+    for scheme in paper_schemes:
+        rows = levels[(levels["scheme"] == scheme) & np.isfinite(levels["l2_ratio"])]
+        if not len(rows):
+            continue
+        finest = rows.loc[rows["level"].idxmax()]
+        eocs = rows[np.isfinite(rows["eoc"])]
+        text = (f"- **{label(scheme)}**: L2 / published between {rows['l2_ratio'].min():.3f} and "
+                f"{rows['l2_ratio'].max():.3f} on levels {_levels(rows['level'])}; on level "
+                f"{finest.level} {sci(finest.l2_error, 4)} against {finest.paper_l2_error:.2e} "
+                f"({pct(finest.l2_ratio - 1, 1)}).")
+        if len(eocs):
+            text += (" EOC " + ", ".join(f"{v:.2f}" for v in eocs["eoc"]) + " (published "
+                     + ", ".join(f"{v:.2f}" for v in eocs["paper_eoc"]) + ").")
+        lines.append(text)
+    return lines + [""]
+
+
+def finest_section(levels, schemes):
+    """The finest level every scheme ran, beyond the paper, and the finer levels
+    some schemes ran (``beyond.finest``): errors, orders and cost.
+
+    Returns
+    -------
+    lines : list of str
+    finest : int
+        The finest level every scheme of ``schemes`` ran.
+    """
+    finest = int(levels.groupby("scheme")["level"].max()[schemes].min())
+    deeper = levels[levels["level"] > finest]
+    lines = [f"## Level {finest} (finest level run" +
+             (f" by every scheme; level {_levels(deeper['level'].unique())} by "
+              f"{', '.join(label(s) for s in dict.fromkeys(deeper['scheme']))} only)"
+              if len(deeper) else ")"), ""]
+    for scheme in schemes:
+        rows = levels[(levels["scheme"] == scheme) & (levels["level"] >= finest)]
+        for r in rows.itertuples():
+            name = f"**{label(scheme)}**" + (f" on level {r.level}" if r.level > finest else "")
+            cost = f"{r.wall_seconds:.0f} s wall, {r.peak_rss_mb:.0f} MB peak memory"
+            if r.status == "ok":
+                eoc = f", EOC {r.eoc:.3f} against level {r.level - 1}" \
+                    if np.isfinite(r.eoc) else ""
+                lines.append(f"- {name}: L2 {sci(r.l2_error, 4)}{eoc}; "
+                             f"{r.iterations} BiCGStab iterations, {cost}.")
+            else:
+                lines.append(f"- {name}: no error, the run broke down: {_breakdown(r)} "
+                             f"({cost} until then).")
+    return lines + [""], finest
+
+
+def cost_section(levels, schemes, reference, finest):
+    """CPU time and iterations of each scheme against ``reference`` on the finest
+    level where both finished, and on level ``finest`` (the finest every scheme ran)."""
+    lines = ["## Cost", ""]
+    ok = levels[levels["status"] == "ok"]
+    cpu = ok.pivot(index="level", columns="scheme", values="cpu_seconds")
+    iters = ok.pivot(index="level", columns="scheme", values="iterations")
+    for scheme in schemes:
+        if scheme == reference or scheme not in cpu or reference not in cpu:
+            continue
+        common = cpu[[scheme, reference]].dropna()
+        if not len(common):
+            continue
+        level = int(common.index.max())
+        lines.append(f"- **{label(scheme)}** on level {level}: {common.loc[level, scheme]:.3g} CPU s "
+                     f"against {common.loc[level, reference]:.3g} s of {label(reference)} (ratio "
+                     f"{common.loc[level, scheme] / common.loc[level, reference]:.2f}), "
+                     f"{iters.loc[level, scheme]:.0f} BiCGStab iterations against "
+                     f"{iters.loc[level, reference]:.0f}.")
+    lines.append(f"- level {finest}: " + ", ".join(
+        f"{label(r.scheme)} {r.cpu_seconds:.0f} CPU s"
+        + ("" if r.status == "ok" else f" until it broke down at step "
+           f"{round(r.t_failed / r.tau)} of {r.N}")
+        for r in levels[levels["level"] == finest].itertuples()) + ".")
+    lines.append("")
+    lines.append("CPU seconds of the flow on one core, from the pipeline's run records "
+                 "(wall seconds, in the tables, depend on the other jobs sharing the machine); "
+                 "`benchmarks/bench_level6.py` times runs alone.")
+    return lines + [""]
+
+
+def order_section(levels, time, space, paper_schemes):
+    lines = ["## Order in time and in space", ""]
+    for scheme, part in time.groupby("scheme", sort=False):
+        orders = part["order"].dropna()
+        if part["status"].ne("ok").all() or not len(orders):
+            lines.append(f"- time, **{label(scheme)}**: no order ({part['message'].iloc[0]}).")
+            continue
+        lines.append(f"- time (level {part['level'].iloc[0]}, tau {part['tau'].max():g} to "
+                     f"{part['tau'].min():g}), **{label(scheme)}**: orders "
+                     + ", ".join(f"{v:.2f}" for v in orders) + ".")
+    if len(time) and time["status"].eq("ok").any():
+        # an error e ~ C (tau - tau_ref) measured against the reference run gives
+        # the order log((t1 - r) / (t2 - r)) / log(t1 / t2) > 1 for the last pair
+        taus = np.sort(time.loc[time["status"] == "ok", "tau"].unique())[::-1]
+        ref = time["reference_tau"].dropna().iloc[0]
+        if len(taus) > 1:
+            biased = np.log((taus[-2] - ref) / (taus[-1] - ref)) / np.log(taus[-2] / taus[-1])
+            lines.append(f"  (Against a reference with tau = {ref:.3g} an exactly first-order "
+                         f"error gives {biased:.2f} for the last pair: the reference's own "
+                         "error, not a change of order.)")
+    for scheme, part in space.groupby("scheme", sort=False):
+        orders = part["eoc"].dropna()
+        lines.append(f"- space (tau = {part['tau'].iloc[0]:.4g}, levels "
+                     f"{_levels(part['level'])}), **{label(scheme)}**: EOC "
+                     + (", ".join(f"{v:.2f}" for v in orders) if len(orders) else "none")
+                     + ".")
+    lines.append("")
+    # the space error alone against the error of Table 3.1 (tau ~ h^2) on the same level
+    both = space[space["status"] == "ok"].merge(
+        levels[levels["status"] == "ok"], on=["scheme", "level"], suffixes=("_space", ""))
+    both = both[both["scheme"].isin(paper_schemes)]
+    if len(both):
+        share = both["l2_error_space"] / both["l2_error"]
+        mostly_time = share.max() < 0.5
+        lines.append(f"With tau ~ h^2 the errors of Table 3.1 are "
+                     f"{'mostly time error' if mostly_time else 'not dominated by either part'}"
+                     f": on levels {_levels(both['level'].unique())} the error with tau = "
+                     f"{space['tau'].iloc[0]:.4g} is {share.min():.2f}-{share.max():.2f} x "
+                     "the error of the L2 table (DDFV schemes)"
+                     + (", so their order 2 is mainly that of the first-order time error, "
+                        "O(tau) = O(h^2)." if mostly_time else "."))
+        lines.append("")
+    finest = space[(space["level"] == space["level"].max()) & (space["status"] == "ok")]
+    if len(finest) > 1:
+        finest = finest.sort_values("l2_error")
+        lines.append(f"In space alone (level {finest['level'].iloc[0]}, tau = "
+                     f"{finest['tau'].iloc[0]:.4g}) the errors rank "
+                     + " < ".join(f"{label(r.scheme)} {sci(r.l2_error)}"
+                                  for r in finest.itertuples())
+                     + ".")
+    return lines + [""]
+
+
+def summary(levels, stable, paper_schemes, finest):
+    """The verdict in two sentences."""
+    variants = [s for s in paper_schemes if s in stable]
+    unstable = [s for s in paper_schemes if s not in stable]
+    if not variants:
+        return ["## Summary", "", "No DDFV scheme finished every run.", ""]
+    rows = levels[(levels["level"] == finest) & levels["scheme"].isin(variants)]
+    rows = rows[rows["status"] == "ok"].sort_values("l2_error")
+    text = (f"Stable (every run finished, no T-vertex left its triangle): "
+            f"{'; '.join(map(label, variants))}; not stable: "
+            f"{'; '.join(map(label, unstable)) or 'none'}.")
+    if len(rows):
+        best = rows.iloc[0]
+        text += f" On level {finest} the most accurate stable variant is {label(best.scheme)} " \
+                f"(L2 {sci(best.l2_error, 4)}"
+        others = [f"{label(r.scheme)} {r.l2_error / best.l2_error:.2f} x that" for r in
+                  rows.iloc[1:].itertuples()]
+        text += ("; " + ", ".join(others) if others else "") + ")."
+    paper = levels[levels["scheme"].isin(variants) & np.isfinite(levels["l2_ratio"])]
+    if len(paper):
+        worst = paper.loc[(paper["l2_ratio"] - 1).abs().groupby(paper["scheme"]).idxmax()]
+        text += " Largest deviation from the published errors (levels of Table 3.1): " + \
+            "; ".join(f"{label(r.scheme)} {pct(r.l2_ratio - 1, 1)} (level {r.level})"
+                      for r in worst.itertuples()) + "."
+    return ["## Summary", "", text, ""]
+
+
+def beyond_findings(levels, stability, time, space, schemes, paper_schemes, t_final, tau_1):
+    """The findings of the beyond study (Markdown) from its tables (DataFrames of
+    :func:`mcfbench.presentation.beyond_tables.beyond_tables`); ``schemes``: those of the level table,
+    ``paper_schemes``: those compared with the published values."""
+    parts = ["# Beyond Table 3.1: findings", "",
+             "Generated by `mcfbench.presentation.beyond_findings.beyond_findings` from the tables in "
+             "`results/beyond/tables/` (every number below is read from them). Shrinking "
+             f"unit sphere, t_f = {t_final:g} unless stated, tau = {tau_1:g} / 4^(level-1).",
+             ""]
+    stab, stable = stability_section(levels, stability, schemes, t_final)
+    fine, finest = finest_section(levels, schemes)
+    reference = paper_schemes[0] if paper_schemes else schemes[0]
+    parts += summary(levels, stable, paper_schemes, finest)
+    parts += stab + accuracy_section(levels, paper_schemes) + fine
+    parts += cost_section(levels, schemes, reference, finest)
+    parts += order_section(levels, time, space, paper_schemes)
+    parts += ["## Figures and tables", "",
+              "![L2 error per level](figures/levels.png)", "",
+              "![T monitor against time](figures/t_monitor.png)", "",
+              "![Convergence in time](figures/time_convergence.png)", "",
+              "![Convergence in space](figures/space_convergence.png)", "",
+              "Tables: [levels](tables/levels.md), [stability](tables/stability.md), "
+              "[time](tables/time_convergence.md), [space](tables/space_convergence.md) "
+              "(CSV and LaTeX next to them).", ""]
+    return "\n".join(parts)
