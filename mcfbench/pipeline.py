@@ -35,12 +35,9 @@ from mcfbench.running.solver import Solver
 from mcfbench.storage.atomic import json_value, save_npz, write_files, write_json
 from mcfbench.storage.provenance import code_hash, provenance
 from mcfbench.storage.records import FIELDS, RecordError, read_record, write_record
+from mcfbench.studies.config import ConfigError
 
 PROBLEM = "sphere"        # the problem of Table 3.1 and of the beyond study
-
-
-class ConfigError(ValueError):
-    """A config value the schema cannot check; the message names the key."""
 
 
 # -- logging and output ---------------------------------------------------------------

@@ -48,6 +48,7 @@ from mcfbench.presentation.documents import (
     render_html,
     render_markdown,
 )
+from mcfbench.presentation.figure_checks import figures
 from mcfbench.presentation.formats import (
     finite_value,
     pct,
@@ -70,7 +71,6 @@ from mcfbench.presentation.report_inputs import (
     sha256,
     table_3_1,
 )
-from mcfbench.presentation.figure_checks import figures
 from mcfbench.storage.atomic import write_files
 from mcfbench.storage.statuses import STATE_STATUSES
 

@@ -160,7 +160,7 @@ def simulate(flow, steps, *, solver=None, save_every=1, observers=(), on_defect=
         broken = err
     save()
     if progress and broken is None:
-        from tqdm import tqdm     # on first use: not paid at start-up without a bar
+        from tqdm import tqdm  # on first use: not paid at start-up without a bar
 
         bar = tqdm(total=int(steps), delay=2.0, unit="step")
     else:

@@ -17,8 +17,6 @@ from typing import Callable, Protocol, runtime_checkable
 import numpy as np
 
 
-
-
 @runtime_checkable
 class Flow(Protocol):
     """One flow of one surface, stepped by the driver.

@@ -19,9 +19,9 @@ from dataclasses import replace
 import numpy as np
 
 from mcfbench.geometry import metrics
-from mcfbench.running.driver import simulate
 from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.mesh import validate_mesh
+from mcfbench.running.driver import simulate
 from mcfbench.running.problems import get_problem
 from mcfbench.running.schemes import get_scheme
 from mcfbench.running.solver import Solver
@@ -167,7 +167,7 @@ def level_sweep(scheme, problem, levels=None, **options):
     """
     problem = get_problem(problem) if isinstance(problem, str) else problem
     levels = [int(level) for level in (problem.levels if levels is None else levels)]
-    import pandas as pd     # on first use: importing pandas takes 0.1-0.2 s
+    import pandas as pd  # on first use: importing pandas takes 0.1-0.2 s
 
     results = [run(scheme, problem, level, **options)[0] for level in levels]
     table = pd.DataFrame([r.to_dict(series=False) for r in results])
@@ -256,3 +256,64 @@ def space_convergence(scheme, problem, levels, tau, *, t_final=None, **options):
         As :func:`level_sweep`.
     """
     return level_sweep(scheme, problem, levels, tau=tau, t_final=t_final, **options)
+
+
+class _Unsupported(Exception):
+    """The scheme refused the surface (a ValueError of its constructor)."""
+
+
+class _Guarded:
+    """A scheme whose constructor's ValueError becomes :class:`_Unsupported`."""
+
+    def __init__(self, scheme):
+        self.scheme = scheme
+        self.name, self.family, self.label = scheme.name, scheme.family, scheme.label
+
+    def make(self, vertices, faces, tau, **options):
+        try:
+            return self.scheme.make(vertices, faces, tau, **options)
+        except ValueError as err:
+            raise _Unsupported(str(err)) from err
+
+
+def _nan_result(scheme, problem, level, mesh, tau, steps, status, message, method, seconds):
+    V, F = mesh
+    nan = float("nan")
+    return RunResult(
+        scheme=scheme.name, problem=problem.name, level=int(level), nV=len(V), nF=len(V),
+        nT=0, h=metrics.mean_edge_length(V, F), tau=float(tau), N=int(steps), steps_done=0,
+        status=status, message=message, t_failed=0.0, t_end=0.0, steady=False, iterations=0,
+        solver=method, cpu_seconds=seconds, wall_seconds=seconds, t_min_barycentric=nan,
+        min_angle=nan, max_aspect=nan, max_flipped=nan, metrics={}, series={})
+
+
+def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None):
+    """:func:`run` with ``save_every=0``, for the studies that keep frames files; a scheme that refuses
+    the surface gives status ``unsupported`` (the initial surface as both frames).
+
+    Returns
+    -------
+    result : RunResult
+    frames : dict of arrays
+        The trajectory's frames (first and last), ``faces``, ``steps``, ``t``.
+    """
+
+    scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
+    problem = get_problem(problem) if isinstance(problem, str) else problem
+    start = time.process_time()
+    try:
+        result, traj = run(_Guarded(scheme), problem, level, solver=solver, save_every=0,
+                           mesh=mesh, tau=tau)
+    except _Unsupported as err:
+        V, F = validate_mesh(*(problem.mesh(level) if mesh is None else mesh))
+        tau = problem.tau(level, (V, F)) if tau is None else float(tau)
+        steps = problem.time_steps(tau)
+        result = _nan_result(scheme, problem, level, (V, F), tau, steps, "unsupported",
+                             f"unsupported at step 0 (t = 0): {err}", solver.method,
+                             time.process_time() - start)
+        key = "F" if scheme.family == "ddfv" else "V"
+        return result, {key: np.stack([V, V]), "faces": F, "steps": np.array([0, 0]),
+                        "t": np.zeros(2)}
+    frames = dict(traj.frames)
+    frames.update(faces=traj.faces, steps=traj.steps, t=traj.t)
+    return result, frames

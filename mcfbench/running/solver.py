@@ -649,7 +649,7 @@ def _blocks(A, b, x0, overwrite_x0=False):
 
 def _factorize(A, ilu, drop_tol=1e-4, fill_factor=10.0):
     """SuperLU ``splu``/``spilu`` of ``A``: ``(lu, None)`` or ``(None, detail)``."""
-    import scipy.sparse.linalg as spla    # on first use (import cost at start-up)
+    import scipy.sparse.linalg as spla  # on first use (import cost at start-up)
 
     what = "ILU" if ilu else "LU"
     try:

@@ -21,14 +21,8 @@ import pandas as pd
 import pytest
 import yaml
 
-from mcfbench.pipeline import (
-    ConfigError,
-    Pipeline,
-    read_records,
-    run_job,
-    time_job,
-    used_schemes,
-)
+from mcfbench.pipeline import Pipeline, read_records, run_job, time_job, used_schemes
+from mcfbench.presentation.beyond_findings import beyond_findings as findings
 from mcfbench.presentation.beyond_tables import (
     beyond_documents,
     beyond_tables,
@@ -42,13 +36,13 @@ from mcfbench.presentation.convergence_tables import (
     level_table,
 )
 from mcfbench.presentation.plots import beyond_figures
-from mcfbench.presentation.beyond_findings import beyond_findings as findings
 from mcfbench.running.run import space_convergence
 from mcfbench.running.schemes import SCHEMES
 from mcfbench.storage.atomic import write_files
 from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.provenance import config_hash
 from mcfbench.storage.records import RecordError, read_record
+from mcfbench.studies.config import ConfigError
 
 REPO = Path(__file__).resolve().parents[2]
 CONFIG = yaml.safe_load((REPO / "config" / "config.yaml").read_text())

@@ -8,8 +8,8 @@ import igl
 import numpy as np
 import pandas as pd
 import pytest
-
 from conftest import bumpy_sphere, cylinder
+
 from mcfbench.cli import main
 from mcfbench.running.schemes import SCHEMES
 

@@ -2,9 +2,9 @@ import numpy as np
 import pytest
 
 from ddfv import Flow
-from mcfbench.running.driver import simulate
 from mcfbench.geometry.exact import SphereL2Error, eoc, sphere_radius
 from mcfbench.geometry.surfaces import icosphere
+from mcfbench.running.driver import simulate
 
 
 def test_l2_error_vanishes_on_the_exact_solution():

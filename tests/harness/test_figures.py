@@ -10,12 +10,24 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from mcfbench.studies.figures import (EXPERIMENTS, LABEL, PAPER_FIGURES, Experiment, Run, Shot, Track,
-                              Zoom, draw_experiment, experiment_panels, run_experiment,
-                              tracked, validate)
+from mcfbench.geometry.surfaces import make_surface
 from mcfbench.presentation.render import cells_centre, cells_points, project
 from mcfbench.running.schemes import SCHEMES, get_scheme
-from mcfbench.geometry.surfaces import make_surface
+from mcfbench.studies.figures import (
+    EXPERIMENTS,
+    LABEL,
+    PAPER_FIGURES,
+    Experiment,
+    Run,
+    Shot,
+    Track,
+    Zoom,
+    draw_experiment,
+    experiment_panels,
+    run_experiment,
+    tracked,
+    validate,
+)
 
 
 def n_vertices(run):

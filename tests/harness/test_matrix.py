@@ -13,11 +13,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mcfbench.studies import matrix
-from mcfbench.storage.statuses import STATUSES
+from mcfbench.presentation import matrix_findings, matrix_tables
 from mcfbench.running.problems import PROBLEMS
-from mcfbench.storage.records import FIELDS, read_record, write_record
 from mcfbench.running.schemes import SCHEMES
+from mcfbench.storage.records import FIELDS, read_record, write_record
+from mcfbench.storage.statuses import STATUSES
+from mcfbench.studies import gallery, matrix
+from mcfbench.studies.config import ConfigError
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -26,7 +28,7 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 def test_plan_defaults_to_every_scheme_and_problem():
-    plan = matrix.matrix_plan({})
+    plan = matrix.plan({})
     assert plan["schemes"] == list(SCHEMES)
     assert list(plan["problems"]) == list(PROBLEMS)
     assert plan["problems"]["sphere"] == sorted(PROBLEMS["sphere"].levels)
@@ -34,7 +36,7 @@ def test_plan_defaults_to_every_scheme_and_problem():
 
 
 def test_plan_levels_and_leaving_out():
-    plan = matrix.matrix_plan({"schemes": ["cotan"], "problems": {"sphere": ["2", 1],
+    plan = matrix.plan({"schemes": ["cotan"], "problems": {"sphere": ["2", 1],
                                                                    "torus": []}})
     assert plan["schemes"] == ["cotan"]
     assert plan["problems"]["sphere"] == [1, 2]
@@ -48,12 +50,12 @@ def test_plan_levels_and_leaving_out():
     ({"solver": "gmres"}, "matrix.solver"),
 ])
 def test_plan_names_the_bad_key(section, key):
-    with pytest.raises(matrix.ConfigError, match=key.replace(".", r"\.")):
-        matrix.matrix_plan(section)
+    with pytest.raises(ConfigError, match=key.replace(".", r"\.")):
+        matrix.plan(section)
 
 
 def test_mesh_problems_get_the_robust_solver():
-    plan = matrix.matrix_plan({})
+    plan = matrix.plan({})
     for name, problem in PROBLEMS.items():
         expected = plan["mesh_solver"] if problem.tau_rule == "mesh" else "bicgstab"
         assert matrix.solver_method(plan, name) == expected
@@ -66,13 +68,13 @@ def test_mesh_problems_get_the_robust_solver():
 def tiny(tmp_path_factory):
     """ddfv and cotan on sphere and catenoid, level 1, through run_job."""
     root = tmp_path_factory.mktemp("matrix")
-    plan = matrix.matrix_plan({"schemes": ["ddfv", "cotan"],
+    plan = matrix.plan({"schemes": ["ddfv", "cotan"],
                                "problems": {p: ([1] if p in ("sphere", "catenoid") else [])
                                             for p in PROBLEMS}})
     runs = matrix.planned_runs(plan, code="test", root=str(root))
     for path, settings in runs.items():
         frames = path.replace("/runs/", "/frames/").removesuffix(".json") + ".npz"
-        matrix.run_job(settings, path, frames)
+        matrix.job(settings, path, frames)
     table, summary = matrix.aggregate(runs, plan, root / "tables")
     return root, plan, runs, table, summary
 
@@ -99,7 +101,7 @@ def test_tiny_records_and_frames(tiny):
     # the paper's level-1 value (Table 3.1: 1.34e-2) within 10 %
     ddfv = sphere[sphere["scheme"] == "ddfv"]["value"].iloc[0]
     assert ddfv == pytest.approx(1.34e-2, rel=0.1)
-    assert list(table.columns) == matrix.LONG_COLUMNS
+    assert list(table.columns) == matrix_tables.LONG_COLUMNS
 
 
 def test_tiny_tables_and_findings(tiny):
@@ -110,7 +112,7 @@ def test_tiny_tables_and_findings(tiny):
         assert (out / name).is_file(), name
     for name in ("sphere.md", "catenoid.md", "summary.md"):
         assert "same footing" in (out / name).read_text()
-    text = matrix.write_findings(out / "summary.csv", root / "findings.md", plan)
+    text = matrix.findings(out / "summary.csv", root / "findings.md", plan)
     for problem in plan["problems"]:
         assert f"### {problem}" in text
     for r in summary.itertuples():  # every status is shown, in the tables and the text
@@ -118,13 +120,17 @@ def test_tiny_tables_and_findings(tiny):
             assert f"{r.status} at t = {r.t_failed:.4g}" in (out / "summary.md").read_text()
             assert f"{r.status} at t = {r.t_failed:.4g}" in text
     assert "## Across problems" in text
-    back = matrix.read_long_table(out / "matrix.csv")
+    back = matrix_tables.read_long_table(out / "matrix.csv")
     assert len(back) == len(table)
     assert np.allclose(back["value"], table["value"], equal_nan=True, rtol=1e-9)
 
 
 def test_tiny_plots(tiny):
-    from mcfbench.presentation.matrix_plots import error_figure, picture_grid, quality_figure
+    from mcfbench.presentation.matrix_plots import (
+        error_figure,
+        picture_grid,
+        quality_figure,
+    )
 
     root, plan, runs, table, _ = tiny
     problems, schemes = list(plan["problems"]), plan["schemes"]
@@ -166,7 +172,7 @@ def test_eoc_is_log2_of_the_error_ratio(tmp_path):
     path = tmp_path / "r.json"
     write_record(path, records[0], {"x": 1})
     assert read_record(path, settings={"x": 1})["l2_error"] == 1.0e-2
-    table = matrix.long_table(records)
+    table = matrix_tables.long_table(records)
     for scheme, es in errors.items():
         eoc = table[(table["scheme"] == scheme) & (table["problem"] == "sphere")]["eoc"]
         assert math.isnan(eoc.iloc[0])
@@ -175,14 +181,14 @@ def test_eoc_is_log2_of_the_error_ratio(tmp_path):
     cat = table[table["problem"] == "catenoid"]
     assert cat["status"].tolist() == ["ok", "t_escaped"]
     assert cat["eoc"].isna().all()
-    summary = matrix.summary_table(table)
+    summary = matrix_tables.summary_table(table)
     a = summary[(summary["problem"] == "sphere") & (summary["scheme"] == "a")].iloc[0]
     assert a["eoc"] == pytest.approx(math.log2(2.5e-3 / 6.0e-4))
     assert a["finest_value"] == 6.0e-4 and a["status"] == "ok"
     c = summary[summary["problem"] == "catenoid"].iloc[0]
     assert c["status"] == "t_escaped" and c["t_failed"] == 0.25 and c["failed_level"] == 2
-    assert "t_escaped at t = 0.25 (level 2)" in matrix.summary_cell(c)
-    text = matrix.findings(summary)
+    assert "t_escaped at t = 0.25 (level 2)" in matrix_tables.summary_cell(c)
+    text = matrix_findings.matrix_findings(summary)
     assert "**a** converges at order ~2" in text
     assert "**b** does not converge" in text
     assert "broke down in 1 of 2 runs (level 2: t_escaped at t = 0.25)" in text
@@ -196,7 +202,7 @@ def test_recommendation_when_one_scheme_wins():
             records += [_record(scheme, problem, k, c * 4.0 ** -k,
                                 metric="l2_error" if problem == "sphere" else "max_height")
                         for k in (1, 2, 3)]
-    text = matrix.findings(matrix.summary_table(matrix.long_table(records)))
+    text = matrix_findings.matrix_findings(matrix_tables.summary_table(matrix_tables.long_table(records)))
     assert "**Recommendation: good**" in text
 
 
@@ -214,13 +220,13 @@ def test_snakemake_dry_run(tmp_path):
             src, work / name, **({"ignore": shutil.ignore_patterns("__pycache__")}
                                  if src.is_dir() else {}))
     meshes = tmp_path / "meshes"
-    matrix.write_obj(meshes / "tet.obj", [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]],
+    gallery.write_obj(meshes / "tet.obj", [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]],
                      [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
     out = subprocess.run([sys.executable, "-m", "snakemake", "-n", "--cores", "2",
                           "matrix", "gallery", "--config", f"meshes={meshes}"],
                          cwd=work, capture_output=True, text=True)
     assert out.returncode == 0, out.stderr[-3000:]
-    plan = matrix.matrix_plan(
+    plan = matrix.plan(
         __import__("yaml").safe_load((REPO / "config" / "config.yaml").read_text())["matrix"])
     runs = sum(len(levels) for levels in plan["problems"].values()) * len(plan["schemes"])
     counts = dict(line.split()[:2] for line in out.stdout.splitlines()
@@ -237,10 +243,10 @@ def test_gallery_runs_every_scheme_on_every_file(tmp_path):
     from mcfbench.geometry.surfaces import make_surface
 
     meshes = tmp_path / "meshes"
-    matrix.write_obj(meshes / "ball.obj", *make_surface("sphere", level=2))
+    gallery.write_obj(meshes / "ball.obj", *make_surface("sphere", level=2))
     (meshes / "broken.off").write_text("OFF\n3 1 0\n0 0 0\n1 0 0\n")
     (meshes / "notes.txt").write_text("not a mesh")
-    plan = matrix.gallery_plan({"schemes": ["ddfv", "cotan"], "steps": 3}, str(meshes))
+    plan = gallery.plan({"schemes": ["ddfv", "cotan"], "steps": 3}, str(meshes))
     assert list(plan["meshes"]) == ["ball.obj", "broken.off"]
     assert plan["C"] == 0.1 and plan["solver"] == matrix.robust_method()
     records = []
@@ -249,15 +255,15 @@ def test_gallery_runs_every_scheme_on_every_file(tmp_path):
             settings = {"study": "gallery", "mesh": mesh, "scheme": scheme,
                         **{k: plan[k] for k in ("C", "steps", "solver", "rtol", "maxiter")}}
             out = tmp_path / "runs" / mesh / f"{scheme}.json"
-            matrix.gallery_job(path, scheme, settings, out, out.with_suffix(".npz"))
+            gallery.job(path, scheme, settings, out, out.with_suffix(".npz"))
             records.append(read_record(out, settings=settings))
-    table = matrix.gallery_table(records)
+    table = matrix_tables.gallery_table(records)
     ball = table[table["mesh"] == "ball.obj"]
     assert ball["status"].tolist() == ["ok", "ok"] and ball["steps_done"].tolist() == [3, 3]
     h = ball["h"].iloc[0]
     assert ball["tau"].iloc[0] == pytest.approx(0.1 * h * h)
     assert (table[table["mesh"] == "broken.off"]["status"] == "unsupported").all()
-    text = matrix.gallery_markdown(table, plan)
+    text = matrix_tables.gallery_markdown(table, plan)
     assert "same footing" in text and "| ball.obj | ddfv | ok | 3/3 |" in text
-    with pytest.raises(matrix.ConfigError, match="'meshes'"):
-        matrix.gallery_plan({}, str(tmp_path / "missing"))
+    with pytest.raises(ConfigError, match="'meshes'"):
+        gallery.plan({}, str(tmp_path / "missing"))

@@ -2,8 +2,8 @@
 
 import numpy as np
 import pytest
-
 from conftest import cylinder, flat_lattice
+
 from mcfbench.geometry.mesh import MeshError, MeshSummary, summarize, validate_mesh
 
 

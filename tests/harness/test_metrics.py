@@ -4,9 +4,23 @@ import numpy as np
 import pytest
 
 from mcfbench.geometry.metrics import (
-    area, area_ratio, aspect_ratios, catenoid_parameter, catenoid_profile_error,
-    flipped_triangles, l2_height, lumped_mass, max_aspect_ratio, max_height, max_speed,
-    mean_edge_length, min_angle, quality, triangle_angles, triangle_areas, volume,
+    area,
+    area_ratio,
+    aspect_ratios,
+    catenoid_parameter,
+    catenoid_profile_error,
+    flipped_triangles,
+    l2_height,
+    lumped_mass,
+    max_aspect_ratio,
+    max_height,
+    max_speed,
+    mean_edge_length,
+    min_angle,
+    quality,
+    triangle_angles,
+    triangle_areas,
+    volume,
 )
 from mcfbench.geometry.surfaces import cylinder, flat_lattice, hemisphere, icosahedron
 
@@ -228,7 +242,11 @@ def test_inputs_of_the_wrong_shape_are_refused():
 
 def _numpy_quality(V, F):
     """The monitors of :func:`quality` evaluated with plain numpy (the test oracle)."""
-    from mcfbench.geometry.metrics import aspect_ratios, flipped_triangles, triangle_areas
+    from mcfbench.geometry.metrics import (
+        aspect_ratios,
+        flipped_triangles,
+        triangle_areas,
+    )
 
     A = triangle_areas(V, F)
     return {"min_angle": float(triangle_angles(V, F).min()),

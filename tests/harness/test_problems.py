@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from mcfbench.storage.statuses import STATUSES
 from mcfbench.geometry.mesh import summarize
 from mcfbench.geometry.metrics import catenoid_parameter
 from mcfbench.running.problems import PROBLEMS, Problem, get_problem, time_steps
-from mcfbench.running.schemes import SCHEMES
 from mcfbench.running.run import run
+from mcfbench.running.schemes import SCHEMES
+from mcfbench.storage.statuses import STATUSES
 
 CLOSED = {"sphere": 0, "torus": 1, "dumbbell": 0, "perturbed_sphere": 0, "remeshed_sphere": 0,
           "anisotropic_sphere": 0, "blobby": 0, "marching_torus": 1}

@@ -5,7 +5,12 @@ import subprocess
 import sys
 from pathlib import Path
 
-from mcfbench.storage.provenance import config_hash, dependency_versions, provenance, source_hash
+from mcfbench.storage.provenance import (
+    config_hash,
+    dependency_versions,
+    provenance,
+    source_hash,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 

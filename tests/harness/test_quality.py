@@ -8,11 +8,20 @@ import pytest
 from baselines.cotan import CotanFlow
 from ddfv import Flow
 from ddfv.topology import diamond_mesh
-from mcfbench.running.driver import simulate
-from mcfbench.geometry.quality import (COLUMNS, DIAMOND_COLUMNS, MeshQuality, describe_violation,
-                              diamond_min_angles, first_violation, mesh_quality, plot_quality,
-                              primal_quality, vertex_quality)
+from mcfbench.geometry.quality import (
+    COLUMNS,
+    DIAMOND_COLUMNS,
+    MeshQuality,
+    describe_violation,
+    diamond_min_angles,
+    first_violation,
+    mesh_quality,
+    plot_quality,
+    primal_quality,
+    vertex_quality,
+)
 from mcfbench.geometry.surfaces import cylinder, icosphere
+from mcfbench.running.driver import simulate
 
 
 @pytest.fixture(scope="module")

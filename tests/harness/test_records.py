@@ -5,8 +5,8 @@ import math
 
 import pytest
 
-from mcfbench.storage.records import RecordError, read_record, write_record
 from mcfbench.running.run import run
+from mcfbench.storage.records import RecordError, read_record, write_record
 
 SETTINGS = {"scheme": "cotan", "problem": "sphere", "level": 1}
 

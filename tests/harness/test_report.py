@@ -24,9 +24,9 @@ import pytest
 import yaml
 
 from mcfbench.presentation import documents, report, report_inputs
-from mcfbench.studies.figures import EXPERIMENTS, PAPER_FIGURES
-from mcfbench.running.schemes import SCHEMES
 from mcfbench.presentation.convergence_tables import PUBLISHED
+from mcfbench.running.schemes import SCHEMES
+from mcfbench.studies.figures import EXPERIMENTS, PAPER_FIGURES
 
 REPO = Path(__file__).resolve().parents[2]
 

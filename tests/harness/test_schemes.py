@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
+from mcfbench.geometry.surfaces import icosphere, random_bumpy_sphere
 from mcfbench.running.driver import simulate
 from mcfbench.running.flow import Flow
 from mcfbench.running.schemes import SCHEMES, get_scheme
-from mcfbench.geometry.surfaces import icosphere, random_bumpy_sphere
 
 
 @pytest.mark.parametrize("name", sorted(SCHEMES))

@@ -10,8 +10,14 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from mcfbench.running.solver import (METHODS, SolveInfo, Solver, SolverFailure, apply_block,
-                             solve)
+from mcfbench.running.solver import (
+    METHODS,
+    SolveInfo,
+    Solver,
+    SolverFailure,
+    apply_block,
+    solve,
+)
 
 pytestmark = pytest.mark.filterwarnings("error")   # no arithmetic warning may escape
 

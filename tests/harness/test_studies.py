@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from mcfbench.running.run import level_sweep, run, space_convergence, time_convergence
 from mcfbench.geometry.surfaces import icosphere
+from mcfbench.running.run import level_sweep, run, space_convergence, time_convergence
 
 
 @pytest.mark.parametrize("scheme", ["ddfv", "cotan"])

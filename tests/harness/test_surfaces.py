@@ -8,9 +8,26 @@ import pytest
 
 from mcfbench.geometry.metrics import area, mean_edge_length, triangle_areas, volume
 from mcfbench.geometry.surfaces import (
-    SURFACES, anisotropic_sphere, blobby, bumpy_sphere, cylinder, dumbbell, dumbbell_profile,
-    flat_lattice, flat_patch, hemisphere, icosahedron, icosphere, implicit_torus, isosurface,
-    make_surface, perturbed_sphere, random_bumpy_sphere, remeshed_sphere, subdivide, torus,
+    SURFACES,
+    anisotropic_sphere,
+    blobby,
+    bumpy_sphere,
+    cylinder,
+    dumbbell,
+    dumbbell_profile,
+    flat_lattice,
+    flat_patch,
+    hemisphere,
+    icosahedron,
+    icosphere,
+    implicit_torus,
+    isosurface,
+    make_surface,
+    perturbed_sphere,
+    random_bumpy_sphere,
+    remeshed_sphere,
+    subdivide,
+    torus,
 )
 
 # name -> (n_F, n_T, boundary loops, Euler characteristic) at the default parameters

@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from mcfbench.running.problems import get_problem
-from mcfbench.running.solver import Solver
-from mcfbench.running.run import run
 from mcfbench.presentation.convergence_tables import PUBLISHED
+from mcfbench.running.problems import get_problem
+from mcfbench.running.run import run
+from mcfbench.running.solver import Solver
 from mcfbench.studies.convergence import sphere_table
 
 

@@ -14,7 +14,9 @@
 # Outputs under results/gallery/: runs/{mesh}/{scheme}.json,
 # frames/{mesh}/{scheme}.npz, table.md, table.csv, pictures.png, pictures.pdf.
 
-GALLERY = _matrix.gallery_plan(config.get("gallery"), config.get("meshes"))
+from mcfbench.studies import gallery as _gallery
+
+GALLERY = _gallery.plan(config.get("gallery"), config.get("meshes"))
 GALLERY_SETTINGS = {
     "study": "gallery",
     **{k: GALLERY[k] for k in ("C", "steps", "solver", "rtol", "maxiter")},

@@ -5,7 +5,7 @@
 #
 # Settings: the config key `matrix` (config/config.yaml), checked against the
 # registries mcfbench.running.schemes.SCHEMES and mcfbench.running.problems.PROBLEMS by
-# mcfbench.studies.matrix.matrix_plan before any job runs. Everything but the rules
+# mcfbench.studies.matrix.plan before any job runs. Everything but the rules
 # is in mcfbench/studies/matrix.py (tables, findings) and mcfbench/presentation/matrix_plots.py.
 #
 # Outputs under results/matrix/:
@@ -21,7 +21,7 @@ from mcfbench.studies import matrix as _matrix
 from mcfbench.pipeline import alternatives as _alternatives
 from mcfbench.storage.provenance import code_hash as _code_hash
 
-MATRIX = _matrix.matrix_plan(config.get("matrix"))
+MATRIX = _matrix.plan(config.get("matrix"))
 # a run is redone when the code that computes it changes (not the tables or plots)
 MATRIX_CODE = _code_hash()
 # {record path: settings} of every run

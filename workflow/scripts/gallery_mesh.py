@@ -1,9 +1,9 @@
 """One of the suite's own gallery meshes as OBJ (rule ``gallery_mesh``,
-workflow/rules/gallery.smk; :func:`mcfbench.studies.matrix.write_generated_mesh`)."""
+workflow/rules/gallery.smk; :func:`mcfbench.studies.gallery.write_generated_mesh`)."""
 
 import logging
 
-from mcfbench.studies.matrix import write_generated_mesh
+from mcfbench.studies.gallery import write_generated_mesh
 
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, force=True)  # noqa: F821
 write_generated_mesh(snakemake.params.entry, snakemake.output[0])  # noqa: F821

@@ -1,5 +1,5 @@
 """One scheme on one mesh file of the gallery (rule ``gallery_run``,
-workflow/rules/gallery.smk; :func:`mcfbench.studies.matrix.gallery_job`)."""
+workflow/rules/gallery.smk; :func:`mcfbench.studies.gallery.job`)."""
 
 import os
 
@@ -8,8 +8,8 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
              "NUMBA_NUM_THREADS"):
     os.environ[_var] = "1"
 
-from mcfbench.studies.matrix import gallery_job  # noqa: E402
+from mcfbench.studies import gallery  # noqa: E402
 
 sm = snakemake  # noqa: F821
-gallery_job(sm.input.mesh, sm.params.settings["scheme"], sm.params.settings,
+gallery.job(sm.input.mesh, sm.params.settings["scheme"], sm.params.settings,
             sm.output.record, sm.output.frames, sm.log[0])

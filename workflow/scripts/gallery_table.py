@@ -1,10 +1,11 @@
 """The gallery table, mesh x scheme (rule ``gallery_table``,
-workflow/rules/gallery.smk; :func:`mcfbench.studies.matrix.gallery_table`)."""
+workflow/rules/gallery.smk; :func:`mcfbench.studies.matrix_tables.gallery_table`)."""
 
 import logging
 
 from mcfbench.storage.atomic import write_text
-from mcfbench.studies.matrix import gallery_markdown, gallery_table, read_runs
+from mcfbench.presentation.matrix_tables import gallery_markdown, gallery_table
+from mcfbench.studies.matrix import read_runs
 
 sm = snakemake  # noqa: F821
 logging.basicConfig(filename=sm.log[0], level=logging.INFO, force=True)

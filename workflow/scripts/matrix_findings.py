@@ -1,14 +1,14 @@
 """findings.md of the benchmark matrix, from the summary table only.
 
 Called by rule ``matrix_findings`` (workflow/rules/matrix.smk); the text is
-:func:`mcfbench.studies.matrix.findings` of ``summary.csv``.
+:func:`mcfbench.studies.matrix_findings.matrix_findings` of ``summary.csv``.
 """
 
 import logging
 
-from mcfbench.studies.matrix import write_findings
+from mcfbench.studies import matrix
 
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, force=True)  # noqa: F821
-text = write_findings(snakemake.input.summary, snakemake.output[0],  # noqa: F821
-                      snakemake.params.plan)  # noqa: F821
+text = matrix.findings(snakemake.input.summary, snakemake.output[0],  # noqa: F821
+                        snakemake.params.plan)  # noqa: F821
 logging.info("\n%s", text)

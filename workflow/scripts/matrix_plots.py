@@ -13,7 +13,8 @@ from mcfbench.presentation.matrix_plots import (
              quality_figure,
 )
 from mcfbench.storage.records import read_record
-from mcfbench.studies.matrix import load_frames, read_long_table, read_runs
+from mcfbench.presentation.matrix_tables import read_long_table
+from mcfbench.studies.matrix import load_frames, read_runs
 
 sm = snakemake  # noqa: F821
 logging.basicConfig(filename=sm.log[0], level=logging.INFO, force=True)

@@ -2,7 +2,7 @@
 
 Called by rule ``matrix_run`` (workflow/rules/matrix.smk); the settings come
 from ``params.settings`` (:func:`mcfbench.studies.matrix.run_settings`). The work is
-:func:`mcfbench.studies.matrix.run_job`.
+:func:`mcfbench.studies.matrix.job`.
 """
 
 import os
@@ -12,7 +12,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
              "NUMBA_NUM_THREADS"):
     os.environ[_var] = "1"
 
-from mcfbench.studies.matrix import run_job  # noqa: E402
+from mcfbench.studies import matrix  # noqa: E402
 
-run_job(snakemake.params.settings, snakemake.output.record,  # noqa: F821
-        snakemake.output.frames, snakemake.log[0])  # noqa: F821
+matrix.job(snakemake.params.settings, snakemake.output.record,  # noqa: F821
+           snakemake.output.frames, snakemake.log[0])  # noqa: F821

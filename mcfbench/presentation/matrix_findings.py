@@ -1,0 +1,263 @@
+"""The findings of the benchmark matrix in words, from its summary table only: which scheme converges at which order on which problem, which breaks down where, and the recommendation."""
+
+import numpy as np
+
+ORDER_BAND = (1.7, 2.3)
+
+
+CONVERGING_EOC = 0.5
+
+
+WRONG_LIMIT = 10.0
+
+
+TIE = 0.05
+
+
+ROUNDOFF = 1e-10
+
+
+def _pct_or(value, metric):
+    """Relative metrics (``*relative*`` or the catenoid's neck) in percent."""
+    if "relative" in metric or metric.startswith("neck"):
+        return f"{100 * value:+.3g} %"
+    return f"{value:.3e}"
+
+
+def _classify(row):
+    """``order2``, ``converging``, ``not_converging``, ``exact`` (round-off),
+    ``broke_down`` or ``no_error``."""
+    if row["runs_ok"] < row["runs"]:
+        return "broke_down"
+    if not row["error"]:
+        return "no_error"
+    values = [abs(float(v)) for v in str(row["values"]).split(";") if v]
+    if values and all(np.isfinite(v) and v <= ROUNDOFF for v in values):
+        return "exact"
+    if not np.isfinite(row["eoc"]):
+        return "one_level" if sum(np.isfinite(v) for v in values) < 2 else "not_converging"
+    if ORDER_BAND[0] <= row["eoc"] <= ORDER_BAND[1]:
+        return "order2"
+    return "converging" if row["eoc"] >= CONVERGING_EOC else "not_converging"
+
+
+def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summary.csv"):
+    """The findings, Markdown, written from the summary table only.
+
+    Parameters
+    ----------
+    summary : pandas.DataFrame
+        :func:`summary_table` (or ``summary.csv`` read back).
+    labels : dict, optional
+        Scheme name -> label.
+    mesh_problems : sequence of str
+        The real-world-like problems (no refinement series).
+    """
+    labels = labels or {}
+    problems = list(dict.fromkeys(summary["problem"]))
+    schemes = list(dict.fromkeys(summary["scheme"]))
+    lines = ["# Findings of the benchmark matrix", "",
+             f"Written by `mcfbench.studies.matrix.findings` from `{source}`: every number below "
+             "is read from the tables, none typed by hand. Order ~2 means an EOC between "
+             f"the two finest finished levels in [{ORDER_BAND[0]}, {ORDER_BAND[1]}]; an "
+             f"error with EOC below {CONVERGING_EOC} is not decreasing.", ""]
+    verdict = {}
+    lines += ["## Per problem", ""]
+    for problem in problems:
+        part = summary[summary["problem"] == problem].copy()
+        part["class"] = [_classify(r) for _, r in part.iterrows()]
+        metric = part["metric"].iloc[0]
+        kind = "real-world-like mesh" if problem in mesh_problems else \
+            "refinement series" if part["error"].iloc[0] else "refinement series, no exact value"
+        done = part[(part["runs_ok"] == part["runs"]) & np.isfinite(part["finest_value"])]
+        smallest = np.abs(done["finest_value"]).min() if len(done) else np.nan
+        lines += [f"### {problem}", "",
+                  f"Main metric `{metric}`; levels {part['levels'].iloc[0]} ({kind}).", ""]
+        for _, r in part.iterrows():
+            verdict[(problem, r["scheme"])] = r
+            name = f"**{r['scheme']}**"
+            values = [float(v) if v else float("nan") for v in str(r["values"]).split(";")]
+            shown = ", ".join(_pct_or(v, metric) if np.isfinite(v) else "–" for v in values)
+            eocs = str(r["eocs"]) if isinstance(r["eocs"], str) else ""
+            if r["class"] == "order2":
+                text = (f"{name} converges at order ~2: EOC {r['eoc']:.2f} (levels "
+                        f"{r['eoc_levels']}), finest error {_pct_or(r['finest_value'], metric)}"
+                        f" (level {int(r['finest_level'])}); errors {shown}.")
+            elif r["class"] == "converging":
+                text = (f"{name} converges at order {r['eoc']:.2f} (levels {r['eoc_levels']}),"
+                        f" not ~2; errors {shown}.")
+            elif r["class"] == "not_converging":
+                text = (f"{name} does not converge: the error is not decreasing (EOCs "
+                        f"{eocs.replace(';', ', ') or '–'}; errors {shown})")
+                ratio = abs(r["finest_value"]) / smallest if smallest > 0 else np.inf
+                if ratio >= WRONG_LIMIT:
+                    text += (f": it converges to another surface (finest error {ratio:.3g} x "
+                             "the smallest of any scheme).")
+                else:
+                    text += "."
+            elif r["class"] == "one_level":
+                text = (f"{name}: one finished level only ({metric} {shown}), no EOC.")
+            elif r["class"] == "exact":
+                text = (f"{name} is exact up to round-off: {metric} at most "
+                        f"{max(abs(v) for v in values):.2e} on every level.")
+            elif r["class"] == "no_error":
+                text = (f"{name} finished every level; {metric} at the finest level "
+                        f"{r['finest_value']:.4g}.")
+            else:
+                fails = [f.split(":") for f in str(r["failed"]).split(";") if f]
+                where = "; ".join(f"level {lv}: {st}" + (f" at t = {float(t):.4g}" if t else "")
+                                  for lv, st, t in fails)
+                text = (f"{name} broke down in {r['runs'] - r['runs_ok']} of {r['runs']} runs "
+                        f"({where}).")
+                if np.isfinite(r["finest_value"]):
+                    text += (f" Finished levels: {metric} {shown}"
+                             + (f", EOC {r['eoc']:.2f}" if np.isfinite(r["eoc"]) else "") + ".")
+            if np.isfinite(r["t_min_barycentric"]):
+                text += f" Smallest T monitor {r['t_min_barycentric']:.3g}."
+            lines.append("- " + text)
+        lines += _common_floor(part, metric)
+        lines.append("")
+    lines += recommendation(summary, verdict, problems, schemes, mesh_problems)
+    return "\n".join(lines).rstrip() + "\n"
+
+
+def _common_floor(part, metric):
+    """A remark when no scheme's error decreases and all finish with about the
+    same error: the floor belongs to the problem, not to a scheme."""
+    finished = part[part["class"].isin(["not_converging", "converging"])]
+    if len(finished) < 2 or (part["class"] == "order2").any() \
+            or not (finished["class"] == "not_converging").all():
+        return []
+    values = np.abs(finished["finest_value"].to_numpy(dtype=float))
+    spread = values.max() / values.min() if values.min() > 0 else np.inf
+    if not spread < 2.0:
+        return []
+    return ["", f"No scheme's error decreases at order ~2 here, and the {len(finished)} schemes "
+                f"that finished end within a factor {spread:.2f} of each other "
+                f"({values.min():.3e} to {values.max():.3e}): an error floor common to all "
+                "schemes (the problem's stopping rule or time error), not a property of one "
+                "scheme."]
+
+
+def recommendation(summary, verdict, problems, schemes, mesh_problems):
+    """The section "Across problems".
+
+    A candidate converges on every problem with an exact error (at order ~2
+    wherever at least one scheme reaches order ~2 there; otherwise it only
+    has to finish every level) and breaks down on none of the
+    real-world-like meshes. Candidates are ranked by the geometric mean over
+    those problems of their finest-level error relative to the smallest
+    one. The problems without an exact value (singular flows such as a
+    pinching torus) only inform: which scheme reaches the latest time.
+    """
+    mesh_problems = [p for p in problems if p in set(mesh_problems)]
+    exact = [p for p in problems if p not in mesh_problems
+             and bool(summary[summary["problem"] == p]["error"].any())]
+    singular = [p for p in problems if p not in exact and p not in mesh_problems]
+    lines = ["## Across problems", ""]
+    if not exact:
+        return lines + ["No problem with an exact error was run: no recommendation.", ""]
+    lines.append(f"Problems with an exact error: {', '.join(exact)}. Real-world-like meshes "
+                 f"(a breakdown disqualifies): {', '.join(mesh_problems) or 'none run'}. "
+                 f"Without an exact value (breakdown times only): "
+                 f"{', '.join(singular) or 'none'}.")
+    lines.append("")
+
+    def cls(p, s):
+        return _classify(verdict[(p, s)]) if (p, s) in verdict else "missing"
+
+    needs_order2 = {p: any(cls(p, s) == "order2" for s in schemes) for p in exact}
+    relaxed = [p for p in exact if not needs_order2[p]]
+    if relaxed:
+        lines.append(f"No scheme reaches order ~2 on {', '.join(relaxed)}: there a scheme "
+                     "only has to finish every level.")
+        lines.append("")
+    winners = {}
+    for p in exact:
+        good = [s for s in schemes if cls(p, s) in ("order2", "exact")] if needs_order2[p] \
+            else [s for s in schemes
+                  if cls(p, s) in ("converging", "not_converging", "exact", "one_level")]
+        if good:
+            winners[p] = min(good, key=lambda s: abs(verdict[(p, s)]["finest_value"]))
+    candidates, why_not = [], {}
+    for s in schemes:
+        reasons = []
+        for p in exact:
+            c = cls(p, s)
+            if c == "missing":
+                reasons.append(f"not run on {p}")
+            elif c == "broke_down":
+                reasons.append(f"broke down on {p}")
+            elif needs_order2[p] and c not in ("order2", "exact"):
+                eoc = verdict[(p, s)]["eoc"]
+                reasons.append(f"EOC {eoc:.2f} on {p}" if np.isfinite(eoc) else
+                               f"no EOC on {p}")
+        for p in mesh_problems:
+            if (p, s) in verdict and cls(p, s) == "broke_down":
+                reasons.append(f"broke down on {p}")
+        if reasons:
+            why_not[s] = reasons
+        else:
+            candidates.append(s)
+    ratios = {}
+    for p in exact:
+        part = summary[(summary["problem"] == p) & np.isfinite(summary["finest_value"])
+                       & (summary["runs_ok"] == summary["runs"])]
+        best = np.abs(part["finest_value"]).min() if len(part) else np.nan
+        if not best > ROUNDOFF:  # exact to round-off somewhere: no ranking by this problem
+            continue
+        for _, r in part.iterrows():
+            ratios[(p, r["scheme"])] = abs(r["finest_value"]) / best
+
+    def geometric_mean(s):
+        logs = [np.log(ratios[(p, s)]) for p in exact if (p, s) in ratios]
+        return float(np.exp(np.mean(logs))) if logs else float("nan")
+
+    if candidates:
+        score = {s: geometric_mean(s) for s in candidates}
+        ranked = sorted(candidates, key=lambda s: (not np.isfinite(score[s]), score[s]))
+        best = ranked[0]
+        lines.append("Converge as required on every problem with an exact error and do not "
+                     "break down on the real-world-like meshes: " + ", ".join(
+                         f"{s} (finest-level errors {score[s]:.3g} x the smallest, geometric "
+                         "mean)" for s in ranked) + ".")
+        lines.append("")
+        tied = [s for s in ranked[1:] if score[s] <= (1 + TIE) * score[best]]
+        if tied:
+            lines.append(f"{best} and {', '.join(tied)} are practically tied (scores within "
+                         f"{100 * TIE:.0f} %): either is a sound choice.")
+            lines.append("")
+        beaten = [f"{p}: {winners[p]}" for p in exact if winners.get(p) not in (None, best)]
+        lines.append(f"**Recommendation: {best}**" + (
+            ", with the smallest finest-level error on every problem with an exact error."
+            if not beaten else
+            ", the smallest finest-level errors on average among them, though not on every "
+            "problem (smallest elsewhere: " + "; ".join(beaten) + ")."))
+    else:
+        lines.append("**No scheme wins everywhere**: none converges as required on every "
+                     "problem with an exact error without breaking down on a real-world-like "
+                     "mesh.")
+    lines.append("")
+    lines.append("Smallest finest-level error per problem (among the schemes that converge as "
+                 "required there): " + "; ".join(f"{p}: {winners.get(p, 'none')}"
+                                                 for p in exact) + ".")
+    if why_not:
+        lines.append("")
+        lines.append("Left out: " + "; ".join(f"{s} ({', '.join(r)})"
+                                              for s, r in why_not.items()) + ".")
+    if singular:
+        lines.append("")
+        for p in singular:
+            done = [s for s in schemes if (p, s) in verdict and cls(p, s) != "broke_down"]
+            times = {s: verdict[(p, s)]["t_failed"] for s in schemes if (p, s) in verdict
+                     and cls(p, s) == "broke_down" and np.isfinite(verdict[(p, s)]["t_failed"])}
+            text = f"On {p} "
+            text += (f"{', '.join(done)} finished every level" if done else
+                     "every scheme broke down")
+            if times:
+                latest = max(times, key=times.get)
+                text += ("; " if done else ", ") + f"the latest breakdown: {latest} at t = " \
+                    f"{times[latest]:.4g} (earliest: {min(times, key=times.get)} at t = " \
+                    f"{min(times.values()):.4g}; coarsest failing level)"
+            lines.append(text + ".")
+    return lines + [""]

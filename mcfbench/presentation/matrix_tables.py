@@ -1,0 +1,395 @@
+"""The tables of the benchmark matrix: the long table (one row per run and metric, EOC (3.1) of every error), the table of one problem, the summary (problem x scheme), their Markdown and LaTeX, and the gallery's table.
+
+Errors and EOC
+--------------
+A metric is an *error* when its exact value is zero (:func:`is_error`:
+``l2_error``, the catenoid's neck and profile errors, the height of the
+hemisphere above the flat disk, the displacement of the flat patch). Its
+EOC between levels ``k - 1`` and ``k`` is ``log2(|e_{k-1}| / |e_k|)``
+(levels one apart, both runs finished). Other metrics (volume, area) have
+no exact value: no EOC. The *main metric* of a problem
+(:func:`main_metric`) is the one of the summary, the plots and the
+findings.
+"""
+
+import math
+
+import numpy as np
+
+TIMING_BASE = (
+    "Timings compare schemes fairly only on the same footing: the same solver and "
+    "tolerance rule, the same machine, one core each. A DDFV system has about 3 times "
+    "the unknowns of a vertex-based scheme (F- and T-vertices)."
+)
+
+
+TIMING_NOTE = TIMING_BASE[:-1] + (
+    "; the matrix uses BiCGStab on the refinement series but the robust solver on the "
+    "real-world-like meshes, so compare timings within one problem only."
+)
+
+
+# metric observer (Problem.metrics) -> preferred main metrics, best first
+MAIN_METRICS = {
+    "sphere_l2": ("l2_error",),
+    "catenoid": ("neck_error", "max_radial_error"),
+    "height": ("max_height", "l2_height"),
+    "shape": ("volume", "area"),
+    "still": ("max_displacement", "max_height"),
+}
+
+
+# metrics whose exact value is zero besides the ones named "*error*"
+ZERO_METRICS = ("max_height", "l2_height", "max_displacement")
+
+
+# modules that do not change what a run computes (left out of the code digest)
+LONG_COLUMNS = ["scheme", "problem", "level", "h", "tau", "steps", "steps_done", "metric",
+                "value", "eoc", "status", "t_failed", "min_angle", "max_flipped",
+                "t_min_barycentric", "iterations", "cpu_seconds"]
+
+
+def is_error(metric):
+    """The metric's exact value is zero (it is an error): EOC applies."""
+    return "error" in metric or metric in ZERO_METRICS
+
+
+def main_metric(problem, available=()):
+    """The metric of ``problem`` shown in the summary, the plots and the findings.
+
+    ``problem.main_metric`` if the problem names one, else the first of
+    :data:`MAIN_METRICS` of its observers found in ``available``, else the
+    first error among ``available``, else the first of ``available``.
+    """
+    from mcfbench.running.problems import get_problem
+
+    problem = get_problem(problem) if isinstance(problem, str) else problem
+    available = list(available)
+    named = getattr(problem, "main_metric", None)
+    if named and (not available or named in available):
+        return named
+    for observer in problem.metrics:
+        for name in MAIN_METRICS.get(observer, ()):
+            if name in available:
+                return name
+    errors = [m for m in available if is_error(m)]
+    return (errors or available or [""])[0]
+
+
+def _metric_names(record):
+    names = record.get("metric_names")
+    if names is None:
+        from mcfbench.storage.records import FIELDS
+
+        names = [k for k in record if k not in FIELDS and k != "metric_names"]
+    return list(names)
+
+
+def long_table(records, schemes=None, problems=None):
+    """One row per run and metric (:data:`LONG_COLUMNS`), with the EOC of the errors.
+
+    Parameters
+    ----------
+    records : iterable of dict
+        Run records (:func:`mcfbench.storage.records.read_record`).
+    schemes, problems : list of str, optional
+        Row order (default: order of first appearance).
+
+    A run without a value of a metric another run of its problem has (a
+    scheme that refused the surface) gets a row with NaN.
+    """
+    import pandas as pd
+
+    by_problem = {}
+    for r in records:
+        names = by_problem.setdefault(r["problem"], [])
+        names.extend(m for m in _metric_names(r) if m not in names)
+    rows = []
+    for r in records:
+        for metric in by_problem[r["problem"]] or [""]:
+            value = r.get(metric, float("nan")) if metric else float("nan")
+            rows.append({
+                "scheme": r["scheme"], "problem": r["problem"], "level": int(r["level"]),
+                "h": r["h"], "tau": r["tau"], "steps": int(r["N"]),
+                "steps_done": int(r["steps_done"]), "metric": metric,
+                "value": float("nan") if value is None else float(value), "eoc": float("nan"),
+                "status": r["status"], "t_failed": r["t_failed"], "min_angle": r["min_angle"],
+                "max_flipped": r["max_flipped"], "t_min_barycentric": r["t_min_barycentric"],
+                "iterations": int(r["iterations"]), "cpu_seconds": r["cpu_seconds"]})
+    table = pd.DataFrame(rows, columns=LONG_COLUMNS)
+    for column in ("h", "tau", "value", "eoc", "t_failed", "min_angle", "max_flipped",
+                   "t_min_barycentric", "cpu_seconds"):
+        table[column] = table[column].astype(float)
+    schemes = schemes or list(dict.fromkeys(table["scheme"]))
+    problems = problems or list(dict.fromkeys(table["problem"]))
+    table = _ordered(table, schemes, problems)
+    return add_eoc(table)
+
+
+def _ordered(table, schemes, problems):
+    rank_s = {s: i for i, s in enumerate(schemes)}
+    rank_p = {p: i for i, p in enumerate(problems)}
+    key = table["problem"].map(rank_p).fillna(len(rank_p)).astype(int) * 10_000 + \
+        table["scheme"].map(rank_s).fillna(len(rank_s)).astype(int) * 100
+    order = np.lexsort([table.index.to_numpy(), table["level"].to_numpy(), key.to_numpy()])
+    return table.iloc[order].reset_index(drop=True)
+
+
+def add_eoc(table):
+    """Fill ``eoc``: ``log2(|e_{k-1}| / |e_k|)`` for error metrics, levels one apart,
+    both values finite and non-zero; NaN elsewhere."""
+    table = table.copy()
+    table["eoc"] = np.nan
+    for (_, _, metric), group in table.groupby(["scheme", "problem", "metric"], sort=False):
+        if not is_error(metric):
+            continue
+        group = group.sort_values("level")
+        levels = group["level"].to_numpy()
+        values = np.abs(group["value"].to_numpy(dtype=float))
+        for i in range(1, len(group)):
+            a, b = values[i - 1], values[i]
+            if levels[i] - levels[i - 1] == 1 and np.isfinite(a) and np.isfinite(b) \
+                    and a > 0 and b > 0:
+                table.loc[group.index[i], "eoc"] = math.log2(a / b)
+    return table
+
+
+def _fmt(x, spec=".3e", none="–"):
+    if x is None or (isinstance(x, float) and not np.isfinite(x)):
+        return none
+    return format(x, spec)
+
+
+def _levels_text(levels):
+    levels = sorted(int(v) for v in levels)
+    if len(levels) > 2 and levels == list(range(levels[0], levels[-1] + 1)):
+        return f"{levels[0]}-{levels[-1]}"
+    return ", ".join(str(v) for v in levels)
+
+
+def breakdown_text(status, t_failed, level=None):
+    """``"t_escaped at t = 0.052 (level 3)"``."""
+    text = str(status)
+    if t_failed is not None and np.isfinite(t_failed):
+        text += f" at t = {t_failed:.4g}"
+    if level is not None:
+        text += f" (level {int(level)})"
+    return text
+
+
+def summary_table(table, problems=None, schemes=None):
+    """Problem x scheme: EOC between the two finest finished levels and the
+    finest-level value of the problem's main metric, or the breakdown.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``problem, scheme, metric, error, levels, runs, runs_ok,
+        eoc, eoc_levels, finest_level, finest_value, eocs, values, status,
+        failed_level, t_failed, min_angle, t_min_barycentric,
+        cpu_seconds`` (CPU of the finest finished level). ``status`` is
+        ``ok`` or that of the coarsest run that did not finish; ``eocs``
+        and ``values`` list every EOC and value by level (``;``-separated).
+    """
+    import pandas as pd
+
+    problems = problems or list(dict.fromkeys(table["problem"]))
+    schemes = schemes or list(dict.fromkeys(table["scheme"]))
+    rows = []
+    for problem in problems:
+        part = table[table["problem"] == problem]
+        if not len(part):
+            continue
+        metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
+        for scheme in schemes:
+            runs = part[(part["scheme"] == scheme) & (part["metric"] == metric)] \
+                .sort_values("level")
+            if not len(runs):
+                continue
+            ok = runs[runs["status"] == "ok"]
+            failed = runs[runs["status"] != "ok"]
+            finished = ok[np.isfinite(ok["value"])]
+            finest = finished.iloc[-1] if len(finished) else None
+            eoc_rows = finished[np.isfinite(finished["eoc"])]
+            last_eoc = eoc_rows.iloc[-1] if len(eoc_rows) else None
+            first_fail = failed.iloc[0] if len(failed) else None
+            rows.append({
+                "problem": problem, "scheme": scheme, "metric": metric,
+                "error": is_error(metric), "levels": _levels_text(runs["level"]),
+                "runs": len(runs), "runs_ok": len(ok),
+                "eoc": np.nan if last_eoc is None else last_eoc["eoc"],
+                "eoc_levels": "" if last_eoc is None else
+                f"{int(last_eoc['level']) - 1}-{int(last_eoc['level'])}",
+                "finest_level": np.nan if finest is None else int(finest["level"]),
+                "finest_value": np.nan if finest is None else finest["value"],
+                "eocs": ";".join(_fmt(v, ".2f", "") for v in runs["eoc"].iloc[1:]),
+                "values": ";".join(_fmt(v, ".4e", "") for v in runs["value"]),
+                "status": "ok" if first_fail is None else first_fail["status"],
+                "failed_level": np.nan if first_fail is None else int(first_fail["level"]),
+                "t_failed": np.nan if first_fail is None else first_fail["t_failed"],
+                "failed": ";".join(f"{int(r.level)}:{r.status}:{_fmt(r.t_failed, '.6g', '')}"
+                                   for r in failed.itertuples()),
+                "min_angle": runs["min_angle"].min(),
+                "t_min_barycentric": runs["t_min_barycentric"].min(),
+                "cpu_seconds": np.nan if finest is None else finest["cpu_seconds"],
+            })
+    return pd.DataFrame(rows)
+
+
+def summary_cell(row):
+    """One cell of the summary: ``"2.01 · 1.23e-03 (L4)"`` or the breakdown."""
+    parts = []
+    if row["error"] and np.isfinite(row["eoc"]):
+        parts.append(f"EOC {row['eoc']:.2f}")
+    if np.isfinite(row["finest_value"]):
+        parts.append(f"{row['finest_value']:.3e} (L{int(row['finest_level'])})")
+    if row["status"] != "ok":
+        parts.append(breakdown_text(row["status"], row["t_failed"], row["failed_level"]))
+    return "; ".join(parts) or "–"
+
+
+def summary_views(summary, problems=None, schemes=None, labels=None):
+    """The summary as a wide frame (problem rows, scheme columns) of cells."""
+    import pandas as pd
+
+    problems = problems or list(dict.fromkeys(summary["problem"]))
+    schemes = schemes or list(dict.fromkeys(summary["scheme"]))
+    labels = labels or {}
+    wide = []
+    for problem in problems:
+        part = summary[summary["problem"] == problem]
+        if not len(part):
+            continue
+        row = {"problem": f"{problem} ({part['metric'].iloc[0]})"}
+        for scheme in schemes:
+            hit = part[part["scheme"] == scheme]
+            row[labels.get(scheme, scheme)] = summary_cell(hit.iloc[0]) if len(hit) else "–"
+        wide.append(row)
+    return pd.DataFrame(wide)
+
+
+def problem_table(table, problem, schemes=None, labels=None):
+    """One problem, schemes as rows: the main metric per level, its EOCs, the
+    status, the mesh quality over all levels and the finest level's cost."""
+    import pandas as pd
+
+    part = table[table["problem"] == problem]
+    metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
+    schemes = schemes or list(dict.fromkeys(part["scheme"]))
+    labels = labels or {}
+    levels = sorted(part["level"].unique())
+    rows = []
+    for scheme in schemes:
+        runs = part[(part["scheme"] == scheme) & (part["metric"] == metric)] \
+            .sort_values("level").set_index("level")
+        if not len(runs):
+            continue
+        row = {"scheme": labels.get(scheme, scheme)}
+        for level in levels:
+            if level not in runs.index:
+                row[f"L{level}"] = "–"
+                continue
+            r = runs.loc[level]
+            row[f"L{level}"] = _fmt(r["value"]) if r["status"] == "ok" else r["status"]
+        row["EOC"] = ", ".join(_fmt(v, ".2f") for v in runs["eoc"].iloc[1:]) \
+            if is_error(metric) and len(runs) > 1 else "–"
+        failed = runs[runs["status"] != "ok"]
+        row["status"] = "ok" if not len(failed) else "; ".join(
+            breakdown_text(r.status, r.t_failed, lv) for lv, r in failed.iterrows())
+        finest = runs.iloc[-1]
+        row["steps (finest)"] = f"{int(finest['steps_done'])}/{int(finest['steps'])}"
+        row["min angle"] = _fmt(runs["min_angle"].min(), ".3g")
+        row["flipped"] = _fmt(runs["max_flipped"].max(), ".0f")
+        row["T monitor"] = _fmt(runs["t_min_barycentric"].min(), ".3g")
+        row["iterations (finest)"] = str(int(finest["iterations"]))
+        row["CPU s (finest)"] = _fmt(finest["cpu_seconds"], ".3g")
+        rows.append(row)
+    return pd.DataFrame(rows), metric
+
+
+def markdown(frame, notes=()):
+    """A pipe table (:func:`mcfbench.presentation.formats.md_table`), then ``notes`` as paragraphs."""
+    from mcfbench.presentation.formats import md_table
+
+    lines = [md_table(list(frame.columns), frame.itertuples(index=False))]
+    lines += [f"\n{note}" for note in notes]
+    return "\n".join(lines) + "\n"
+
+
+def latex(frame, caption="", notes=()):
+    """A ``table`` with a booktabs ``tabular`` (:func:`mcfbench.presentation.formats.tex_tabular`),
+    the notes below it."""
+    from mcfbench.presentation.formats import tex_escape, tex_tabular
+
+    lines = [r"\begin{table}[ht]",
+             tex_tabular([tex_escape(c) for c in frame.columns],
+                         [[tex_escape(v) for v in row] for row in frame.itertuples(index=False)],
+                         "l" + "r" * (len(frame.columns) - 1))]
+    if caption:
+        lines.append(r"\caption{" + tex_escape(caption) + "}")
+    lines += [r"\par\smallskip{\footnotesize " + tex_escape(note) + "}" for note in notes]
+    lines.append(r"\end{table}")
+    return "\n".join(lines) + "\n"
+
+
+SUMMARY_TEXT = ("levels", "eoc_levels", "eocs", "values", "failed", "metric", "status")
+
+
+def read_summary(path):
+    """``summary.csv`` back as written (text columns as text, empty as "")."""
+    import pandas as pd
+
+    summary = pd.read_csv(path, dtype={c: str for c in SUMMARY_TEXT})
+    for column in SUMMARY_TEXT:
+        summary[column] = summary[column].fillna("")
+    summary["error"] = summary["error"].astype(bool)
+    return summary
+
+
+def read_long_table(path):
+    """``matrix.csv`` back (metric names as text)."""
+    import pandas as pd
+
+    table = pd.read_csv(path, dtype={"metric": str, "status": str, "scheme": str,
+                                     "problem": str})
+    table["metric"] = table["metric"].fillna("")
+    return table
+
+
+GALLERY_COLUMNS = ["mesh", "scheme", "status", "steps_done", "steps", "t_failed", "min_angle",
+                   "max_flipped", "t_min_barycentric", "cpu_seconds", "vertices",
+                   "triangles", "h", "tau", "solver", "message"]
+
+
+def gallery_table(records):
+    """Mesh x scheme: one row per record (:data:`GALLERY_COLUMNS`)."""
+    import pandas as pd
+
+    rows = [{"mesh": r["mesh"], "scheme": r["scheme"], "status": r["status"],
+             "steps_done": int(r["steps_done"]), "steps": int(r["N"]),
+             "t_failed": r["t_failed"], "min_angle": r["min_angle"],
+             "max_flipped": r["max_flipped"], "t_min_barycentric": r["t_min_barycentric"],
+             "cpu_seconds": r["cpu_seconds"], "vertices": int(r["nF"]),
+             "triangles": int(r["nT"]) if r["nT"] else np.nan, "h": r["h"], "tau": r["tau"],
+             "solver": r["solver"], "message": r["message"]} for r in records]
+    return pd.DataFrame(rows, columns=GALLERY_COLUMNS)
+
+
+def gallery_markdown(table, plan):
+    """The gallery table as Markdown: mesh x scheme, with the settings and timing note."""
+    import pandas as pd
+
+    view = pd.DataFrame({
+        "mesh": table["mesh"], "scheme": table["scheme"], "status": table["status"],
+        "steps": [f"{a}/{b}" for a, b in zip(table["steps_done"], table["steps"])],
+        "breakdown t": [_fmt(v, ".4g") for v in table["t_failed"]],
+        "min angle": [_fmt(v, ".3g") for v in table["min_angle"]],
+        "flipped": [_fmt(v, ".0f") for v in table["max_flipped"]],
+        "T monitor": [_fmt(v, ".3g") for v in table["t_min_barycentric"]],
+        "CPU s": [_fmt(v, ".3g") for v in table["cpu_seconds"]]})
+    notes = [f"Every scheme on every mesh: tau = C (mean edge length)^2 with C = {plan['C']:g}, "
+             f"{plan['steps']} steps, solver {plan['solver']} (rtol {plan['rtol']:g}). "
+             "Min angle and flipped triangles: worst over the sampled time levels; "
+             "T monitor: smallest barycentric coordinate of a T-vertex (DDFV only).",
+             TIMING_BASE]
+    return "# Gallery\n\n" + markdown(view, notes)

@@ -1,0 +1,164 @@
+"""The gallery: every scheme on every mesh file of a folder (default: the suite's generated real-world-like meshes), one run job per (mesh, scheme)."""
+
+from pathlib import Path
+
+import numpy as np
+
+from mcfbench.running.run import framed_run
+from mcfbench.storage.logs import setup_logging
+from mcfbench.studies.config import ConfigError
+from mcfbench.studies.matrix import REAL_WORLD_SURFACES, is_real_world, robust_method
+
+GALLERY_SURFACES = REAL_WORLD_SURFACES
+
+
+MESH_SUFFIXES = (".obj", ".off", ".ply", ".stl")
+
+
+def plan(section=None, meshes=None, schemes=None):
+    """The config key ``gallery`` (and ``meshes``) checked and normalised.
+
+    Parameters
+    ----------
+    section : dict
+        ``C`` (tau = C (mean edge)^2), ``steps``, ``solver`` (a method or
+        ``"robust"``), ``rtol``, ``maxiter``, ``schemes`` ("all" or names).
+    meshes : str, optional
+        A folder of mesh files; None: the suite's own meshes
+        (:func:`generated_meshes`) under ``results/gallery/meshes``.
+
+    Returns
+    -------
+    dict
+        ``C, steps, solver, rtol, maxiter, schemes, meshes`` (file name ->
+        path), ``generated`` (file name -> (surface or problem, params)).
+    """
+    from mcfbench.running import solver as _solver
+
+    if schemes is None:
+        from mcfbench.running.schemes import SCHEMES as schemes
+    section = dict(section or {})
+    chosen = section.get("schemes", "all")
+    chosen = list(schemes) if chosen in ("all", None) else \
+        [chosen] if isinstance(chosen, str) else list(chosen)
+    unknown = [s for s in chosen if s not in schemes]
+    if unknown:
+        raise ConfigError(f"config key 'gallery.schemes': unknown scheme(s) {unknown}; the "
+                          f"registry mcfbench.running.schemes.SCHEMES has {list(schemes)}")
+    method = section.get("solver", "robust")
+    method = robust_method() if method == "robust" else method
+    if method not in _solver.METHODS:
+        raise ConfigError(f"config key 'gallery.solver': unknown solver {method!r}; choose one "
+                          f"of {', '.join(_solver.METHODS)} or robust")
+    C, steps = float(section.get("C", 0.1)), int(section.get("steps", 40))
+    if not C > 0:
+        raise ConfigError(f"config key 'gallery.C': must be > 0, got {C!r}")
+    if steps < 1:
+        raise ConfigError(f"config key 'gallery.steps': must be >= 1, got {steps!r}")
+    plan = {"C": C, "steps": steps, "solver": method,
+            "rtol": float(section.get("rtol", 1e-9)),
+            "maxiter": int(section.get("maxiter", 1000)), "schemes": chosen}
+    if meshes:
+        folder = Path(meshes)
+        if not folder.is_dir():
+            raise ConfigError(f"config key 'meshes': {folder} is not a folder")
+        files = sorted(p for p in folder.iterdir()
+                       if p.is_file() and p.suffix.lower() in MESH_SUFFIXES)
+        if not files:
+            raise ConfigError(f"config key 'meshes': no mesh file "
+                              f"({' '.join(MESH_SUFFIXES)}) in {folder}")
+        plan["meshes"] = {p.name: str(p) for p in files}
+        plan["generated"] = {}
+    else:
+        generated = generated_meshes()
+        plan["meshes"] = {name: f"results/gallery/meshes/{name}" for name in generated}
+        plan["generated"] = generated
+    return plan
+
+
+def generated_meshes():
+    """``{file name: (kind, name, level)}`` of the built-in gallery: the
+    real-world-like problems of the registry (:func:`is_real_world`) at the
+    middle level of their refinement series, or (when there are none) the surfaces
+    :data:`GALLERY_SURFACES` at their defaults."""
+    from mcfbench.geometry.surfaces import SURFACES
+    from mcfbench.running.problems import PROBLEMS
+
+    mesh_problems = [p for p in PROBLEMS.values() if is_real_world(p)]
+    if mesh_problems:
+        return {f"{p.name}.obj": ("problem", p.name, int(sorted(p.levels)[len(p.levels) // 2]))
+                for p in mesh_problems}
+    return {f"{s}.obj": ("surface", s, 0) for s in GALLERY_SURFACES if s in SURFACES}
+
+
+def write_obj(path, vertices, faces):
+    """A triangle mesh as Wavefront OBJ (atomic, 17 significant digits)."""
+    from mcfbench.storage.atomic import write_text
+
+    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in np.asarray(vertices, float).tolist()]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in np.asarray(faces, int).tolist()]
+    write_text(path, "\n".join(lines) + "\n")
+
+
+def write_generated_mesh(entry, path):
+    """Write one mesh of :func:`generated_meshes` (``entry`` = its value)."""
+    from mcfbench.geometry.surfaces import make_surface
+    from mcfbench.running.problems import get_problem
+
+    kind, name, level = entry
+    V, F = get_problem(name).mesh(level) if kind == "problem" else make_surface(name)
+    write_obj(path, V, F)
+
+
+def _gallery_problem(C, steps):
+    from mcfbench.running.problems import Problem
+
+    return Problem("gallery", "a user's mesh", "", lambda level: {}, levels=(1,), tau_1=C,
+                   t_final=1.0, metrics=(), tau_rule="mesh", steps=int(steps),
+                   exact="none (mesh quality and breakdown only)")
+
+
+def job(mesh_path, scheme, settings, record, frames, log_path=None):
+    """One scheme on one mesh file: ``tau = C h^2``, ``steps`` steps; record and
+    first and last frames. A file the reader refuses gives status
+    ``unsupported`` with the reader's message."""
+    from mcfbench.geometry import metrics
+    from mcfbench.geometry.mesh_files import read_mesh
+    from mcfbench.running.schemes import get_scheme
+    from mcfbench.running.solver import Solver
+    from mcfbench.storage.atomic import save_npz
+    from mcfbench.storage.records import write_record
+
+    log = setup_logging(log_path)
+    solver = Solver(method=settings["solver"], rtol=settings["rtol"],
+                    maxiter=settings["maxiter"])
+    problem = _gallery_problem(settings["C"], settings["steps"])
+    scheme = get_scheme(scheme)
+    extra = {"mesh": Path(mesh_path).name}
+    try:
+        V, F, report = read_mesh(mesh_path)
+    except ValueError as err:
+        log.warning("%s", err)
+        result = None
+        message = f"unsupported at step 0 (t = 0): the mesh was refused: {err}"
+    else:
+        extra["intake"] = report.notes()
+        tau = settings["C"] * metrics.mean_edge_length(V, F) ** 2
+        log.info("%s on %s: %d vertices, %d triangles, tau %.3g, %d steps, solver %s",
+                 scheme.name, mesh_path, len(V), len(F), tau, settings["steps"], solver.method)
+        result, arrays = framed_run(scheme, problem, 1, solver=solver, mesh=(V, F), tau=tau)
+        save_npz(frames, **arrays)
+    if result is None:
+        from mcfbench.storage.records import RunResult
+
+        nan = float("nan")
+        result = RunResult(scheme=scheme.name, problem="gallery", level=1, nV=0, nF=0, nT=0,
+                           h=nan, tau=nan, N=settings["steps"], steps_done=0,
+                           status="unsupported", message=message, t_failed=0.0, t_end=0.0,
+                           steady=False, iterations=0, solver=solver.method, cpu_seconds=0.0,
+                           wall_seconds=0.0, t_min_barycentric=nan, min_angle=nan,
+                           max_aspect=nan, max_flipped=nan)
+        save_npz(frames, faces=np.zeros((0, 3), int), steps=np.zeros(0, int), t=np.zeros(0))
+    write_record(record, result, settings, metric_names=[], **extra)
+    log.info("%s: %s, %d/%d steps", scheme.name, result.status, result.steps_done, result.N)
+    return result
