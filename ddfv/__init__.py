@@ -21,8 +21,16 @@ DiamondMesh, diamond_mesh(faces)
     The diamond mesh (Section 2.2.2).
 """
 
-from .flow import Flow
-from .topology import DiamondMesh, diamond_mesh
-from .variants import VARIANTS, variant_options
+import importlib
 
-__all__ = ["DiamondMesh", "Flow", "VARIANTS", "diamond_mesh", "variant_options"]
+_EXPORTS = {"Flow": "flow", "DiamondMesh": "topology", "diamond_mesh": "topology",
+            "VARIANTS": "variants", "variant_options": "variants"}
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name):
+    """The public names on first use: ``import ddfv.topology`` (a picture of the
+    diamond mesh) loads neither the flow nor its compiled kernels (numba)."""
+    if name in _EXPORTS:
+        return getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
+    raise AttributeError(f"module 'ddfv' has no attribute {name!r}")

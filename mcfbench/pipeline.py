@@ -540,7 +540,8 @@ def figure_job(name, outputs, log):
     """
     import pandas as pd
 
-    from mcfbench.geometry.quality import COLUMNS, plot_quality
+    from mcfbench.geometry.quality import COLUMNS
+    from mcfbench.presentation.quality_plots import plot_quality
     from mcfbench.presentation.render import DPI, rasterize_meshes
     from mcfbench.studies.figures import (
         EXPERIMENTS,

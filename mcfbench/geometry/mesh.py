@@ -110,27 +110,27 @@ def validate_mesh(vertices, faces, *, vertex_ids=None, face_ids=None):
     if len(out):
         bad = F[out][(F[out] < 0) | (F[out] >= n)]
         raise MeshError("index out of range",
-                        f"face indices out of range: triangle(s) {_few(fid[out])} refer to "
-                        f"vertex index(es) {_few(np.unique(bad))}, but there are {n} "
+                        f"face indices out of range: triangle(s) {first_ids(fid[out])} refer to "
+                        f"vertex index(es) {first_ids(np.unique(bad))}, but there are {n} "
                         f"vertices (valid indices 0 to {n - 1})")
     F = F.astype(np.int64)
 
     nonfinite = np.flatnonzero(~np.isfinite(V).all(axis=1))
     if len(nonfinite):
         raise MeshError("non-finite coordinate",
-                        f"NaN or inf coordinates at vertex(es) {_few(vid[nonfinite])}")
+                        f"NaN or inf coordinates at vertex(es) {first_ids(vid[nonfinite])}")
 
     repeated = np.flatnonzero((F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2])
                               | (F[:, 2] == F[:, 0]))
     if len(repeated):
         raise MeshError("repeated vertex",
-                        f"triangle(s) {_few(fid[repeated])} repeat a vertex, e.g. "
+                        f"triangle(s) {first_ids(fid[repeated])} repeat a vertex, e.g. "
                         f"{tri(repeated[0])}")
 
     unused = np.flatnonzero(np.bincount(F.ravel(), minlength=n) == 0)
     if len(unused):
         raise MeshError("unreferenced vertex",
-                        f"unreferenced vertex(es) {_few(vid[unused])}: no triangle uses "
+                        f"unreferenced vertex(es) {first_ids(vid[unused])}: no triangle uses "
                         "them (remove them first; read_mesh drops them)")
 
     S = np.sort(F, axis=1)
@@ -150,7 +150,7 @@ def validate_mesh(vertices, faces, *, vertex_ids=None, face_ids=None):
     if len(bad):
         shown = "; ".join(
             f"edge ({int(vid[edges.a[s]])}, {int(vid[edges.b[s]])}) is shared by "
-            f"triangles {_few(fid[edges.tri[s:s + c]])}"
+            f"triangles {first_ids(fid[edges.tri[s:s + c]])}"
             for s, c in zip(edges.start[bad[:3]], edges.count[bad[:3]]))
         raise MeshError("non-manifold edge",
                         f"non-manifold edge(s): {len(bad)} edge(s) have more than two "
@@ -171,7 +171,7 @@ def validate_mesh(vertices, faces, *, vertex_ids=None, face_ids=None):
     bad = np.flatnonzero(fans > 1)
     if len(bad):
         raise MeshError("non-manifold vertex",
-                        f"non-manifold vertex(es) {_few(vid[bad])}: the triangles around "
+                        f"non-manifold vertex(es) {first_ids(vid[bad])}: the triangles around "
                         "each form more than one fan, as where two surfaces touch at a "
                         f"point (vertex {int(vid[bad[0]])} has {int(fans[bad[0]])} fans)")
 
@@ -180,7 +180,7 @@ def validate_mesh(vertices, faces, *, vertex_ids=None, face_ids=None):
     zero = np.flatnonzero(~(geo.area_rel > ZERO_AREA))
     if len(zero):
         raise MeshError("zero-area triangle",
-                        f"zero-area (degenerate) triangle(s) {_few(fid[zero])}: area <= "
+                        f"zero-area (degenerate) triangle(s) {first_ids(fid[zero])}: area <= "
                         f"{ZERO_AREA:g} x (longest edge)^2, e.g. {tri(zero[0])}")
     return V, F
 
@@ -231,9 +231,9 @@ class MeshSummary:
         genus = str(self.genus[0]) if len(self.genus) == 1 else f"[{', '.join(map(str, self.genus))}]"
         edge = (f"{self.mean_edge:.4f}" if 1e-3 <= self.mean_edge < 1e4
                 else f"{self.mean_edge:.3e}")
-        return (f"{_count(self.vertices, 'vertex', 'vertices')}, "
-                f"{_count(self.faces, 'face')}, {_count(self.components, 'component')}, "
-                f"genus {genus}, {_count(self.boundary_loops, 'boundary loop')}, "
+        return (f"{count_phrase(self.vertices, 'vertex', 'vertices')}, "
+                f"{count_phrase(self.faces, 'face')}, {count_phrase(self.components, 'component')}, "
+                f"genus {genus}, {count_phrase(self.boundary_loops, 'boundary loop')}, "
                 f"smallest angle {self.smallest_angle:.1f} deg, "
                 f"area ratio {self.area_ratio:.2f}, mean edge {edge}")
 
@@ -419,7 +419,7 @@ def _triangle_geometry(V, F, angles=True):
     return _TriangleGeometry(area_rel, log_area, angle.min(axis=1))
 
 
-def _few(ids, limit=10):
+def first_ids(ids, limit=10):
     """Format the first few numbers of an error report."""
     ids = np.asarray(ids).ravel()
     shown = ", ".join(str(int(i)) for i in ids[:limit])
@@ -427,5 +427,6 @@ def _few(ids, limit=10):
     return f"[{shown}]{more}"
 
 
-def _count(k, singular, plural=None):
+def count_phrase(k, singular, plural=None):
+    """``"1 vertex"``, ``"3 vertices"``: a count with its noun."""
     return f"{k} {singular if k == 1 else (plural or singular + 's')}"

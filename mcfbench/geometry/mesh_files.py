@@ -52,7 +52,7 @@ from pathlib import Path
 import igl
 import numpy as np
 
-from mcfbench.geometry.mesh import MeshError, _count, _few, validate_mesh
+from mcfbench.geometry.mesh import MeshError, count_phrase, first_ids, validate_mesh
 
 SUPPORTED = (".obj", ".off", ".ply", ".stl")
 
@@ -98,13 +98,13 @@ class IntakeReport:
         """One line per repair made, e.g. ``"merged 34 coincident vertices"``."""
         notes = []
         if self.polygons:
-            notes.append(f"split {_count(self.polygons, 'polygon')} into "
+            notes.append(f"split {count_phrase(self.polygons, 'polygon')} into "
                          f"{self.triangles - (self.file_faces - self.polygons)} "
                          "triangles (fan from the first corner)")
         if self.dropped:
-            notes.append(f"dropped {_count(self.dropped, 'unreferenced vertex', 'unreferenced vertices')}")
+            notes.append(f"dropped {count_phrase(self.dropped, 'unreferenced vertex', 'unreferenced vertices')}")
         if self.merged:
-            notes.append(f"merged {_count(self.merged, 'coincident vertex', 'coincident vertices')}")
+            notes.append(f"merged {count_phrase(self.merged, 'coincident vertex', 'coincident vertices')}")
         return notes
 
     def to_file_order(self, values, fill=np.nan):
@@ -169,7 +169,7 @@ def read_mesh(path):
     nonfinite = np.flatnonzero(~np.isfinite(V).all(axis=1))
     if len(nonfinite):
         _refuse_vertex_lines(path, ext)
-        raise ValueError(f"{path}: NaN or inf coordinates at vertex(es) {_few(nonfinite)} "
+        raise ValueError(f"{path}: NaN or inf coordinates at vertex(es) {first_ids(nonfinite)} "
                          "(0-based, in the order of the file)")
     scan = _scan(path, ext)
 
@@ -179,7 +179,7 @@ def read_mesh(path):
         short = np.flatnonzero(scan.sizes < 3)
         if len(short):
             j = short[0]
-            raise ValueError(f"{path}: face(s) {_few(short)} have fewer than 3 corners, e.g. "
+            raise ValueError(f"{path}: face(s) {first_ids(short)} have fewer than 3 corners, e.g. "
                              f"face {j} (line {scan.face_lines[j]}) has {scan.sizes[j]}")
         expected = np.maximum(scan.sizes - 2, 0)
         if expected.sum() == len(F):
@@ -198,7 +198,7 @@ def read_mesh(path):
                          "(a point cloud is not a surface)")
     out = np.flatnonzero(((F < 0) | (F >= len(V))).any(axis=1))
     if len(out):
-        raise ValueError(f"{path}: face(s) {_few(face_of[out])} refer to vertices that do "
+        raise ValueError(f"{path}: face(s) {first_ids(face_of[out])} refer to vertices that do "
                          f"not exist (the file has {len(V)} vertices)")
 
     # drop unreferenced vertices, then merge coincident ones (first one wins)
@@ -223,7 +223,7 @@ def read_mesh(path):
         hint = ""
         if report.merged and err.kind in ("repeated vertex", "duplicate triangle",
                                           "non-manifold edge", "non-manifold vertex"):
-            hint = (f" (after merging {_count(report.merged, 'coincident vertex', 'coincident vertices')}; "
+            hint = (f" (after merging {count_phrase(report.merged, 'coincident vertex', 'coincident vertices')}; "
                     "vertices are named by their first copy in the file)")
         raise MeshError(err.kind, f"{path}: {err}{hint} (numbers are 0-based, in the "
                         "order of the file)") from None

@@ -376,7 +376,7 @@ def validate(experiment):
 
 
 @dataclass
-class RunResult:
+class FigureRun:
     """Frames and record of one :class:`Run`."""
 
     run: Run
@@ -426,7 +426,7 @@ def run_one(run):
 
     Returns
     -------
-    RunResult
+    FigureRun
     """
     scheme = get_scheme(run.scheme)
     V, faces = validate_mesh(*make_surface(run.shape, **run.params))
@@ -435,19 +435,19 @@ def run_one(run):
     try:
         flow = scheme.make(V, faces, run.tau, **options)
     except ValueError as err:
-        return RunResult(run, V[None], None, np.array([0]), faces, np.array([], int),
+        return FigureRun(run, V[None], None, np.array([0]), faces, np.array([], int),
                          "unsupported", str(err), -1, time.perf_counter() - start)
     quality = MeshQuality()   # diamond and primal monitors (DDFV), primal (the others)
     traj = simulate(flow, run.steps, save_every=run.save_every, on_defect="record",
                     observers=[quality])
     frames = traj.frames
-    return RunResult(run, frames.get("F", frames.get("V")), frames.get("T"), traj.steps,
+    return FigureRun(run, frames.get("F", frames.get("V")), frames.get("T"), traj.steps,
                      traj.faces, traj.iterations, traj.status, traj.message, traj.failed_step,
                      time.perf_counter() - start, quality.frame())
 
 
 def run_experiment(experiment):
-    """:func:`run_one` for every run of the experiment: ``{key: RunResult}``."""
+    """:func:`run_one` for every run of the experiment: ``{key: FigureRun}``."""
     validate(experiment)
     return {run.key: run_one(run) for run in experiment.runs}
 

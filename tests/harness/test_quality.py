@@ -16,11 +16,11 @@ from mcfbench.geometry.quality import (
     diamond_min_angles,
     first_violation,
     mesh_quality,
-    plot_quality,
     primal_quality,
     vertex_quality,
 )
 from mcfbench.geometry.surfaces import cylinder, icosphere
+from mcfbench.presentation.quality_plots import plot_quality
 from mcfbench.running.driver import simulate
 
 
