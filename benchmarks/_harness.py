@@ -85,8 +85,8 @@ def harness_run(scheme, level, *, problem="sphere", solver=None, steps=None, **o
     :class:`~mcfbench.storage.records.RunResult` and the flow it stepped.
     """
     from mcfbench.running.problems import get_problem
-    from mcfbench.running.solver import Solver
     from mcfbench.running.run import run
+    from mcfbench.running.solver import Solver
 
     capture = _Capture(scheme)
     t_final = None

@@ -58,7 +58,7 @@ def numpy_reference(rev, tmp):
 def icosphere(level):
     """The icosphere of Table 3.1 (the harness's generator if there is one)."""
     try:
-        from mcfbench.geometry.surfaces import icosphere as harness_icosphere
+        from mcfbench.geometry.spheres import icosphere as harness_icosphere
         return harness_icosphere(level)
     except ImportError:
         pass

@@ -101,7 +101,7 @@ def old_bicgstab(A, b, x0, rtol=1e-10, maxiter=1000):
 def sphere_systems(level):
     """``[(A, b, x0)]`` of the first two steps of the Table 3.1 run at ``level``."""
     from ddfv import Flow
-    from mcfbench.geometry.surfaces import icosphere
+    from mcfbench.geometry.spheres import icosphere
 
     V, F = icosphere(level)
     flow = Flow(V, F, 0.04 / 4.0 ** (level - 1))

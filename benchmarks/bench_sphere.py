@@ -56,8 +56,17 @@ import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from _harness import (OLD_REV, ROOT, OldWorker, footing, harness_run, machine_line,  # noqa: E402
-                      median, one_core, split)
+from _harness import (  # noqa: E402
+    OLD_REV,
+    ROOT,
+    OldWorker,
+    footing,
+    harness_run,
+    machine_line,
+    median,
+    one_core,
+    split,
+)
 
 from mcfbench.storage.memory import tune_malloc  # noqa: E402
 
@@ -270,10 +279,11 @@ def profile(level, solver, runs, repeats=30):
 
 def _kernel_codes():
     """``(file name, first line, name)`` of every compiled kernel, as cProfile keys them."""
+    from numba.core.registry import CPUDispatcher
+
     import baselines.kernels
     import ddfv.kernels
     from mcfbench.running import solver as solver_module
-    from numba.core.registry import CPUDispatcher
 
     codes = set()
     for module in (ddfv.kernels, baselines.kernels, solver_module):

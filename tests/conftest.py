@@ -6,12 +6,13 @@ import numpy as np
 import pytest
 
 from mcfbench.geometry import surfaces
-from mcfbench.geometry.surfaces import flat_lattice
-from mcfbench.geometry.surfaces import random_bumpy_sphere as bumpy_sphere
+from mcfbench.geometry.shapes import flat_lattice
+from mcfbench.geometry.spheres import icosphere
+from mcfbench.geometry.spheres import random_bumpy_sphere as bumpy_sphere
 
 # The tests that import ``cylinder`` from here were written for quads all cut
 # along the same diagonal; the positional parameters (around, along, radius,
-# half_height = 0.5) are those of mcfbench.geometry.surfaces.cylinder.
+# half_height = 0.5) are those of mcfbench.geometry.shapes.cylinder.
 cylinder = functools.partial(surfaces.cylinder, diagonals="parallel")
 
 __all__ = ["approaches_the_catenoid", "bumpy_sphere", "cylinder", "flat_lattice"]
@@ -25,7 +26,7 @@ def bumpy():
 @pytest.fixture(scope="module")
 def noisy_sphere():
     """A level-2 icosphere with radial noise: no symmetry hides index errors."""
-    V, F = surfaces.icosphere(2)
+    V, F = icosphere(2)
     rng = np.random.default_rng(7)
     return V * (1.0 + 0.1 * rng.random((len(V), 1))), F
 

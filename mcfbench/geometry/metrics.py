@@ -179,7 +179,7 @@ def catenoid_parameter(radius=1.0, half_height=0.5):
     """
     R, h = float(radius), float(half_height)
     # a cosh(h/a) is smallest where tanh(h/a) = a/h
-    from scipy.optimize import brentq   # on first use: importing it takes 0.3 s
+    from scipy.optimize import brentq  # on first use: importing it takes 0.3 s
 
     a_min = brentq(lambda a: np.tanh(h / a) - a / h, 1e-6 * h, h)
     if a_min * np.cosh(h / a_min) > R:
@@ -201,7 +201,7 @@ def catenoid_profile_error(vertices, a, fixed_mask=None, neck_band=None):
     ``neck_radius``
         The mean of ``rho_i / cosh(z_i/a)`` over the neck ring: the free
         vertices whose ``|z_i|`` is within ``neck_band`` of the smallest
-        ``|z|`` (for :func:`mcfbench.geometry.surfaces.cylinder` with even ``along``
+        ``|z|`` (for :func:`mcfbench.geometry.shapes.cylinder` with even ``along``
         the middle ring, on ``z = 0``, where this is the mean radius).
         Dividing by ``cosh(z_i/a)`` makes each term exactly ``a`` on the
         catenoid, so a ring slightly off ``z = 0`` still measures the neck.

@@ -1,4 +1,5 @@
-"""The findings of the beyond study in words, from its tables (rule beyond_findings): every number is read from the tables."""
+"""The findings of the beyond study in words, from its tables (rule beyond_findings): every
+number is read from the tables."""
 
 import numpy as np
 

@@ -1,4 +1,5 @@
-"""The report's documents: Jinja filters and templates, Markdown, self-contained HTML, LaTeX fragments and the PDF."""
+"""The report's documents: Jinja filters and templates, Markdown, self-contained HTML,
+LaTeX fragments and the PDF."""
 
 import base64
 import functools

@@ -1,4 +1,5 @@
-"""The figures of the report checked against the paper's captions: every claim of a caption (panels, statuses, the T-vertices) against the figure's record and frames."""
+"""The figures of the report checked against the paper's captions: every claim of a caption
+(panels, statuses, the T-vertices) against the figure's record and frames."""
 
 from pathlib import Path
 

@@ -1,20 +1,27 @@
-"""The findings of the benchmark matrix in words, from its summary table only: which scheme converges at which order on which problem, which breaks down where, and the recommendation."""
+"""The findings of the benchmark matrix in words, from its summary table only: which scheme
+converges at which order on which problem, which breaks down where, and the
+recommendation."""
 
 import numpy as np
 
 ORDER_BAND = (1.7, 2.3)
+"""An EOC in this band counts as order ~2."""
 
 
 CONVERGING_EOC = 0.5
+"""Below this EOC (between the two finest levels) an error is not decreasing."""
 
 
 WRONG_LIMIT = 10.0
+"""A non-decreasing error this many times the smallest of any scheme: a wrong limit."""
 
 
 TIE = 0.05
+"""Candidates whose scores differ by less than this (relative) are called tied."""
 
 
 ROUNDOFF = 1e-10
+"""An error at most this large on every finished level is exact up to round-off."""
 
 
 def _pct_or(value, metric):

@@ -18,9 +18,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from mcfbench.presentation.matrix_tables import is_error, main_metric  # noqa: E402
 from mcfbench.presentation.plots import style as scheme_style  # noqa: E402
 from mcfbench.storage.atomic import save_figure  # noqa: E402
-from mcfbench.presentation.matrix_tables import is_error, main_metric  # noqa: E402
 
 T_FLOOR = -0.5
 """Lower limit of the T monitor axes (values below are clipped and noted)."""

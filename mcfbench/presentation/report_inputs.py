@@ -1,4 +1,5 @@
-"""The inputs of the reproduction report: the result files read and checked against the paper (Table 3.1, the figures, the beyond study, the deviations, the provenance)."""
+"""The inputs of the reproduction report: the result files read and checked against the
+paper (Table 3.1, the figures, the beyond study, the deviations, the provenance)."""
 
 import hashlib
 import json

@@ -16,7 +16,6 @@ from dataclasses import dataclass, field, replace
 
 from mcfbench.geometry import metrics as _metrics
 from mcfbench.geometry.exact import SphereL2Error
-from mcfbench.geometry.surfaces import make_surface
 
 
 @dataclass(frozen=True)
@@ -71,6 +70,8 @@ class Problem:
 
     def mesh(self, level):
         """``(vertices, faces)`` of refinement ``level``."""
+        from mcfbench.geometry.surfaces import make_surface  # scipy: on first use
+
         return make_surface(self.surface, **self.params(int(level)))
 
     def tau(self, level, mesh=None):

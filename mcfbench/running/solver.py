@@ -106,10 +106,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 
-from ddfv.kernels import check_threads, for_threads
-from mcfbench.running import krylov
+# scipy.sparse, the compiled kernels (numba) and ddfv's thread checks are imported
+# on first use: the command line reads METHODS and ROBUST for its help in 0.1 s.
 
 METHODS = ("bicgstab", "jacobi-bicgstab", "ilu-bicgstab", "direct")
 ROBUST = "direct"
@@ -177,6 +176,8 @@ def _unsigned(a):
 
 def _csr(A):
     """``(indptr, indices, data)`` of ``A`` as CSR, the index arrays unsigned views."""
+    import scipy.sparse as sp
+
     if not (sp.issparse(A) and A.format == "csr"):
         if not sp.issparse(A):
             A = np.asarray(A, dtype=float)
@@ -234,6 +235,7 @@ def _blocks(A, b, x0, overwrite_x0=False):
 
 def _factorize(A, ilu, drop_tol=1e-4, fill_factor=10.0):
     """SuperLU ``splu``/``spilu`` of ``A``: ``(lu, None)`` or ``(None, detail)``."""
+    import scipy.sparse as sp
     import scipy.sparse.linalg as spla  # on first use (import cost at start-up)
 
     what = "ILU" if ilu else "LU"
@@ -304,6 +306,11 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
     ValueError
         Unknown method or shapes that do not fit together.
     """
+    import scipy.sparse as sp
+
+    from ddfv.kernels import check_threads, for_threads
+    from mcfbench.running import krylov
+
     if method not in METHODS:
         raise ValueError(f"unknown solver method {method!r}; choose one of "
                          f"{', '.join(METHODS)}")
@@ -356,6 +363,8 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
 
 def _direct(A, csr, b, x0, cmean, cfull, rtol):
     """LU solve in the (k, m) layout, iterative refinement, residual check."""
+    from mcfbench.running import krylov
+
     method = "direct"
     r = np.empty_like(b)
     _, ref2, _, _, _, bad, cfloor = krylov.residual(*csr, b, x0, cmean, cfull, r)
@@ -405,6 +414,8 @@ def apply_block(A, X, out=None):
     ``X.ravel()``: one compiled pass over the entries of ``A`` for all rows,
     each entry bitwise that of scipy's ``A @ x``.
     """
+    from mcfbench.running import krylov
+
     X = np.ascontiguousarray(X, dtype=float)
     if X.ndim != 2:
         raise ValueError(f"X must be a (k, n) block, got shape {X.shape}")
@@ -483,6 +494,8 @@ class Solver:
     can_overwrite_x0 = True
 
     def __post_init__(self):
+        from ddfv.kernels import check_threads
+
         if self.method not in METHODS:
             raise ValueError(f"unknown solver method {self.method!r}; choose one of "
                              f"{', '.join(METHODS)}")

@@ -1,4 +1,5 @@
-"""Table 3.1 of the paper (Section 3.1): the shrinking sphere on each level, any scheme, with the published values."""
+"""Table 3.1 of the paper (Section 3.1): the shrinking sphere on each level, any scheme,
+with the published values."""
 
 import pandas as pd
 

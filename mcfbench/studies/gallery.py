@@ -1,4 +1,5 @@
-"""The gallery: every scheme on every mesh file of a folder (default: the suite's generated real-world-like meshes), one run job per (mesh, scheme)."""
+"""The gallery: every scheme on every mesh file of a folder (default: the suite's generated
+real-world-like meshes), one run job per (mesh, scheme)."""
 
 from pathlib import Path
 
@@ -10,6 +11,7 @@ from mcfbench.studies.config import ConfigError
 from mcfbench.studies.matrix import REAL_WORLD_SURFACES, is_real_world, robust_method
 
 GALLERY_SURFACES = REAL_WORLD_SURFACES
+"""Surfaces of the built-in gallery when the registry has no real-world-like problem."""
 
 
 MESH_SUFFIXES = (".obj", ".off", ".ply", ".stl")

@@ -40,11 +40,6 @@ from mcfbench.studies.config import ConfigError
 
 EXACT_SOLVER = "bicgstab"
 """Solver of the problems with a refinement series: the paper's comparison."""
-"""An EOC in this band counts as order ~2."""
-"""Below this EOC (between the two finest levels) an error is not decreasing."""
-"""A non-decreasing error this many times the smallest of any scheme: a wrong limit."""
-"""Candidates whose scores differ by less than this (relative) are called tied."""
-"""An error at most this large on every finished level is exact up to round-off."""
 
 
 # ---------------------------------------------------------------- config
@@ -319,7 +314,5 @@ def picture_runs(plan, root="results/matrix"):
 
 
 # ---------------------------------------------------------------- gallery
-
-"""Surfaces of the built-in gallery when the registry has no real-world-like problem."""
 
 

@@ -9,10 +9,10 @@ from scipy.sparse.linalg import spsolve
 
 from baselines.bgn import BGNFlow
 from baselines.cotan import cotangent_laplacian
-from mcfbench.running.driver import simulate
 from mcfbench.geometry.exact import SphereL2Error, eoc
+from mcfbench.geometry.spheres import icosphere
+from mcfbench.running.driver import simulate
 from mcfbench.running.solver import Solver
-from mcfbench.geometry.surfaces import icosphere
 
 EXACT = Solver(method="direct", rtol=1e-12)
 

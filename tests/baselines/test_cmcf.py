@@ -6,10 +6,10 @@ from conftest import cylinder
 
 from baselines.cmcf import CMCFFlow
 from baselines.cotan import CotanFlow, cotangent_laplacian, lumped_mass
-from mcfbench.running.driver import simulate
 from mcfbench.geometry.exact import SphereL2Error, eoc, sphere_radius
+from mcfbench.geometry.spheres import icosphere
+from mcfbench.running.driver import simulate
 from mcfbench.running.solver import Solver
-from mcfbench.geometry.surfaces import icosphere
 
 EXACT = Solver(method="direct", rtol=1e-12)
 

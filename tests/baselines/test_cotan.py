@@ -8,10 +8,10 @@ from conftest import approaches_the_catenoid, cylinder, flat_lattice
 from baselines import cotan
 from baselines.cotan import CotanAssembler, CotanFlow, cotangent_laplacian, lumped_mass
 from baselines.mesh import edge_mesh
-from mcfbench.running.driver import simulate
 from mcfbench.geometry.exact import SphereL2Error, eoc
+from mcfbench.geometry.spheres import icosphere
+from mcfbench.running.driver import simulate
 from mcfbench.running.solver import Solver
-from mcfbench.geometry.surfaces import icosphere
 
 EXACT = Solver(method="direct", rtol=1e-12)
 

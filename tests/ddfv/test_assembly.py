@@ -1,14 +1,14 @@
 import numpy as np
 import pytest
-
 from conftest import bumpy_sphere, cylinder, flat_lattice
 from reference import literal_system
+
 from ddfv import kernels
 from ddfv.assembly import Assembler, flux_coefficients
 from ddfv.geometry import covolume_areas, diamond_geometry
 from ddfv.t_vertices import initial_t_vertices
 from ddfv.topology import diamond_mesh
-from mcfbench.geometry.surfaces import icosphere
+from mcfbench.geometry.spheres import icosphere
 
 
 def _state(V, F, t_init="paper", noise=0.0, seed=0):

@@ -2,16 +2,17 @@
 
 import numpy as np
 import pytest
-
 from conftest import cylinder
+
 from ddfv import Flow
 from ddfv.geometry import covolume_areas, diamond_geometry
 from ddfv.topology import diamond_mesh
-from mcfbench.running.driver import simulate as drive
-from mcfbench.running.solver import Solver
 from mcfbench.geometry import surfaces
 from mcfbench.geometry.metrics import catenoid_parameter
-from mcfbench.geometry.surfaces import hemisphere, icosphere
+from mcfbench.geometry.shapes import hemisphere
+from mcfbench.geometry.spheres import icosphere
+from mcfbench.running.driver import simulate as drive
+from mcfbench.running.solver import Solver
 
 TIGHT = dict(rtol=1e-13, t_init="paper")
 
@@ -123,8 +124,8 @@ def test_collapse_to_a_point_is_detected():
 
 def test_t_vertex_escape_is_named_with_step_triangle_and_coordinate():
     """The cylinder of Fig. 3.6: without (3.6) a T-vertex leaves its triangle at n = 592."""
-    from mcfbench.studies.figures import EXPERIMENTS
     from mcfbench.geometry.surfaces import make_surface
+    from mcfbench.studies.figures import EXPERIMENTS
 
     run = EXPERIMENTS["fig_3_6"].runs[0]
     V, F = make_surface(run.shape, **run.params)
@@ -187,7 +188,7 @@ def test_degenerate_initial_t_vertices_are_a_defect_at_step_0(bumpy):
 def test_paper_initialisation_keeps_t_vertices_in_their_triangles():
     """On a coarse sharp mesh (a cube split twice) the osculating-sphere recipe would
     put T-vertices outside their triangles; those keep the barycentre."""
-    from mcfbench.geometry.surfaces import subdivide
+    from mcfbench.geometry.spheres import subdivide
 
     V = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
     F = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],

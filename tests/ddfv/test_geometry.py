@@ -1,12 +1,18 @@
 import numpy as np
 import pytest
-
 from conftest import bumpy_sphere, cylinder, flat_lattice
-from ddfv.geometry import (covolume_areas, diamond_corners, diamond_geometry,
-                           t_barycentric, triangle_areas, vertex_normals)
+
+from ddfv.geometry import (
+    covolume_areas,
+    diamond_corners,
+    diamond_geometry,
+    t_barycentric,
+    triangle_areas,
+    vertex_normals,
+)
 from ddfv.t_vertices import initial_t_vertices
 from ddfv.topology import DiamondMesh, diamond_mesh
-from mcfbench.geometry.surfaces import icosphere
+from mcfbench.geometry.spheres import icosphere
 
 
 def _random_state(seed=1):

@@ -1,10 +1,10 @@
 import numpy as np
 import pytest
-
 from conftest import cylinder, flat_lattice
-from mcfbench.geometry.surfaces import icosphere
+
 from ddfv.t_vertices import cotangent_mean_curvature_vector, initial_t_vertices
 from ddfv.topology import diamond_mesh
+from mcfbench.geometry.spheres import icosphere
 
 
 def test_exact_initialisation_lies_on_the_sphere():

@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
-
 from conftest import flat_lattice
+
 from ddfv.topology import diamond_mesh, locality_order
-from mcfbench.geometry.surfaces import icosphere
+from mcfbench.geometry.spheres import icosphere
 
 
 @pytest.mark.parametrize("level", [0, 1, 2, 3])

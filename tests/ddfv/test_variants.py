@@ -4,8 +4,8 @@ import pytest
 
 from ddfv import Flow
 from ddfv.variants import VARIANTS, variant_options
+from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.schemes import SCHEMES
-from mcfbench.geometry.surfaces import icosphere
 
 
 def test_variants_are_options_of_the_flow():

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from mcfbench.cli import main
-from mcfbench.geometry.surfaces import icosphere
+from mcfbench.geometry.spheres import icosphere
 
 TET_V = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
 TET_F = "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n"

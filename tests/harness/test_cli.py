@@ -110,7 +110,7 @@ def test_run_reports_a_breakdown_and_keeps_frames(tmp_path, capsys):
 
 def test_run_names_the_escape_of_a_t_vertex(tmp_path, capsys):
     """A cube split twice (192 triangles): the T-vertices leave their triangles."""
-    from mcfbench.geometry.surfaces import subdivide
+    from mcfbench.geometry.spheres import subdivide
 
     V = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
     F = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],

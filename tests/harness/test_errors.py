@@ -3,7 +3,7 @@ import pytest
 
 from ddfv import Flow
 from mcfbench.geometry.exact import SphereL2Error, eoc, sphere_radius
-from mcfbench.geometry.surfaces import icosphere
+from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate
 
 

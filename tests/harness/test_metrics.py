@@ -22,7 +22,8 @@ from mcfbench.geometry.metrics import (
     triangle_areas,
     volume,
 )
-from mcfbench.geometry.surfaces import cylinder, flat_lattice, hemisphere, icosahedron
+from mcfbench.geometry.shapes import cylinder, flat_lattice, hemisphere
+from mcfbench.geometry.spheres import icosahedron
 
 # a* of R = 1, h = 0.5 to 21 digits (mpmath.findroot at 30 digits)
 A_CATENOID = 0.848337938094979002054
@@ -257,7 +258,7 @@ def _numpy_quality(V, F):
 
 def test_quality_kernel_matches_a_numpy_evaluation():
     from mcfbench.geometry.metrics import edge_neighbours
-    from mcfbench.geometry.surfaces import icosphere
+    from mcfbench.geometry.spheres import icosphere
 
     rng = np.random.default_rng(3)
     V, F = icosphere(3)

@@ -19,7 +19,8 @@ from mcfbench.geometry.quality import (
     primal_quality,
     vertex_quality,
 )
-from mcfbench.geometry.surfaces import cylinder, icosphere
+from mcfbench.geometry.shapes import cylinder
+from mcfbench.geometry.spheres import icosphere
 from mcfbench.presentation.quality_plots import plot_quality
 from mcfbench.running.driver import simulate
 

@@ -7,7 +7,8 @@ from matplotlib.collections import PolyCollection
 
 from ddfv import Flow
 from ddfv.topology import diamond_mesh
-from mcfbench.geometry.surfaces import cylinder, icosphere
+from mcfbench.geometry.shapes import cylinder
+from mcfbench.geometry.spheres import icosphere
 from mcfbench.presentation.render import (
     DPI,
     HIGHLIGHT_COLOR,

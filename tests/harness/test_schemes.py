@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from mcfbench.geometry.surfaces import icosphere, random_bumpy_sphere
+from mcfbench.geometry.spheres import icosphere, random_bumpy_sphere
 from mcfbench.running.driver import simulate
 from mcfbench.running.flow import Flow
 from mcfbench.running.schemes import SCHEMES, get_scheme

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from mcfbench.geometry.surfaces import icosphere
+from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.run import level_sweep, run, space_convergence, time_convergence
 
 

@@ -6,29 +6,28 @@ import igl
 import numpy as np
 import pytest
 
+from mcfbench.geometry.implicit import blobby, implicit_torus, isosurface
 from mcfbench.geometry.metrics import area, mean_edge_length, triangle_areas, volume
-from mcfbench.geometry.surfaces import (
-    SURFACES,
-    anisotropic_sphere,
-    blobby,
-    bumpy_sphere,
+from mcfbench.geometry.shapes import (
     cylinder,
     dumbbell,
     dumbbell_profile,
     flat_lattice,
     flat_patch,
     hemisphere,
+    torus,
+)
+from mcfbench.geometry.spheres import (
+    anisotropic_sphere,
+    bumpy_sphere,
     icosahedron,
     icosphere,
-    implicit_torus,
-    isosurface,
-    make_surface,
     perturbed_sphere,
     random_bumpy_sphere,
     remeshed_sphere,
     subdivide,
-    torus,
 )
+from mcfbench.geometry.surfaces import SURFACES, make_surface
 
 # name -> (n_F, n_T, boundary loops, Euler characteristic) at the default parameters
 EXPECTED = {

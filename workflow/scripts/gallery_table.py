@@ -3,8 +3,8 @@ workflow/rules/gallery.smk; :func:`mcfbench.studies.matrix_tables.gallery_table`
 
 import logging
 
-from mcfbench.storage.atomic import write_text
 from mcfbench.presentation.matrix_tables import gallery_markdown, gallery_table
+from mcfbench.storage.atomic import write_text
 from mcfbench.studies.matrix import read_runs
 
 sm = snakemake  # noqa: F821

@@ -12,8 +12,8 @@ from mcfbench.presentation.matrix_plots import (
              picture_grid,
              quality_figure,
 )
-from mcfbench.storage.records import read_record
 from mcfbench.presentation.matrix_tables import read_long_table
+from mcfbench.storage.records import read_record
 from mcfbench.studies.matrix import load_frames, read_runs
 
 sm = snakemake  # noqa: F821
