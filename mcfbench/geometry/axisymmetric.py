@@ -226,7 +226,7 @@ def evolve(X0, times, ends=("axis", "axis"), periodic=False, method="radau", tau
     list of (n, 2) float arrays
         The nodes at each of ``times``.
     """
-    system = _System(len(X0), tuple(ends), bool(periodic))
+    system = _System(len(X0), tuple(ends or ()), bool(periodic))
     y, t, out, step = np.asarray(X0, float).ravel().copy(), 0.0, [], None
     for t1 in times:
         if method == "cn":
@@ -244,60 +244,62 @@ def evolve(X0, times, ends=("axis", "axis"), periodic=False, method="radau", tau
     return out
 
 
-def evolve_until(X0, quantity, level, ends=("axis", "axis"), periodic=False, rtol=1e-11,
+def evolve_until(X0, quantity, levels, ends=("axis", "axis"), periodic=False, rtol=1e-11,
                  atol=1e-11, t_max=10.0):
-    """Flow by adaptive Radau until ``quantity(X)`` falls to ``level``.
+    """Flow by adaptive Radau until ``quantity(X)`` has fallen through each of ``levels``.
 
     Parameters
     ----------
     X0 : (n, 2) float array
     quantity : callable
         ``quantity(X) -> float``, decreasing along the flow (a neck radius).
-    level : float
-        Stop at the time ``t*`` with ``quantity(X(t*)) = level``.
+    levels : sequence of float
+        Decreasing; the times ``t_k`` with ``quantity(X(t_k)) = levels[k]`` are found.
 
     Returns
     -------
-    t_star : float
-        Found by secant steps, each one re-integrating from the last accepted
-        step before the crossing (``|quantity - level| < 1e-13``).
-    history : (k, 2) float array
-        ``(t, quantity)`` at every accepted step up to the crossing.
+    t_levels : (k,) float array
+        Each by secant steps, every one a fresh Radau integration from the
+        last accepted step before the crossing, to ``|quantity - level| < 1e-13``
+        (the main integration is not disturbed).
+    history : (m, 2) float array
+        ``(t, quantity)`` at every accepted step up to the last crossing.
     X : (n, 2) float array
-        The nodes at ``t_star``.
+        The nodes at ``t_levels[-1]``.
     """
     from scipy.integrate import Radau
 
-    system = _System(len(X0), tuple(ends), bool(periodic))
+    levels = list(levels)
+    system = _System(len(X0), tuple(ends or ()), bool(periodic))
     y = np.asarray(X0, float).ravel().copy()
     solver = Radau(system.f, 0.0, y, t_max, rtol=rtol, atol=atol, jac=system.jac)
     hist = [(0.0, quantity(X0))]
-    t_prev, y_prev = 0.0, y
-    while True:
-        t_prev, y_prev = solver.t, solver.y.copy()
+    found, X_last = [], None
+    while levels:
+        t_prev, y_prev, q_prev = solver.t, solver.y.copy(), hist[-1][1]
         msg = solver.step()
         if solver.status == "failed":
             raise RuntimeError(f"Radau failed at t = {solver.t:.6g}: {msg}")
         qv = quantity(solver.y.reshape(-1, 2))
         if not np.isfinite(qv):
             raise RuntimeError(f"non-finite quantity at t = {solver.t:.6g}")
-        if qv <= level:
-            break
         hist.append((solver.t, qv))
-        if solver.status == "finished":
-            raise RuntimeError(f"{level} not reached before t_max = {t_max}")
-    # secant on t in [t_prev, solver.t], each value by a fresh integration from t_prev
-    ta, qa = t_prev, hist[-1][1]
-    tb, qb = solver.t, qv
-    yb = solver.y.copy()
-    for _ in range(40):
-        tc = tb - (qb - level) * (tb - ta) / (qb - qa)
-        yc, _ = _radau_to(system, y_prev, t_prev, tc, rtol, atol, (tc - t_prev) / 4)
-        qc = quantity(yc.reshape(-1, 2))
-        ta, qa, tb, qb, yb = tb, qb, tc, qc, yc
-        if abs(qc - level) < 1e-13:
-            break
-    return tb, np.array(hist), yb.reshape(-1, 2)
+        while levels and qv <= levels[0]:
+            level = levels.pop(0)
+            ta, qa, tb, qb = t_prev, q_prev, solver.t, qv
+            yb = solver.y.copy()
+            for _ in range(40):  # secant on t in [t_prev, solver.t]
+                tc = tb - (qb - level) * (tb - ta) / (qb - qa)
+                yc, _ = _radau_to(system, y_prev, t_prev, tc, rtol, atol, (tc - t_prev) / 4)
+                qc = quantity(yc.reshape(-1, 2))
+                ta, qa, tb, qb, yb = tb, qb, tc, qc, yc
+                if abs(qc - level) < 1e-13 or tb == ta:
+                    break
+            found.append(tb)
+            X_last = yb.reshape(-1, 2)
+        if levels and solver.status == "finished":
+            raise RuntimeError(f"{levels[0]} not reached before t_max = {t_max}")
+    return np.array(found), np.array(hist), X_last
 
 
 # ---------------------------------------------------------------- measured quantities
@@ -362,14 +364,17 @@ def measures(X, periodic=False):
     dict
         ``area``, ``volume``, ``max_height``, ``mid_radius`` (``r`` of the
         middle node, the neck of a mirror-symmetric open meridian with an odd
-        number of nodes), ``min_radius`` (smallest nodal ``r`` off the axis);
+        number of nodes), ``min_radius`` (smallest nodal ``r`` at an interior
+        local minimum of ``r``, nan if none; a check that the neck is the
+        middle node);
         for a closed meridian also ``cross_section`` and ``tube_radius``
         ``= sqrt(cross_section / pi)``.
     """
     Y = _closed(X) if periodic else X
     out = {"area": area(Y), "volume": volume(Y), "max_height": max_height(X, periodic)}
     r = X[:, 0]
-    out["min_radius"] = float(r[r > 0].min())
+    inner = (r[1:-1] <= r[:-2]) & (r[1:-1] <= r[2:]) if not periodic else np.zeros(0, bool)
+    out["min_radius"] = float(r[1:-1][inner].min()) if inner.any() else float("nan")
     if periodic:
         out["cross_section"] = cross_section(X)
         out["tube_radius"] = math.sqrt(out["cross_section"] / math.pi)
@@ -558,3 +563,146 @@ def initial_meridian(shape, n, **params):
         s = prof["length"] * np.arange(n) / n
         return prof["curve"](s), None, True
     raise ValueError(f"unknown shape {shape!r}")
+
+
+# ---------------------------------------------------------------- the Angenent torus
+
+ANGENENT_RHO0_PUBLISHED = 0.437123967096460
+"""Inner radius of the Angenent torus's meridian as published (NOTES.md, "More exact
+answers"; the normalisation ``H = x . nu / 2``, extinction at ``t = 1``)."""
+
+
+def _angenent_rhs(s, y):
+    """Shrinker meridian ODE by arc length (NOTES.md, "More exact answers")::
+
+        rho' = sin a,  z' = cos a,  a' = (1/rho - rho/2) cos a + (z/2) sin a,
+
+    with three quadratures appended: ``int rho``, ``int rho^2 z'``,
+    ``int rho exp(-(rho^2 + z^2)/4)`` (area, volume, entropy).
+    """
+    rho, z, a = y[0], y[1], y[2]
+    sa, ca = np.sin(a), np.cos(a)
+    return [sa, ca, (1.0 / rho - 0.5 * rho) * ca + 0.5 * z * sa,
+            rho, rho * rho * ca, rho * np.exp(-0.25 * (rho * rho + z * z))]
+
+
+def _angenent_shoot(rho0, tol=1e-13):
+    """Integrate from ``(rho0, 0)``, ``a = 0`` (upwards) to the next crossing of ``z = 0``."""
+
+    def cross(s, y):
+        return y[1]
+
+    cross.terminal, cross.direction = True, -1
+    sol = solve_ivp(_angenent_rhs, (0.0, 50.0), [rho0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                    method="DOP853", rtol=tol, atol=tol, events=cross, dense_output=True)
+    if not sol.t_events[0].size:
+        raise RuntimeError(f"the meridian from rho0 = {rho0} does not return to z = 0")
+    return sol, float(sol.t_events[0][0]), sol.y_events[0][0]
+
+
+def angenent_rho0(tol=1e-13):
+    """Inner radius ``rho0`` of the Angenent torus by shooting.
+
+    The meridian starts at ``(rho0, 0)`` vertically upwards and closes
+    symmetrically iff it crosses ``z = 0`` again vertically (angle ``pi``);
+    ``rho0`` is the root of ``a(crossing) - pi`` in ``[0.42, 0.45]`` (brentq,
+    ``xtol = 1e-15``).
+
+    Returns
+    -------
+    float
+    """
+    return brentq(lambda r0: _angenent_shoot(r0, tol)[2][2] - np.pi, 0.42, 0.45,
+                  xtol=1e-15, rtol=1e-15)
+
+
+def angenent_profile(rho0=None):
+    """The Angenent torus at ``t = 0`` (extinct at ``t = 1``, ``M_t = sqrt(1 - t) M_0``).
+
+    Parameters
+    ----------
+    rho0 : float, optional
+        Inner radius; computed by :func:`angenent_rho0` if not given.
+
+    Returns
+    -------
+    dict
+        ``rho0``; ``rho_outer``; ``half_height`` (largest ``z``); ``length``
+        (of the closed meridian); ``area`` ``= 2 pi int rho ds``; ``volume``;
+        ``entropy`` ``= (4 pi)^-1 int exp(-|x|^2/4) dA``; ``curve`` (callable,
+        arc length ``s`` (m,) -> (m, 2) points ``(rho, z)`` of the closed
+        meridian, periodic with period ``length``, counter-clockwise from
+        the inner point); ``upper`` (the dense ODE solution of the upper
+        half, state ``(rho, z, a, ...)``), ``half_length``.
+    """
+    rho0 = angenent_rho0() if rho0 is None else float(rho0)
+    sol, S, y_end = _angenent_shoot(rho0)
+    ss = np.linspace(0.0, S, 4001)
+    zz = sol.sol(ss)[1]
+
+    def curve(s):
+        s = np.mod(np.asarray(s, dtype=float), 2.0 * S)
+        up = s <= S
+        sig = np.where(up, s, 2.0 * S - s)
+        y = sol.sol(sig)
+        return np.column_stack([y[0], np.where(up, y[1], -y[1])])
+
+    zmax = max_height(np.column_stack([sol.sol(ss)[0], zz]))
+    return {"rho0": rho0, "rho_outer": float(y_end[0]), "half_height": float(zmax),
+            "length": 2.0 * S, "half_length": S,
+            "area": float(4.0 * np.pi * y_end[3]), "volume": float(2.0 * np.pi * abs(y_end[4])),
+            "entropy": float(y_end[5]), "curve": curve, "upper": sol}
+
+
+def angenent_area(t, profile=None):
+    """Area of the Angenent torus at time ``t < 1``: ``(1 - t) area_0``."""
+    profile = angenent_profile() if profile is None else profile
+    return (1.0 - t) * profile["area"]
+
+
+def angenent_distance(points, t, profile=None):
+    """Unsigned distance of points to the Angenent torus ``M_t = sqrt(1 - t) M_0``.
+
+    Parameters
+    ----------
+    points : (m, 3) or (m, 2) float array
+        Points in space, or meridian points ``(rho, z)``.
+    t : float
+        Time, ``< 1``.
+
+    Returns
+    -------
+    (m,) float array
+        Nearest point on the upper half meridian (the torus is symmetric in
+        ``z``) from a dense sample, refined by Newton's method on the arc length
+        with the ODE's exact derivatives ``c' = (sin a, cos a)``,
+        ``c'' = a' (cos a, -sin a)``.
+    """
+    from scipy.spatial import cKDTree
+
+    profile = angenent_profile() if profile is None else profile
+    P = np.asarray(points, dtype=float)
+    if P.shape[1] == 3:
+        P = np.column_stack([np.hypot(P[:, 0], P[:, 1]), P[:, 2]])
+    scale = math.sqrt(1.0 - t)
+    p = P / scale
+    p[:, 1] = np.abs(p[:, 1])
+    sol, S = profile["upper"], profile["half_length"]
+    ss = np.linspace(0.0, S, 20001)
+    Y = sol.sol(ss)
+    s = ss[cKDTree(Y[:2].T).query(p)[1]]
+    for _ in range(20):
+        y = sol.sol(s)
+        rho, z, a = y[0], y[1], y[2]
+        d = np.column_stack([rho, z]) - p
+        c1 = np.column_stack([np.sin(a), np.cos(a)])
+        da = (1.0 / rho - 0.5 * rho) * np.cos(a) + 0.5 * z * np.sin(a)
+        c2 = da[:, None] * np.column_stack([np.cos(a), -np.sin(a)])
+        g = np.sum(d * c1, axis=1)
+        hess = 1.0 + np.sum(d * c2, axis=1)
+        step = g / np.where(hess > 0.1, hess, 1.0)
+        s = np.clip(s - step, 0.0, S)
+        if np.abs(step).max() < 1e-15:
+            break
+    y = sol.sol(s)
+    return scale * np.hypot(y[0] - p[:, 0], y[1] - p[:, 1])
