@@ -245,7 +245,7 @@ def evolve(X0, times, ends=("axis", "axis"), periodic=False, method="radau", tau
 
 
 def evolve_until(X0, quantity, levels, ends=("axis", "axis"), periodic=False, rtol=1e-11,
-                 atol=1e-11, t_max=10.0):
+                 atol=1e-11, t_max=10.0, record_times=()):
     """Flow by adaptive Radau until ``quantity(X)`` has fallen through each of ``levels``.
 
     Parameters
@@ -255,6 +255,9 @@ def evolve_until(X0, quantity, levels, ends=("axis", "axis"), periodic=False, rt
         ``quantity(X) -> float``, decreasing along the flow (a neck radius).
     levels : sequence of float
         Decreasing; the times ``t_k`` with ``quantity(X(t_k)) = levels[k]`` are found.
+    record_times : sequence of float
+        Increasing times at which the nodes are also returned (each by a fresh
+        integration from the last accepted step before it).
 
     Returns
     -------
@@ -266,8 +269,12 @@ def evolve_until(X0, quantity, levels, ends=("axis", "axis"), periodic=False, rt
         ``(t, quantity)`` at every accepted step up to the last crossing.
     X : (n, 2) float array
         The nodes at ``t_levels[-1]``.
+    recorded : list of (n, 2) float arrays
+        The nodes at ``record_times`` (only if ``record_times`` is given).
     """
     from scipy.integrate import Radau
+
+    pending, recorded = list(record_times), []
 
     levels = list(levels)
     system = _System(len(X0), tuple(ends or ()), bool(periodic))
@@ -284,6 +291,11 @@ def evolve_until(X0, quantity, levels, ends=("axis", "axis"), periodic=False, rt
         if not np.isfinite(qv):
             raise RuntimeError(f"non-finite quantity at t = {solver.t:.6g}")
         hist.append((solver.t, qv))
+        while pending and solver.t >= pending[0]:
+            tr = pending.pop(0)
+            yr = solver.y.copy() if tr == solver.t else _radau_to(
+                system, y_prev, t_prev, tr, rtol, atol, (tr - t_prev) / 4)[0]
+            recorded.append(yr.reshape(-1, 2))
         while levels and qv <= levels[0]:
             level = levels.pop(0)
             ta, qa, tb, qb = t_prev, q_prev, solver.t, qv
@@ -299,6 +311,10 @@ def evolve_until(X0, quantity, levels, ends=("axis", "axis"), periodic=False, rt
             X_last = yb.reshape(-1, 2)
         if levels and solver.status == "finished":
             raise RuntimeError(f"{levels[0]} not reached before t_max = {t_max}")
+    if pending:
+        raise ValueError(f"record times {pending} are after the last level was reached")
+    if record_times:
+        return np.array(found), np.array(hist), X_last, recorded
     return np.array(found), np.array(hist), X_last
 
 
@@ -706,3 +722,268 @@ def angenent_distance(points, t, profile=None):
             break
     y = sol.sol(s)
     return scale * np.hypot(y[0] - p[:, 0], y[1] - p[:, 1])
+
+
+# ---------------------------------------------------------------- pinch times from the approach
+
+
+def pinch_time_tube(t_levels, levels):
+    """Extinction time of a closed meridian shrinking to a point (a thin torus's tube).
+
+    Near extinction the tube is a thin round cylinder bent into a ring:
+    ``d(pi rho^2)/dt = -2 pi + O(rho^2)`` for the cross-section radius
+    ``rho = sqrt(A / pi)`` (the first term is ``-int kappa ds = -2 pi``; the
+    parallel curvature ``cos(theta) / r`` integrates to ``O(rho^2)``), so
+    ``t(rho) = T - rho^2/2 - a rho^4 - b rho^6 - ...``. Least squares for
+    ``T, a, b`` on the given levels.
+
+    Parameters
+    ----------
+    t_levels, levels : (k,) float arrays
+        Times at which ``rho`` reached ``levels`` (decreasing), ``k >= 4``.
+
+    Returns
+    -------
+    T, error : float
+        ``T`` from the fit with ``rho^4, rho^6``; the error estimate is the
+        largest change of ``T`` when the ``rho^6`` term or the largest level is
+        dropped.
+    """
+    t, r = np.asarray(t_levels, float), np.asarray(levels, float)
+
+    def fit(sel, powers):
+        A = np.column_stack([np.ones(sel.sum())] + [-r[sel] ** p for p in powers])
+        return np.linalg.lstsq(A, t[sel] + 0.5 * r[sel] ** 2, rcond=None)[0][0]
+
+    allk = np.ones(len(t), bool)
+    drop = allk.copy()
+    drop[0] = False
+    T = fit(allk, (4, 6))
+    alts = [fit(allk, (4,)), fit(drop, (4, 6)), fit(drop, (4,))]
+    return float(T), float(max(abs(a - T) for a in alts))
+
+
+def pinch_time_neck(t_levels, levels, last=(4, 5, 6), ncoefs=(1, 2)):
+    """Pinch time of a rotationally symmetric neck from the times it reached radii ``levels``.
+
+    Fits the neckpinch asymptotics (Angenent and Velazquez; Angenent and
+    Knopf: a round cylinder with logarithmic corrections)::
+
+        r^2 = 2 D (1 + c_1 / L + c_2 / L^2),   D = T - t,   L = -log D,
+
+    by nonlinear least squares (relative residuals) on the smallest ``k``
+    levels. ``T`` is the fit with 2 coefficients on the smallest
+    ``last[1]`` levels; the error estimate is the largest deviation of the
+    fits with ``ncoefs`` coefficients on the smallest ``last`` levels.
+
+    Returns
+    -------
+    T, error : float
+    fits : list of (k, ncoef, T, coefficients)
+    """
+    from scipy.optimize import least_squares
+
+    t, r2 = np.asarray(t_levels, float), np.asarray(levels, float) ** 2
+    fits = []
+    for k in last:
+        for nc in ncoefs:
+            tt, rr = t[-k:], r2[-k:]
+
+            def res(p, tt=tt, rr=rr, nc=nc):
+                D = np.maximum(p[0] - tt, 1e-300)
+                L = -np.log(D)
+                return 2.0 * D * (1.0 + sum(p[1 + i] / L ** (i + 1) for i in range(nc))) / rr - 1.0
+
+            p0 = [t[-1] + 0.5 * r2[-1] * 1.3] + [0.0] * nc
+            sol = least_squares(res, p0, x_scale=[r2[-1]] + [1.0] * nc,
+                                bounds=([t[-1] + 1e-300] + [-np.inf] * nc, np.inf),
+                                xtol=1e-15, ftol=1e-15, gtol=1e-15)
+            fits.append((k, nc, float(sol.x[0]), sol.x[1:].tolist()))
+    best = next(f[2] for f in fits if f[0] == last[1] and f[1] == 2)
+    return best, max(abs(f[2] - best) for f in fits), fits
+
+
+# ---------------------------------------------------------------- reference numbers
+
+J01_SQUARED = 5.783185962946784
+"""Square of the first zero of the Bessel function ``J_0`` (NOTES.md)."""
+
+
+def catenoid_parameter(radius=1.0, half_height=0.5):
+    """The stable root ``a`` of ``a cosh(h / a) = R`` (the larger one), by brentq."""
+    x_crit = brentq(lambda x: x * math.tanh(x) - 1.0, 0.5, 2.0, xtol=1e-15)  # h/a at the fold
+    a_fold = half_height / x_crit
+    if a_fold * math.cosh(x_crit) > radius:
+        raise ValueError(f"no catenoid spans circles of radius {radius} at +-{half_height}")
+    return brentq(lambda a: a * math.cosh(half_height / a) - radius, a_fold, radius,
+                  xtol=1e-16, rtol=4 * np.finfo(float).eps)
+
+
+def catenoid_area(radius=1.0, half_height=0.5):
+    """Area ``pi a (2 h + a sinh(2 h / a))`` of the stable catenoid (NOTES.md)."""
+    a = catenoid_parameter(radius, half_height)
+    return math.pi * a * (2.0 * half_height + a * math.sinh(2.0 * half_height / a))
+
+
+def critical_aspect_ratio():
+    """Largest ``h / R`` for which a catenoid spans circles of radius ``R`` at ``z = +-h``.
+
+    ``h / R = x / cosh x`` at the root of ``x tanh x = 1`` (the fold of the
+    catenoid family); 0.662743... Beyond it a cylinder between the circles
+    pinches.
+    """
+    x = brentq(lambda x: x * math.tanh(x) - 1.0, 0.5, 2.0, xtol=1e-15)
+    return x / math.cosh(x)
+
+
+def _extrapolate(per_mesh, coarse_tight=None, coarse=None):
+    """Richardson over meshes of each quantity; the time-tolerance effect (the
+    coarsest mesh run with tolerances 10x tighter) is added to the error."""
+    out = {}
+    for key in per_mesh[0]:
+        vals = np.array([m[key] for m in per_mesh], dtype=float)
+        if vals.ndim == 1:
+            v, e, _ = richardson(vals)
+            if coarse_tight is not None:
+                e += abs(coarse_tight[key] - coarse[key])
+            out[key] = (v, e)
+        else:
+            rows = [richardson(vals[:, k]) for k in range(vals.shape[1])]
+            err = np.array([r[1] for r in rows])
+            if coarse_tight is not None:
+                err = err + np.abs(np.asarray(coarse_tight[key]) - np.asarray(coarse[key]))
+            out[key] = (np.array([r[0] for r in rows]), err)
+    return out
+
+
+def _fixed_time_run(shape, n, times, params, rtol):
+    X, ends, per = initial_meridian(shape, n, **params)
+    states = evolve(X, times, ends, per, rtol=rtol, atol=rtol)
+    ms = [measures(Y, per) for Y in states]
+    return {k: [m[k] for m in ms] for k in ms[0]}
+
+
+def _pinch_run(shape, n, levels, times, params, rtol, quantity):
+    X, ends, per = initial_meridian(shape, n, **params)
+    t_lev, _, X_last, rec = evolve_until(X, quantity, levels, ends, per, rtol=rtol, atol=rtol,
+                                         record_times=times)
+    ms = [measures(Y, per) for Y in rec]
+    out = {k: [m[k] for m in ms] for k in ms[0]}
+    out["t_levels"] = t_lev
+    last = measures(X_last, per)
+    out["max_height_at_last_level"] = last["max_height"]
+    return out
+
+
+def _series_run(run, ns, *args, rtol=1e-11):
+    per_mesh = [run(n, *args, rtol) for n in ns]
+    coarse_tight = run(ns[0], *args, rtol / 10)
+    return _extrapolate(per_mesh, coarse_tight, per_mesh[0]), per_mesh
+
+
+def _mid(X):
+    return float(X[len(X) // 2, 0])
+
+
+def _tube(X):
+    return math.sqrt(cross_section(X) / math.pi)
+
+
+def reference_numbers(problems=("torus", "dumbbell", "catenoid", "hemisphere", "long_cylinder"),
+                      quick=False):
+    """Reference answers for the suite's axisymmetric problems (computed, nothing cached).
+
+    Every number is ``(value, error_estimate)``: Richardson extrapolation over
+    meshes ``n, 2n, 4n, 8n`` (orders 2, 4, 6; error = difference to the
+    next-lower order) plus the change when the coarsest mesh is rerun with
+    time tolerances ten times tighter; pinch times add the spread of the
+    asymptotic fits (:func:`pinch_time_tube`, :func:`pinch_time_neck`).
+
+    Problems (initial shapes of ``mcfbench.problems``):
+
+    * ``torus``: ``R = 2, r = 0.5``; ``volume``, ``area``, ``tube_radius``
+      (``sqrt(cross-section / pi)``), ``max_height`` at ``times``; ``pinch_time``
+      (the tube shrinks to a circle of radius ``ring_radius``).
+    * ``dumbbell``: ``volume``, ``area``, ``mid_radius`` (the neck on
+      ``z = 0``), ``max_height`` at ``times``; ``pinch_time``.
+    * ``catenoid``: cylinder ``R = 1, h = 0.5`` between fixed circles:
+      ``mid_radius`` (neck) and ``area`` at ``times``, the last one (t = 8) at
+      the steady state, with the exact catenoid ``a``, its area.
+    * ``hemisphere``: ``R = 1``, equator fixed: ``max_height`` at ``times``;
+      ``decay_rate = log(z(1.5) / z(2)) / 0.5`` against ``j01^2 / R^2``.
+    * ``long_cylinder``: ``R = 1, h = 1`` (``h / R`` beyond
+      :func:`critical_aspect_ratio`): neck at ``times`` and ``pinch_time``.
+
+    Parameters
+    ----------
+    problems : sequence of str
+    quick : bool
+        Coarser meshes (a smoke test: about 10 s, errors far larger).
+
+    Returns
+    -------
+    dict
+        ``problem -> {quantity: (value, error)}`` (arrays over ``times`` for
+        time series) plus ``times`` and setting entries.
+    """
+    out = {}
+    neck_levels = 0.1 * 2.0 ** (-0.5 * np.arange(10 if not quick else 6))
+    if "torus" in problems:
+        ns = (128, 256, 512, 1024) if not quick else (32, 64, 128)
+        levels = 0.1 * 2.0 ** (-0.5 * np.arange(9))
+        times = (0.025, 0.05, 0.075, 0.1)
+        ex, per_mesh = _series_run(lambda n, rtol: _pinch_run(
+            "torus", n, levels, times, {"R": 2.0, "r": 0.5}, rtol, _tube), ns)
+        T, eT = pinch_time_tube(ex["t_levels"][0], levels)
+        res = {k: ex[k] for k in ("volume", "area", "tube_radius", "max_height")}
+        res.update(times=times, meshes=ns, levels=levels, t_levels=ex["t_levels"],
+                   pinch_time=(T, eT + float(ex["t_levels"][1].max())))
+        out["torus"] = res
+    if "dumbbell" in problems:
+        ns = (1601, 3201, 6401, 12801) if not quick else (201, 401, 801)
+        times = (0.02, 0.04, 0.06, 0.08)
+        ex, _ = _series_run(lambda n, rtol: _pinch_run(
+            "dumbbell", n, neck_levels, times, {}, rtol, _mid), ns)
+        T, eT, _fits = pinch_time_neck(ex["t_levels"][0], neck_levels,
+                                       last=(4, 5, 6) if not quick else (3, 4, 5))
+        res = {k: ex[k] for k in ("volume", "area", "mid_radius", "max_height")}
+        res.update(times=times, meshes=ns, levels=neck_levels, t_levels=ex["t_levels"],
+                   max_height_at_last_level=ex["max_height_at_last_level"],
+                   pinch_time=(T, eT + float(ex["t_levels"][1].max())))
+        out["dumbbell"] = res
+    if "catenoid" in problems:
+        ns = (33, 65, 129, 257, 513) if not quick else (17, 33, 65)
+        times = (0.1, 0.25, 0.5, 1.0, 1.5, 8.0)
+        ex, _ = _series_run(lambda n, rtol: _fixed_time_run(
+            "cylinder", n, times, {"radius": 1.0, "half_height": 0.5}, rtol), ns)
+        out["catenoid"] = {"mid_radius": ex["mid_radius"], "area": ex["area"],
+                           "volume": ex["volume"], "times": times, "meshes": ns,
+                           "exact_neck": catenoid_parameter(1.0, 0.5),
+                           "exact_area": catenoid_area(1.0, 0.5)}
+    if "hemisphere" in problems:
+        ns = (33, 65, 129, 257, 513) if not quick else (17, 33, 65)
+        times = (0.1, 0.25, 0.5, 1.0, 1.5, 2.0)
+
+        def run(n, rtol):
+            r = _fixed_time_run("hemisphere", n, times, {"radius": 1.0}, rtol)
+            r["decay_rate"] = math.log(r["max_height"][4] / r["max_height"][5]) / 0.5
+            return r
+
+        ex, _ = _series_run(run, ns)
+        out["hemisphere"] = {"max_height": ex["max_height"], "area": ex["area"],
+                             "decay_rate": ex["decay_rate"], "times": times, "meshes": ns,
+                             "exact_rate": J01_SQUARED}
+    if "long_cylinder" in problems:
+        ns = (801, 1601, 3201, 6401) if not quick else (101, 201, 401)
+        times = (0.05, 0.1, 0.15)
+        ex, _ = _series_run(lambda n, rtol: _pinch_run(
+            "cylinder", n, neck_levels, times, {"radius": 1.0, "half_height": 1.0}, rtol, _mid), ns)
+        T, eT, _fits = pinch_time_neck(ex["t_levels"][0], neck_levels,
+                                       last=(4, 5, 6) if not quick else (3, 4, 5))
+        out["long_cylinder"] = {"radius": 1.0, "half_height": 1.0,
+                                "critical_ratio": critical_aspect_ratio(),
+                                "mid_radius": ex["mid_radius"], "area": ex["area"],
+                                "times": times, "meshes": ns, "levels": neck_levels,
+                                "t_levels": ex["t_levels"],
+                                "pinch_time": (T, eT + float(ex["t_levels"][1].max()))}
+    return out
