@@ -3,11 +3,13 @@
 A surface of revolution about the ``z`` axis is given by its meridian curve
 ``x(u, t) = (r(u, t), z(u, t))``, ``u`` in ``[0, 1]``. Mean curvature flow
 (normal velocity ``V = H``, ``H`` the SUM of the principal curvatures, so a
-sphere has ``r(t) = sqrt(R^2 - 4 t)``) is solved in the DeTurck-type form of
-Barrett, Deckelnick and Nuernberg (IMA J. Numer. Anal. 41 (2021), arXiv
-1911.05398, their equation for the generating curve; see also Barrett,
-Garcke and Nuernberg, Numer. Math. 141 (2019) 791-837, for the parametric
-axisymmetric setting)::
+sphere has ``r(t) = sqrt(R^2 - 4 t)``) is solved in the DeTurck-type form
+(tangential velocity from ``x_uu / |x_u|^2``, as in the axisymmetric
+schemes of Barrett, Deckelnick and Nuernberg, IMA J. Numer. Anal. 41 (2021),
+arXiv 1911.05398, and Barrett, Garcke and Nuernberg, Numer. Math. 141 (2019)
+791-837; only their abstracts could be consulted here, so no equation
+number of theirs is cited: (A1)-(A3) are derived in this module and checked
+against the sphere, the catenoid and the Angenent torus)::
 
     x_t = x_uu / |x_u|^2 - (nu . e_1) / (x . e_1) nu,          (A1)
 
@@ -23,7 +25,8 @@ constant, i.e. the nodes towards equal arc length. In components, with
 Discretisation (this module, not BDN's finite elements): central finite
 differences on the uniform grid ``u_j = j / N`` (second order; the scheme
 and every measured quantity are symmetric, so the error expands in even
-powers ``h^2, h^4, ...`` and Richardson extrapolation in ``h`` applies).
+powers ``h^2, h^4, ...``, with an extra ``h^4 log h`` term at a pole, and
+Richardson extrapolation in ``h`` applies, see :func:`richardson`).
 Both (A2) are invariant under ``u -> c u``, so index units are used.
 
 Ends of the meridian:
@@ -847,7 +850,8 @@ def critical_aspect_ratio():
 
 def _extrapolate(per_mesh, coarse_tight=None, coarse=None):
     """Richardson over meshes of each quantity; the time-tolerance effect (the
-    coarsest mesh run with tolerances 10x tighter) is added to the error."""
+    coarsest mesh run with tolerances 10x tighter) is added to the error, which
+    is floored at ``1e-14 |value|`` (rounding)."""
     out = {}
     for key in per_mesh[0]:
         vals = np.array([m[key] for m in per_mesh], dtype=float)
@@ -855,13 +859,14 @@ def _extrapolate(per_mesh, coarse_tight=None, coarse=None):
             v, e, _ = richardson(vals)
             if coarse_tight is not None:
                 e += abs(coarse_tight[key] - coarse[key])
-            out[key] = (v, e)
+            out[key] = (v, max(e, 1e-14 * abs(v)))  # floor: rounding of the sums
         else:
             rows = [richardson(vals[:, k]) for k in range(vals.shape[1])]
             err = np.array([r[1] for r in rows])
             if coarse_tight is not None:
                 err = err + np.abs(np.asarray(coarse_tight[key]) - np.asarray(coarse[key]))
-            out[key] = (np.array([r[0] for r in rows]), err)
+            value = np.array([r[0] for r in rows])
+            out[key] = (value, np.maximum(err, 1e-14 * np.abs(value)))
     return out
 
 
@@ -943,7 +948,7 @@ def reference_numbers(problems=("torus", "dumbbell", "catenoid", "hemisphere", "
         ns = (128, 256, 512, 1024) if not quick else (32, 64, 128)
         levels = 0.1 * 2.0 ** (-0.5 * np.arange(9))
         times = (0.025, 0.05, 0.075, 0.1)
-        ex, per_mesh = _series_run(lambda n, rtol: _pinch_run(
+        ex, _ = _series_run(lambda n, rtol: _pinch_run(
             "torus", n, levels, times, {"R": 2.0, "r": 0.5}, rtol, _tube), ns)
         T, eT = pinch_time_tube(ex["t_levels"][0], levels)
         res = {k: ex[k] for k in ("volume", "area", "tube_radius", "max_height")}
@@ -1001,3 +1006,28 @@ def reference_numbers(problems=("torus", "dumbbell", "catenoid", "hemisphere", "
                                 "t_levels": ex["t_levels"],
                                 "pinch_time": (T, eT + float(ex["t_levels"][1].max()))}
     return out
+
+
+def format_reference_table(ref):
+    """Plain-text table of :func:`reference_numbers` (value and error estimate per row).
+
+    Returns
+    -------
+    str
+    """
+    lines = [f"{'problem':<14}{'quantity':<26}{'t':>8}  {'value':>22}  {'error est.':>10}"]
+    for prob, res in ref.items():
+        times = res.get("times", ())
+        for key, item in res.items():
+            if not (isinstance(item, tuple) and len(item) == 2) or key == "times":
+                continue
+            value, err = item
+            if np.ndim(value) == 1 and len(value) == len(times):
+                for t, v, e in zip(times, value, err):
+                    lines.append(f"{prob:<14}{key:<26}{t:>8g}  {v:>22.15g}  {e:>10.1e}")
+            elif np.ndim(value) == 0:
+                lines.append(f"{prob:<14}{key:<26}{'':>8}  {float(value):>22.15g}  {float(err):>10.1e}")
+        for key in ("exact_neck", "exact_area", "exact_rate", "critical_ratio"):
+            if key in res:
+                lines.append(f"{prob:<14}{key:<26}{'':>8}  {res[key]:>22.15g}  {'exact':>10}")
+    return "\n".join(lines)

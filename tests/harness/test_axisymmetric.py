@@ -106,7 +106,7 @@ def test_pinch_time_fits_recover_synthetic_pinches():
     assert abs(T - 0.3) < 1e-12 and err < 1e-10
     from scipy.optimize import brentq
 
-    t_neck = [brentq(lambda s: 2 * (0.3 - s) * (1 - 2 / -math.log(0.3 - s)) - r * r,
+    t_neck = [brentq(lambda s, r=r: 2 * (0.3 - s) * (1 - 2 / -math.log(0.3 - s)) - r * r,
                      0.3 - 2 * r * r, 0.3 - 1e-15) for r in levels]
     T, err, _ = ax.pinch_time_neck(t_neck, levels)
     assert abs(T - 0.3) < 1e-9
