@@ -18,7 +18,7 @@ Settings
     aggregation to refuse stale records (:func:`mcfbench.storage.records.read_record`).
 Jobs
     :func:`run_job`, :func:`time_job`, :func:`figure_job` run flows;
-    :func:`read_records` checks records for the aggregations;
+    :func:`record_fields` says what the aggregations check in a record;
     :func:`write_files` writes every output of a job at once.
 """
 
@@ -34,7 +34,7 @@ from mcfbench.running.schemes import SCHEMES, get_scheme
 from mcfbench.running.solver import Solver
 from mcfbench.storage.atomic import json_value, save_npz, write_files, write_json
 from mcfbench.storage.provenance import code_hash, provenance
-from mcfbench.storage.records import FIELDS, RecordError, read_record, write_record
+from mcfbench.storage.records import FIELDS, write_record
 from mcfbench.studies.config import ConfigError
 
 PROBLEM = "sphere"        # the problem of Table 3.1 and of the beyond study
@@ -487,32 +487,11 @@ def time_job(settings, output, log):
                  row["status"])
 
 
-def read_records(expected, log):
-    """Read and check every record of ``expected`` (``{path: settings}``).
-
-    Returns
-    -------
-    dict
-        ``{path: record}``.
-
-    Raises
-    ------
-    RecordError
-        Listing every invalid record (each message names its file), after
-        logging them.
-    """
-    records, errors = {}, []
-    for path, settings in expected.items():
-        required = TIME_FIELDS if settings.get("study") == "time" else FIELDS
-        try:
-            records[path] = read_record(path, settings, required=required)
-        except RecordError as err:
-            errors.append(str(err))
-            log.error("invalid run record: %s", err)
-    if errors:
-        raise RecordError(f"aggregation stopped: {len(errors)} invalid run record(s):\n"
-                          + "\n".join(errors))
-    return records
+def record_fields(settings):
+    """The keys and types a record of ``settings`` must have (``required`` of
+    :func:`mcfbench.storage.records.read_records`): the time study's records
+    have their own (:data:`TIME_FIELDS`), every other run record :data:`FIELDS`."""
+    return TIME_FIELDS if settings.get("study") == "time" else FIELDS
 
 
 FIGURE_OUTPUTS = ("png", "pdf", "frames", "record", "csv", "plot")

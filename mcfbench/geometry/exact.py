@@ -75,24 +75,49 @@ class SphereL2Error:
         return float(np.sqrt(self.total))
 
 
-def eoc(errors):
-    """Experimental order of convergence (3.1) between successive halvings of h.
+def eoc(errors, levels=None, ok=None, sizes=None):
+    """Experimental order of convergence (3.1): the one EOC of the suite.
+
+    ``log(|e_{j-1}| / |e_j|) / log(s_{j-1} / s_j)`` between successive rows,
+    ``s`` the mesh size (halved per level: ``log 2``) or the time step.
 
     Parameters
     ----------
     errors : (k,) array_like
-        Errors on meshes of edge length ``h, h/2, h/4, ...``.
+        Errors, rows ordered from coarse to fine.
+    levels : (k,) int array_like, optional
+        Refinement levels of the rows: an order is taken only between rows one
+        level apart (default: every pair of successive rows).
+    ok : (k,) bool array_like, optional
+        Rows whose run finished; no order is taken against any other.
+    sizes : (k,) array_like, optional
+        Mesh sizes or time steps of the rows (default: halved per row).
 
     Returns
     -------
     (k,) float array
-        ``log2(e_{j-1} / e_j)``; the first entry is NaN.
+        The order of each row against the previous one; NaN for the first
+        row, next to a row that is not ok, between rows that are not one
+        level apart, and where an error is zero or not finite.
 
     Examples
     --------
     >>> eoc([1e-2, 2.5e-3]).round(3).tolist()
     [nan, 2.0]
+    >>> eoc([1e-2, 2.5e-3, float("nan"), 4e-4], levels=[1, 2, 3, 4]).round(3).tolist()
+    [nan, 2.0, nan, nan]
     """
-    e = np.asarray(errors, dtype=float)
+    e = np.abs(np.asarray(errors, dtype=float))
+    valid = np.isfinite(e) & (e > 0)
+    if ok is not None:
+        valid &= np.asarray(ok, dtype=bool)
+    pair = np.r_[False, valid[1:] & valid[:-1]]
+    if levels is not None:
+        pair &= np.r_[False, np.diff(np.asarray(levels)) == 1]
     with np.errstate(divide="ignore", invalid="ignore"):
-        return np.r_[np.nan, np.log2(e[:-1] / e[1:])]
+        if sizes is None:
+            order = np.r_[np.nan, np.log2(e[:-1] / e[1:])]
+        else:
+            s = np.asarray(sizes, dtype=float)
+            order = np.r_[np.nan, np.log(e[:-1] / e[1:]) / np.log(s[:-1] / s[1:])]
+    return np.where(pair, order, np.nan)

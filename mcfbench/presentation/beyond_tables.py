@@ -3,6 +3,7 @@
 import numpy as np
 import pandas as pd
 
+from mcfbench.geometry.exact import eoc
 from mcfbench.presentation.convergence_tables import (
     LEVEL_COLUMNS,
     eoc_column,
@@ -130,12 +131,7 @@ def time_order(taus, errors, status):
     down. For halved time steps it is the ``eoc`` of
     :func:`mcfbench.running.run.time_convergence`.
     """
-    taus = np.asarray(taus, dtype=float)
-    ok = (np.asarray(status) == "ok") & np.isfinite(np.asarray(errors, dtype=float))
-    e = np.where(ok, np.asarray(errors, dtype=float), np.nan)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        order = np.r_[np.nan, np.log(e[:-1] / e[1:]) / np.log(taus[:-1] / taus[1:])]
-    return np.where(np.r_[False, ok[1:] & ok[:-1]], order, np.nan)
+    return eoc(errors, ok=np.asarray(status) == "ok", sizes=taus)
 
 
 def time_table(records):

@@ -91,11 +91,7 @@ def eoc_column(levels, l2_error, status):
     ...            ["ok", "ok", "t_escaped", "ok"]).round(3).tolist()
     [nan, 2.0, nan, nan]
     """
-    levels = np.asarray(levels)
-    ok = (np.asarray(status) == "ok") & np.isfinite(np.asarray(l2_error, dtype=float))
-    errors = np.where(ok, np.asarray(l2_error, dtype=float), np.nan)
-    valid = np.r_[False, (np.diff(levels) == 1) & ok[1:] & ok[:-1]]
-    return np.where(valid, eoc(errors), np.nan)
+    return eoc(l2_error, levels=levels, ok=np.asarray(status) == "ok")
 
 
 def record_rows(records, schemes, levels):

@@ -12,9 +12,10 @@ no exact value: no EOC. The *main metric* of a problem
 findings.
 """
 
-import math
 
 import numpy as np
+
+from mcfbench.geometry.exact import eoc
 
 TIMING_BASE = (
     "Timings compare schemes fairly only on the same footing: the same solver and "
@@ -144,13 +145,7 @@ def add_eoc(table):
         if not is_error(metric):
             continue
         group = group.sort_values("level")
-        levels = group["level"].to_numpy()
-        values = np.abs(group["value"].to_numpy(dtype=float))
-        for i in range(1, len(group)):
-            a, b = values[i - 1], values[i]
-            if levels[i] - levels[i - 1] == 1 and np.isfinite(a) and np.isfinite(b) \
-                    and a > 0 and b > 0:
-                table.loc[group.index[i], "eoc"] = math.log2(a / b)
+        table.loc[group.index, "eoc"] = eoc(group["value"], levels=group["level"])
     return table
 
 

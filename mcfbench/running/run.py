@@ -171,10 +171,8 @@ def level_sweep(scheme, problem, levels=None, **options):
 
     results = [run(scheme, problem, level, **options)[0] for level in levels]
     table = pd.DataFrame([r.to_dict(series=False) for r in results])
-    consecutive = np.r_[False, np.diff(levels) == 1]
     for name in results[0].metrics:
-        table[f"eoc_{name}"] = np.where(consecutive, eoc(np.abs(table[name].to_numpy())),
-                                        np.nan)
+        table[f"eoc_{name}"] = eoc(table[name], levels=levels)
     return table
 
 

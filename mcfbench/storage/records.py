@@ -218,3 +218,42 @@ def read_record(path, settings=None, required=FIELDS):
     return {k: (float("nan") if v is None and required.get(k, float) is float else v)
             for k, v in record.items()}
 
+
+def read_records(expected, log=None, required=None):
+    """Read and check every record of ``expected`` (``{path: settings}``), all of
+    them before refusing any: the one reader of every aggregation.
+
+    Parameters
+    ----------
+    expected : dict
+        Record path -> the settings it must come from (stale records are refused).
+    log : logging.Logger, optional
+        Each invalid record is logged as an error.
+    required : callable, optional
+        ``required(settings)`` -> the keys and types a record of those settings
+        must have (default: a run record, :data:`FIELDS`).
+
+    Returns
+    -------
+    dict
+        ``{path: record}`` in the order of ``expected``.
+
+    Raises
+    ------
+    RecordError
+        Listing every invalid record, each message naming its file.
+    """
+    records, errors = {}, []
+    for path, settings in expected.items():
+        try:
+            records[path] = read_record(path, settings,
+                                        required=FIELDS if required is None else required(settings))
+        except RecordError as err:
+            errors.append(str(err))
+            if log is not None:
+                log.error("invalid run record: %s", err)
+    if errors:
+        raise RecordError(f"aggregation stopped: {len(errors)} invalid run record(s):\n"
+                          + "\n".join(errors))
+    return records
+

@@ -36,6 +36,7 @@ from mcfbench.presentation.matrix_tables import (
 )
 from mcfbench.running.run import framed_run
 from mcfbench.storage.logs import setup_logging
+from mcfbench.storage.records import read_records
 from mcfbench.studies.config import ConfigError
 
 EXACT_SOLVER = "bicgstab"
@@ -262,18 +263,10 @@ def write_tables(table, out_dir, plan):
     return summary
 
 
-def read_runs(expected):
-    """Read and check the records ``{path: settings}`` (stale or edited ones are
-    refused, :func:`mcfbench.storage.records.read_record`)."""
-    from mcfbench.storage.records import read_record
-
-    return [read_record(path, settings=settings) for path, settings in expected.items()]
-
-
 def aggregate(expected, plan, out_dir):
     """The records of every planned run into the long table and its views
     (:func:`write_tables`); returns ``(table, summary)``."""
-    table = long_table(read_runs(expected), plan["schemes"], list(plan["problems"]))
+    table = long_table(list(read_records(expected).values()), plan["schemes"], list(plan["problems"]))
     return table, write_tables(table, out_dir, plan)
 
 

@@ -21,7 +21,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from mcfbench.pipeline import Pipeline, read_records, run_job, time_job, used_schemes
+from mcfbench.pipeline import Pipeline, record_fields, run_job, time_job, used_schemes
 from mcfbench.presentation.beyond_findings import beyond_findings as findings
 from mcfbench.presentation.beyond_tables import (
     beyond_documents,
@@ -41,7 +41,7 @@ from mcfbench.running.schemes import SCHEMES
 from mcfbench.storage.atomic import write_files
 from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.provenance import config_hash
-from mcfbench.storage.records import RecordError, read_record
+from mcfbench.storage.records import RecordError, read_record, read_records
 from mcfbench.studies.config import ConfigError
 
 REPO = Path(__file__).resolve().parents[2]
@@ -368,7 +368,7 @@ def test_time_study_runs_for_a_vertex_scheme(tmp_path):
     path = tmp_path / "cotan.json"
     log = setup_logging(tmp_path / "time.log")
     time_job(settings, path, log)
-    rec = read_records({path: settings}, log)[path]
+    rec = read_records({path: settings}, log, required=record_fields)[path]
     assert rec["outcome"] == "ok" and [r["status"] for r in rec["rows"]] == ["ok", "ok"]
     assert rec["wall_seconds"] > 0 and rec["peak_rss_mb"] > 0
     assert rec["rows"][1]["error"] < rec["rows"][0]["error"]

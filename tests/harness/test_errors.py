@@ -68,3 +68,12 @@ def test_l2_error_kernel_matches_the_numpy_formula():
     X = state.X - np.array([0.1, -0.2, 0.3])[:, None]
     dist = np.sqrt((X**2).sum(axis=0)) - sphere_radius(0.02, 1.5)
     assert error.total == pytest.approx(0.01 * np.dot(dist**2, state.l2_weights), rel=1e-13)
+
+
+def test_eoc_only_between_finished_runs_one_level_apart_and_for_any_step_ratio():
+    """The one EOC (3.1) of the suite: Table 3.1, the matrix, the sweeps, the time study."""
+    e = [1e-2, -2.5e-3, 6.25e-4, 1e-4, 2.5e-5]          # signed errors: |e| counts
+    np.testing.assert_allclose(eoc(e, levels=[1, 2, 3, 5, 6], ok=[1, 1, 0, 1, 1]),
+                               [np.nan, 2.0, np.nan, np.nan, 2.0])
+    assert np.isnan(eoc([1e-2, 0.0])).all()                      # an exact zero: no order
+    np.testing.assert_allclose(eoc([1e-2, 1e-3], sizes=[0.3, 0.03]), [np.nan, 1.0])

@@ -16,7 +16,7 @@ import pytest
 from mcfbench.presentation import matrix_findings, matrix_tables
 from mcfbench.running.problems import PROBLEMS
 from mcfbench.running.schemes import SCHEMES
-from mcfbench.storage.records import FIELDS, read_record, write_record
+from mcfbench.storage.records import FIELDS, read_record, read_records, write_record
 from mcfbench.storage.statuses import STATUSES
 from mcfbench.studies import gallery, matrix
 from mcfbench.studies.config import ConfigError
@@ -136,7 +136,7 @@ def test_tiny_plots(tiny):
     problems, schemes = list(plan["problems"]), plan["schemes"]
     figs = root / "figures"
     error_figure(table, [figs / "errors.png"], problems, schemes)
-    quality_figure(matrix.read_runs(runs), [figs / "quality.png"], problems, schemes)
+    quality_figure(list(read_records(runs).values()), [figs / "quality.png"], problems, schemes)
     entries = {key: (read_record(r), matrix.load_frames(f))
                for key, (r, f) in matrix.picture_runs(plan, str(root)).items()}
     picture_grid(entries, [figs / "pictures.png"], problems, schemes)

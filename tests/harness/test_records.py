@@ -6,7 +6,7 @@ import math
 import pytest
 
 from mcfbench.running.run import run
-from mcfbench.storage.records import RecordError, read_record, write_record
+from mcfbench.storage.records import RecordError, read_record, read_records, write_record
 
 SETTINGS = {"scheme": "cotan", "problem": "sphere", "level": 1}
 
@@ -57,3 +57,16 @@ def test_damaged_records_are_named(tmp_path, text, message):
     with pytest.raises(RecordError, match=message) as err:
         read_record(path)
     assert str(path) in str(err.value)
+
+
+def test_read_records_names_every_bad_record_not_only_the_first(tmp_path, result):
+    good, stale, damaged = (tmp_path / f"{name}.json" for name in ("good", "stale", "damaged"))
+    for path in (good, stale):
+        write_record(path, result, SETTINGS)
+    damaged.write_text("{")
+    expected = {good: SETTINGS, stale: {**SETTINGS, "level": 2}, damaged: SETTINGS}
+    with pytest.raises(RecordError, match="2 invalid run record") as err:
+        read_records(expected)
+    assert str(stale) in str(err.value) and str(damaged) in str(err.value)
+    assert str(good) not in str(err.value)
+    assert list(read_records({good: SETTINGS})) == [good]

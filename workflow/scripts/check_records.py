@@ -3,15 +3,16 @@
 A separate job, so that a bad record stops the pipeline here and the tables
 of the previous good run stay in place (Snakemake removes the outputs of a
 job before it runs it). Writes the checksum of every record
-(:func:`mcfbench.pipeline.read_records`: checksum, schema, stale settings).
+(:func:`mcfbench.storage.records.read_records`: checksum, schema, stale settings).
 """
 
-from mcfbench.pipeline import json_text, read_records
+from mcfbench.pipeline import json_text, record_fields
 from mcfbench.storage.atomic import write_files
 from mcfbench.storage.logs import setup_logging
+from mcfbench.storage.records import read_records
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])
-records = read_records(dict(sm.params.expected), log)
+records = read_records(dict(sm.params.expected), log, required=record_fields)
 write_files({str(sm.output[0]): json_text({p: r["checksum"] for p, r in records.items()})})
 log.info("%d run records checked", len(records))

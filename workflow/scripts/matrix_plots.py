@@ -13,8 +13,8 @@ from mcfbench.presentation.matrix_plots import (
              quality_figure,
 )
 from mcfbench.presentation.matrix_tables import read_long_table
-from mcfbench.storage.records import read_record
-from mcfbench.studies.matrix import load_frames, read_runs
+from mcfbench.storage.records import read_record, read_records
+from mcfbench.studies.matrix import load_frames
 
 sm = snakemake  # noqa: F821
 logging.basicConfig(filename=sm.log[0], level=logging.INFO, force=True)
@@ -22,7 +22,7 @@ plan, out = sm.params.plan, sm.output
 problems, schemes = list(plan["problems"]), plan["schemes"]
 error_figure(read_long_table(sm.input.table), [out.errors_png, out.errors_pdf],
              problems, schemes)
-quality_figure(read_runs(sm.params.expected), [out.quality_png, out.quality_pdf],
+quality_figure(list(read_records(sm.params.expected).values()), [out.quality_png, out.quality_pdf],
                problems, schemes)
 entries = {key: (read_record(record), load_frames(frames))
            for key, (record, frames) in sm.params.pictures.items()}
