@@ -26,7 +26,10 @@ Discretisation (this module, not BDN's finite elements): central finite
 differences on the uniform grid ``u_j = j / N`` (second order; the scheme
 and every measured quantity are symmetric, so the error expands in even
 powers ``h^2, h^4, ...``, with an extra ``h^4 log h`` term at a pole, and
-Richardson extrapolation in ``h`` applies, see :func:`richardson`).
+Richardson extrapolation in ``h`` applies, see
+:func:`mcfbench.geometry.extrapolation.richardson`; the reference numbers are in
+:mod:`mcfbench.geometry.axisymmetric_references`, the Angenent torus in
+:mod:`mcfbench.geometry.angenent`).
 Both (A2) are invariant under ``u -> c u``, so index units are used.
 
 Ends of the meridian:
@@ -66,9 +69,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 from scipy.sparse.linalg import splu
+
+from mcfbench.geometry.shapes import dumbbell_profile
 
 # ---------------------------------------------------------------- the velocity
 
@@ -324,7 +328,7 @@ def evolve_until(X0, quantity, levels, ends=("axis", "axis"), periodic=False, rt
 # ---------------------------------------------------------------- measured quantities
 
 
-def area(X):
+def meridian_area(X):
     """Area of the surface of revolution of the polygon, ``sum pi (r_j + r_j+1) |x_j+1 - x_j|``.
 
     Parameters
@@ -339,7 +343,7 @@ def area(X):
     return float(np.pi * np.sum((X[1:, 0] + X[:-1, 0]) * np.hypot(d[:, 0], d[:, 1])))
 
 
-def volume(X):
+def meridian_volume(X):
     """Volume swept by the polygon: ``|sum pi dz (r_j^2 + r_j r_j+1 + r_j+1^2) / 3|`` (frusta).
 
     For a meridian from pole to pole, or a closed one (pass it closed), the
@@ -360,7 +364,7 @@ def _closed(X):
     return np.vstack([X, X[:1]])
 
 
-def max_height(X, periodic=False):
+def meridian_max_height(X, periodic=False):
     """Largest ``z`` of the meridian, by the quartic through the 5 nodes around the
     largest node (interior maximum), or the node itself at the ends."""
     z = X[:, 1]
@@ -390,7 +394,7 @@ def measures(X, periodic=False):
         ``= sqrt(cross_section / pi)``.
     """
     Y = _closed(X) if periodic else X
-    out = {"area": area(Y), "volume": volume(Y), "max_height": max_height(X, periodic)}
+    out = {"area": meridian_area(Y), "volume": meridian_volume(Y), "max_height": meridian_max_height(X, periodic)}
     r = X[:, 0]
     inner = (r[1:-1] <= r[:-2]) & (r[1:-1] <= r[2:]) if not periodic else np.zeros(0, bool)
     out["min_radius"] = float(r[1:-1][inner].min()) if inner.any() else float("nan")
@@ -405,64 +409,7 @@ def measures(X, periodic=False):
 # ---------------------------------------------------------------- Richardson extrapolation
 
 
-def richardson(values, orders=(2, 4, 4, 6, 6), ratio=2.0):
-    """Richardson table of a sequence computed with ``h, h/ratio, h/ratio^2, ...``.
-
-    The default orders eliminate ``h^2``, then ``h^4 log h`` and ``h^4`` (two
-    ``h^4`` steps: the first turns ``c h^4 log h`` into ``-c h^4 log(ratio) /
-    15``, the second removes it), then ``h^6 log h`` and ``h^6``. Quantities
-    at a pole (the ``"axis"`` ends) carry an ``h^4 log h`` term: for the
-    sphere's pole height, orders (2, 4, 6, 8) stall at 5e-10 while (2, 4, 4, 6,
-    6) reach 1e-14 (meshes 21 to 641). Quantities without such terms only
-    lose one order.
-
-    Parameters
-    ----------
-    values : (k,) array_like
-        ``Q(h_i)``, coarse to fine, with ``Q(h) = Q + c_1 h^p1 + c_2 h^p2 + ...``.
-    orders : sequence of float
-        The exponents ``p1, p2, ...`` eliminated one per column (a repeated
-        exponent eliminates ``h^p log h`` and ``h^p``).
-
-    Returns
-    -------
-    value : float
-        The most extrapolated entry (last row, last column).
-    error : float
-        Its error estimate: the difference to the entry one order lower in the
-        same row (conservative: that entry's error).
-    table : list of (k - c,) float arrays
-        Column ``c`` eliminates ``orders[:c]``.
-    """
-    cols = [np.asarray(values, dtype=float)]
-    for p in orders[: len(cols[0]) - 1]:
-        prev = cols[-1]
-        f = ratio ** p
-        cols.append((f * prev[1:] - prev[:-1]) / (f - 1.0))
-    value = float(cols[-1][-1])
-    error = float(abs(cols[-1][-1] - cols[-2][-1])) if len(cols) > 1 else float("nan")
-    return value, error, cols
-
-
-def observed_orders(values, ratio=2.0):
-    """Observed orders ``log(|Q_i - Q_i+1| / |Q_i+1 - Q_i+2|) / log(ratio)`` of a sequence."""
-    d = np.abs(np.diff(np.asarray(values, dtype=float)))
-    return np.log(d[:-1] / d[1:]) / np.log(ratio)
-
-
 # ---------------------------------------------------------------- initial meridians
-
-
-def dumbbell_profile(z, centre=1.2, neck=0.25, blend=0.05):
-    """``r(z)^2`` of the suite's dumbbell (the formula of ``mcfbench.surfaces.dumbbell_profile``).
-
-    ``k log(exp(p_+/k) + exp(p_-/k) + exp(q/k))``, ``p_+- = 1 - (z -+ c)^2``,
-    ``q = n^2 (1 - (z/c)^8)``, ``k = blend``.
-    """
-    z = np.asarray(z, dtype=float)
-    terms = np.stack([1.0 - (z - centre) ** 2, 1.0 - (z + centre) ** 2,
-                      neck**2 * (1.0 - (z / centre) ** 8)])
-    return blend * np.logaddexp.reduce(terms / blend, axis=0)
 
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(16)
@@ -587,6 +534,8 @@ def initial_meridian(shape, n, **params):
             X[n // 2, 1] = 0.0
         return X, ("axis", "axis"), False
     if shape == "angenent":
+        from mcfbench.geometry.angenent import angenent_profile   # it imports this module
+
         prof = angenent_profile()
         s = prof["length"] * np.arange(n) / n
         return prof["curve"](s), None, True
@@ -595,439 +544,10 @@ def initial_meridian(shape, n, **params):
 
 # ---------------------------------------------------------------- the Angenent torus
 
-ANGENENT_RHO0_PUBLISHED = 0.437123967096460
-"""Inner radius of the Angenent torus's meridian as published (NOTES.md, "More exact
-answers"; the normalisation ``H = x . nu / 2``, extinction at ``t = 1``)."""
-
-
-def _angenent_rhs(s, y):
-    """Shrinker meridian ODE by arc length (NOTES.md, "More exact answers")::
-
-        rho' = sin a,  z' = cos a,  a' = (1/rho - rho/2) cos a + (z/2) sin a,
-
-    with three quadratures appended: ``int rho``, ``int rho^2 z'``,
-    ``int rho exp(-(rho^2 + z^2)/4)`` (area, volume, entropy).
-    """
-    rho, z, a = y[0], y[1], y[2]
-    sa, ca = np.sin(a), np.cos(a)
-    return [sa, ca, (1.0 / rho - 0.5 * rho) * ca + 0.5 * z * sa,
-            rho, rho * rho * ca, rho * np.exp(-0.25 * (rho * rho + z * z))]
-
-
-def _angenent_shoot(rho0, tol=1e-13):
-    """Integrate from ``(rho0, 0)``, ``a = 0`` (upwards) to the next crossing of ``z = 0``."""
-
-    def cross(s, y):
-        return y[1]
-
-    cross.terminal, cross.direction = True, -1
-    sol = solve_ivp(_angenent_rhs, (0.0, 50.0), [rho0, 0.0, 0.0, 0.0, 0.0, 0.0],
-                    method="DOP853", rtol=tol, atol=tol, events=cross, dense_output=True)
-    if not sol.t_events[0].size:
-        raise RuntimeError(f"the meridian from rho0 = {rho0} does not return to z = 0")
-    return sol, float(sol.t_events[0][0]), sol.y_events[0][0]
-
-
-def angenent_rho0(tol=1e-13):
-    """Inner radius ``rho0`` of the Angenent torus by shooting.
-
-    The meridian starts at ``(rho0, 0)`` vertically upwards and closes
-    symmetrically iff it crosses ``z = 0`` again vertically (angle ``pi``);
-    ``rho0`` is the root of ``a(crossing) - pi`` in ``[0.42, 0.45]`` (brentq,
-    ``xtol = 1e-15``).
-
-    Returns
-    -------
-    float
-    """
-    return brentq(lambda r0: _angenent_shoot(r0, tol)[2][2] - np.pi, 0.42, 0.45,
-                  xtol=1e-15, rtol=1e-15)
-
-
-def angenent_profile(rho0=None):
-    """The Angenent torus at ``t = 0`` (extinct at ``t = 1``, ``M_t = sqrt(1 - t) M_0``).
-
-    Parameters
-    ----------
-    rho0 : float, optional
-        Inner radius; computed by :func:`angenent_rho0` if not given.
-
-    Returns
-    -------
-    dict
-        ``rho0``; ``rho_outer``; ``half_height`` (largest ``z``); ``length``
-        (of the closed meridian); ``area`` ``= 2 pi int rho ds``; ``volume``;
-        ``entropy`` ``= (4 pi)^-1 int exp(-|x|^2/4) dA``; ``curve`` (callable,
-        arc length ``s`` (m,) -> (m, 2) points ``(rho, z)`` of the closed
-        meridian, periodic with period ``length``, counter-clockwise from
-        the inner point); ``upper`` (the dense ODE solution of the upper
-        half, state ``(rho, z, a, ...)``), ``half_length``.
-    """
-    rho0 = angenent_rho0() if rho0 is None else float(rho0)
-    sol, S, y_end = _angenent_shoot(rho0)
-    ss = np.linspace(0.0, S, 4001)
-    zz = sol.sol(ss)[1]
-
-    def curve(s):
-        s = np.mod(np.asarray(s, dtype=float), 2.0 * S)
-        up = s <= S
-        sig = np.where(up, s, 2.0 * S - s)
-        y = sol.sol(sig)
-        return np.column_stack([y[0], np.where(up, y[1], -y[1])])
-
-    zmax = max_height(np.column_stack([sol.sol(ss)[0], zz]))
-    return {"rho0": rho0, "rho_outer": float(y_end[0]), "half_height": float(zmax),
-            "length": 2.0 * S, "half_length": S,
-            "area": float(4.0 * np.pi * y_end[3]), "volume": float(2.0 * np.pi * abs(y_end[4])),
-            "entropy": float(y_end[5]), "curve": curve, "upper": sol}
-
-
-def angenent_area(t, profile=None):
-    """Area of the Angenent torus at time ``t < 1``: ``(1 - t) area_0``."""
-    profile = angenent_profile() if profile is None else profile
-    return (1.0 - t) * profile["area"]
-
-
-def angenent_distance(points, t, profile=None):
-    """Unsigned distance of points to the Angenent torus ``M_t = sqrt(1 - t) M_0``.
-
-    Parameters
-    ----------
-    points : (m, 3) or (m, 2) float array
-        Points in space, or meridian points ``(rho, z)``.
-    t : float
-        Time, ``< 1``.
-
-    Returns
-    -------
-    (m,) float array
-        Nearest point on the upper half meridian (the torus is symmetric in
-        ``z``) from a dense sample, refined by Newton's method on the arc length
-        with the ODE's exact derivatives ``c' = (sin a, cos a)``,
-        ``c'' = a' (cos a, -sin a)``.
-    """
-    from scipy.spatial import cKDTree
-
-    profile = angenent_profile() if profile is None else profile
-    P = np.asarray(points, dtype=float)
-    if P.shape[1] == 3:
-        P = np.column_stack([np.hypot(P[:, 0], P[:, 1]), P[:, 2]])
-    scale = math.sqrt(1.0 - t)
-    p = P / scale
-    p[:, 1] = np.abs(p[:, 1])
-    sol, S = profile["upper"], profile["half_length"]
-    ss = np.linspace(0.0, S, 20001)
-    Y = sol.sol(ss)
-    s = ss[cKDTree(Y[:2].T).query(p)[1]]
-    for _ in range(20):
-        y = sol.sol(s)
-        rho, z, a = y[0], y[1], y[2]
-        d = np.column_stack([rho, z]) - p
-        c1 = np.column_stack([np.sin(a), np.cos(a)])
-        da = (1.0 / rho - 0.5 * rho) * np.cos(a) + 0.5 * z * np.sin(a)
-        c2 = da[:, None] * np.column_stack([np.cos(a), -np.sin(a)])
-        g = np.sum(d * c1, axis=1)
-        hess = 1.0 + np.sum(d * c2, axis=1)
-        step = g / np.where(hess > 0.1, hess, 1.0)
-        s = np.clip(s - step, 0.0, S)
-        if np.abs(step).max() < 1e-15:
-            break
-    y = sol.sol(s)
-    return scale * np.hypot(y[0] - p[:, 0], y[1] - p[:, 1])
-
 
 # ---------------------------------------------------------------- pinch times from the approach
 
 
-def pinch_time_tube(t_levels, levels):
-    """Extinction time of a closed meridian shrinking to a point (a thin torus's tube).
-
-    Near extinction the tube is a thin round cylinder bent into a ring:
-    ``d(pi rho^2)/dt = -2 pi + O(rho^2)`` for the cross-section radius
-    ``rho = sqrt(A / pi)`` (the first term is ``-int kappa ds = -2 pi``; the
-    parallel curvature ``cos(theta) / r`` integrates to ``O(rho^2)``), so
-    ``t(rho) = T - rho^2/2 - a rho^4 - b rho^6 - ...``. Least squares for
-    ``T, a, b`` on the given levels.
-
-    Parameters
-    ----------
-    t_levels, levels : (k,) float arrays
-        Times at which ``rho`` reached ``levels`` (decreasing), ``k >= 4``.
-
-    Returns
-    -------
-    T, error : float
-        ``T`` from the fit with ``rho^4, rho^6``; the error estimate is the
-        largest change of ``T`` when the ``rho^6`` term or the largest level is
-        dropped.
-    """
-    t, r = np.asarray(t_levels, float), np.asarray(levels, float)
-
-    def fit(sel, powers):
-        A = np.column_stack([np.ones(sel.sum())] + [-r[sel] ** p for p in powers])
-        return np.linalg.lstsq(A, t[sel] + 0.5 * r[sel] ** 2, rcond=None)[0][0]
-
-    allk = np.ones(len(t), bool)
-    drop = allk.copy()
-    drop[0] = False
-    T = fit(allk, (4, 6))
-    alts = [fit(allk, (4,)), fit(drop, (4, 6)), fit(drop, (4,))]
-    return float(T), float(max(abs(a - T) for a in alts))
-
-
-def pinch_time_neck(t_levels, levels, last=(4, 5, 6), ncoefs=(1, 2)):
-    """Pinch time of a rotationally symmetric neck from the times it reached radii ``levels``.
-
-    Fits the neckpinch asymptotics (Angenent and Velazquez; Angenent and
-    Knopf: a round cylinder with logarithmic corrections)::
-
-        r^2 = 2 D (1 + c_1 / L + c_2 / L^2),   D = T - t,   L = -log D,
-
-    by nonlinear least squares (relative residuals) on the smallest ``k``
-    levels. ``T`` is the fit with 2 coefficients on the smallest
-    ``last[1]`` levels; the error estimate is the largest deviation of the
-    fits with ``ncoefs`` coefficients on the smallest ``last`` levels.
-
-    Returns
-    -------
-    T, error : float
-    fits : list of (k, ncoef, T, coefficients)
-    """
-    from scipy.optimize import least_squares
-
-    t, r2 = np.asarray(t_levels, float), np.asarray(levels, float) ** 2
-    fits = []
-    for k in last:
-        for nc in ncoefs:
-            tt, rr = t[-k:], r2[-k:]
-
-            def res(p, tt=tt, rr=rr, nc=nc):
-                D = np.maximum(p[0] - tt, 1e-300)
-                L = -np.log(D)
-                return 2.0 * D * (1.0 + sum(p[1 + i] / L ** (i + 1) for i in range(nc))) / rr - 1.0
-
-            p0 = [t[-1] + 0.5 * r2[-1] * 1.3] + [0.0] * nc
-            sol = least_squares(res, p0, x_scale=[r2[-1]] + [1.0] * nc,
-                                bounds=([t[-1] + 1e-300] + [-np.inf] * nc, np.inf),
-                                xtol=1e-15, ftol=1e-15, gtol=1e-15)
-            fits.append((k, nc, float(sol.x[0]), sol.x[1:].tolist()))
-    best = next(f[2] for f in fits if f[0] == last[1] and f[1] == 2)
-    return best, max(abs(f[2] - best) for f in fits), fits
-
-
 # ---------------------------------------------------------------- reference numbers
 
-J01_SQUARED = 5.783185962946784
-"""Square of the first zero of the Bessel function ``J_0`` (NOTES.md)."""
 
-
-def catenoid_parameter(radius=1.0, half_height=0.5):
-    """The stable root ``a`` of ``a cosh(h / a) = R`` (the larger one), by brentq."""
-    x_crit = brentq(lambda x: x * math.tanh(x) - 1.0, 0.5, 2.0, xtol=1e-15)  # h/a at the fold
-    a_fold = half_height / x_crit
-    if a_fold * math.cosh(x_crit) > radius:
-        raise ValueError(f"no catenoid spans circles of radius {radius} at +-{half_height}")
-    return brentq(lambda a: a * math.cosh(half_height / a) - radius, a_fold, radius,
-                  xtol=1e-16, rtol=4 * np.finfo(float).eps)
-
-
-def catenoid_area(radius=1.0, half_height=0.5):
-    """Area ``pi a (2 h + a sinh(2 h / a))`` of the stable catenoid (NOTES.md)."""
-    a = catenoid_parameter(radius, half_height)
-    return math.pi * a * (2.0 * half_height + a * math.sinh(2.0 * half_height / a))
-
-
-def critical_aspect_ratio():
-    """Largest ``h / R`` for which a catenoid spans circles of radius ``R`` at ``z = +-h``.
-
-    ``h / R = x / cosh x`` at the root of ``x tanh x = 1`` (the fold of the
-    catenoid family); 0.662743... Beyond it a cylinder between the circles
-    pinches.
-    """
-    x = brentq(lambda x: x * math.tanh(x) - 1.0, 0.5, 2.0, xtol=1e-15)
-    return x / math.cosh(x)
-
-
-def _extrapolate(per_mesh, coarse_tight=None, coarse=None):
-    """Richardson over meshes of each quantity; the time-tolerance effect (the
-    coarsest mesh run with tolerances 10x tighter) is added to the error, which
-    is floored at ``1e-14 |value|`` (rounding)."""
-    out = {}
-    for key in per_mesh[0]:
-        vals = np.array([m[key] for m in per_mesh], dtype=float)
-        if vals.ndim == 1:
-            v, e, _ = richardson(vals)
-            if coarse_tight is not None:
-                e += abs(coarse_tight[key] - coarse[key])
-            out[key] = (v, max(e, 1e-14 * abs(v)))  # floor: rounding of the sums
-        else:
-            rows = [richardson(vals[:, k]) for k in range(vals.shape[1])]
-            err = np.array([r[1] for r in rows])
-            if coarse_tight is not None:
-                err = err + np.abs(np.asarray(coarse_tight[key]) - np.asarray(coarse[key]))
-            value = np.array([r[0] for r in rows])
-            out[key] = (value, np.maximum(err, 1e-14 * np.abs(value)))
-    return out
-
-
-def _fixed_time_run(shape, n, times, params, rtol, atol_factor=1.0):
-    X, ends, per = initial_meridian(shape, n, **params)
-    states = evolve(X, times, ends, per, rtol=rtol, atol=rtol * atol_factor)
-    ms = [measures(Y, per) for Y in states]
-    return {k: [m[k] for m in ms] for k in ms[0]}
-
-
-def _pinch_run(shape, n, levels, times, params, rtol, quantity):
-    X, ends, per = initial_meridian(shape, n, **params)
-    t_lev, _, X_last, rec = evolve_until(X, quantity, levels, ends, per, rtol=rtol, atol=rtol,
-                                         record_times=times)
-    ms = [measures(Y, per) for Y in rec]
-    out = {k: [m[k] for m in ms] for k in ms[0]}
-    out["t_levels"] = t_lev
-    last = measures(X_last, per)
-    out["max_height_at_last_level"] = last["max_height"]
-    return out
-
-
-def _series_run(run, ns, *args, rtol=1e-11):
-    per_mesh = [run(n, *args, rtol) for n in ns]
-    coarse_tight = run(ns[0], *args, rtol / 10)
-    return _extrapolate(per_mesh, coarse_tight, per_mesh[0]), per_mesh
-
-
-def _mid(X):
-    return float(X[len(X) // 2, 0])
-
-
-def _tube(X):
-    return math.sqrt(cross_section(X) / math.pi)
-
-
-def reference_numbers(problems=("torus", "dumbbell", "catenoid", "hemisphere", "long_cylinder"),
-                      quick=False):
-    """Reference answers for the suite's axisymmetric problems (computed, nothing cached).
-
-    Every number is ``(value, error_estimate)``: Richardson extrapolation over
-    meshes ``n, 2n, 4n, 8n`` (orders 2, 4, 4, 6 of :func:`richardson`; error =
-    difference to the next-lower column) plus the change when the coarsest mesh is rerun with
-    time tolerances ten times tighter; pinch times add the spread of the
-    asymptotic fits (:func:`pinch_time_tube`, :func:`pinch_time_neck`).
-
-    Problems (initial shapes of ``mcfbench.problems``):
-
-    * ``torus``: ``R = 2, r = 0.5``; ``volume``, ``area``, ``tube_radius``
-      (``sqrt(cross-section / pi)``), ``max_height`` at ``times``; ``pinch_time``
-      (the tube shrinks to a circle of radius ``ring_radius``).
-    * ``dumbbell``: ``volume``, ``area``, ``mid_radius`` (the neck on
-      ``z = 0``), ``max_height`` at ``times``; ``pinch_time``.
-    * ``catenoid``: cylinder ``R = 1, h = 0.5`` between fixed circles:
-      ``mid_radius`` (neck) and ``area`` at ``times``, the last one (t = 8) at
-      the steady state, with the exact catenoid ``a``, its area.
-    * ``hemisphere``: ``R = 1``, equator fixed: ``max_height`` at ``times``;
-      ``decay_rate = log(z(1.5) / z(2)) / 0.5`` and ``decay_rate_late`` (from
-      ``t = 2`` to 2.5) against ``j01^2 / R^2`` (they differ from it by the
-      nonlinear ``O(z^2)`` correction, 3e-8 and 1e-10).
-    * ``long_cylinder``: ``R = 1, h = 1`` (``h / R`` beyond
-      :func:`critical_aspect_ratio`): neck at ``times`` and ``pinch_time``.
-
-    Parameters
-    ----------
-    problems : sequence of str
-    quick : bool
-        Coarser meshes (a smoke test: about 10 s, errors far larger).
-
-    Returns
-    -------
-    dict
-        ``problem -> {quantity: (value, error)}`` (arrays over ``times`` for
-        time series) plus ``times`` and setting entries.
-    """
-    out = {}
-    neck_levels = 0.1 * 2.0 ** (-0.5 * np.arange(10 if not quick else 6))
-    if "torus" in problems:
-        ns = (128, 256, 512, 1024) if not quick else (32, 64, 128)
-        levels = 0.1 * 2.0 ** (-0.5 * np.arange(9))
-        times = (0.025, 0.05, 0.075, 0.1)
-        ex, _ = _series_run(lambda n, rtol: _pinch_run(
-            "torus", n, levels, times, {"R": 2.0, "r": 0.5}, rtol, _tube), ns)
-        T, eT = pinch_time_tube(ex["t_levels"][0], levels)
-        res = {k: ex[k] for k in ("volume", "area", "tube_radius", "max_height")}
-        res.update(times=times, meshes=ns, levels=levels, t_levels=ex["t_levels"],
-                   pinch_time=(T, eT + float(ex["t_levels"][1].max())))
-        out["torus"] = res
-    if "dumbbell" in problems:
-        ns = (1601, 3201, 6401, 12801) if not quick else (201, 401, 801)
-        times = (0.02, 0.04, 0.06, 0.08)
-        ex, _ = _series_run(lambda n, rtol: _pinch_run(
-            "dumbbell", n, neck_levels, times, {}, rtol, _mid), ns)
-        T, eT, _fits = pinch_time_neck(ex["t_levels"][0], neck_levels,
-                                       last=(4, 5, 6) if not quick else (3, 4, 5))
-        res = {k: ex[k] for k in ("volume", "area", "mid_radius", "max_height")}
-        res.update(times=times, meshes=ns, levels=neck_levels, t_levels=ex["t_levels"],
-                   max_height_at_last_level=ex["max_height_at_last_level"],
-                   pinch_time=(T, eT + float(ex["t_levels"][1].max())))
-        out["dumbbell"] = res
-    if "catenoid" in problems:
-        ns = (33, 65, 129, 257, 513) if not quick else (17, 33, 65)
-        times = (0.1, 0.25, 0.5, 1.0, 1.5, 8.0)
-        ex, _ = _series_run(lambda n, rtol: _fixed_time_run(
-            "cylinder", n, times, {"radius": 1.0, "half_height": 0.5}, rtol), ns)
-        out["catenoid"] = {"mid_radius": ex["mid_radius"], "area": ex["area"],
-                           "volume": ex["volume"], "times": times, "meshes": ns,
-                           "exact_neck": catenoid_parameter(1.0, 0.5),
-                           "exact_area": catenoid_area(1.0, 0.5)}
-    if "hemisphere" in problems:
-        ns = (33, 65, 129, 257, 513) if not quick else (17, 33, 65)
-        times = (0.1, 0.25, 0.5, 1.0, 1.5, 2.0, 2.5)
-
-        def run(n, rtol):  # heights down to 1e-6: absolute tolerance 1e-5 rtol
-            r = _fixed_time_run("hemisphere", n, times, {"radius": 1.0}, rtol, 1e-5)
-            z = r["max_height"]
-            r["decay_rate"] = math.log(z[4] / z[5]) / 0.5
-            r["decay_rate_late"] = math.log(z[5] / z[6]) / 0.5
-            return r
-
-        ex, _ = _series_run(run, ns)
-        out["hemisphere"] = {"max_height": ex["max_height"], "area": ex["area"],
-                             "volume": ex["volume"], "decay_rate": ex["decay_rate"],
-                             "decay_rate_late": ex["decay_rate_late"], "times": times,
-                             "meshes": ns, "exact_rate": J01_SQUARED}
-    if "long_cylinder" in problems:
-        ns = (801, 1601, 3201, 6401) if not quick else (101, 201, 401)
-        times = (0.05, 0.1, 0.15)
-        ex, _ = _series_run(lambda n, rtol: _pinch_run(
-            "cylinder", n, neck_levels, times, {"radius": 1.0, "half_height": 1.0}, rtol, _mid), ns)
-        T, eT, _fits = pinch_time_neck(ex["t_levels"][0], neck_levels,
-                                       last=(4, 5, 6) if not quick else (3, 4, 5))
-        out["long_cylinder"] = {"radius": 1.0, "half_height": 1.0,
-                                "critical_ratio": critical_aspect_ratio(),
-                                "mid_radius": ex["mid_radius"], "area": ex["area"],
-                                "times": times, "meshes": ns, "levels": neck_levels,
-                                "t_levels": ex["t_levels"],
-                                "pinch_time": (T, eT + float(ex["t_levels"][1].max()))}
-    return out
-
-
-def format_reference_table(ref):
-    """Plain-text table of :func:`reference_numbers` (value and error estimate per row).
-
-    Returns
-    -------
-    str
-    """
-    lines = [f"{'problem':<14}{'quantity':<26}{'t':>8}  {'value':>22}  {'error est.':>10}"]
-    for prob, res in ref.items():
-        times = res.get("times", ())
-        for key, item in res.items():
-            if not (isinstance(item, tuple) and len(item) == 2) or key == "times":
-                continue
-            value, err = item
-            if np.ndim(value) == 1 and len(value) == len(times):
-                for t, v, e in zip(times, value, err):
-                    lines.append(f"{prob:<14}{key:<26}{t:>8g}  {v:>22.15g}  {e:>10.1e}")
-            elif np.ndim(value) == 0:
-                lines.append(f"{prob:<14}{key:<26}{'':>8}  {float(value):>22.15g}  {float(err):>10.1e}")
-        for key in ("exact_neck", "exact_area", "exact_rate", "critical_ratio"):
-            if key in res:
-                lines.append(f"{prob:<14}{key:<26}{'':>8}  {res[key]:>22.15g}  {'exact':>10}")
-    return "\n".join(lines)
