@@ -12,17 +12,9 @@ from mcfbench.geometry.axisymmetric import (
     initial_meridian,
     measures,
 )
+from mcfbench.geometry.exact import J01_SQUARED, catenoid_area
 from mcfbench.geometry.extrapolation import pinch_time_neck, pinch_time_tube, richardson
 from mcfbench.geometry.metrics import catenoid_parameter
-
-J01_SQUARED = 5.783185962946784
-"""Square of the first zero of the Bessel function ``J_0`` (NOTES.md)."""
-
-
-def catenoid_area(radius=1.0, half_height=0.5):
-    """Area ``pi a (2 h + a sinh(2 h / a))`` of the stable catenoid (NOTES.md)."""
-    a = catenoid_parameter(radius, half_height)
-    return math.pi * a * (2.0 * half_height + a * math.sinh(2.0 * half_height / a))
 
 
 def critical_aspect_ratio():

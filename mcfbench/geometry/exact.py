@@ -1,6 +1,10 @@
 """Errors against the shrinking sphere and the experimental order of convergence."""
 
+import math
+
 import numpy as np
+
+from mcfbench.geometry.metrics import catenoid_parameter
 
 _KERNEL = None
 
@@ -121,3 +125,21 @@ def eoc(errors, levels=None, ok=None, sizes=None):
             s = np.asarray(sizes, dtype=float)
             order = np.r_[np.nan, np.log(e[:-1] / e[1:]) / np.log(s[:-1] / s[1:])]
     return np.where(pair, order, np.nan)
+
+
+J01_SQUARED = 5.783185962946784
+"""Square of the first zero of the Bessel function ``J_0`` (NOTES.md)."""
+
+
+def disk_decay_rate(radius=1.0):
+    """Rate ``lambda = j_{0,1}^2 / R^2`` at which a surface spanning a circle of
+    radius ``R`` relaxes to the flat disk: near it the height solves the heat
+    equation with Dirichlet data, ``z ~ exp(-lambda t) J_0(j_{0,1} r / R)``
+    (NOTES.md, "More exact answers")."""
+    return J01_SQUARED / radius**2
+
+
+def catenoid_area(radius=1.0, half_height=0.5):
+    """Area ``pi a (2 h + a sinh(2 h / a))`` of the stable catenoid (NOTES.md)."""
+    a = catenoid_parameter(radius, half_height)
+    return math.pi * a * (2.0 * half_height + a * math.sinh(2.0 * half_height / a))

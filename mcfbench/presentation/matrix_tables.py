@@ -37,6 +37,8 @@ MAIN_METRICS = {
     "height": ("max_height", "l2_height"),
     "shape": ("volume", "area"),
     "still": ("max_displacement", "max_height"),
+    "decay": ("decay_rate_error",),
+    "reference_volume": ("volume_error", "pinch_time_error"),
 }
 
 

@@ -132,9 +132,10 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defec
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
     values = {}
     for observer in observers:
-        values.update(observer.result())
-    if not traj.ok:
-        values = {k: float("nan") for k in values}
+        kept = traj.ok or getattr(observer, "keeps_before_breakdown", False)
+        values.update({k: v if kept else float("nan") for k, v in observer.result().items()})
+    if "pinch_time" in problem.reference:
+        values["pinch_time_error"] = pinch_time_error(traj, problem.reference["pinch_time"])
     X = flow.X
     q = monitor.quality
     result = RunResult(
@@ -149,6 +150,15 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defec
         max_flipped=_worst(np.max, q["flipped"]), metrics=values,
         series={"t": monitor.t, "t_min_barycentric": monitor.t_monitor, **q})
     return result, traj
+
+
+def pinch_time_error(traj, pinch_time):
+    """Relative error of the time a run stopped against the reference
+    ``pinch_time`` of the singularity: ``t_failed / pinch_time - 1`` for a run
+    that broke down (a state defect, or a solver that fails on the collapsing
+    cells: the status says which), NaN for a run that finished (it went
+    through the pinch without noticing it)."""
+    return float("nan") if traj.ok else traj.t_failed / pinch_time - 1.0
 
 
 def _worst(reduce, values):
