@@ -1,5 +1,6 @@
 """The Angenent torus: a self-shrinker of mean curvature flow, M_t = sqrt(1 - t) M_0, extinct at t = 1. Its meridian curve by shooting (the ODE of Angenent, 1992, by arclength: rho' = sin a, z' = cos a, a' = (1/rho - rho/2) cos a + (z/2) sin a, from (rho0, 0) with a = 0), the distance of points to the exact surface at any t and its area."""
 
+import functools
 import math
 
 import numpy as np
@@ -7,6 +8,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from mcfbench.geometry.axisymmetric import meridian_max_height
+from mcfbench.geometry.construction import quad_grid
 
 ANGENENT_RHO0_PUBLISHED = 0.437123967096460
 """Inner radius of the Angenent torus's meridian as published (NOTES.md, "More exact
@@ -147,3 +149,35 @@ def angenent_distance(points, t, profile=None):
             break
     y = sol.sol(s)
     return scale * np.hypot(y[0] - p[:, 0], y[1] - p[:, 1])
+
+
+@functools.cache
+def default_profile():
+    """:func:`angenent_profile` with the computed ``rho0``, computed once per process."""
+    return angenent_profile()
+
+
+def angenent_torus(n_major=48, n_minor=24):
+    """The Angenent torus at ``t = 0`` as a triangle mesh (genus 1).
+
+    Its meridian (:func:`angenent_profile`) sampled at ``n_minor`` points equally
+    spaced in arc length, turned about the ``z`` axis at ``n_major`` angles;
+    quads cut by alternating diagonals as :func:`mcfbench.geometry.shapes.torus`,
+    vertex ``j n_major + i`` at angle ``2 pi i / n_major`` and meridian point
+    ``j``, normals outwards.
+
+    Returns
+    -------
+    vertices : (n_major n_minor, 3) float array
+    faces : (2 n_major n_minor, 3) int64 array
+    """
+    if n_major < 3 or n_minor < 3:
+        raise ValueError(f"need n_major, n_minor >= 3, got {n_major}, {n_minor}")
+    profile = default_profile()
+    rz = profile["curve"](profile["length"] * np.arange(n_minor) / n_minor)
+    phi = 2.0 * np.pi * np.arange(n_major) / n_major
+    rho, z = np.repeat(rz[:, 0], n_major), np.repeat(rz[:, 1], n_major)
+    angle = np.tile(phi, n_minor)
+    V = np.column_stack([rho * np.cos(angle), rho * np.sin(angle), z])
+    # the meridian runs clockwise in (rho, z) seen with the axis on the left: reversed
+    return V, quad_grid(n_major, n_minor, True, True, "alternating")[:, ::-1].copy()

@@ -31,6 +31,8 @@ name                     n_F    n_T    boundary  what
 ``dumbbell``             2546   5088   none      two unit spheres, neck 0.25 (level 1)
 ``blobby``               2646   5288   none      marching cubes of metaballs, 40^3
 ``implicit_torus``       4476   8952   none      marching cubes of a tilted torus, 48^3
+``angenent_torus``       1152   2304   none      Angenent's self-shrinking torus, 48 x 24
+``enneper_patch``        376    687    1 loop    Enneper patch R = 0.8, interior lifted 0.2
 ======================== ====== ====== ========= ======================================
 
 Refinement: the icosphere family (``sphere``, ``bumpy_sphere``,
@@ -41,7 +43,9 @@ Refinement: the icosphere family (``sphere``, ``bumpy_sphere``,
 surfaces (double ``resolution``).
 """
 
+from mcfbench.geometry.angenent import angenent_torus
 from mcfbench.geometry.implicit import blobby, implicit_torus
+from mcfbench.geometry.minimal import enneper_patch
 from mcfbench.geometry.shapes import (
     cylinder,
     dumbbell,
@@ -76,6 +80,8 @@ SURFACES = {
     "dumbbell": dumbbell,
     "blobby": blobby,
     "implicit_torus": implicit_torus,
+    "angenent_torus": angenent_torus,
+    "enneper_patch": enneper_patch,
 }
 """Name -> generator of the initial surfaces; ``SURFACES[name](**params)``."""
 

@@ -38,6 +38,8 @@ MAIN_METRICS = {
     "shape": ("volume", "area"),
     "still": ("max_displacement", "max_height"),
     "decay": ("decay_rate_error",),
+    "angenent": ("distance_error", "area_error"),
+    "enneper": ("height_error", "area_error"),
     "reference_volume": ("volume_error", "pinch_time_error"),
 }
 

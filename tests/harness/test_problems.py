@@ -11,8 +11,8 @@ from mcfbench.running.schemes import SCHEMES
 from mcfbench.storage.statuses import STATUSES
 
 CLOSED = {"sphere": 0, "torus": 1, "dumbbell": 0, "perturbed_sphere": 0, "remeshed_sphere": 0,
-          "anisotropic_sphere": 0, "blobby": 0, "marching_torus": 1}
-OPEN = {"catenoid": 2, "hemisphere": 1, "flat_patch": 1}
+          "anisotropic_sphere": 0, "blobby": 0, "marching_torus": 1, "angenent": 1}
+OPEN = {"catenoid": 2, "hemisphere": 1, "flat_patch": 1, "enneper": 1}
 
 
 @pytest.mark.parametrize("name", sorted(PROBLEMS))

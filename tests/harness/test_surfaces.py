@@ -46,6 +46,8 @@ EXPECTED = {
     "dumbbell": (2546, 5088, 0, 2),
     "blobby": (2646, 5288, 0, 2),
     "implicit_torus": (4476, 8952, 0, 0),
+    "angenent_torus": (1152, 2304, 0, 0),
+    "enneper_patch": (376, 687, 1, 1),
 }
 CLOSED = sorted(name for name, e in EXPECTED.items() if e[2] == 0)
 RANDOM = {"random_bumpy_sphere": {}, "perturbed_sphere": {}, "remeshed_sphere": {},
@@ -371,3 +373,38 @@ def test_blobby_resolution_refines():
 def test_unknown_surface_is_named():
     with pytest.raises(ValueError, match="unknown surface 'klein_bottle'"):
         make_surface("klein_bottle")
+
+
+def test_angenent_torus_is_the_self_shrinker_profile():
+    """Vertices on the exact surface (distance 0 at t = 0), outward normals (positive
+    volume), area and volume converging at order 2 to the profile's."""
+    from mcfbench.geometry.angenent import angenent_distance, angenent_torus, default_profile
+    from mcfbench.geometry.exact import eoc
+    from mcfbench.geometry.metrics import area, volume
+
+    profile = default_profile()
+    meshes = [angenent_torus(48 * 2**k, 24 * 2**k) for k in range(3)]
+    assert max(angenent_distance(V, 0.0).max() for V, _ in meshes) < 1e-12
+    volumes = [volume(V, F) / profile["volume"] - 1.0 for V, F in meshes]
+    areas = [area(V, F) / profile["area"] - 1.0 for V, F in meshes]
+    assert all(-0.02 < v < 0 for v in volumes)          # inscribed polyhedron: a little less
+    np.testing.assert_allclose(eoc(volumes)[1:], 2.0, atol=0.05)
+    np.testing.assert_allclose(eoc(areas)[1:], 2.0, atol=0.05)
+
+
+def test_enneper_patch_boundary_on_the_surface_and_area_converges():
+    from mcfbench.geometry.exact import eoc
+    from mcfbench.geometry.metrics import area
+    from mcfbench.geometry.metrics import triangle_normals
+    from mcfbench.geometry.minimal import enneper, enneper_area, enneper_height_error, enneper_patch
+
+    V, F = enneper_patch(1, radius=0.8, lift=0.2)
+    boundary = np.unique(undirected_edges(F)[0][undirected_edges(F)[1] == 1])
+    assert enneper_height_error(V[boundary]) < 1e-13         # the fixed circle lies on it
+    assert enneper_height_error(V) == pytest.approx(0.2, rel=1e-12)   # lifted at the centre
+    assert (triangle_normals(V, F)[:, 2] > 0).all()
+    # the unlifted patch: the area of the inscribed mesh converges to the exact one
+    errors = [area(*enneper_patch(k, lift=0.0)) / enneper_area(0.8) - 1.0 for k in (1, 2, 3)]
+    assert all(e < 0 for e in errors) and (eoc(errors)[1:] > 1.9).all()
+    np.testing.assert_allclose(enneper(np.array([0.5]), np.array([0.0])),
+                               [[0.5 - 0.125 / 3, 0.0, 0.25]], rtol=1e-15)   # by hand
