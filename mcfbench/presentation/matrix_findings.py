@@ -4,6 +4,8 @@ recommendation."""
 
 import numpy as np
 
+from mcfbench.presentation.matrix_tables import is_error, main_metric
+
 ORDER_BAND = (1.7, 2.3)
 """An EOC in this band counts as order ~2."""
 
@@ -48,7 +50,60 @@ def _classify(row):
     return "converging" if row["eoc"] >= CONVERGING_EOC else "not_converging"
 
 
-def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summary.csv"):
+def cheapest_to_reach(table):
+    """Work-precision verdicts: per problem with an error metric, the target error
+    ``E`` = the largest of the schemes' smallest errors (so every scheme with a
+    finite error reaches it), and for each scheme the fewest CPU seconds of a run
+    whose ``|error| <= E``.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The long table (:func:`mcfbench.presentation.matrix_tables.long_table`).
+
+    Returns
+    -------
+    list of dict
+        ``problem, metric, target, costs`` (scheme -> CPU seconds, cheapest first).
+    """
+    rows = []
+    for problem in dict.fromkeys(table["problem"]):
+        part = table[table["problem"] == problem]
+        metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
+        runs = part[(part["metric"] == metric) & np.isfinite(part["value"])]
+        if not is_error(metric) or runs.empty:
+            continue
+        runs = runs.assign(error=np.abs(runs["value"]))
+        best = runs.groupby("scheme", sort=False)["error"].min()
+        target = float(best.max())
+        reach = runs[runs["error"] <= target].groupby("scheme", sort=False)["cpu_seconds"].min()
+        rows.append({"problem": problem, "metric": metric, "target": target,
+                     "costs": dict(sorted(reach.items(), key=lambda kv: kv[1]))})
+    return rows
+
+
+def work_precision_section(rows, labels=None):
+    """The work-precision verdicts of :func:`cheapest_to_reach` in words."""
+    labels = labels or {}
+    lines = ["## Accuracy per CPU second", "",
+             "To reach the error every scheme with a finite error reaches on a problem "
+             "(the largest of their smallest errors), the cheapest run of each scheme, in CPU "
+             "seconds on one core with the problem's solver rule for every scheme (the same "
+             "footing within a problem; `figures/work_precision.png`):", ""]
+    for r in rows:
+        costs = list(r["costs"].items())
+        if not costs:
+            continue
+        first, seconds = costs[0]
+        rest = ", ".join(f"{labels.get(s, s)} {c:.3g} s" for s, c in costs[1:])
+        lines.append(f"- {r['problem']} ({r['metric']} <= {r['target']:.3g}): "
+                     f"**{labels.get(first, first)}** is the cheapest, {seconds:.3g} s"
+                     + (f" (then {rest})." if rest else "."))
+    return lines + [""]
+
+
+def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summary.csv",
+                    work_precision=()):
     """The findings, Markdown, written from the summary table only.
 
     Parameters
@@ -59,6 +114,8 @@ def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summa
         Scheme name -> label.
     mesh_problems : sequence of str
         The real-world-like problems (no refinement series).
+    work_precision : list of dict
+        :func:`cheapest_to_reach` of the long table (a section when given).
     """
     labels = labels or {}
     problems = list(dict.fromkeys(summary["problem"]))
@@ -124,6 +181,8 @@ def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summa
             lines.append("- " + text)
         lines += _common_floor(part, metric)
         lines.append("")
+    if work_precision:
+        lines += work_precision_section(work_precision, labels)
     lines += recommendation(summary, verdict, problems, schemes, mesh_problems)
     return "\n".join(lines).rstrip() + "\n"
 

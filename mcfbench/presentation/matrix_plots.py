@@ -85,8 +85,8 @@ def error_figure(table, paths, problems=None, schemes=None):
             label, style = scheme_style(scheme)
             if (rows["status"] != "ok").any():
                 broke.append(scheme)
-            if error:
-                ok = rows[(rows["status"] == "ok") & np.isfinite(rows["value"])]
+            if error:     # a value measured before a later breakdown (the pinch) counts
+                ok = rows[np.isfinite(rows["value"])]
                 x, y = ok["h"].to_numpy(), np.abs(ok["value"].to_numpy())
                 if len(y) and (y == 0).all():
                     exact.append(scheme)
@@ -129,6 +129,58 @@ def error_figure(table, paths, problems=None, schemes=None):
     fig.tight_layout(rect=(0, 0.06 / rows_, 1, 1))
     _legend(fig, schemes)
     save_figure(fig, *paths)
+
+
+WORK_PRECISION_NOTE = ("CPU seconds of one run on one core, the problem's solver rule for "
+                       "every scheme (same footing within a panel)")
+
+
+def work_precision_figure(table, paths, problems=None, schemes=None):
+    """Work-precision diagram: the main error of every run against its CPU
+    seconds, log-log, one panel per problem with an error metric, one line per
+    scheme through its levels (runs whose value is not finite left out).
+
+    Timings are on the same footing within a panel (one core, the same solver
+    rule and tolerance for every scheme of a problem); the figure says so.
+
+    Returns
+    -------
+    dict
+        ``{problem: {scheme: (cpu_seconds, |error|)}}``: the points drawn.
+    """
+    problems = problems or list(dict.fromkeys(table["problem"]))
+    schemes = schemes or list(dict.fromkeys(table["scheme"]))
+    shown = []
+    for problem in problems:
+        part = table[table["problem"] == problem]
+        metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
+        if is_error(metric):
+            shown.append((problem, metric, part[part["metric"] == metric]))
+    rows_ = max(1, int(np.ceil(len(shown) / PER_ROW)))
+    fig, axes = _grid(max(1, len(shown)), rows=rows_)
+    drawn = {}
+    for (problem, metric, runs), ax in zip(shown, axes.ravel()):
+        for scheme in schemes:
+            rows = runs[(runs["scheme"] == scheme) & np.isfinite(runs["value"])
+                        & (runs["value"] != 0)].sort_values("level")
+            if len(rows):
+                label, style = scheme_style(scheme)
+                x, y = rows["cpu_seconds"].to_numpy(), np.abs(rows["value"].to_numpy())
+                ax.plot(x, y, label=label, **style)
+                drawn.setdefault(problem, {})[scheme] = (x, y)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        _log_axis(ax.xaxis)
+        _log_axis(ax.yaxis)
+        ax.set_xlabel("CPU seconds (one core)")
+        ax.set_ylabel(f"|{metric}|")
+        ax.set_title(problem)
+        ax.grid(True, which="both", lw=0.3, alpha=0.5)
+    fig.suptitle(f"Benchmark matrix: error against cost ({WORK_PRECISION_NOTE})", fontsize=9)
+    fig.tight_layout(rect=(0, 0.06 / rows_, 1, 1))
+    _legend(fig, schemes)
+    save_figure(fig, *paths)
+    return drawn
 
 
 def _wrap(text, width=48):

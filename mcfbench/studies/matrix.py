@@ -23,13 +23,14 @@ from pathlib import Path
 
 import numpy as np
 
-from mcfbench.presentation.matrix_findings import matrix_findings
+from mcfbench.presentation.matrix_findings import cheapest_to_reach, matrix_findings
 from mcfbench.presentation.matrix_tables import (
     TIMING_NOTE,
     latex,
     long_table,
     markdown,
     problem_table,
+    read_long_table,
     read_summary,
     summary_table,
     summary_views,
@@ -277,15 +278,17 @@ def mesh_problems(plan):
     return [p for p in plan["problems"] if is_real_world(get_problem(p))]
 
 
-def findings(summary_csv, out, plan):
-    """``findings.md`` from ``summary.csv`` (numbers from the table only)."""
+def findings(summary_csv, out, plan, long_csv=None):
+    """``findings.md`` from ``summary.csv`` and, for the cost of accuracy, the long
+    table ``matrix.csv`` (numbers from the tables only)."""
     from mcfbench.running.schemes import SCHEMES
     from mcfbench.storage.atomic import write_text
 
     summary = read_summary(summary_csv)
     labels = {s: SCHEMES[s].label for s in plan["schemes"] if s in SCHEMES}
+    costs = cheapest_to_reach(read_long_table(long_csv)) if long_csv else ()
     text = matrix_findings(summary, labels, mesh_problems(plan),
-                    source=Path(summary_csv).as_posix())
+                           source=Path(summary_csv).as_posix(), work_precision=costs)
     write_text(out, text)
     return text
 

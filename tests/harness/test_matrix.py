@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from mcfbench.presentation import matrix_findings, matrix_tables
@@ -130,6 +131,7 @@ def test_tiny_plots(tiny):
         error_figure,
         picture_grid,
         quality_figure,
+        work_precision_figure,
     )
 
     root, plan, runs, table, _ = tiny
@@ -140,7 +142,17 @@ def test_tiny_plots(tiny):
     entries = {key: (read_record(r), matrix.load_frames(f))
                for key, (r, f) in matrix.picture_runs(plan, str(root)).items()}
     picture_grid(entries, [figs / "pictures.png"], problems, schemes)
-    for name in ("errors.png", "quality.png", "pictures.png"):
+    drawn = work_precision_figure(table, [figs / "work_precision.png"], problems, schemes)
+    for problem, lines in drawn.items():          # every point is a run's (CPU s, |error|)
+        for scheme, (cpu, err) in lines.items():
+            metric = matrix_tables.main_metric(problem, table["metric"].unique())
+            rows = table[(table["problem"] == problem) & (table["scheme"] == scheme)
+                         & (table["metric"] == metric)].sort_values("level")
+            np.testing.assert_array_equal(cpu, rows["cpu_seconds"])
+            np.testing.assert_array_equal(err, np.abs(rows["value"]))
+    assert set(drawn) == {"sphere", "catenoid"} and set(drawn["sphere"]) == set(schemes)
+    assert set(drawn["catenoid"]) == {"cotan"}        # ddfv's T-vertex escapes: no error
+    for name in ("errors.png", "work_precision.png", "quality.png", "pictures.png"):
         assert (figs / name).stat().st_size > 1000
 
 
@@ -267,3 +279,18 @@ def test_gallery_runs_every_scheme_on_every_file(tmp_path):
     assert "same footing" in text and "| ball.obj | ddfv | ok | 3/3 |" in text
     with pytest.raises(ConfigError, match="'meshes'"):
         gallery.plan({}, str(tmp_path / "missing"))
+
+
+def test_cheapest_to_reach_reads_the_long_table():
+    """The work-precision verdict on known numbers: target = the largest of the
+    schemes' smallest errors; per scheme the cheapest run at or below it."""
+    from mcfbench.presentation.matrix_findings import cheapest_to_reach, work_precision_section
+
+    rows = [("a", 1, 1e-2, 1.0), ("a", 2, 2.5e-3, 4.0), ("b", 1, 4e-3, 3.0), ("b", 2, 1e-3, 9.0)]
+    table = pd.DataFrame([{"problem": "sphere", "scheme": s, "level": lv, "metric": "l2_error",
+                           "value": e, "cpu_seconds": c} for s, lv, e, c in rows])
+    (verdict,) = cheapest_to_reach(table)
+    assert verdict["target"] == 2.5e-3                    # a's smallest error; b reaches it too
+    assert verdict["costs"] == {"a": 4.0, "b": 9.0}
+    text = "\n".join(work_precision_section([verdict], {"a": "A"}))
+    assert "**A** is the cheapest, 4 s (then b 9 s)" in text

@@ -40,7 +40,7 @@ MATRIX_TABLES = [
 ]
 MATRIX_FIGURES = {
     f"{name}_{ext}": f"results/matrix/figures/{name}.{ext}"
-    for name in ("errors", "quality", "pictures")
+    for name in ("errors", "work_precision", "quality", "pictures")
     for ext in ("png", "pdf")
 }
 MATRIX_TARGETS = [*MATRIX_TABLES, *MATRIX_FIGURES.values(), "results/matrix/findings.md"]
@@ -126,6 +126,7 @@ rule matrix_findings:
     """findings.md from the summary table (no hand-typed numbers)."""
     input:
         summary="results/matrix/tables/summary.csv",
+        table="results/matrix/tables/matrix.csv",
     output:
         "results/matrix/findings.md",
     params:

@@ -10,5 +10,5 @@ from mcfbench.studies import matrix
 
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, force=True)  # noqa: F821
 text = matrix.findings(snakemake.input.summary, snakemake.output[0],  # noqa: F821
-                        snakemake.params.plan)  # noqa: F821
+                       snakemake.params.plan, snakemake.input.table)  # noqa: F821
 logging.info("\n%s", text)

@@ -11,6 +11,7 @@ from mcfbench.presentation.matrix_plots import (
              error_figure,
              picture_grid,
              quality_figure,
+    work_precision_figure,
 )
 from mcfbench.presentation.matrix_tables import read_long_table
 from mcfbench.storage.records import read_record, read_records
@@ -20,8 +21,9 @@ sm = snakemake  # noqa: F821
 logging.basicConfig(filename=sm.log[0], level=logging.INFO, force=True)
 plan, out = sm.params.plan, sm.output
 problems, schemes = list(plan["problems"]), plan["schemes"]
-error_figure(read_long_table(sm.input.table), [out.errors_png, out.errors_pdf],
-             problems, schemes)
+table = read_long_table(sm.input.table)
+error_figure(table, [out.errors_png, out.errors_pdf], problems, schemes)
+work_precision_figure(table, [out.work_precision_png, out.work_precision_pdf], problems, schemes)
 quality_figure(list(read_records(sm.params.expected).values()), [out.quality_png, out.quality_pdf],
                problems, schemes)
 entries = {key: (read_record(record), load_frames(frames))
