@@ -32,7 +32,7 @@ name                     n_F    n_T    boundary  what
 ``blobby``               2646   5288   none      marching cubes of metaballs, 40^3
 ``implicit_torus``       4476   8952   none      marching cubes of a tilted torus, 48^3
 ``angenent_torus``       1152   2304   none      Angenent's self-shrinking torus, 48 x 24
-``enneper_patch``        376    687    1 loop    Enneper patch R = 0.8, interior lifted 0.2
+``enneper_patch``        376    687    1 loop    Enneper patch R = 0.8, interior lifted 0.2 (defaults)
 ======================== ====== ====== ========= ======================================
 
 Refinement: the icosphere family (``sphere``, ``bumpy_sphere``,
