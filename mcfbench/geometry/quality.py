@@ -35,7 +35,9 @@ pipeline adds a first column ``run``, the run's key in its experiment):
 ``worst_t``, ``worst_diamond``
     Where: the T-vertex with the smallest barycentric coordinate and the
     diamond with the smallest area (empty for ``vertex`` runs).
-``primal_angle_min_deg``, ``primal_area_min_rel``, ``primal_flipped``, ``worst_triangle``
+``min_angle``, ``primal_area_min_rel``, ``flipped``, ``worst_triangle``
+    (``min_angle`` and ``flipped`` are named as in the monitor of every run,
+    :func:`mcfbench.running.run.run`, and in the run records)
     The primal triangle mesh (the F-vertices; every scheme): smallest
     interior angle in degrees (:func:`mcfbench.geometry.metrics.min_angle`),
     smallest triangle area over the mean, number of triangles folded over
@@ -62,12 +64,12 @@ COLLAPSE_AREA = 1e-8
 
 COLUMNS = ("n", "t", "t_bary_min", "t_bary_median", "diamond_area_min_rel",
            "angle_min_deg", "area", "volume", "worst_t", "worst_diamond", "family",
-           "primal_angle_min_deg", "primal_area_min_rel", "primal_flipped", "worst_triangle")
+           "min_angle", "primal_area_min_rel", "flipped", "worst_triangle")
 
 #: the monitors of the diamond mesh (empty for ``vertex`` runs)
 DIAMOND_COLUMNS = ("t_bary_min", "t_bary_median", "diamond_area_min_rel", "angle_min_deg",
                    "worst_t", "worst_diamond")
-_INTEGER_COLUMNS = ("worst_t", "worst_diamond", "primal_flipped", "worst_triangle")
+_INTEGER_COLUMNS = ("worst_t", "worst_diamond", "flipped", "worst_triangle")
 
 
 def mesh_quality(mesh, F, T, geometry=None):
@@ -128,14 +130,14 @@ def primal_quality(vertices, faces):
     Returns
     -------
     dict
-        ``primal_angle_min_deg``, ``primal_area_min_rel``,
-        ``primal_flipped``, ``worst_triangle`` (see module docstring).
+        ``min_angle``, ``primal_area_min_rel``,
+        ``flipped``, ``worst_triangle`` (see module docstring).
 
     Examples
     --------
     >>> from mcfbench.geometry.surfaces import icosphere
     >>> q = primal_quality(*icosphere(1))
-    >>> round(q["primal_angle_min_deg"], 1), q["primal_flipped"]
+    >>> round(q["min_angle"], 1), q["flipped"]
     (55.6, 0)
     """
     from mcfbench.geometry.metrics import flipped_triangles, min_angle, triangle_areas
@@ -146,9 +148,9 @@ def primal_quality(vertices, faces):
         rel = areas / areas.mean()
     finite = np.isfinite(V).all()
     return {
-        "primal_angle_min_deg": min_angle(V, faces) if finite else float("nan"),
+        "min_angle": min_angle(V, faces) if finite else float("nan"),
         "primal_area_min_rel": float(rel.min()) if finite else float("nan"),
-        "primal_flipped": flipped_triangles(V, faces) if finite else 0,
+        "flipped": flipped_triangles(V, faces) if finite else 0,
         "worst_triangle": int(np.nanargmin(rel)) if finite else 0,
     }
 
@@ -211,7 +213,7 @@ def first_violation(df, collapse_area=COLLAPSE_AREA):
     when a T-vertex has left its triangle (``t_bary_min < 0``) or a diamond
     cell collapsed (``diamond_area_min_rel < collapse_area``); a
     ``vertex`` level when a triangle collapsed (``primal_area_min_rel <
-    collapse_area``) or folded over (``primal_flipped > 0``). NaN monitors
+    collapse_area``) or folded over (``flipped > 0``). NaN monitors
     count too.
 
     Parameters
@@ -236,7 +238,7 @@ def violations(df, collapse_area=COLLAPSE_AREA):
     if not vertex.any():
         return diamond
     primal = ~(df["primal_area_min_rel"] >= collapse_area) \
-        | (df["primal_flipped"].fillna(0).astype(float) > 0)
+        | (df["flipped"].fillna(0).astype(float) > 0)
     return pd.Series(np.where(vertex, primal, diamond), index=df.index)
 
 
@@ -251,8 +253,8 @@ def describe_violation(df, collapse_area=COLLAPSE_AREA):
         if not row["primal_area_min_rel"] >= collapse_area:
             what.append(f"triangle {_index(row['worst_triangle'])} collapsed "
                         f"(relative area {row['primal_area_min_rel']:.3g})")
-        if row["primal_flipped"] > 0:
-            what.append(f"{int(row['primal_flipped'])} triangle(s) folded over")
+        if row["flipped"] > 0:
+            what.append(f"{int(row['flipped'])} triangle(s) folded over")
     else:
         if not row["t_bary_min"] >= 0:
             what.append(f"T-vertex {_index(row['worst_t'])} left its triangle "

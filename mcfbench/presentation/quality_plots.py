@@ -90,7 +90,7 @@ def plot_levels(frames, title=""):
     ax_b.set_xlabel("T-vertex barycentric coordinate\n(1/3: barycentre, < 0: outside)")
     bars(ax_g, y + h / 2, [r["angle_min_deg"] for r in rows], diamond_c, ".1f",
          "diamond mesh (F, F, T)")
-    bars(ax_g, y - h / 2, [r["primal_angle_min_deg"] for r in rows], primal_c, ".1f",
+    bars(ax_g, y - h / 2, [r["min_angle"] for r in rows], primal_c, ".1f",
          "primal triangles")
     ax_g.set_xlim(0, 75)
     ax_g.set_xlabel("smallest angle [deg]")
@@ -143,7 +143,7 @@ def plot_series(frames, title="", marks=()):
             ax_g.plot(n, df["angle_min_deg"].astype(float), color=color)
             ax_a.semilogy(n, df["diamond_area_min_rel"].astype(float).clip(lower=1e-16),
                           color=color)
-        ax_g.plot(n, df["primal_angle_min_deg"].astype(float), color=color, ls="--")
+        ax_g.plot(n, df["min_angle"].astype(float), color=color, ls="--")
         ax_a.semilogy(n, df["primal_area_min_rel"].astype(float).clip(lower=1e-16),
                       color=color, ls="--")
         a0 = df["area"].iloc[0]

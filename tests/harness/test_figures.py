@@ -223,9 +223,9 @@ def test_diagnostics_of_a_cotangent_run_contain_its_rows(small_comparison):
     assert cotan["t_bary_min"].isna().all() and ddfv["t_bary_min"].notna().all()
     # the primal monitors of both: the twisted 24 x 8 cylinder, nothing folded
     for rows in (cotan, ddfv):
-        assert (rows["primal_angle_min_deg"] > 30).all()
+        assert (rows["min_angle"] > 30).all()
         assert (rows["primal_area_min_rel"] > 0.5).all()
-        assert (rows["primal_flipped"] == 0).all()
+        assert (rows["flipped"] == 0).all()
     # the flow decreases the area of the open cylinder, boundary fixed
     assert (np.diff(cotan["area"]) < 0).all()
     assert cotan["area"].iloc[0] == pytest.approx(4 * np.pi * 0.55, rel=0.02)  # 2 pi R h

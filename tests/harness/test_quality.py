@@ -41,8 +41,8 @@ def test_paper_initialisation_puts_t_vertices_near_the_barycentres(sphere):
     assert 20.0 < q["angle_min_deg"] <= 30.0 + 1e-9
     # the primal icosphere: near-equilateral triangles, none folded
     assert q["family"] == "ddfv"
-    assert 50.0 < q["primal_angle_min_deg"] <= 60.0
-    assert 0.8 < q["primal_area_min_rel"] <= 1.0 and q["primal_flipped"] == 0
+    assert 50.0 < q["min_angle"] <= 60.0
+    assert 0.8 < q["primal_area_min_rel"] <= 1.0 and q["flipped"] == 0
 
 
 def test_area_and_volume_approach_the_sphere(sphere):
@@ -119,9 +119,9 @@ def test_primal_quality_of_a_flat_square():
     V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 0.0]])
     faces = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
     q = primal_quality(V, faces)
-    assert q["primal_angle_min_deg"] == pytest.approx(45.0)
+    assert q["min_angle"] == pytest.approx(45.0)
     assert q["primal_area_min_rel"] == pytest.approx(1.0)
-    assert q["primal_flipped"] == 0
+    assert q["flipped"] == 0
     V[4] = [0.9, 0.5, 0.0]          # the centre moved right: triangle 1 shrinks
     q = primal_quality(V, faces)
     assert q["worst_triangle"] == 1
@@ -136,7 +136,7 @@ def test_cotangent_run_has_primal_rows_and_empty_diamond_columns():
     assert list(df.columns) == list(COLUMNS) and len(df) == 5
     assert (df["family"] == "vertex").all()
     assert df[list(DIAMOND_COLUMNS)].isna().all().all()
-    assert (df["primal_angle_min_deg"] > 20).all() and (df["primal_flipped"] == 0).all()
+    assert (df["min_angle"] > 20).all() and (df["flipped"] == 0).all()
     # the area of the triangle mesh decreases under the flow (boundary fixed)
     assert df["area"].iloc[0] == pytest.approx(vertex_quality(V, faces)["area"])
     assert (np.diff(df["area"]) < 0).all()
@@ -147,7 +147,7 @@ def test_cotangent_run_has_primal_rows_and_empty_diamond_columns():
     assert first_violation(bad) == 3
     assert "triangle 7 collapsed" in describe_violation(bad)
     bad = df.copy()
-    bad.loc[2, "primal_flipped"] = 2
+    bad.loc[2, "flipped"] = 2
     assert first_violation(bad) == 2 and "2 triangle(s) folded over" in describe_violation(bad)
 
 
@@ -169,7 +169,7 @@ def _series(n_steps, family, **values):
             df[key] = values.get(key, np.full(n_steps, np.nan if (
                 family == "vertex" and key in DIAMOND_COLUMNS) else 0.5))
     df["area"] = 1.0 - 0.01 * n
-    df["primal_flipped"] = 0
+    df["flipped"] = 0
     return df[list(COLUMNS)]
 
 
