@@ -4,7 +4,7 @@ Every record is checked first (:func:`mcfbench.storage.records.read_records`: ch
 schema, stale settings); one bad record stops the aggregation with a message
 naming the file. The tables are :func:`mcfbench.presentation.convergence_tables.level_table` and
 :func:`mcfbench.presentation.convergence_tables.convergence_documents`; all four files are written
-together (:func:`mcfbench.pipeline.write_files`).
+together (:func:`mcfbench.storage.atomic.write_files`).
 """
 
 from mcfbench.pipeline import json_text, record_fields, sidecar

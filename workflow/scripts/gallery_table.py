@@ -1,5 +1,5 @@
 """The gallery table, mesh x scheme (rule ``gallery_table``,
-workflow/rules/gallery.smk; :func:`mcfbench.studies.matrix_tables.gallery_table`)."""
+workflow/rules/gallery.smk; :func:`mcfbench.presentation.matrix_tables.gallery_table`)."""
 
 import logging
 

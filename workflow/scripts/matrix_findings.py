@@ -1,7 +1,7 @@
 """findings.md of the benchmark matrix, from the summary table only.
 
 Called by rule ``matrix_findings`` (workflow/rules/matrix.smk); the text is
-:func:`mcfbench.studies.matrix_findings.matrix_findings` of ``summary.csv``.
+:func:`mcfbench.presentation.matrix_findings.matrix_findings` of ``summary.csv``.
 """
 
 import logging
