@@ -1,5 +1,6 @@
 """The gallery: every scheme on every mesh file of a folder (default: the suite's generated
-real-world-like meshes), one run job per (mesh, scheme)."""
+real-world-like meshes and the real meshes shipped inside pinned packages,
+:data:`mcfbench.geometry.packaged_meshes.PACKAGED_MESHES`), one run job per (mesh, scheme)."""
 
 from pathlib import Path
 
@@ -26,14 +27,15 @@ def plan(section=None, meshes=None, schemes=None):
         ``C`` (tau = C (mean edge)^2), ``steps``, ``solver`` (a method or
         ``"robust"``), ``rtol``, ``maxiter``, ``schemes`` ("all" or names).
     meshes : str, optional
-        A folder of mesh files; None: the suite's own meshes
-        (:func:`generated_meshes`) under ``results/gallery/meshes``.
+        A folder of mesh files; None: the suite's own meshes and the packaged
+        real meshes (:func:`generated_meshes`) under ``results/gallery/meshes``.
 
     Returns
     -------
     dict
         ``C, steps, solver, rtol, maxiter, schemes, meshes`` (file name ->
-        path), ``generated`` (file name -> (surface or problem, params)).
+        path), ``generated`` (file name -> ``(kind, name, level)``, kind
+        ``problem``, ``surface`` or ``packaged``).
     """
     from mcfbench.running import solver as _solver
 
@@ -82,15 +84,24 @@ def generated_meshes():
     """``{file name: (kind, name, level)}`` of the built-in gallery: the
     real-world-like problems of the registry (:func:`is_real_world`) at the
     middle level of their refinement series, or (when there are none) the surfaces
-    :data:`GALLERY_SURFACES` at their defaults."""
+    :data:`GALLERY_SURFACES` at their defaults; then the real meshes of
+    :data:`~mcfbench.geometry.packaged_meshes.PACKAGED_MESHES` (kind ``packaged``,
+    level 0)."""
+    from mcfbench.geometry.packaged_meshes import PACKAGED_MESHES
     from mcfbench.geometry.surfaces import SURFACES
     from mcfbench.running.problems import PROBLEMS
 
     mesh_problems = [p for p in PROBLEMS.values() if is_real_world(p)]
     if mesh_problems:
-        return {f"{p.name}.obj": ("problem", p.name, int(sorted(p.levels)[len(p.levels) // 2]))
-                for p in mesh_problems}
-    return {f"{s}.obj": ("surface", s, 0) for s in GALLERY_SURFACES if s in SURFACES}
+        own = {f"{p.name}.obj": ("problem", p.name, int(sorted(p.levels)[len(p.levels) // 2]))
+               for p in mesh_problems}
+    else:
+        own = {f"{s}.obj": ("surface", s, 0) for s in GALLERY_SURFACES if s in SURFACES}
+    packaged = {f"{name}.obj": ("packaged", name, 0) for name in PACKAGED_MESHES}
+    clash = sorted(set(own) & set(packaged))
+    if clash:
+        raise ConfigError(f"gallery: packaged mesh name(s) {clash} clash with the suite's own")
+    return {**own, **packaged}
 
 
 def write_obj(path, vertices, faces):
@@ -103,12 +114,21 @@ def write_obj(path, vertices, faces):
 
 
 def write_generated_mesh(entry, path):
-    """Write one mesh of :func:`generated_meshes` (``entry`` = its value)."""
+    """Write one mesh of :func:`generated_meshes` (``entry`` = its value). A
+    packaged mesh is read from its installed package (SHA-256 checked) through
+    :func:`~mcfbench.geometry.mesh_files.read_mesh` and written as the intake
+    left it (vertices in the file's order, unreferenced ones dropped)."""
+    from mcfbench.geometry.packaged_meshes import read_packaged_mesh
     from mcfbench.geometry.surfaces import make_surface
     from mcfbench.running.problems import get_problem
 
     kind, name, level = entry
-    V, F = get_problem(name).mesh(level) if kind == "problem" else make_surface(name)
+    if kind == "packaged":
+        V, F, _ = read_packaged_mesh(name)
+    elif kind == "problem":
+        V, F = get_problem(name).mesh(level)
+    else:
+        V, F = make_surface(name)
     write_obj(path, V, F)
 
 

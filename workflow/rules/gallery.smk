@@ -1,13 +1,15 @@
 # The gallery of real meshes (issue "Real meshes"): every scheme on every mesh
 # file of a folder. Not part of `rule all`:
 #
-#   snakemake --cores 2 gallery                       # the suite's own meshes
+#   snakemake --cores 2 gallery                       # the suite's own meshes and the packaged real ones
 #   snakemake --cores 2 gallery --config meshes=DIR   # every .obj .off .ply .stl in DIR
 #
 # Each run: the mesh read by mcfbench.geometry.mesh_files.read_mesh (repaired and
 # validated), tau = C * (mean edge length)^2, `steps` steps, the robust solver
 # (config key `gallery`). Without `meshes` the suite first writes its own
-# real-world-like meshes as OBJ to results/gallery/meshes/. Uses MATRIX_CODE
+# real-world-like meshes and the real meshes shipped inside pinned packages
+# (mcfbench.geometry.packaged_meshes: pyvista, nilearn; read from the installed
+# package, SHA-256 checked) as OBJ to results/gallery/meshes/. Uses MATRIX_CODE
 # and _alternatives (mcfbench.pipeline.alternatives) of workflow/rules/matrix.smk
 # (included before).
 #
@@ -48,7 +50,8 @@ GALLERY_TARGETS = [
 if GALLERY["generated"]:
 
     rule gallery_mesh:
-        """One of the suite's own meshes as OBJ (when no `meshes` folder is given)."""
+        """One of the suite's own meshes, or a packaged real mesh, as OBJ (when no
+        `meshes` folder is given)."""
         output:
             "results/gallery/meshes/{mesh}",
         params:

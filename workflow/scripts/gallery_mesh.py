@@ -1,4 +1,4 @@
-"""One of the suite's own gallery meshes as OBJ (rule ``gallery_mesh``,
+"""One of the suite's own gallery meshes, or a packaged real mesh, as OBJ (rule ``gallery_mesh``,
 workflow/rules/gallery.smk; :func:`mcfbench.studies.gallery.write_generated_mesh`)."""
 
 import logging
