@@ -5,7 +5,11 @@
 ``study PROBLEM``
     Any scheme on any problem over its refinement series, with EOC.
 ``run MESH``
-    Any scheme on a user's mesh, frames into an ``.npz``.
+    Any scheme on a user's mesh, frames into an ``.npz`` or a ParaView
+    collection (``.pvd``).
+``export RUN.npz OUT.pvd``
+    The frames of a run (``run``'s ``.npz``, a matrix or gallery frames
+    file) as a ParaView collection.
 ``report``
     The reproduction report from the result files.
 ``schemes``, ``problems``
@@ -107,8 +111,16 @@ def build_parser():
     flow.add_argument("--steps", type=_level, required=True, help="number of time steps")
     flow.add_argument("--save-every", type=_count, default=1,
                       help="keep every K-th step as a frame (0: first and last only)")
-    flow.add_argument("--out", type=Path, required=True, help="output file (.npz)")
+    flow.add_argument("--out", type=Path, required=True,
+                      help="output file: .npz (the frames and the run's data) or .pvd (a "
+                           "ParaView collection, one .vtu per frame in the folder OUT/)")
     _common(flow, ROBUST)
+
+    export = commands.add_parser("export", help="a run's frames (.npz of run, matrix or "
+                                 "gallery) as a ParaView collection (.pvd)")
+    export.add_argument("source", type=Path, help="the run's .npz")
+    export.add_argument("out", type=Path, help="the collection (.pvd); its .vtu files go to "
+                        "the folder OUT/ next to it")
 
     report = commands.add_parser("report", help="the reproduction report from the result "
                                  "files (what the pipeline's rule reproduction_report does)")
@@ -240,6 +252,10 @@ def _int(x):
     return "" if x is None or np.isnan(x) else f"{int(x)}"
 
 
+OUTPUTS = (".npz", ".pvd")
+"""What ``run --out`` writes, by suffix."""
+
+
 def _run(args):
     from mcfbench.geometry.mesh import summarize
     from mcfbench.geometry.mesh_files import read_mesh
@@ -248,8 +264,9 @@ def _run(args):
     scheme = _scheme(args)
     options = _options(args, scheme)
     check_writable(args.out)
-    if args.out.suffix != ".npz":
-        raise ValueError(f"--out {args.out}: the output is an .npz archive; name it *.npz")
+    if args.out.suffix not in OUTPUTS:
+        raise ValueError(f"--out {args.out}: the output is an .npz archive or a ParaView "
+                         f"collection; name it *.npz or *.pvd")
     V, F, intake = read_mesh(args.mesh)
     for note in intake.notes():
         print(f"note: {note}")
@@ -263,12 +280,19 @@ def _run(args):
                        **options)
     config = {**_settings(args, scheme), "mesh": str(args.mesh), "tau": result.tau,
               "steps": args.steps, "save_every": args.save_every}
-    save_npz(args.out, **{k: v for k, v in traj.frames.items()}, faces=traj.faces,
-             vertex_map=intake.kept, t=traj.t, steps=traj.steps, iterations=traj.iterations,
-             t_min_barycentric=np.array(result.series["t_min_barycentric"]),
-             status=traj.status, message=traj.message, failed_step=traj.failed_step,
-             scheme=scheme.name, defects=json.dumps(traj.defects),
-             provenance=json.dumps(provenance(config)))
+    arrays = dict(traj.frames, faces=traj.faces, vertex_map=intake.kept, t=traj.t,
+                  steps=traj.steps, iterations=traj.iterations,
+                  t_min_barycentric=np.array(result.series["t_min_barycentric"]),
+                  status=traj.status, message=traj.message, failed_step=traj.failed_step,
+                  scheme=scheme.name, defects=json.dumps(traj.defects),
+                  provenance=json.dumps(provenance(config)))
+    if args.out.suffix == ".pvd":
+        from mcfbench.presentation.paraview_export import export_pvd, run_provenance
+
+        arrays = {k: np.asarray(v) for k, v in arrays.items()}
+        export_pvd(arrays, args.out, run_provenance(arrays))
+    else:
+        save_npz(args.out, **arrays)
     print(f"wrote {args.out}: {len(traj.t)} frames, {traj.steps_done} steps, "
           f"{int(traj.iterations.sum())} solver iterations, smallest angle "
           f"{result.min_angle:.3g} deg"
@@ -278,6 +302,17 @@ def _run(args):
         print(f"error: {traj.message} (frames up to step {traj.steps[-1]} kept)",
               file=sys.stderr)
         return 1
+    return 0
+
+
+def _export(args):
+    from mcfbench.presentation.paraview_export import export_file
+
+    check_writable(args.out)
+    if args.out.suffix != ".pvd":
+        raise ValueError(f"{args.out}: the export is a ParaView collection; name it *.pvd")
+    files = export_file(args.source, args.out)
+    print(f"wrote {args.out}: {len(files) - 1} frame files in {args.out.parent / args.out.stem}/")
     return 0
 
 
@@ -310,5 +345,5 @@ def _problems(args):
     return 0
 
 
-COMMANDS = {"sphere-table": _sphere_table, "study": _study, "run": _run,
+COMMANDS = {"sphere-table": _sphere_table, "study": _study, "run": _run, "export": _export,
             "report": _report, "schemes": _schemes, "problems": _problems}
