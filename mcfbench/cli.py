@@ -147,6 +147,11 @@ def main(argv=None):
         return 2
 
 
+def _terminal():
+    """Progress bars only when standard error is a terminal (none in logs, pipes, jobs)."""
+    return sys.stderr.isatty()
+
+
 def _scheme(args):
     if args.variant is not None:
         name = "ddfv" if args.variant == "paper" else f"ddfv-{args.variant}"
@@ -179,7 +184,8 @@ def _sphere_table(args):
     scheme = _scheme(args)
     if args.csv:
         check_writable(args.csv)
-    table = sphere_table(args.levels, scheme.name, **_options(args, scheme))
+    table = sphere_table(args.levels, scheme.name, progress=_terminal(),
+                         **_options(args, scheme))
     print(format_table(table))
     if args.csv:
         _write_csv(args.csv, table, {**_settings(args, scheme), "levels": args.levels})
@@ -193,7 +199,8 @@ def _study(args):
     scheme, problem = _scheme(args), get_problem(args.problem)
     if args.csv:
         check_writable(args.csv)
-    table = level_sweep(scheme.name, problem, args.levels, **_options(args, scheme))
+    table = level_sweep(scheme.name, problem, args.levels, progress=_terminal(),
+                        **_options(args, scheme))
     columns = ["level", "nV", "h", "tau", "N", "steps_done", "status",
                *[c for c in table.columns if c.startswith("eoc_")],
                *[c for c in table.columns if c not in _NOT_METRICS and
@@ -277,7 +284,7 @@ def _run(args):
           f"{' (the robust default)' if args.solver == ROBUST else f' (rtol {args.rtol:g})'}, "
           f"tau {tau if tau else problem.tau(0, (V, F)):.4g}, {args.steps} steps")
     result, traj = run(scheme, problem, 0, tau=tau, mesh=(V, F), save_every=args.save_every,
-                       **options)
+                       progress=_terminal(), **options)
     config = {**_settings(args, scheme), "mesh": str(args.mesh), "tau": result.tau,
               "steps": args.steps, "save_every": args.save_every}
     arrays = dict(traj.frames, faces=traj.faces, vertex_map=intake.kept, t=traj.t,
