@@ -7,9 +7,9 @@
 ``run MESH``
     Any scheme on a user's mesh, frames into an ``.npz`` or a ParaView
     collection (``.pvd``).
-``export RUN.npz OUT.pvd``
+``export RUN.npz OUT.pvd`` (or ``OUT.gif``)
     The frames of a run (``run``'s ``.npz``, a matrix or gallery frames
-    file) as a ParaView collection.
+    file) as a ParaView collection or an animation.
 ``report``
     The reproduction report from the result files.
 ``schemes``, ``problems``
@@ -114,13 +114,15 @@ def build_parser():
     flow.add_argument("--out", type=Path, required=True,
                       help="output file: .npz (the frames and the run's data) or .pvd (a "
                            "ParaView collection, one .vtu per frame in the folder OUT/)")
+    flow.add_argument("--movie", type=Path, help="also an animation of the saved frames "
+                      "(.gif; one camera and scale, time and status on each frame)")
     _common(flow, ROBUST)
 
     export = commands.add_parser("export", help="a run's frames (.npz of run, matrix or "
-                                 "gallery) as a ParaView collection (.pvd)")
+                                 "gallery) as a ParaView collection (.pvd) or a GIF")
     export.add_argument("source", type=Path, help="the run's .npz")
-    export.add_argument("out", type=Path, help="the collection (.pvd); its .vtu files go to "
-                        "the folder OUT/ next to it")
+    export.add_argument("out", type=Path, help="the collection (.pvd; its .vtu files go to "
+                        "the folder OUT/ next to it) or an animation (.gif)")
 
     report = commands.add_parser("report", help="the reproduction report from the result "
                                  "files (what the pipeline's rule reproduction_report does)")
@@ -274,6 +276,10 @@ def _run(args):
     if args.out.suffix not in OUTPUTS:
         raise ValueError(f"--out {args.out}: the output is an .npz archive or a ParaView "
                          f"collection; name it *.npz or *.pvd")
+    if args.movie is not None:
+        check_writable(args.movie)
+        if args.movie.suffix.lower() != ".gif":
+            raise ValueError(f"--movie {args.movie}: the animation is a GIF; name it *.gif")
     V, F, intake = read_mesh(args.mesh)
     for note in intake.notes():
         print(f"note: {note}")
@@ -293,10 +299,10 @@ def _run(args):
                   status=traj.status, message=traj.message, failed_step=traj.failed_step,
                   scheme=scheme.name, defects=json.dumps(traj.defects),
                   provenance=json.dumps(provenance(config)))
+    arrays = {k: np.asarray(v) for k, v in arrays.items()}
     if args.out.suffix == ".pvd":
         from mcfbench.presentation.paraview_export import export_pvd, run_provenance
 
-        arrays = {k: np.asarray(v) for k, v in arrays.items()}
         export_pvd(arrays, args.out, run_provenance(arrays))
     else:
         save_npz(args.out, **arrays)
@@ -305,6 +311,11 @@ def _run(args):
           f"{result.min_angle:.3g} deg"
           + (f", min T barycentric {result.t_min_barycentric:.3f}"
              if scheme.family == "ddfv" else ""))
+    if args.movie is not None:
+        from mcfbench.presentation.movie import write_movie
+
+        write_movie(arrays, args.movie, title=f"{scheme.label} on {args.mesh.name}")
+        print(f"wrote {args.movie}: {len(traj.t)} frames")
     if traj.status != "ok":
         print(f"error: {traj.message} (frames up to step {traj.steps[-1]} kept)",
               file=sys.stderr)
@@ -313,11 +324,20 @@ def _run(args):
 
 
 def _export(args):
-    from mcfbench.presentation.paraview_export import export_file
+    from mcfbench.presentation.paraview_export import export_file, load_frames_file
 
     check_writable(args.out)
+    if args.out.suffix == ".gif":
+        from mcfbench.presentation.movie import write_movie
+
+        arrays = load_frames_file(args.source)
+        scheme = str(arrays["scheme"]) if "scheme" in arrays else args.source.parent.name
+        write_movie(arrays, args.out, title=f"{scheme}: {args.source.name}")
+        print(f"wrote {args.out}: {len(arrays['t'])} frames")
+        return 0
     if args.out.suffix != ".pvd":
-        raise ValueError(f"{args.out}: the export is a ParaView collection; name it *.pvd")
+        raise ValueError(f"{args.out}: the export is a ParaView collection (.pvd) or an "
+                         f"animation (.gif); name it *.pvd or *.gif")
     files = export_file(args.source, args.out)
     print(f"wrote {args.out}: {len(files) - 1} frame files in {args.out.parent / args.out.stem}/")
     return 0

@@ -130,7 +130,7 @@ def test_export_refuses_what_it_cannot_convert(tmp_path, capsys):
     assert main(["export", str(tmp_path / "other.npz"), str(tmp_path / "x.pvd")]) == 2
     assert "not a run's frames file" in capsys.readouterr().err
     assert main(["export", str(empty), str(tmp_path / "x.vtu")]) == 2
-    assert "name it *.pvd" in capsys.readouterr().err
+    assert "name it *.pvd or *.gif" in capsys.readouterr().err
     assert main(["run", str(_mesh_file(tmp_path)), "--tau", "0.1", "--steps", "1",
                  "--out", str(tmp_path / "x.vtk")]) == 2
     assert "name it *.npz or *.pvd" in capsys.readouterr().err
