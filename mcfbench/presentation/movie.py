@@ -145,12 +145,32 @@ def write_movie(arrays, out, *, title="", view=(20.0, -60.0), fps=4, size=4.0, d
                     ha="center", va="top", fontsize=6, color=DEFECT_COLOR, wrap=True)
         return ax.collections
 
-    animation = FuncAnimation(fig, draw, frames=len(t), blit=False, repeat=False)
+    _save_gif(fig, FuncAnimation(fig, draw, frames=len(t), blit=False, repeat=False), out,
+              fps, dpi)
+    return out
+
+
+def _save_gif(fig, animation, out, fps, dpi):
+    """Encode ``animation`` with PillowWriter into ``out`` atomically; close ``fig``."""
+    import matplotlib.pyplot as plt
+
     try:
         with tempfile.TemporaryDirectory() as folder:
             gif = Path(folder) / "movie.gif"      # Pillow takes the format from the suffix
             animation.save(gif, writer=PillowWriter(fps=fps), dpi=dpi)
-            write_files({out: gif.read_bytes()})
+            write_files({Path(out): gif.read_bytes()})
     finally:
         plt.close(fig)
-    return out
+
+
+def write_notice(out, title, status, message, size=4.0, dpi=100):
+    """A one-frame GIF saying why a run has nothing to animate (e.g. its mesh was refused)."""
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(size, size))
+    fig.text(0.5, 0.93, title, ha="center", va="top", fontsize=9)
+    fig.text(0.5, 0.55, status, ha="center", va="center", fontsize=12, weight="bold",
+             color=OK_COLOR if status == "ok" else DEFECT_COLOR)
+    fig.text(0.5, 0.45, textwrap.fill(message, 60), ha="center", va="top", fontsize=7)
+    _save_gif(fig, FuncAnimation(fig, lambda k: [], frames=1, repeat=False), out, 1, dpi)
+    return Path(out)

@@ -315,9 +315,11 @@ def _nan_result(scheme, problem, level, mesh, tau, steps, status, message, metho
         min_angle=nan, max_aspect=nan, max_flipped=nan, metrics={}, series={})
 
 
-def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None):
-    """:func:`run` with ``save_every=0``, for the studies that keep frames files; a scheme that refuses
-    the surface gives status ``unsupported`` (the initial surface as both frames).
+def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_every=0):
+    """:func:`run` for the studies that keep frames files (by default the first and the
+    last, ``save_every=0``; see :func:`mcfbench.running.driver.simulate`); a scheme
+    that refuses the surface gives status ``unsupported`` (the initial surface as both
+    frames).
 
     Returns
     -------
@@ -330,8 +332,8 @@ def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None):
     problem = get_problem(problem) if isinstance(problem, str) else problem
     start = time.process_time()
     try:
-        result, traj = run(_Guarded(scheme), problem, level, solver=solver, save_every=0,
-                           mesh=mesh, tau=tau)
+        result, traj = run(_Guarded(scheme), problem, level, solver=solver,
+                           save_every=save_every, mesh=mesh, tau=tau)
     except _Unsupported as err:
         V, F = validate_mesh(*(problem.mesh(level) if mesh is None else mesh))
         tau = problem.tau(level, (V, F)) if tau is None else float(tau)

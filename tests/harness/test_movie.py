@@ -84,3 +84,32 @@ def test_run_writes_a_movie_and_export_converts_a_run(tmp_path, capsys):
     with pytest.raises(ValueError, match="no frames"):
         write_movie({**_shrinking_run(), "t": np.zeros(0)}, tmp_path / "d.gif")
     assert not list(tmp_path.glob("[cd].*"))
+
+
+def test_gallery_run_keeps_frames_for_its_movie(tmp_path):
+    """A gallery run keeps every ``steps // 20``-th step (here all 8) and its movie has
+    one frame each; a mesh the reader refuses gives a one-frame notice."""
+    import igl
+
+    from mcfbench.studies import gallery
+
+    V, F = icosphere(1)
+    mesh = tmp_path / "s.obj"
+    igl.write_triangle_mesh(str(mesh), V, F)
+    settings = {"study": "gallery", "C": 0.1, "steps": 8, "solver": "direct", "rtol": 1e-9,
+                "maxiter": 1000, "mesh": "s.obj", "scheme": "cotan"}
+    record, frames = tmp_path / "runs/s.obj/cotan.json", tmp_path / "frames/s.obj/cotan.npz"
+    assert gallery.job(mesh, "cotan", settings, record, frames).status == "ok"
+    assert np.load(frames)["steps"].tolist() == list(range(9))
+    gallery.run_movie(record, frames, tmp_path / "cotan.gif")
+    assert Image.open(tmp_path / "cotan.gif").n_frames == 9
+
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n")
+    record, frames = tmp_path / "runs/bad.obj/cotan.json", tmp_path / "frames/bad.obj/cotan.npz"
+    assert gallery.job(bad, "cotan", {**settings, "mesh": "bad.obj"}, record,
+                       frames).status == "unsupported"
+    gallery.run_movie(record, frames, tmp_path / "bad.gif")
+    _, shown = _frames(tmp_path / "bad.gif")
+    assert len(shown) == 1                                  # the status, in red
+    assert ((shown[0][..., 0] > 150) & (shown[0][..., 1] < 90)).sum() > 50

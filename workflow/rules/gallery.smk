@@ -12,7 +12,8 @@
 # (included before).
 #
 # Outputs under results/gallery/: runs/{mesh}/{scheme}.json,
-# frames/{mesh}/{scheme}.npz, table.md, table.csv, pictures.png, pictures.pdf.
+# frames/{mesh}/{scheme}.npz (about 20 frames), movies/{mesh}/{scheme}.gif,
+# table.md, table.csv, pictures.png, pictures.pdf.
 
 from mcfbench.studies import gallery as _gallery
 
@@ -37,11 +38,17 @@ GALLERY_FRAMES = [
     for mesh in GALLERY["meshes"]
     for scheme in GALLERY["schemes"]
 ]
+GALLERY_MOVIES = [
+    f"results/gallery/movies/{mesh}/{scheme}.gif"
+    for mesh in GALLERY["meshes"]
+    for scheme in GALLERY["schemes"]
+]
 GALLERY_TARGETS = [
     "results/gallery/table.md",
     "results/gallery/table.csv",
     "results/gallery/pictures.png",
     "results/gallery/pictures.pdf",
+    *GALLERY_MOVIES,
 ]
 
 
@@ -140,3 +147,25 @@ rule gallery_pictures:
         "../envs/ddfv.yaml"
     script:
         "../scripts/gallery_pictures.py"
+
+
+rule gallery_movie:
+    """One run's frames as an animated GIF (one camera, time and status per frame)."""
+    input:
+        record="results/gallery/runs/{mesh}/{scheme}.json",
+        frames="results/gallery/frames/{mesh}/{scheme}.npz",
+    output:
+        gif="results/gallery/movies/{mesh}/{scheme}.gif",
+    log:
+        "results/logs/gallery/movies/{mesh}/{scheme}.log",
+    wildcard_constraints:
+        mesh=_alternatives(GALLERY["meshes"]),
+        scheme=_alternatives(GALLERY["schemes"]),
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=10,
+    conda:
+        "../envs/ddfv.yaml"
+    script:
+        "../scripts/gallery_movie.py"
