@@ -61,6 +61,8 @@ if GALLERY["generated"]:
         params:
             entry=lambda wildcards: GALLERY["generated"][wildcards.mesh],
             code=MATRIX_CODE,
+        benchmark:
+            "results/benchmarks/gallery/meshes/{mesh}.tsv",
         log:
             "results/logs/gallery/meshes/{mesh}.log",
         wildcard_constraints:
@@ -87,6 +89,8 @@ rule gallery_run:
         settings=lambda wildcards: GALLERY_RUNS[
             f"results/gallery/runs/{wildcards.mesh}/{wildcards.scheme}.json"
         ],
+    benchmark:
+        "results/benchmarks/gallery/{mesh}/{scheme}.tsv",
     log:
         "results/logs/gallery/{mesh}/{scheme}.log",
     wildcard_constraints:
@@ -112,6 +116,8 @@ rule gallery_table:
     params:
         expected=GALLERY_RUNS,
         plan=GALLERY,
+    benchmark:
+        "results/benchmarks/gallery/table.tsv",
     log:
         "results/logs/gallery/table.log",
     localrule: True
@@ -136,6 +142,8 @@ rule gallery_pictures:
     params:
         expected=GALLERY_RUNS,
         plan=GALLERY,
+    benchmark:
+        "results/benchmarks/gallery/pictures.tsv",
     log:
         "results/logs/gallery/pictures.log",
     localrule: True
@@ -156,6 +164,8 @@ rule gallery_movie:
         frames="results/gallery/frames/{mesh}/{scheme}.npz",
     output:
         gif="results/gallery/movies/{mesh}/{scheme}.gif",
+    benchmark:
+        "results/benchmarks/gallery/movies/{mesh}/{scheme}.tsv",
     log:
         "results/logs/gallery/movies/{mesh}/{scheme}.log",
     wildcard_constraints:
