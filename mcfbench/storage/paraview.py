@@ -12,8 +12,9 @@ Layout of ``OUT.pvd``: the frame files go to the folder ``OUT/`` next to it,
 ``OUT/{part}_{k:04d}.vtu`` for frame ``k`` of each part (e.g. ``surface``
 and ``t_vertices``), referenced relative to the ``.pvd``. Everything is
 written at once, all or nothing (:func:`mcfbench.storage.atomic.atomic_path`
-per file, renamed only when all are written); frame files of an earlier
-export that the new one does not list are removed afterwards.
+per file, renamed only when all are written); frame files that an earlier
+collection at the same path listed and the new one does not are removed
+afterwards (no other file is touched).
 """
 
 import contextlib
@@ -144,6 +145,7 @@ def write_pvd(path, frames, times, provenance=None):
                           part=str(index), name=part, file=frame_file(path, part, k))
     ET.indent(root)
     xml = '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+    before = _listed_files(path)
     written = []
     with contextlib.ExitStack() as stack:
         for name, mesh in meshes.items():
@@ -153,10 +155,19 @@ def write_pvd(path, frames, times, provenance=None):
         tmp = stack.enter_context(atomic_path(path))
         tmp.write_text(xml)
         written.append(path)
-    folder = path.parent / path.stem
-    for stale in set(folder.glob("*.vtu")) - set(written):
+    for stale in before - set(written):
         stale.unlink(missing_ok=True)
     return written
+
+
+def _listed_files(path):
+    """The files an existing collection ``path`` lists (empty when there is none or it
+    cannot be read): the frames an export over it may leave behind."""
+    try:
+        root = ET.parse(path).getroot()
+    except (OSError, ET.ParseError):
+        return set()
+    return {path.parent / d.get("file") for d in root.iter("DataSet") if d.get("file")}
 
 
 @dataclass

@@ -142,9 +142,11 @@ def test_rewrite_removes_stale_frames_and_checks_shapes(tmp_path):
     piece = Piece(V, np.array([[0, 1, 2]]), {"a": np.arange(3.0)})
     pvd = tmp_path / "c.pvd"
     write_pvd(pvd, [{"surface": piece}] * 3, [0.0, 1.0, 2.0], {"note": "a -- b"})
+    (tmp_path / "c" / "mine.vtu").write_text("a file of the user's")
     write_pvd(pvd, [{"surface": piece}] * 2, [0.0, 1.0], {"note": "a -- b"})
     collection = read_pvd(pvd)
-    assert len(list((tmp_path / "c").glob("*.vtu"))) == 2
+    assert sorted(p.name for p in (tmp_path / "c").iterdir()) == \
+        ["mine.vtu", "surface_0000.vtu", "surface_0001.vtu"]
     assert collection.provenance == {"note": "a -- b"}      # "--" survives the XML comment
     with pytest.raises(ValueError, match="frame 0, part 'surface': point field 'a' has shape"):
         write_pvd(pvd, [{"surface": Piece(V, piece.cells, {"a": np.zeros(2)})}], [0.0])
