@@ -5,7 +5,11 @@
 ``study PROBLEM``
     Any scheme on any problem over its refinement series, with EOC.
 ``run MESH``
-    Any scheme on a user's mesh, frames into an ``.npz``.
+    Any scheme on a user's mesh, frames into an ``.npz`` or a ParaView
+    collection (``.pvd``).
+``export RUN.npz OUT.pvd`` (or ``OUT.gif``)
+    The frames of a run (``run``'s ``.npz``, a matrix or gallery frames
+    file) as a ParaView collection or an animation.
 ``report``
     The reproduction report from the result files.
 ``schemes``, ``problems``
@@ -107,8 +111,18 @@ def build_parser():
     flow.add_argument("--steps", type=_level, required=True, help="number of time steps")
     flow.add_argument("--save-every", type=_count, default=1,
                       help="keep every K-th step as a frame (0: first and last only)")
-    flow.add_argument("--out", type=Path, required=True, help="output file (.npz)")
+    flow.add_argument("--out", type=Path, required=True,
+                      help="output file: .npz (the frames and the run's data) or .pvd (a "
+                           "ParaView collection, one .vtu per frame in the folder OUT/)")
+    flow.add_argument("--movie", type=Path, help="also an animation of the saved frames "
+                      "(.gif; one camera and scale, time and status on each frame)")
     _common(flow, ROBUST)
+
+    export = commands.add_parser("export", help="a run's frames (.npz of run, matrix or "
+                                 "gallery) as a ParaView collection (.pvd) or a GIF")
+    export.add_argument("source", type=Path, help="the run's .npz")
+    export.add_argument("out", type=Path, help="the collection (.pvd; its .vtu files go to "
+                        "the folder OUT/ next to it) or an animation (.gif)")
 
     report = commands.add_parser("report", help="the reproduction report from the result "
                                  "files (what the pipeline's rule reproduction_report does)")
@@ -133,6 +147,11 @@ def main(argv=None):
     except (ValueError, FileNotFoundError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
+
+
+def _terminal():
+    """Progress bars only when standard error is a terminal (none in logs, pipes, jobs)."""
+    return sys.stderr.isatty()
 
 
 def _scheme(args):
@@ -167,7 +186,8 @@ def _sphere_table(args):
     scheme = _scheme(args)
     if args.csv:
         check_writable(args.csv)
-    table = sphere_table(args.levels, scheme.name, **_options(args, scheme))
+    table = sphere_table(args.levels, scheme.name, progress=_terminal(),
+                         **_options(args, scheme))
     print(format_table(table))
     if args.csv:
         _write_csv(args.csv, table, {**_settings(args, scheme), "levels": args.levels})
@@ -181,7 +201,8 @@ def _study(args):
     scheme, problem = _scheme(args), get_problem(args.problem)
     if args.csv:
         check_writable(args.csv)
-    table = level_sweep(scheme.name, problem, args.levels, **_options(args, scheme))
+    table = level_sweep(scheme.name, problem, args.levels, progress=_terminal(),
+                        **_options(args, scheme))
     columns = ["level", "nV", "h", "tau", "N", "steps_done", "status",
                *[c for c in table.columns if c.startswith("eoc_")],
                *[c for c in table.columns if c not in _NOT_METRICS and
@@ -240,6 +261,10 @@ def _int(x):
     return "" if x is None or np.isnan(x) else f"{int(x)}"
 
 
+OUTPUTS = (".npz", ".pvd")
+"""What ``run --out`` writes, by suffix."""
+
+
 def _run(args):
     from mcfbench.geometry.mesh import summarize
     from mcfbench.geometry.mesh_files import read_mesh
@@ -248,8 +273,13 @@ def _run(args):
     scheme = _scheme(args)
     options = _options(args, scheme)
     check_writable(args.out)
-    if args.out.suffix != ".npz":
-        raise ValueError(f"--out {args.out}: the output is an .npz archive; name it *.npz")
+    if args.out.suffix not in OUTPUTS:
+        raise ValueError(f"--out {args.out}: the output is an .npz archive or a ParaView "
+                         f"collection; name it *.npz or *.pvd")
+    if args.movie is not None:
+        check_writable(args.movie)
+        if args.movie.suffix.lower() != ".gif":
+            raise ValueError(f"--movie {args.movie}: the animation is a GIF; name it *.gif")
     V, F, intake = read_mesh(args.mesh)
     for note in intake.notes():
         print(f"note: {note}")
@@ -260,24 +290,56 @@ def _run(args):
           f"{' (the robust default)' if args.solver == ROBUST else f' (rtol {args.rtol:g})'}, "
           f"tau {tau if tau else problem.tau(0, (V, F)):.4g}, {args.steps} steps")
     result, traj = run(scheme, problem, 0, tau=tau, mesh=(V, F), save_every=args.save_every,
-                       **options)
+                       progress=_terminal(), **options)
     config = {**_settings(args, scheme), "mesh": str(args.mesh), "tau": result.tau,
               "steps": args.steps, "save_every": args.save_every}
-    save_npz(args.out, **{k: v for k, v in traj.frames.items()}, faces=traj.faces,
-             vertex_map=intake.kept, t=traj.t, steps=traj.steps, iterations=traj.iterations,
-             t_min_barycentric=np.array(result.series["t_min_barycentric"]),
-             status=traj.status, message=traj.message, failed_step=traj.failed_step,
-             scheme=scheme.name, defects=json.dumps(traj.defects),
-             provenance=json.dumps(provenance(config)))
+    arrays = dict(traj.frames, faces=traj.faces, vertex_map=intake.kept, t=traj.t,
+                  steps=traj.steps, iterations=traj.iterations,
+                  t_min_barycentric=np.array(result.series["t_min_barycentric"]),
+                  status=traj.status, message=traj.message, failed_step=traj.failed_step,
+                  scheme=scheme.name, defects=json.dumps(traj.defects),
+                  provenance=json.dumps(provenance(config)))
+    arrays = {k: np.asarray(v) for k, v in arrays.items()}
+    if args.out.suffix == ".pvd":
+        from mcfbench.presentation.paraview_export import export_pvd, run_provenance
+
+        export_pvd(arrays, args.out, run_provenance(arrays))
+    else:
+        save_npz(args.out, **arrays)
     print(f"wrote {args.out}: {len(traj.t)} frames, {traj.steps_done} steps, "
           f"{int(traj.iterations.sum())} solver iterations, smallest angle "
           f"{result.min_angle:.3g} deg"
           + (f", min T barycentric {result.t_min_barycentric:.3f}"
              if scheme.family == "ddfv" else ""))
+    if args.movie is not None:
+        from mcfbench.presentation.movie import write_movie
+
+        write_movie(arrays, args.movie, title=f"{scheme.label} on {args.mesh.name}")
+        print(f"wrote {args.movie}: {len(traj.t)} frames")
     if traj.status != "ok":
         print(f"error: {traj.message} (frames up to step {traj.steps[-1]} kept)",
               file=sys.stderr)
         return 1
+    return 0
+
+
+def _export(args):
+    from mcfbench.presentation.paraview_export import export_file, load_frames_file
+
+    check_writable(args.out)
+    if args.out.suffix == ".gif":
+        from mcfbench.presentation.movie import write_movie
+
+        arrays = load_frames_file(args.source)
+        scheme = str(arrays["scheme"]) if "scheme" in arrays else args.source.parent.name
+        write_movie(arrays, args.out, title=f"{scheme}: {args.source.name}")
+        print(f"wrote {args.out}: {len(arrays['t'])} frames")
+        return 0
+    if args.out.suffix != ".pvd":
+        raise ValueError(f"{args.out}: the export is a ParaView collection (.pvd) or an "
+                         f"animation (.gif); name it *.pvd or *.gif")
+    files = export_file(args.source, args.out)
+    print(f"wrote {args.out}: {len(files) - 1} frame files in {args.out.parent / args.out.stem}/")
     return 0
 
 
@@ -310,5 +372,5 @@ def _problems(args):
     return 0
 
 
-COMMANDS = {"sphere-table": _sphere_table, "study": _study, "run": _run,
+COMMANDS = {"sphere-table": _sphere_table, "study": _study, "run": _run, "export": _export,
             "report": _report, "schemes": _schemes, "problems": _problems}

@@ -17,6 +17,9 @@ from mcfbench.running.solver import Solver, SolverFailure
 
 ON_DEFECT = ("stop", "record")
 
+PROGRESS_DELAY = 2.0
+"""Seconds a run goes before its progress bar appears (short runs show none)."""
+
 
 @dataclass
 class Trajectory:
@@ -115,7 +118,9 @@ def simulate(flow, steps, *, solver=None, save_every=1, observers=(), on_defect=
         ``n >= 1``: True ends the run there (e.g. a steady state), status
         ``ok``.
     progress : bool
-        A progress bar for runs longer than two seconds.
+        A progress bar of the steps (tqdm, on standard error) once the run
+        has lasted :data:`PROGRESS_DELAY` seconds, removed when it ends.
+        The command line asks for it when standard error is a terminal.
 
     Returns
     -------
@@ -162,7 +167,7 @@ def simulate(flow, steps, *, solver=None, save_every=1, observers=(), on_defect=
     if progress and broken is None:
         from tqdm import tqdm  # on first use: not paid at start-up without a bar
 
-        bar = tqdm(total=int(steps), delay=2.0, unit="step")
+        bar = tqdm(total=int(steps), delay=PROGRESS_DELAY, unit="step", leave=False)
     else:
         bar = _NoBar()
     with bar:

@@ -81,7 +81,7 @@ class _Steady:
 
 
 def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defect="stop",
-        save_every=0, samples=20, mesh=None, threads=1, **options):
+        save_every=0, samples=20, mesh=None, threads=1, progress=False, **options):
     """Run ``scheme`` on ``problem`` at refinement ``level``.
 
     Parameters
@@ -105,6 +105,8 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defec
         Threads of the solver and of the scheme's compiled passes
         (:meth:`mcfbench.running.schemes.Scheme.make`); ``solver.threads`` is
         replaced by it when more than one.
+    progress : bool
+        A progress bar of the steps (:func:`mcfbench.running.driver.simulate`).
     **options
         Options of the scheme's flow class (override the registry's).
 
@@ -127,7 +129,8 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defec
     cpu, wall = time.process_time(), time.perf_counter()
     flow = scheme.make(V, F, tau, threads=threads, **options)
     traj = simulate(flow, steps, solver=solver, save_every=save_every,
-                    observers=[monitor, *observers], on_defect=on_defect, until=until)
+                    observers=[monitor, *observers], on_defect=on_defect, until=until,
+                    progress=progress)
     monitor.final(flow)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
     values = {}
@@ -166,8 +169,19 @@ def _worst(reduce, values):
     return float(reduce(values)) if len(values) else float("nan")
 
 
-def level_sweep(scheme, problem, levels=None, **options):
+def level_sweep(scheme, problem, levels=None, *, progress=False, **options):
     """:func:`run` on each level and the EOC (3.1) of every metric.
+
+    Parameters
+    ----------
+    scheme, problem : str or registry entry
+    levels : sequence of int, optional
+        Default: the problem's.
+    progress : bool
+        A progress bar of the levels (tqdm, on standard error), and of each
+        run's steps below it (:func:`run`).
+    **options
+        Passed to :func:`run`.
 
     Returns
     -------
@@ -179,11 +193,27 @@ def level_sweep(scheme, problem, levels=None, **options):
     levels = [int(level) for level in (problem.levels if levels is None else levels)]
     import pandas as pd  # on first use: importing pandas takes 0.1-0.2 s
 
-    results = [run(scheme, problem, level, **options)[0] for level in levels]
+    bar = _level_bar(levels, problem) if progress else None
+    results = []
+    for level in levels:
+        if bar is not None:
+            bar.set_postfix_str(f"level {level}")
+        results.append(run(scheme, problem, level, progress=progress, **options)[0])
+        if bar is not None:
+            bar.update()
+    if bar is not None:
+        bar.close()
     table = pd.DataFrame([r.to_dict(series=False) for r in results])
     for name in results[0].metrics:
         table[f"eoc_{name}"] = eoc(table[name], levels=levels)
     return table
+
+
+def _level_bar(levels, problem):
+    """The progress bar of a level sweep (tqdm imported on first use)."""
+    from tqdm import tqdm
+
+    return tqdm(total=len(levels), desc=problem.name, unit="level")
 
 
 def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_final=None,
@@ -295,9 +325,11 @@ def _nan_result(scheme, problem, level, mesh, tau, steps, status, message, metho
         min_angle=nan, max_aspect=nan, max_flipped=nan, metrics={}, series={})
 
 
-def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None):
-    """:func:`run` with ``save_every=0``, for the studies that keep frames files; a scheme that refuses
-    the surface gives status ``unsupported`` (the initial surface as both frames).
+def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_every=0):
+    """:func:`run` for the studies that keep frames files (by default the first and the
+    last, ``save_every=0``; see :func:`mcfbench.running.driver.simulate`); a scheme
+    that refuses the surface gives status ``unsupported`` (the initial surface as both
+    frames).
 
     Returns
     -------
@@ -310,8 +342,8 @@ def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None):
     problem = get_problem(problem) if isinstance(problem, str) else problem
     start = time.process_time()
     try:
-        result, traj = run(_Guarded(scheme), problem, level, solver=solver, save_every=0,
-                           mesh=mesh, tau=tau)
+        result, traj = run(_Guarded(scheme), problem, level, solver=solver,
+                           save_every=save_every, mesh=mesh, tau=tau)
     except _Unsupported as err:
         V, F = validate_mesh(*(problem.mesh(level) if mesh is None else mesh))
         tau = problem.tau(level, (V, F)) if tau is None else float(tau)

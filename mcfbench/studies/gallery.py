@@ -17,6 +17,10 @@ GALLERY_SURFACES = REAL_WORLD_SURFACES
 
 MESH_SUFFIXES = (".obj", ".off", ".ply", ".stl")
 
+MOVIE_FRAMES = 20
+"""About how many frames a gallery run keeps (every ``steps // MOVIE_FRAMES``-th step,
+and the first and last) for its animation (:func:`run_movie`)."""
+
 
 def plan(section=None, meshes=None, schemes=None):
     """The config key ``gallery`` (and ``meshes``) checked and normalised.
@@ -150,8 +154,8 @@ def _gallery_problem(C, steps):
 
 def job(mesh_path, scheme, settings, record, frames, log_path=None):
     """One scheme on one mesh file: ``tau = C h^2``, ``steps`` steps; record and
-    first and last frames. A file the reader refuses gives status
-    ``unsupported`` with the reader's message."""
+    frames (about :data:`MOVIE_FRAMES`, the first and last among them). A file the
+    reader refuses gives status ``unsupported`` with the reader's message."""
     from mcfbench.geometry import metrics
     from mcfbench.geometry.mesh_files import read_mesh
     from mcfbench.running.schemes import get_scheme
@@ -176,7 +180,8 @@ def job(mesh_path, scheme, settings, record, frames, log_path=None):
         tau = settings["C"] * metrics.mean_edge_length(V, F) ** 2
         log.info("%s on %s: %d vertices, %d triangles, tau %.3g, %d steps, solver %s",
                  scheme.name, mesh_path, len(V), len(F), tau, settings["steps"], solver.method)
-        result, arrays = framed_run(scheme, problem, 1, solver=solver, mesh=(V, F), tau=tau)
+        result, arrays = framed_run(scheme, problem, 1, solver=solver, mesh=(V, F), tau=tau,
+                                    save_every=max(1, settings["steps"] // MOVIE_FRAMES))
         save_npz(frames, **arrays)
     if result is None:
         from mcfbench.storage.records import RunResult
@@ -192,3 +197,30 @@ def job(mesh_path, scheme, settings, record, frames, log_path=None):
     write_record(record, result, settings, metric_names=[], **extra)
     log.info("%s: %s, %d/%d steps", scheme.name, result.status, result.steps_done, result.N)
     return result
+
+
+def run_movie(record, frames, out, log_path=None):
+    """The animation of one gallery run (:func:`mcfbench.presentation.movie.write_movie`),
+    titled with the scheme and the mesh, the status from its record (from the step of
+    the breakdown on); a run without frames (its mesh refused) gives a one-frame GIF
+    with the record's message."""
+    from mcfbench.presentation.movie import write_movie, write_notice
+    from mcfbench.running.schemes import SCHEMES
+    from mcfbench.storage.records import read_record
+    from mcfbench.studies.matrix import load_frames
+
+    log = setup_logging(log_path)
+    data = read_record(record)
+    scheme = SCHEMES[data["scheme"]].label if data["scheme"] in SCHEMES else data["scheme"]
+    title = f"{scheme} on {data.get('mesh', Path(frames).parent.name)}"
+    arrays = load_frames(frames)
+    if not len(arrays["t"]):
+        write_notice(out, title, data["status"], data["message"])
+        log.info("%s: no frames (%s) -> %s", title, data["status"], out)
+        return
+    failed = data.get("t_failed")
+    failed_step = -1 if data["status"] == "ok" or failed is None else \
+        round(failed / data["tau"])
+    write_movie({**arrays, "status": data["status"], "message": data["message"],
+                 "failed_step": failed_step}, out, title=title)
+    log.info("%s: %d frames, %s -> %s", title, len(arrays["t"]), data["status"], out)

@@ -56,6 +56,8 @@ rule beyond_run:
         "results/beyond/runs/{study}/{scheme}/level{level}.json",
     params:
         settings=beyond_run_settings,
+    benchmark:
+        "results/benchmarks/beyond/{study}/{scheme}/level{level}.tsv",
     log:
         "results/logs/beyond/{study}/{scheme}/level{level}.log",
     threads: THREADS
@@ -77,6 +79,8 @@ rule beyond_time:
         "results/beyond/runs/time/{scheme}.json",
     params:
         settings=time_settings,
+    benchmark:
+        "results/benchmarks/beyond/time/{scheme}.tsv",
     log:
         "results/logs/beyond/time/{scheme}.log",
     threads: THREADS
@@ -98,6 +102,8 @@ rule beyond_records:
         "results/beyond/tables/records.json",
     params:
         expected={path: s for runs in BEYOND_RUNS.values() for path, s in runs.items()},
+    benchmark:
+        "results/benchmarks/beyond/records.tsv",
     log:
         "results/logs/beyond/records.log",
     localrule: True
@@ -140,6 +146,8 @@ rule beyond_tables:
         beyond=BEYOND,
         paper_schemes=BEYOND_PAPER_SCHEMES,
         settings={k: config[k] for k in ("tau_level_1", "t_final", "rtol")},
+    benchmark:
+        "results/benchmarks/beyond/tables.tsv",
     log:
         "results/logs/beyond/tables.log",
     localrule: True
@@ -178,6 +186,8 @@ rule beyond_figures:
     params:
         beyond=BEYOND,
         t_final=config["t_final"],
+    benchmark:
+        "results/benchmarks/beyond/figures.tsv",
     log:
         "results/logs/beyond/figures.log",
     localrule: True
@@ -210,6 +220,8 @@ rule beyond_findings:
         paper_schemes=BEYOND_PAPER_SCHEMES,
         t_final=config["t_final"],
         tau_level_1=config["tau_level_1"],
+    benchmark:
+        "results/benchmarks/beyond/findings.tsv",
     log:
         "results/logs/beyond/findings.log",
     localrule: True

@@ -20,6 +20,8 @@ rule run_scheme:
     params:
         # includes the source hash of ddfv, baselines, mcfbench: changed code reruns it
         settings=run_settings,
+    benchmark:
+        "results/benchmarks/runs/{scheme}/level{level}.tsv",
     log:
         "results/logs/runs/{scheme}/level{level}.log",
     threads: THREADS
@@ -42,6 +44,8 @@ rule convergence_records:
         "results/tables/convergence.records.json",
     params:
         expected=PIPELINE.expected_runs(),
+    benchmark:
+        "results/benchmarks/convergence_records.tsv",
     log:
         "results/logs/convergence_records.log",
     localrule: True
@@ -75,6 +79,8 @@ rule convergence_table:
         schemes=SCHEMES,
         levels=LEVELS,
         settings=PIPELINE.convergence_settings(),
+    benchmark:
+        "results/benchmarks/convergence_table.tsv",
     log:
         "results/logs/convergence_table.log",
     localrule: True
@@ -102,6 +108,8 @@ rule convergence_figure:
         pdf="results/figures/convergence.pdf",
     params:
         t_final=config["t_final"],
+    benchmark:
+        "results/benchmarks/convergence_figure.tsv",
     log:
         "results/logs/convergence_figure.log",
     localrule: True

@@ -60,6 +60,8 @@ rule figure:
         settings=lambda wildcards: EXPERIMENTS[wildcards.figure].describe(),
         # rerun when the experiment's definition changes
         config=lambda wildcards: EXPERIMENTS[wildcards.figure].config(),
+    benchmark:
+        "results/benchmarks/figures/{figure}.tsv",
     log:
         "results/logs/figures/{figure}.log",
     threads: 1

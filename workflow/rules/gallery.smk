@@ -14,7 +14,8 @@
 # (included before).
 #
 # Outputs under results/gallery/: runs/{mesh}/{scheme}.json,
-# frames/{mesh}/{scheme}.npz, table.md, table.csv, pictures.png, pictures.pdf.
+# frames/{mesh}/{scheme}.npz (about 20 frames), movies/{mesh}/{scheme}.gif,
+# table.md, table.csv, pictures.png, pictures.pdf.
 
 from mcfbench.studies import gallery as _gallery
 
@@ -39,11 +40,17 @@ GALLERY_FRAMES = [
     for mesh in GALLERY["meshes"]
     for scheme in GALLERY["schemes"]
 ]
+GALLERY_MOVIES = [
+    f"results/gallery/movies/{mesh}/{scheme}.gif"
+    for mesh in GALLERY["meshes"]
+    for scheme in GALLERY["schemes"]
+]
 GALLERY_TARGETS = [
     "results/gallery/table.md",
     "results/gallery/table.csv",
     "results/gallery/pictures.png",
     "results/gallery/pictures.pdf",
+    *GALLERY_MOVIES,
 ]
 
 
@@ -57,6 +64,8 @@ if GALLERY["generated"]:
         params:
             entry=lambda wildcards: GALLERY["generated"][wildcards.mesh],
             code=MATRIX_CODE,
+        benchmark:
+            "results/benchmarks/gallery/meshes/{mesh}.tsv",
         log:
             "results/logs/gallery/meshes/{mesh}.log",
         wildcard_constraints:
@@ -83,6 +92,8 @@ rule gallery_run:
         settings=lambda wildcards: GALLERY_RUNS[
             f"results/gallery/runs/{wildcards.mesh}/{wildcards.scheme}.json"
         ],
+    benchmark:
+        "results/benchmarks/gallery/{mesh}/{scheme}.tsv",
     log:
         "results/logs/gallery/{mesh}/{scheme}.log",
     wildcard_constraints:
@@ -108,6 +119,8 @@ rule gallery_table:
     params:
         expected=GALLERY_RUNS,
         plan=GALLERY,
+    benchmark:
+        "results/benchmarks/gallery/table.tsv",
     log:
         "results/logs/gallery/table.log",
     localrule: True
@@ -132,6 +145,8 @@ rule gallery_pictures:
     params:
         expected=GALLERY_RUNS,
         plan=GALLERY,
+    benchmark:
+        "results/benchmarks/gallery/pictures.tsv",
     log:
         "results/logs/gallery/pictures.log",
     localrule: True
@@ -143,3 +158,27 @@ rule gallery_pictures:
         "../envs/ddfv.yaml"
     script:
         "../scripts/gallery_pictures.py"
+
+
+rule gallery_movie:
+    """One run's frames as an animated GIF (one camera, time and status per frame)."""
+    input:
+        record="results/gallery/runs/{mesh}/{scheme}.json",
+        frames="results/gallery/frames/{mesh}/{scheme}.npz",
+    output:
+        gif="results/gallery/movies/{mesh}/{scheme}.gif",
+    benchmark:
+        "results/benchmarks/gallery/movies/{mesh}/{scheme}.tsv",
+    log:
+        "results/logs/gallery/movies/{mesh}/{scheme}.log",
+    wildcard_constraints:
+        mesh=_alternatives(GALLERY["meshes"]),
+        scheme=_alternatives(GALLERY["schemes"]),
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=10,
+    conda:
+        "../envs/ddfv.yaml"
+    script:
+        "../scripts/gallery_movie.py"

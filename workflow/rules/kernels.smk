@@ -10,6 +10,8 @@ rule compile_kernels:
         # a code change compiles again (the cache is keyed by source file)
         code=PIPELINE.code,
         threads=THREADS,
+    benchmark:
+        "results/benchmarks/kernels.tsv",
     log:
         "results/logs/kernels.log",
     threads: THREADS

@@ -57,6 +57,8 @@ rule matrix_run:
         settings=lambda wildcards: MATRIX_RUNS[
             _matrix.record_path(wildcards.problem, wildcards.scheme, wildcards.level)
         ],
+    benchmark:
+        "results/benchmarks/matrix/{problem}/{scheme}/level{level}.tsv",
     log:
         "results/logs/matrix/{problem}/{scheme}/level{level}.log",
     wildcard_constraints:
@@ -84,6 +86,8 @@ rule matrix_tables:
     params:
         expected=MATRIX_RUNS,
         plan=MATRIX,
+    benchmark:
+        "results/benchmarks/matrix/tables.tsv",
     log:
         "results/logs/matrix/tables.log",
     localrule: True
@@ -109,6 +113,8 @@ rule matrix_plots:
         expected=MATRIX_RUNS,
         plan=MATRIX,
         pictures=_matrix.picture_runs(MATRIX),
+    benchmark:
+        "results/benchmarks/matrix/plots.tsv",
     log:
         "results/logs/matrix/plots.log",
     localrule: True
@@ -131,6 +137,8 @@ rule matrix_findings:
         "results/matrix/findings.md",
     params:
         plan=MATRIX,
+    benchmark:
+        "results/benchmarks/matrix/findings.tsv",
     log:
         "results/logs/matrix/findings.log",
     localrule: True

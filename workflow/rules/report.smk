@@ -115,6 +115,8 @@ rule reproduction_report:
         # results/, paper/ and results/beyond/ are found from the inputs
         beyond_targets=BEYOND_RESULTS,
         figures=FIGURES,
+    benchmark:
+        "results/benchmarks/report.tsv",
     log:
         "results/logs/report.log",
     localrule: True
@@ -137,6 +139,8 @@ rule report_pdf:
         figures=expand("results/figures/{figure}.pdf", figure=[*FIGURES, "convergence"]),
     output:
         pdf=f"{REPORT_DIR}/reproduction.pdf",
+    benchmark:
+        "results/benchmarks/report_pdf.tsv",
     log:
         "results/logs/report_pdf.log",
     localrule: True

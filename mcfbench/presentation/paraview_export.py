@@ -1,0 +1,142 @@
+"""A run's frames as a ParaView collection (``mcfbench run --out NAME.pvd``, ``mcfbench export``).
+
+Reads the frames a run kept (the ``run`` command's ``.npz``, or a frames
+file of the matrix or the gallery, :func:`mcfbench.running.run.framed_run`:
+``V`` or ``F`` and ``T``, ``faces``, ``t``) and writes one ``.vtu`` per frame
+and part through :func:`mcfbench.storage.paraview.write_pvd`:
+
+``surface``
+    The triangle mesh (DDFV: the F-vertices) with the point fields
+    ``displacement`` (since the previous frame) and ``vertex_area`` (vertex
+    schemes) or ``covolume`` (DDFV), and for DDFV the cell field
+    ``t_monitor`` per triangle (:mod:`mcfbench.geometry.frame_fields`).
+``t_vertices`` (DDFV only)
+    The T-vertices as a point cloud (one vertex cell each) with
+    ``displacement``, ``covolume`` and ``t_monitor``.
+
+The collection carries the provenance: that of the run (the ``.npz``'s own,
+or the record next to a matrix or gallery frames file,
+``.../frames/X/Y.npz`` -> ``.../runs/X/Y.json``), its scheme, status and
+message when known, and that of the export.
+"""
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from mcfbench.geometry.frame_fields import ddfv_frame_fields, vertex_frame_fields
+from mcfbench.storage.paraview import Piece, write_pvd
+from mcfbench.storage.provenance import provenance
+from mcfbench.storage.records import load_json
+
+RUN_KEYS = ("scheme", "status", "message", "failed_step")
+"""Scalars of a run ``.npz`` copied into the collection's provenance."""
+
+
+def load_frames_file(path):
+    """The arrays of a run's ``.npz`` as a dict, checked for frames.
+
+    Raises
+    ------
+    ValueError
+        Not readable as ``.npz``, no ``faces``/``t``, neither ``V`` nor
+        ``F`` and ``T``, or no frame (a gallery run whose mesh was refused);
+        the message names the file.
+    """
+    path = Path(path)
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {key: data[key] for key in data.files}
+    except (OSError, ValueError) as err:
+        raise ValueError(f"{path}: not a run's .npz ({err})") from None
+    if "t" in arrays and len(arrays["t"]) == 0:
+        raise ValueError(f"{path}: the run has no frames (its mesh was refused; see its record)")
+    missing = [k for k in ("faces", "t") if k not in arrays]
+    if missing or not ("V" in arrays or {"F", "T"} <= set(arrays)):
+        raise ValueError(f"{path}: not a run's frames file: it has {sorted(arrays)}, expected "
+                         f"faces, t and V (or F and T)")
+    return arrays
+
+
+def run_pieces(arrays):
+    """The parts of every frame of a run.
+
+    Parameters
+    ----------
+    arrays : dict
+        ``faces`` (m, 3), ``V`` (frames, n, 3) or ``F`` (frames, n_f, 3) and
+        ``T`` (frames, m, 3).
+
+    Returns
+    -------
+    list of dict of str -> mcfbench.storage.paraview.Piece
+        Per frame: ``surface`` (and ``t_vertices`` for DDFV).
+    """
+    faces = np.asarray(arrays["faces"], dtype=np.int64)
+    if "V" in arrays:
+        V = np.asarray(arrays["V"], dtype=np.float64)
+        return [{"surface": Piece(V[k], faces, point_data)}
+                for k, point_data in enumerate(vertex_frame_fields(V, faces))]
+    F, T = np.asarray(arrays["F"], dtype=np.float64), np.asarray(arrays["T"], dtype=np.float64)
+    single = np.arange(len(faces))[:, None]
+    return [{"surface": Piece(F[k], faces, fields["F"], fields["triangles"]),
+             "t_vertices": Piece(T[k], single, fields["T"])}
+            for k, fields in enumerate(ddfv_frame_fields(F, T, faces))]
+
+
+def run_provenance(arrays, source=None):
+    """What the collection says of the run: its scheme, status and message,
+    and its provenance (the ``.npz``'s, or that of the record next to a
+    matrix or gallery frames file ``source``)."""
+    run = {key: arrays[key].item() for key in RUN_KEYS if key in arrays}
+    if "provenance" in arrays:
+        run["provenance"] = json.loads(arrays["provenance"].item())
+    elif source is not None:
+        record = sibling_record(source)
+        if record is not None:
+            data = load_json(record)
+            run.update({key: data[key] for key in ("scheme", "status", "message", "settings",
+                                                   "provenance") if key in data})
+            run["record"] = record.as_posix()
+    return run
+
+
+def sibling_record(frames_path):
+    """The record of a matrix or gallery frames file (``.../frames/...npz`` ->
+    ``.../runs/...json``), or None when there is none."""
+    parts = Path(frames_path).with_suffix(".json").parts
+    if "frames" not in parts:
+        return None
+    index = len(parts) - 1 - parts[::-1].index("frames")
+    record = Path(*parts[:index], "runs", *parts[index + 1:])
+    return record if record.is_file() else None
+
+
+def export_pvd(arrays, out, run=None, config=None):
+    """Write the frames ``arrays`` of a run as the collection ``out`` (``.pvd``).
+
+    Parameters
+    ----------
+    arrays : dict
+        As :func:`run_pieces`, with ``t`` (frames,).
+    out : str or Path
+    run : dict, optional
+        The run's provenance and status (:func:`run_provenance`).
+    config : dict, optional
+        Settings of the export, in its provenance.
+
+    Returns
+    -------
+    list of Path
+        The files written, the ``.pvd`` last.
+    """
+    return write_pvd(out, run_pieces(arrays), arrays["t"],
+                     provenance={"run": run or {}, "export": provenance(config or {})})
+
+
+def export_file(source, out):
+    """Convert an existing run ``.npz`` (:func:`load_frames_file`) to the collection ``out``."""
+    arrays = load_frames_file(source)
+    return export_pvd(arrays, out, run_provenance(arrays, source),
+                      {"command": "export", "source": str(source)})
