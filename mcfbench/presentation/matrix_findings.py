@@ -176,7 +176,7 @@ def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summa
         lines += _common_floor(part, metric)
         lines.append("")
     lines += recommendation(summary, verdict, problems, schemes, mesh_problems)
-    solver = summary[summary.get("solver_only", "") != ""] if "solver_only" in summary \
+    solver = summary[summary["solver_only"] != ""] if "solver_only" in summary \
         else summary.iloc[:0]
     if len(solver):
         lines += ["## Solver verdicts", "",
