@@ -1,9 +1,11 @@
 """Shared meshes for the tests: the generators of :mod:`mcfbench.geometry.surfaces`."""
 
 import functools
+import os
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, settings
 
 from mcfbench.geometry import surfaces
 from mcfbench.geometry.shapes import flat_lattice
@@ -16,6 +18,15 @@ from mcfbench.geometry.spheres import random_bumpy_sphere as bumpy_sphere
 cylinder = functools.partial(surfaces.cylinder, diagonals="parallel")
 
 __all__ = ["approaches_the_catenoid", "bumpy_sphere", "cylinder", "flat_lattice"]
+
+# hypothesis (tests/harness/test_properties.py): "ci", the default, draws the same few
+# examples on every run (derandomized, no example database); HYPOTHESIS_PROFILE=nightly
+# draws fresh ones, 25 times as many.
+settings.register_profile("ci", max_examples=10, derandomize=True, database=None, deadline=None,
+                          suppress_health_check=[HealthCheck.too_slow], print_blob=True)
+settings.register_profile("nightly", max_examples=100, deadline=None,
+                          suppress_health_check=[HealthCheck.too_slow], print_blob=True)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
 
 @pytest.fixture

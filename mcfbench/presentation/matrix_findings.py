@@ -1,6 +1,12 @@
 """The findings of the benchmark matrix in words, from its summary table only: which scheme
 converges at which order on which problem, which breaks down where, and the
-recommendation."""
+recommendation.
+
+A verdict is the scheme's, not its linear solver's: a run that ended with a
+``solver_*`` status and that the robust solver (``direct``) finished when run
+again (:func:`mcfbench.studies.matrix.job`) counts as finished, with the
+robust run's value, and its text says that the failure was the solver's
+(:func:`scheme_view`)."""
 
 import numpy as np
 
@@ -102,6 +108,48 @@ def work_precision_section(rows, labels=None):
     return lines + [""]
 
 
+def _where(failed):
+    """``"level 3: solver_failed at t = 0.03; ..."`` from ``"3:solver_failed:0.03;..."``."""
+    return "; ".join(f"level {lv}: {st}" + (f" at t = {float(t):.4g}" if t else "")
+                     for lv, st, t in (f.split(":") for f in str(failed).split(";") if f))
+
+
+def scheme_view(summary):
+    """The summary with the robust solver's re-runs in place of the runs whose failure
+    they remove, and a ``solver_note`` column saying so.
+
+    A row whose every failure is such a solver failure becomes a finished row
+    (``runs_ok``, ``eoc``, ``values``, ``finest_*`` from the ``robust_*``
+    columns of :func:`mcfbench.presentation.matrix_tables.summary_table`,
+    ``status`` ``ok``); a row with other failures keeps them and only gets the
+    note. Summaries written before the re-runs existed are returned unchanged
+    (empty notes).
+    """
+    summary = summary.copy()
+    notes = []
+    for i, r in summary.iterrows():
+        fixed = str(r.get("solver_only", "") or "")
+        if not fixed:
+            notes.append("")
+            continue
+        notes.append(f"A solver verdict, not a scheme verdict: the matrix's solver failed "
+                     f"({_where(fixed)}) and the robust solver (direct) finished "
+                     f"{'that run' if ';' not in fixed else 'those runs'} when run again.")
+        if r["runs_robust_ok"] == r["runs"]:
+            for column in ("eoc", "eoc_levels", "finest_level", "finest_value", "values"):
+                summary.at[i, column] = r[f"robust_{column}"]
+            summary.at[i, "runs_ok"] = r["runs"]
+            summary.at[i, "status"] = "ok"
+    summary["solver_note"] = notes
+    for i, r in summary.iterrows():
+        failed = str(r.get("robust_failed", "") or "")
+        if failed:
+            summary.at[i, "solver_note"] = (
+                r["solver_note"] + " " if r["solver_note"] else "") + (
+                f"The robust solver (direct) failed too ({_where(failed)}): a scheme verdict.")
+    return summary
+
+
 def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summary.csv",
                     work_precision=()):
     """The findings, Markdown, written from the summary table only.
@@ -118,6 +166,7 @@ def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summa
         :func:`cheapest_to_reach` of the long table (a section when given).
     """
     labels = labels or {}
+    summary = scheme_view(summary)
     problems = list(dict.fromkeys(summary["problem"]))
     schemes = list(dict.fromkeys(summary["scheme"]))
     lines = ["# Findings of the benchmark matrix", "",
@@ -178,12 +227,23 @@ def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summa
                              + (f", EOC {r['eoc']:.2f}" if np.isfinite(r["eoc"]) else "") + ".")
             if np.isfinite(r["t_min_barycentric"]):
                 text += f" Smallest T monitor {r['t_min_barycentric']:.3g}."
+            if r["solver_note"]:
+                text += " " + r["solver_note"]
             lines.append("- " + text)
         lines += _common_floor(part, metric)
         lines.append("")
     if work_precision:
         lines += work_precision_section(work_precision, labels)
     lines += recommendation(summary, verdict, problems, schemes, mesh_problems)
+    solver = summary[summary["solver_only"] != ""] if "solver_only" in summary \
+        else summary.iloc[:0]
+    if len(solver):
+        lines += ["## Solver verdicts", "",
+                  "Runs whose failure the robust solver removes: the failure belongs to "
+                  "the linear solver on that system, not to the scheme, and the verdicts "
+                  "above count those runs as finished with the robust solver's values: "
+                  + "; ".join(f"{r['scheme']} on {r['problem']} ({_where(r['solver_only'])})"
+                              for _, r in solver.iterrows() if r["solver_only"]) + ".", ""]
     return "\n".join(lines).rstrip() + "\n"
 
 

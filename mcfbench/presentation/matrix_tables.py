@@ -51,7 +51,11 @@ ZERO_METRICS = ("max_height", "l2_height", "max_displacement")
 # modules that do not change what a run computes (left out of the code digest)
 LONG_COLUMNS = ["scheme", "problem", "level", "h", "tau", "steps", "steps_done", "metric",
                 "value", "eoc", "status", "t_failed", "min_angle", "max_flipped",
-                "t_min_barycentric", "iterations", "cpu_seconds"]
+                "t_min_barycentric", "iterations", "cpu_seconds", "robust_status",
+                "robust_value", "robust_t_failed"]
+"""Columns of the long table. ``robust_*``: the re-run of a run that ended with a
+``solver_*`` status with the robust solver (:func:`mcfbench.studies.matrix.job`;
+``robust_status`` empty without a re-run)."""
 
 
 def is_error(metric):
@@ -120,15 +124,34 @@ def long_table(records, schemes=None, problems=None):
                 "value": float("nan") if value is None else float(value), "eoc": float("nan"),
                 "status": r["status"], "t_failed": r["t_failed"], "min_angle": r["min_angle"],
                 "max_flipped": r["max_flipped"], "t_min_barycentric": r["t_min_barycentric"],
-                "iterations": int(r["iterations"]), "cpu_seconds": r["cpu_seconds"]})
+                "iterations": int(r["iterations"]), "cpu_seconds": r["cpu_seconds"],
+                **_robust(r, metric)})
     table = pd.DataFrame(rows, columns=LONG_COLUMNS)
     for column in ("h", "tau", "value", "eoc", "t_failed", "min_angle", "max_flipped",
-                   "t_min_barycentric", "cpu_seconds"):
+                   "t_min_barycentric", "cpu_seconds", "robust_value", "robust_t_failed"):
         table[column] = table[column].astype(float)
     schemes = schemes or list(dict.fromkeys(table["scheme"]))
     problems = problems or list(dict.fromkeys(table["problem"]))
     table = _ordered(table, schemes, problems)
     return add_eoc(table)
+
+
+def _robust(record, metric):
+    """The robust re-run's columns of one row of the long table."""
+    value = (record.get("robust_metrics") or {}).get(metric) if metric else None
+    t_failed = record.get("robust_t_failed")
+    return {"robust_status": record.get("robust_status") or "",
+            "robust_value": float("nan") if value is None else float(value),
+            "robust_t_failed": float("nan") if t_failed is None else float(t_failed)}
+
+
+def solver_only(row):
+    """A run (a row of the long table) that ended with a ``solver_*`` status whose
+    re-run with the robust solver finished: the failure is the solver's, not the
+    scheme's."""
+    from mcfbench.storage.statuses import SOLVER_STATUSES
+
+    return row["status"] in SOLVER_STATUSES and row.get("robust_status", "") == "ok"
 
 
 def _ordered(table, schemes, problems):
@@ -189,6 +212,12 @@ def summary_table(table, problems=None, schemes=None):
         cpu_seconds`` (CPU of the finest finished level). ``status`` is
         ``ok`` or that of the coarsest run that did not finish; ``eocs``
         and ``values`` list every EOC and value by level (``;``-separated).
+        The scheme's own verdict, with the robust solver's re-run in place of
+        a run whose failure it removes (:func:`solver_only`): ``solver_only``
+        (those runs, ``level:status:t_failed``), ``robust_failed`` (the re-runs
+        that failed too, ``level:robust_status:robust_t_failed``), ``runs_robust_ok``,
+        ``robust_values``, ``robust_eoc``, ``robust_eoc_levels``,
+        ``robust_finest_level``, ``robust_finest_value``.
     """
     import pandas as pd
 
@@ -231,8 +260,40 @@ def summary_table(table, problems=None, schemes=None):
                 "min_angle": runs["min_angle"].min(),
                 "t_min_barycentric": runs["t_min_barycentric"].min(),
                 "cpu_seconds": np.nan if finest is None else finest["cpu_seconds"],
+                **_robust_summary(runs, metric),
             })
     return pd.DataFrame(rows)
+
+
+def _robust_summary(runs, metric):
+    """The summary's ``robust_*`` columns of one scheme on one problem (its runs of the
+    main metric, by level): each run whose failure the robust solver removes replaced
+    by its re-run."""
+    fixed = runs[[solver_only(r) for _, r in runs.iterrows()]] if len(runs) else runs
+    values = np.where([solver_only(r) for _, r in runs.iterrows()], runs["robust_value"],
+                      np.where(runs["status"] == "ok", runs["value"], np.nan)) \
+        if len(runs) else np.array([])
+    levels = runs["level"].to_numpy()
+    eocs = eoc(values, levels=levels) if is_error(metric) and len(values) \
+        else np.full(len(values), np.nan)
+    finite = np.flatnonzero(np.isfinite(values))
+    with_eoc = np.flatnonzero(np.isfinite(eocs))
+    rerun = runs[[r["robust_status"] not in ("", "ok") for _, r in runs.iterrows()]] \
+        if len(runs) else runs
+    return {
+        "robust_failed": ";".join(f"{int(r.level)}:{r.robust_status}:"
+                                  f"{_fmt(r.robust_t_failed, '.6g', '')}"
+                                  for r in rerun.itertuples()),
+        "solver_only": ";".join(f"{int(r.level)}:{r.status}:{_fmt(r.t_failed, '.6g', '')}"
+                                for r in fixed.itertuples()),
+        "runs_robust_ok": int((runs["status"] == "ok").sum()) + len(fixed),
+        "robust_values": ";".join(_fmt(v, ".4e", "") for v in values),
+        "robust_eoc": eocs[with_eoc[-1]] if len(with_eoc) else np.nan,
+        "robust_eoc_levels": f"{int(levels[with_eoc[-1]]) - 1}-{int(levels[with_eoc[-1]])}"
+        if len(with_eoc) else "",
+        "robust_finest_level": int(levels[finite[-1]]) if len(finite) else np.nan,
+        "robust_finest_value": values[finite[-1]] if len(finite) else np.nan,
+    }
 
 
 def summary_cell(row):
@@ -244,6 +305,11 @@ def summary_cell(row):
         parts.append(f"{row['finest_value']:.3e} (L{int(row['finest_level'])})")
     if row["status"] != "ok":
         parts.append(breakdown_text(row["status"], row["t_failed"], row["failed_level"]))
+        if row.get("solver_only", ""):
+            parts.append("the robust solver finishes " + (
+                "every level" if row["runs_robust_ok"] == row["runs"] else
+                "level(s) " + ", ".join(f.split(":")[0]
+                                        for f in str(row["solver_only"]).split(";"))))
     return "; ".join(parts) or "–"
 
 
@@ -331,7 +397,8 @@ def latex(frame, caption="", notes=()):
     return "\n".join(lines) + "\n"
 
 
-SUMMARY_TEXT = ("levels", "eoc_levels", "eocs", "values", "failed", "metric", "status")
+SUMMARY_TEXT = ("levels", "eoc_levels", "eocs", "values", "failed", "metric", "status",
+                "solver_only", "robust_failed", "robust_values", "robust_eoc_levels")
 
 
 def read_summary(path):
@@ -340,7 +407,8 @@ def read_summary(path):
 
     summary = pd.read_csv(path, dtype={c: str for c in SUMMARY_TEXT})
     for column in SUMMARY_TEXT:
-        summary[column] = summary[column].fillna("")
+        if column in summary:
+            summary[column] = summary[column].fillna("")
     summary["error"] = summary["error"].astype(bool)
     return summary
 

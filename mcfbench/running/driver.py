@@ -2,7 +2,9 @@
 
 :func:`simulate` steps a :class:`~mcfbench.running.flow.Flow` with the shared
 linear solver, checks every state it reaches (the initial one included)
-through :meth:`Flow.defects`, calls observers at every time level and keeps
+through :class:`mcfbench.geometry.collapse.CollapseCheck` (a component shrunk to a
+point or a line, before the scheme assembles a matrix on it) and
+:meth:`Flow.defects`, calls observers at every time level and keeps
 frames. Every way a run can end is one :class:`~mcfbench.running.flow.FlowBreakdown`
 with one message format, ``"{status} at step {n} (t = {t}): {detail}"``.
 """
@@ -12,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from mcfbench.geometry.collapse import CollapseCheck
 from mcfbench.running.flow import FlowBreakdown
 from mcfbench.running.solver import Solver, SolverFailure
 
@@ -92,7 +95,7 @@ class _NoBar:
 
 
 def simulate(flow, steps, *, solver=None, save_every=1, observers=(), on_defect="stop",
-             until=None, progress=False):
+             until=None, progress=False, collapse=True):
     """Step ``flow`` ``steps`` times.
 
     Parameters
@@ -121,6 +124,13 @@ def simulate(flow, steps, *, solver=None, save_every=1, observers=(), on_defect=
         A progress bar of the steps (tqdm, on standard error) once the run
         has lasted :data:`PROGRESS_DELAY` seconds, removed when it ends.
         The command line asks for it when standard error is a terminal.
+    collapse : bool
+        Check every state, before the scheme's own :meth:`Flow.defects` and
+        before the next solve, for a component that shrank to a point or a
+        line or has non-finite coordinates
+        (:class:`mcfbench.geometry.collapse.CollapseCheck`): status
+        ``degenerated`` naming the component. It ends the run in both
+        ``on_defect`` modes (there is no surface left to step).
 
     Returns
     -------
@@ -136,13 +146,20 @@ def simulate(flow, steps, *, solver=None, save_every=1, observers=(), on_defect=
     solver = Solver() if solver is None else solver
     frames, steps_kept, iterations, defects = [], [], [], []
     seen = set()
+    collapsed = CollapseCheck(flow.vertices, flow.faces) if collapse else None
 
     def save():
         steps_kept.append(flow.n)
         frames.append(flow.frame())
 
     def check():
-        """Record the defects of the current state; raise in stop mode."""
+        """Record the defects of the current state; raise in stop mode (always for a
+        collapse)."""
+        detail = collapsed(flow.vertices) if collapsed is not None else None
+        if detail is not None:
+            defects.append({"status": "degenerated", "step": flow.n,
+                            "time": flow.n * flow.tau, "detail": detail})
+            raise FlowBreakdown("degenerated", flow.n, flow.n * flow.tau, detail)
         for status, detail in flow.defects():
             if status in seen:
                 continue

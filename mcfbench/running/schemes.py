@@ -15,6 +15,18 @@ import inspect
 from dataclasses import dataclass, field
 
 
+MATRICES = {
+    "nonsymmetric": "BiCGStab (the paper's) or a sparse LU (`direct`): the matrix is not "
+                    "symmetric, nor a diagonal scaling of a symmetric one",
+    "scaled-spd": "conjugate gradients or Cholesky on the symmetric form (each row times "
+                  "its lumped mass): the matrix is a row scaling of a symmetric positive "
+                  "definite one on a closed surface (the Dirichlet rows of an open one "
+                  "break the symmetry unless eliminated); of the shared solver's methods, "
+                  "BiCGStab or `direct` (it has no CG)",
+}
+"""Kinds of linear system -> the solver that suits it (:attr:`Scheme.matrix`)."""
+
+
 @dataclass(frozen=True)
 class Scheme:
     """One scheme of the benchmark.
@@ -36,6 +48,15 @@ class Scheme:
     family : str
         ``"ddfv"`` (F- and T-vertices; the T monitor applies) or
         ``"vertex"`` (the mesh vertices only).
+    matrix : str
+        The kind of its linear system, a key of :data:`MATRICES`:
+        ``"nonsymmetric"`` or ``"scaled-spd"`` (checked on a bumpy sphere by
+        ``tests/harness/test_schemes.py``). :attr:`suited_solver` says which
+        solver suits it.
+    robust_solver : str
+        The shared solver's method that re-runs a run that ended with a
+        ``solver_*`` status, to tell the solver's failure from the scheme's
+        (the matrix study): :data:`mcfbench.running.solver.ROBUST`.
     """
 
     name: str
@@ -45,6 +66,18 @@ class Scheme:
     style: dict = field(default_factory=dict)
     description: str = ""
     family: str = "vertex"
+    matrix: str = "nonsymmetric"
+    robust_solver: str = "direct"
+
+    def __post_init__(self):
+        if self.matrix not in MATRICES:
+            raise ValueError(f"scheme {self.name!r}: unknown matrix kind {self.matrix!r}; "
+                             f"choose one of {', '.join(MATRICES)}")
+
+    @property
+    def suited_solver(self):
+        """Which solver suits the scheme's matrix, one sentence (:data:`MATRICES`)."""
+        return MATRICES[self.matrix]
 
     @property
     def flow_class(self):
@@ -65,12 +98,15 @@ class Scheme:
 
 
 def _ddfv(variant, label, color, marker, linestyle, description):
+    """The chord length of the dual curves makes the DDFV matrix a row scaling of a
+    symmetric one (the paper's broken line does not: measured, 1e-2 off)."""
     name = "ddfv" if variant == "paper" else f"ddfv-{variant}"
     from ddfv.variants import variant_options
 
     return Scheme(name, label, "ddfv.flow:Flow", variant_options(variant),
                   {"color": color, "marker": marker, "linestyle": linestyle},
-                  description, family="ddfv")
+                  description, family="ddfv",
+                  matrix="scaled-spd" if "chord" in variant else "nonsymmetric")
 
 
 SCHEMES = {s.name: s for s in (
@@ -84,18 +120,19 @@ SCHEMES = {s.name: s for s in (
           "DDFV with chord |gamma| and the elimination (3.6)"),
     Scheme("cotan", "cotangent", "baselines.cotan:CotanFlow", {"mass": "barycentric"},
            {"color": "C3", "marker": "v", "linestyle": "-"},
-           "the cotangent scheme (Dziuk 1991), barycentric lumped mass"),
+           "the cotangent scheme (Dziuk 1991), barycentric lumped mass", matrix="scaled-spd"),
     Scheme("cotan-voronoi", "cotangent, Voronoi mass", "baselines.cotan:CotanFlow",
            {"mass": "voronoi"}, {"color": "C5", "marker": "<", "linestyle": "--"},
-           "the cotangent scheme (Dziuk 1991), Voronoi (mixed) lumped mass (Meyer et al. 2003)"),
+           "the cotangent scheme (Dziuk 1991), Voronoi (mixed) lumped mass (Meyer et al. 2003)",
+           matrix="scaled-spd"),
     Scheme("cmcf", "conformalized MCF", "baselines.cmcf:CMCFFlow", {"mass": "barycentric"},
            {"color": "C6", "marker": ">", "linestyle": "-."},
            "conformalized mean curvature flow (Kazhdan, Solomon, Ben-Chen 2012): initial "
-           "stiffness kept, mass rebuilt, no rescaling"),
+           "stiffness kept, mass rebuilt, no rescaling", matrix="scaled-spd"),
     Scheme("bgn", "BGN", "baselines.bgn:BGNFlow", {"scaling": "mass"},
            {"color": "C7", "marker": "P", "linestyle": ":"},
            "Barrett, Garcke, Nuernberg (2008): mass-lumped vertex normals, tangential "
-           "motion that equidistributes the mesh"),
+           "motion that equidistributes the mesh", matrix="scaled-spd"),
 )}
 """Scheme name -> :class:`Scheme`."""
 

@@ -11,7 +11,9 @@ Statuses
 ``solver_stagnated``
     The residual stopped decreasing above the tolerance.
 ``degenerated``
-    Non-finite coordinates or collapsed cells (diamonds, triangles).
+    Non-finite coordinates or collapsed cells (diamonds, triangles), or a
+    connected component that shrank to a point or a line (the driver's check
+    before every solve, :mod:`mcfbench.geometry.collapse`).
 ``t_escaped``
     A T-vertex left its triangle (DDFV, Section 2.2.2 of the paper): its
     projection onto the plane of the triangle has a negative barycentric

@@ -150,11 +150,12 @@ def test_tau_past_the_extinction_of_a_sphere_is_named(capsys):
 
 
 def test_flow_past_extinction_on_a_users_sphere_ends_with_a_named_status(tmp_path, capsys):
-    for scheme, cells in (("cotan", "320 triangle(s)"), ("ddfv", "480 diamond cell(s)")):
+    for scheme in ("cotan", "ddfv"):
         code, out, err = _run(tmp_path, capsys, _sphere_obj(2), "--tau", "10", "--steps",
                               "3", "--scheme", scheme)       # extinction at t = 0.25
         assert code == 1
-        assert f"error: degenerated at step 3 (t = 30): {cells} collapsed" in err
+        assert "error: degenerated at step 2 (t = 20): component 0 of 1 (162 vertices, e.g. " \
+               "vertex 0) shrank to a point" in err
         assert str(np.load(tmp_path / "run.npz")["status"]) == "degenerated"
 
 

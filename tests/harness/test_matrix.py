@@ -218,6 +218,74 @@ def test_recommendation_when_one_scheme_wins():
     assert "**Recommendation: good**" in text
 
 
+# ------------------------------------------------------------ solver verdicts (issue #24)
+
+
+def test_solver_failure_is_rerun_with_the_robust_solver(tmp_path):
+    """maxiter = 1 forces BiCGStab to fail on the sphere; the job re-runs the level with
+    ``direct``, which finishes, and the findings call it a solver verdict."""
+    plan = matrix.plan({"schemes": ["cotan", "bgn"], "maxiter": 1,
+                        "problems": {p: ([1, 2] if p == "sphere" else []) for p in PROBLEMS}})
+    runs = matrix.planned_runs(plan, code="test", root=str(tmp_path))
+    for path, settings in runs.items():
+        matrix.job(settings, path, path.replace(".json", ".npz"))
+    for path, settings in runs.items():
+        record = read_record(path, settings=settings)
+        assert record["status"] == "solver_failed" and "iteration limit 1" in record["message"]
+        assert record["robust_status"] == "ok" and record["robust_solver"] == "direct"
+        assert record["robust_message"] == "" and record["robust_steps_done"] == record["N"]
+        assert record["robust_metrics"]["l2_error"] < 2e-2
+    table, summary = matrix.aggregate(runs, plan, tmp_path / "tables")
+    assert (table["robust_status"] == "ok").all() and np.isfinite(table["robust_value"]).all()
+    cotan = summary[summary["scheme"] == "cotan"].iloc[0]
+    assert cotan["runs_ok"] == 0 and cotan["runs_robust_ok"] == 2
+    assert cotan["solver_only"] == "1:solver_failed:0.04;2:solver_failed:0.01"
+    assert 1.7 < cotan["robust_eoc"] < 2.3 and cotan["robust_eoc_levels"] == "1-2"
+    assert "the robust solver finishes every level" in (tmp_path / "tables" / "summary.md").read_text()
+    text = matrix.findings(tmp_path / "tables" / "summary.csv", tmp_path / "findings.md", plan)
+    assert "**cotan** converges at order ~2" in text
+    assert "A solver verdict, not a scheme verdict: the matrix's solver failed (level 1: " \
+           "solver_failed at t = 0.04; level 2: solver_failed at t = 0.01)" in text
+    assert "## Solver verdicts" in text and "broke down" not in text
+
+
+def test_a_run_that_ended_otherwise_is_not_rerun(tmp_path):
+    plan = matrix.plan({"schemes": ["cotan"], "problems": {p: ([1] if p == "sphere" else [])
+                                                             for p in PROBLEMS}})
+    path, settings = next(iter(matrix.planned_runs(plan, code="test", root=str(tmp_path)).items()))
+    matrix.job(settings, path, path.replace(".json", ".npz"))
+    record = read_record(path, settings=settings)
+    assert record["status"] == "ok" and record["robust_status"] == ""
+    assert "robust_metrics" not in record
+
+
+def test_findings_tell_solver_verdicts_from_scheme_verdicts():
+    """``a`` fails at level 3 with the solver only (the robust re-run finishes it with an
+    order-2 error); ``b`` fails at level 3 with the solver and the robust solver fails
+    too: only ``b`` broke down."""
+    records = []
+    for scheme, c in (("a", 1.0), ("b", 2.0)):
+        for k in (1, 2, 3):
+            records.append(_record(scheme, "sphere", k, c * 4.0 ** -k))
+        records[-1].update(status="solver_failed", t_failed=0.03, l2_error=float("nan"),
+                           robust_status="ok" if scheme == "a" else "solver_breakdown",
+                           robust_metrics={"l2_error": c * 4.0 ** -3 if scheme == "a" else None})
+    summary = matrix_tables.summary_table(matrix_tables.long_table(records))
+    a = summary[summary["scheme"] == "a"].iloc[0]
+    assert a["status"] == "solver_failed" and a["runs_robust_ok"] == 3
+    assert a["robust_eoc"] == pytest.approx(2.0) and a["robust_finest_value"] == 4.0 ** -3
+    b = summary[summary["scheme"] == "b"].iloc[0]
+    assert b["runs_robust_ok"] == 2 and b["solver_only"] == ""
+    text = matrix_findings.matrix_findings(summary)
+    assert "**a** converges at order ~2: EOC 2.00 (levels 2-3)" in text
+    assert "A solver verdict, not a scheme verdict" in text
+    assert "**b** broke down in 1 of 3 runs (level 3: solver_failed at t = 0.03)" in text
+    assert "The robust solver (direct) failed too (level 3: solver_breakdown): a scheme " \
+           "verdict." in text
+    assert "a on sphere (level 3: solver_failed at t = 0.03)" in text
+    assert "**Recommendation: a**" in text
+
+
 # ------------------------------------------------------------ the Snakemake DAG
 
 

@@ -48,3 +48,62 @@ def test_options_override_the_entry():
 def test_unknown_scheme_lists_the_known_ones():
     with pytest.raises(ValueError, match="unknown scheme 'x'; choose one of ddfv, ddfv-chord"):
         get_scheme("x")
+
+
+def _second_matrix(scheme, V, F):
+    """The matrix of a scheme's second step (the first may start from a special state)."""
+    from mcfbench.running.solver import Solver
+
+    flow, seen, solver = scheme.make(V, F, 0.01), [], Solver("direct")
+
+    def solve(A, b, x0):
+        seen.append(A)
+        return solver(A, b, x0)
+
+    flow.step(solve)
+    flow.step(solve)
+    return seen[-1]
+
+
+def _symmetrizing_residual(A):
+    """How far ``A`` is from ``diag(d) S`` with ``S`` symmetric: the least-squares misfit of
+    ``log d_i - log d_j = log(A_ji / A_ij)`` over the off-diagonal pairs (0: exactly)."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as sla
+
+    A = sp.csr_matrix(A)
+    C = sp.triu(A, k=1).tocoo()
+    r, c, v = C.row, C.col, C.data
+    keep = v != 0
+    r, c, v = r[keep], c[keep], v[keep]
+    vt = np.asarray(A[c, r]).ravel()
+    assert (np.sign(vt) == np.sign(v)).all()          # structurally symmetric, signs alike
+    q = np.log(vt / v)
+    rows = np.arange(len(q))
+    G = sp.csr_matrix((np.r_[np.ones(len(q)), -np.ones(len(q))],
+                       (np.r_[rows, rows], np.r_[r, c])), shape=(len(q), A.shape[0]))
+    d = sla.lsqr(G, q, atol=1e-15, btol=1e-15)[0]
+    return float(np.abs(G @ d - q).max()), A
+
+
+@pytest.mark.parametrize("name", sorted(SCHEMES))
+def test_matrix_kind_of_every_scheme_is_what_the_registry_says(name):
+    """``Scheme.matrix``: ``scaled-spd`` is a row scaling of an SPD matrix (misfit at
+    round-off, real positive eigenvalues), ``nonsymmetric`` is not (misfit 1e-2 for the
+    paper's broken-line DDFV)."""
+    scheme = get_scheme(name)
+    misfit, A = _symmetrizing_residual(_second_matrix(scheme, *random_bumpy_sphere(1)))
+    if scheme.matrix == "scaled-spd":
+        assert misfit < 1e-10
+        eig = np.linalg.eigvals(A.toarray())
+        assert np.abs(eig.imag).max() < 1e-8 and eig.real.min() > 0
+    else:
+        assert misfit > 1e-4
+    assert scheme.robust_solver == "direct" and scheme.suited_solver
+
+
+def test_unknown_matrix_kind_is_refused():
+    from mcfbench.running.schemes import Scheme
+
+    with pytest.raises(ValueError, match="unknown matrix kind 'spd'"):
+        Scheme("x", "x", "baselines.cotan:CotanFlow", matrix="spd")
