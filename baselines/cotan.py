@@ -132,11 +132,18 @@ class SurfaceGeometry:
     area_vectors : (m, 3) float array
         ``(x_1 - x_0) x (x_2 - x_0)`` per triangle (twice the area times
         the unit normal).
+    degenerate : int
+        Triangles of zero (or non-finite) area, left out of ``L`` and the
+        mass by the kernel instead of dividing by zero.
+    first_degenerate : int
+        The first of them, ``-1`` if none.
     """
 
     L_data: np.ndarray
     mass: np.ndarray
     area_vectors: np.ndarray
+    degenerate: int = 0
+    first_degenerate: int = -1
 
 
 class CotanAssembler:
@@ -190,10 +197,12 @@ class CotanAssembler:
         L_data = np.empty(p.nnz) if with_laplacian else np.empty(0)
         mass = np.empty(mesh.n_vertices)
         area_vectors = np.empty((mesh.n_faces, 3))
-        cotan_geometry(np.ascontiguousarray(vertices, dtype=np.float64), mesh.faces,
-                       p.corner_slots, p.diag_slots, self.mass_type == "voronoi",
-                       with_laplacian, L_data, mass, area_vectors)
-        return SurfaceGeometry(L_data if with_laplacian else None, mass, area_vectors)
+        degenerate, first = cotan_geometry(
+            np.ascontiguousarray(vertices, dtype=np.float64), mesh.faces, p.corner_slots,
+            p.diag_slots, self.mass_type == "voronoi", with_laplacian, L_data, mass,
+            area_vectors)
+        return SurfaceGeometry(L_data if with_laplacian else None, mass, area_vectors,
+                               int(degenerate), int(first))
 
     def csr(self, data):
         """A CSR matrix with the pattern of ``L`` and values ``data``."""
@@ -385,7 +394,9 @@ class VertexFlow:
     def defects(self):
         """What is wrong with the current state: ``[(status, description)]``.
 
-        ``"degenerated"``: non-finite coordinates, or triangles whose area
+        ``"degenerated"``: non-finite coordinates, triangles of zero area
+        (which the compiled geometry reports instead of dividing by zero,
+        :attr:`SurfaceGeometry.degenerate`), or triangles whose area
         fell below ``1e-10`` x the mean area (a local collapse) or ``1e-12`` x
         the initial mean area (the surface shrinking to a point, as the DDFV
         scheme checks its diamonds). ``"inverted"``: triangles whose
@@ -397,6 +408,10 @@ class VertexFlow:
             bad = np.flatnonzero(~np.isfinite(self._X).all(axis=0))
             return [("degenerated", f"non-finite coordinates at {len(bad)} vertex(es), "
                      f"e.g. vertex {int(bad[0])}")]
+        g = self.geometry
+        if g.degenerate:
+            return [("degenerated", f"{g.degenerate} triangle(s) of zero area (no cotangent "
+                     f"weights), e.g. triangle {g.first_degenerate}")]
         area = self._triangle_checks[1]
         collapsed = np.flatnonzero(~(area > max(COLLAPSED * area.mean(),
                                                 1e-2 * COLLAPSED * self._area0)))
