@@ -59,6 +59,8 @@ import scipy.sparse as sp
 
 from .kernels import cotan_geometry, neighbour_cosines, row_scaled_system
 from .mesh import edge_mesh, laplacian_pattern
+from .redistribution import (MAX_SHIFT, OMEGA, REDISTRIBUTIONS, redistribution_source,
+                             shift_limit, solve_potential, tangential_velocity)
 
 MASS_TYPES = {"barycentric": igl.MASSMATRIX_TYPE_BARYCENTRIC,
               "voronoi": igl.MASSMATRIX_TYPE_VORONOI}
@@ -445,6 +447,20 @@ class CotanFlow(VertexFlow):
         Lumped mass matrix (see :func:`lumped_mass`).
     assembly : {"cached", "igl"}
         See the module docstring.
+    redistribution : {None, "area"}
+        ``"area"``: add the area-oriented tangential velocity ``v_T = grad
+        psi`` of :mod:`baselines.redistribution` (Mikula, Remesikova,
+        Sarkoci, Sevcovic 2014), explicitly: ``b = X^n + tau v_T^n`` in
+        (C3), the matrix unchanged (R3).
+    omega : float
+        Relaxation rate of the area ratios in (R2), ``>= 0`` (default
+        :data:`baselines.redistribution.OMEGA`).
+    psi_rtol : float
+        Relative residual of the conjugate-gradient solve for ``psi``.
+    max_shift : float or None
+        Largest change of an edge vector by the explicit tangential step
+        ``tau v_T``, as a fraction of the edge's length: ``v_T`` is scaled
+        by one factor for the whole mesh when needed (R4); None: no limit.
 
     Examples
     --------
@@ -456,12 +472,31 @@ class CotanFlow(VertexFlow):
     ((4, 4), (3, 4), 13.8564)
     """
 
-    def __init__(self, vertices, faces, tau, *, mass="barycentric", assembly="cached"):
+    def __init__(self, vertices, faces, tau, *, mass="barycentric", assembly="cached",
+                 redistribution=None, omega=OMEGA, psi_rtol=1e-10, max_shift=MAX_SHIFT):
         if assembly not in ASSEMBLIES:
             raise ValueError(f"unknown assembly {assembly!r}; choose one of "
                              f"{', '.join(ASSEMBLIES)}")
+        if redistribution not in REDISTRIBUTIONS:
+            raise ValueError(f"unknown redistribution {redistribution!r}; choose None or "
+                             f"'area'")
+        if not (np.isfinite(omega) and omega >= 0):
+            raise ValueError(f"omega must be a finite number >= 0, got {omega!r}")
+        if max_shift is not None and not (np.isfinite(max_shift) and max_shift > 0):
+            raise ValueError(f"max_shift must be None or a positive number, got {max_shift!r}")
+        self.max_shift = None if max_shift is None else float(max_shift)
+        self.shift_factors = []
+        """Factor ``s <= 1`` of each step's tangential velocity (R4)."""
         self.assembly = assembly
+        self.redistribution = redistribution
+        self.omega = float(omega)
+        self.psi_rtol = float(psi_rtol)
+        self.psi = None
+        """The potential of the last step's tangential velocity (R2), (n,)."""
+        self.psi_iterations = []
+        """CG iterations of each step's solve for ``psi`` (-1: direct fallback)."""
         super().__init__(vertices, faces, tau, mass=mass)
+        self.timings["redistribution"] = 0.0
 
     def _needs_laplacian(self):
         return self.assembly == "cached"
@@ -480,14 +515,41 @@ class CotanFlow(VertexFlow):
     def _laplacian_data(self):
         return self.geometry.L_data
 
+    def tangential_velocity(self):
+        """``v_T = grad psi`` (R2) at the current state, (3, n); zero at fixed vertices.
+
+        Solves (R2) with the stiffness and mass of this step's system
+        (warm start: the previous ``psi``) and stores ``psi``.
+        """
+        clock = time.perf_counter()
+        L, mass = self.laplacian(), self._system_mass()
+        f = redistribution_source(L, mass, self._X, self.fixed, self.omega)
+        self.psi, its = solve_potential(L, mass, f, self.psi, self.psi_rtol)
+        self.psi_iterations.append(its)
+        alpha, _ = tangential_velocity(self._X.T, self.faces, self.psi)
+        alpha[:, self.fixed] = 0.0
+        factor = 1.0
+        if self.max_shift is not None:
+            factor = shift_limit(self._X, self.mesh.edges, alpha, self.tau, self.max_shift)
+            alpha *= factor
+        self.shift_factors.append(factor)
+        self.timings["redistribution"] += time.perf_counter() - clock
+        return alpha
+
+    def _rhs(self):
+        if self.redistribution is None:
+            return self._X
+        return self._X + self.tau * self.tangential_velocity()     # (R3)
+
     def system(self):
         """``(A, b)``: ``A = I + tau diag(1/M^n) L^n`` (C3), CSR, rows of
-        boundary vertices = identity; ``b = X^n`` (3, n)."""
+        boundary vertices = identity; ``b = X^n`` (3, n), or ``X^n + tau
+        v_T^n`` with ``redistribution="area"`` (R3)."""
         if self.assembly == "igl":
             L = self.laplacian()
             L.data *= np.repeat(self.tau / self._system_mass(), np.diff(L.indptr))
             A = (L + sp.identity(L.shape[0], format="csr")).tocsr()
-            return (dirichlet_rows(A, self.fixed) if self.mesh.has_boundary else A), self._X
+            return (dirichlet_rows(A, self.fixed) if self.mesh.has_boundary else A), self._rhs()
         A = self.assembler.row_scaled(self._laplacian_data(), self.geometry.mass, self.tau,
                                       self.fixed)
-        return A, self._X
+        return A, self._rhs()

@@ -343,7 +343,13 @@ def vertex_gradients(V, faces, psi, alpha):
                 = sum_t N_t x (sum_k psi_k e_k) / |N_t|  /  sum_t |N_t|
 
     (``N_t = 2 |t| nu_t``), a combination of tangent vectors of the
-    triangles at ``i``: the tangential velocity ``v_T = grad psi`` of
+    triangles at ``i``, then projected onto the tangent plane of the
+    area-weighted vertex normal ``n_i = sum_t N_t / |sum_t N_t|``:
+    ``alpha_i - (alpha_i . n_i) n_i``. (Without the projection the mean of
+    the tilted triangle gradients has a normal part of order ``h |grad
+    psi| / R``, a motion that is not tangential; with it, the field is
+    exactly zero at a vertex fixed by a rotation of the mesh about
+    ``n_i``.) The tangential velocity ``v_T = grad psi`` of
     :mod:`baselines.redistribution`.
 
     Parameters
@@ -364,6 +370,7 @@ def vertex_gradients(V, faces, psi, alpha):
     """
     n = V.shape[0]
     weight = np.zeros(n)
+    normal = np.zeros((n, 3))
     alpha[:] = 0.0
     degenerate, first = 0, -1
     for t in range(faces.shape[0]):
@@ -392,9 +399,19 @@ def vertex_gradients(V, faces, psi, alpha):
             alpha[i, 1] += gy
             alpha[i, 2] += gz
             weight[i] += dbl
+            normal[i, 0] += nx
+            normal[i, 1] += ny
+            normal[i, 2] += nz
     for i in range(n):
-        if weight[i] > 0.0:
-            alpha[i, 0] /= weight[i]
-            alpha[i, 1] /= weight[i]
-            alpha[i, 2] /= weight[i]
+        if not weight[i] > 0.0:
+            continue
+        ux, uy, uz = normal[i, 0], normal[i, 1], normal[i, 2]
+        length = np.sqrt(ux * ux + uy * uy + uz * uz)
+        if not length > 0.0:                        # normals cancel: no tangent plane
+            alpha[i, 0] = alpha[i, 1] = alpha[i, 2] = 0.0
+            continue
+        ux, uy, uz = ux / length, uy / length, uz / length
+        gx, gy, gz = alpha[i, 0] / weight[i], alpha[i, 1] / weight[i], alpha[i, 2] / weight[i]
+        d = gx * ux + gy * uy + gz * uz
+        alpha[i, 0], alpha[i, 1], alpha[i, 2] = gx - d * ux, gy - d * uy, gz - d * uz
     return degenerate, first

@@ -88,6 +88,11 @@ SCHEMES = {s.name: s for s in (
     Scheme("cotan-voronoi", "cotangent, Voronoi mass", "baselines.cotan:CotanFlow",
            {"mass": "voronoi"}, {"color": "C5", "marker": "<", "linestyle": "--"},
            "the cotangent scheme (Dziuk 1991), Voronoi (mixed) lumped mass (Meyer et al. 2003)"),
+    Scheme("cotan-redistribute", "cotangent, area redistribution", "baselines.cotan:CotanFlow",
+           {"mass": "barycentric", "redistribution": "area"},
+           {"color": "C8", "marker": "X", "linestyle": "--"},
+           "the cotangent scheme (Dziuk 1991) with the area-oriented tangential redistribution "
+           "of Mikula, Remesikova, Sarkoci, Sevcovic (2014), explicit, omega = 10"),
     Scheme("cmcf", "conformalized MCF", "baselines.cmcf:CMCFFlow", {"mass": "barycentric"},
            {"color": "C6", "marker": ">", "linestyle": "-."},
            "conformalized mean curvature flow (Kazhdan, Solomon, Ben-Chen 2012): initial "
