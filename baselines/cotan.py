@@ -455,8 +455,6 @@ class CotanFlow(VertexFlow):
     omega : float
         Relaxation rate of the area ratios in (R2), ``>= 0`` (default
         :data:`baselines.redistribution.OMEGA`).
-    psi_rtol : float
-        Relative residual of the conjugate-gradient solve for ``psi``.
     max_shift : float or None
         Largest change of an edge vector by the explicit tangential step
         ``tau v_T``, as a fraction of the edge's length: ``v_T`` is scaled
@@ -473,7 +471,7 @@ class CotanFlow(VertexFlow):
     """
 
     def __init__(self, vertices, faces, tau, *, mass="barycentric", assembly="cached",
-                 redistribution=None, omega=OMEGA, psi_rtol=1e-10, max_shift=MAX_SHIFT):
+                 redistribution=None, omega=OMEGA, max_shift=MAX_SHIFT):
         if assembly not in ASSEMBLIES:
             raise ValueError(f"unknown assembly {assembly!r}; choose one of "
                              f"{', '.join(ASSEMBLIES)}")
@@ -490,11 +488,8 @@ class CotanFlow(VertexFlow):
         self.assembly = assembly
         self.redistribution = redistribution
         self.omega = float(omega)
-        self.psi_rtol = float(psi_rtol)
         self.psi = None
         """The potential of the last step's tangential velocity (R2), (n,)."""
-        self.psi_iterations = []
-        """CG iterations of each step's solve for ``psi`` (-1: direct fallback)."""
         super().__init__(vertices, faces, tau, mass=mass)
         self.timings["redistribution"] = 0.0
 
@@ -519,13 +514,12 @@ class CotanFlow(VertexFlow):
         """``v_T = grad psi`` (R2) at the current state, (3, n); zero at fixed vertices.
 
         Solves (R2) with the stiffness and mass of this step's system
-        (warm start: the previous ``psi``) and stores ``psi``.
+        and stores ``psi``.
         """
         clock = time.perf_counter()
         L, mass = self.laplacian(), self._system_mass()
         f = redistribution_source(L, mass, self._X, self.fixed, self.omega)
-        self.psi, its = solve_potential(L, mass, f, self.psi, self.psi_rtol)
-        self.psi_iterations.append(its)
+        self.psi = solve_potential(L, mass, f)
         alpha, _ = tangential_velocity(self._X.T, self.faces, self.psi)
         alpha[:, self.fixed] = 0.0
         factor = 1.0
