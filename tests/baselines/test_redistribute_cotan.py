@@ -176,6 +176,32 @@ def test_fixed_boundary_stays_and_velocity_vanishes_there():
         np.testing.assert_array_equal(frame[flow.fixed], V[flow.fixed])
 
 
+def test_area_ratios_relax_at_the_rate_omega():
+    # icosphere(3) pulled towards the north pole (x + 0.6 e_z, normalised): the
+    # covolumes differ by 18x. (R1) makes ln q relax like exp(-omega t); measured
+    # std(ln q) 0.634 -> 0.267 at t = 0.1 with omega = 10 (exp(-1) 0.634 = 0.233),
+    # while cotan keeps it (0.636) and the radius error stays that of cotan (5e-3)
+    V, F = icosphere(3)
+    V = V + np.array([0.0, 0.0, 0.6])
+    V /= np.linalg.norm(V, axis=1, keepdims=True)
+
+    def spread(flow):
+        q = len(flow.mass) * flow.mass / flow.mass.sum()
+        return np.std(np.log(q))
+
+    results = {}
+    for name, flow in (("cotan", CotanFlow(V, F, 0.0025)), ("area", redistributing(V, F, 0.0025))):
+        start = spread(flow)
+        traj = simulate(flow, 40, solver=Solver(), save_every=0)
+        assert traj.status == "ok", traj.message
+        radius_error = np.abs(np.linalg.norm(flow.vertices, axis=1) - np.sqrt(0.6)).max()
+        results[name] = (start, spread(flow), radius_error)
+    assert results["cotan"][0] == pytest.approx(0.634, abs=1e-3)
+    assert results["cotan"][1] == pytest.approx(0.636, abs=2e-3)
+    assert results["area"][1] == pytest.approx(0.267, abs=2e-3)
+    assert results["area"][2] < 1.2 * results["cotan"][2] < 6e-3
+
+
 # -- a sliver-rich mesh --------------------------------------------------------------
 
 @pytest.mark.parametrize("options, steps, status", [
