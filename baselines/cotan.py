@@ -44,6 +44,11 @@ Assembly (``assembly=``):
     ``igl.cotmatrix`` and ``igl.massmatrix`` at every step (the reference;
     the matrices agree with ``"cached"`` to rounding).
 
+Tangential redistribution (``redistribution="area"``): the right-hand
+side of (C3) becomes ``X^{n-1} + tau v_T^{n-1}``, ``v_T = grad psi`` the
+area-oriented tangential velocity of :mod:`baselines.redistribution`
+(Mikula, Remesikova, Sarkoci, Sevcovic 2014); the matrix is unchanged.
+
 This module also holds :class:`VertexFlow`, what every vertex-based
 baseline shares: the state, the contract of ``mcfbench.flow.Flow``, the
 warm start and the checks of a state (:meth:`VertexFlow.defects`).
