@@ -65,7 +65,7 @@ import scipy.sparse as sp
 from .kernels import cotan_geometry, neighbour_cosines, row_scaled_system
 from .mesh import edge_mesh, laplacian_pattern
 from .redistribution import (MAX_SHIFT, OMEGA, REDISTRIBUTIONS, redistribution_source,
-                             shift_limit, solve_potential, tangential_velocity)
+                             shift_limit, solve_potential, tangential_velocity, target_shares)
 
 MASS_TYPES = {"barycentric": igl.MASSMATRIX_TYPE_BARYCENTRIC,
               "voronoi": igl.MASSMATRIX_TYPE_VORONOI}
@@ -464,6 +464,10 @@ class CotanFlow(VertexFlow):
         Largest change of an edge vector by the explicit tangential step
         ``tau v_T``, as a fraction of the edge's length: ``v_T`` is scaled
         by one factor for the whole mesh when needed (R4); None: no limit.
+    target : {"vertex", "triangle"}
+        Target covolume areas of (R2): all equal (``"vertex"``, default) or
+        those of equal-area triangles (``"triangle"``,
+        :func:`baselines.redistribution.target_shares`).
 
     Examples
     --------
@@ -476,7 +480,8 @@ class CotanFlow(VertexFlow):
     """
 
     def __init__(self, vertices, faces, tau, *, mass="barycentric", assembly="cached",
-                 redistribution=None, omega=OMEGA, max_shift=MAX_SHIFT):
+                 redistribution=None, omega=OMEGA, max_shift=MAX_SHIFT,
+                 target="vertex"):
         if assembly not in ASSEMBLIES:
             raise ValueError(f"unknown assembly {assembly!r}; choose one of "
                              f"{', '.join(ASSEMBLIES)}")
@@ -488,6 +493,8 @@ class CotanFlow(VertexFlow):
         if max_shift is not None and not (np.isfinite(max_shift) and max_shift > 0):
             raise ValueError(f"max_shift must be None or a positive number, got {max_shift!r}")
         self.max_shift = None if max_shift is None else float(max_shift)
+        self.target = target
+        self._shares = target_shares(faces, len(vertices), target)
         self.shift_factors = []
         """Factor ``s <= 1`` of each step's tangential velocity (R4)."""
         self.assembly = assembly
@@ -523,7 +530,7 @@ class CotanFlow(VertexFlow):
         """
         clock = time.perf_counter()
         L, mass = self.laplacian(), self._system_mass()
-        f = redistribution_source(L, mass, self._X, self.fixed, self.omega)
+        f = redistribution_source(L, mass, self._X, self.fixed, self.omega, self._shares)
         self.psi = solve_potential(L, mass, f)
         alpha, _ = tangential_velocity(self._X.T, self.faces, self.psi)
         alpha[:, self.fixed] = 0.0

@@ -83,7 +83,33 @@ def mean_curvature_vectors(L, mass, X):
     return np.where(mass > 0.0, -LX / safe, 0.0)
 
 
-def redistribution_source(L, mass, X, fixed, omega):
+def target_shares(faces, n, target="vertex"):
+    """Target share ``w_i`` of the total area for each covolume, ``sum w_i = 1``.
+
+    ``"vertex"``: ``1/N``, every covolume the same area (R2), the
+    asymptotically uniform redistribution. ``"triangle"``: ``d_i / (3
+    n_T)``, ``d_i`` the number of triangles at ``i``: the barycentric
+    covolumes of a mesh whose triangles all have the same area (boundary
+    vertices of a straight boundary get half, valence-5 vertices 5/6).
+
+    Parameters
+    ----------
+    faces : (m, 3) int array
+    n : int
+    target : {"vertex", "triangle"}
+
+    Returns
+    -------
+    (n,) float array
+    """
+    if target == "vertex":
+        return np.full(n, 1.0 / n)
+    if target == "triangle":
+        return np.bincount(np.asarray(faces).ravel(), minlength=n) / (3.0 * len(faces))
+    raise ValueError(f"unknown target {target!r}; choose 'vertex' or 'triangle'")
+
+
+def redistribution_source(L, mass, X, fixed, omega, shares=None):
     """The right-hand side ``f`` of (R2), shape (n,), with ``sum m_i f_i = 0``.
 
     Parameters
@@ -96,6 +122,9 @@ def redistribution_source(L, mass, X, fixed, omega):
         Boundary vertices: no motion, ``h . V = 0``.
     omega : float
         Relaxation rate (``>= 0``).
+    shares : (n,) float array, optional
+        Target shares ``w_i`` (:func:`target_shares`); default ``1/N``:
+        the term is ``omega (w_i |G| / m_i - 1)``.
 
     Returns
     -------
@@ -106,7 +135,8 @@ def redistribution_source(L, mass, X, fixed, omega):
     area = mass.sum()
     f = hV - (mass * hV).sum() / area
     if omega:
-        f = f + omega * (area / (len(mass) * mass) - 1.0)
+        w = np.full(len(mass), 1.0 / len(mass)) if shares is None else shares
+        f = f + omega * (w * area / mass - 1.0)
     return f
 
 

@@ -8,7 +8,7 @@ from scipy.spatial import ConvexHull
 from baselines.cotan import CotanFlow
 from baselines.kernels import vertex_gradients
 from baselines.redistribution import (redistribution_source, shift_limit, solve_potential,
-                                      tangential_velocity)
+                                      target_shares)
 from mcfbench.driver import simulate
 from mcfbench.errors import SphereL2Error, eoc
 from mcfbench.solver import Solver
@@ -200,6 +200,34 @@ def test_area_ratios_relax_at_the_rate_omega():
     assert results["cotan"][1] == pytest.approx(0.636, abs=2e-3)
     assert results["area"][1] == pytest.approx(0.267, abs=2e-3)
     assert results["area"][2] < 1.2 * results["cotan"][2] < 6e-3
+
+
+def test_target_shares():
+    V, F = cylinder(24, 8, diagonals="parallel")
+    for target in ("vertex", "triangle"):
+        assert target_shares(F, len(V), target).sum() == pytest.approx(1.0, rel=1e-14)
+    w = target_shares(F, len(V), "triangle")
+    fixed = CotanFlow(V, F, 0.01).fixed
+    # straight boundary rings: 3 triangles per vertex, interior 6: half the share
+    np.testing.assert_allclose(w[fixed], 3 / (3 * len(F)))
+    np.testing.assert_allclose(w[~fixed], 6 / (3 * len(F)))
+    with pytest.raises(ValueError, match="unknown target"):
+        target_shares(F, len(V), "edge")
+
+
+@pytest.mark.parametrize("target, radial_error, smallest_angle", [
+    ("vertex", 3.932e-3, 16.39),       # cotan: 3.437e-3, 25.59 degrees
+    ("triangle", 3.361e-3, 25.59),
+])
+def test_catenoid_level_1_with_either_target(target, radial_error, smallest_angle):
+    # the uniform target cannot be met at the fixed boundary (half stars) and
+    # leaves the interior squeezed; the equal-triangle target keeps cotan's angles
+    from mcfbench.studies import run
+
+    result, traj = run("cotan-redistribute", "catenoid", 1, target=target)
+    assert traj.status == "ok" and traj.steps_done == 375
+    assert result.metrics["max_radial_error"] == pytest.approx(radial_error, rel=1e-3)
+    assert result.min_angle == pytest.approx(smallest_angle, abs=0.01)
 
 
 # -- a sliver-rich mesh --------------------------------------------------------------
