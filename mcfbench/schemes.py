@@ -93,6 +93,12 @@ SCHEMES = {s.name: s for s in (
            {"color": "C8", "marker": "X", "linestyle": "--"},
            "the cotangent scheme (Dziuk 1991) with the area-oriented tangential redistribution "
            "of Mikula, Remesikova, Sarkoci, Sevcovic (2014), explicit, omega = 10"),
+    Scheme("cotan-redistribute-tri", "cotangent, area redistribution (triangle target)",
+           "baselines.cotan:CotanFlow",
+           {"mass": "barycentric", "redistribution": "area", "target": "triangle"},
+           {"color": "C9", "marker": "*", "linestyle": "-."},
+           "cotan-redistribute with the covolumes of equal-area triangles as target (half "
+           "at a straight fixed boundary) instead of equal covolumes"),
     Scheme("cmcf", "conformalized MCF", "baselines.cmcf:CMCFFlow", {"mass": "barycentric"},
            {"color": "C6", "marker": ">", "linestyle": "-."},
            "conformalized mean curvature flow (Kazhdan, Solomon, Ben-Chen 2012): initial "

@@ -262,4 +262,5 @@ def test_registry_entry():
     V, F = icosphere(1)
     flow = get_scheme("cotan-redistribute").make(V, F, 0.01)
     assert isinstance(flow, CotanFlow) and flow.redistribution == "area"
-    assert flow.omega == 10.0 and flow.max_shift is None
+    assert flow.omega == 10.0 and flow.max_shift is None and flow.target == "vertex"
+    assert get_scheme("cotan-redistribute-tri").make(V, F, 0.01).target == "triangle"
