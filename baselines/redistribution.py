@@ -43,7 +43,12 @@ Covolume of vertex ``i`` = its lumped mass ``m_i`` (the scheme's own), so
 normalised by ``sum m_i psi_i = 0`` (the constant projected out; it does
 not enter ``grad psi``).
 The tangential velocity at the vertices is the lumped L2 projection of
-the piecewise constant gradient (:func:`baselines.kernels.vertex_gradients`).
+the piecewise constant gradient, projected onto the tangent plane of the
+area-weighted vertex normal (:func:`baselines.kernels.vertex_gradients`).
+It enters the cotangent step explicitly, ``(I + tau M^{-1} L) X^{n+1} =
+X^n + tau s v^n`` (R3), ``s = 1`` or the limiter :func:`shift_limit` (R4).
+``target="triangle"`` (:func:`target_shares`) replaces ``1/N`` in (R2)
+by the share of a mesh of equal-area triangles.
 
 Fixed boundary: boundary vertices do not move (``V = 0`` and ``v_T = 0``
 there, so ``h . V = 0`` in (R2)); ``psi`` takes the natural (Neumann)
