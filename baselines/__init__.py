@@ -7,7 +7,10 @@ Every scheme is one class following the contract of ``mcfbench.running.flow.Flow
 ``mcfbench`` (see ``baselines/README.md``).
 
 cotan (:class:`baselines.cotan.CotanFlow`)
-    The cotangent scheme (Dziuk 1991), barycentric or Voronoi lumped mass.
+    The cotangent scheme (Dziuk 1991), barycentric or Voronoi lumped mass;
+    ``redistribution="area"`` adds the area-oriented tangential velocity of
+    :mod:`baselines.redistribution` (Mikula, Remesikova, Sarkoci, Sevcovic
+    2014; registry entry ``cotan-redistribute``).
 cmcf (:class:`baselines.cmcf.CMCFFlow`)
     Conformalized mean curvature flow (Kazhdan, Solomon, Ben-Chen 2012).
 bgn (:class:`baselines.bgn.BGNFlow`)

@@ -44,6 +44,11 @@ Assembly (``assembly=``):
     ``igl.cotmatrix`` and ``igl.massmatrix`` at every step (the reference;
     the matrices agree with ``"cached"`` to rounding).
 
+Tangential redistribution (``redistribution="area"``): the right-hand
+side of (C3) becomes ``X^{n-1} + tau v_T^{n-1}``, ``v_T = grad psi`` the
+area-oriented tangential velocity of :mod:`baselines.redistribution`
+(Mikula, Remesikova, Sarkoci, Sevcovic 2014); the matrix is unchanged.
+
 This module also holds :class:`VertexFlow`, what every vertex-based
 baseline shares: the state, the contract of ``mcfbench.running.flow.Flow``, the
 warm start and the checks of a state (:meth:`VertexFlow.defects`).
@@ -59,6 +64,8 @@ import scipy.sparse as sp
 
 from .kernels import cotan_geometry, neighbour_cosines, row_scaled_system
 from .mesh import edge_mesh, laplacian_pattern
+from .redistribution import (MAX_SHIFT, OMEGA, REDISTRIBUTIONS, redistribution_source,
+                             shift_limit, solve_potential, tangential_velocity, target_shares)
 
 MASS_TYPES = {"barycentric": igl.MASSMATRIX_TYPE_BARYCENTRIC,
               "voronoi": igl.MASSMATRIX_TYPE_VORONOI}
@@ -132,11 +139,18 @@ class SurfaceGeometry:
     area_vectors : (m, 3) float array
         ``(x_1 - x_0) x (x_2 - x_0)`` per triangle (twice the area times
         the unit normal).
+    degenerate : int
+        Triangles of zero (or non-finite) area, left out of ``L`` and the
+        mass by the kernel instead of dividing by zero.
+    first_degenerate : int
+        The first of them, ``-1`` if none.
     """
 
     L_data: np.ndarray
     mass: np.ndarray
     area_vectors: np.ndarray
+    degenerate: int = 0
+    first_degenerate: int = -1
 
 
 class CotanAssembler:
@@ -190,10 +204,12 @@ class CotanAssembler:
         L_data = np.empty(p.nnz) if with_laplacian else np.empty(0)
         mass = np.empty(mesh.n_vertices)
         area_vectors = np.empty((mesh.n_faces, 3))
-        cotan_geometry(np.ascontiguousarray(vertices, dtype=np.float64), mesh.faces,
-                       p.corner_slots, p.diag_slots, self.mass_type == "voronoi",
-                       with_laplacian, L_data, mass, area_vectors)
-        return SurfaceGeometry(L_data if with_laplacian else None, mass, area_vectors)
+        degenerate, first = cotan_geometry(
+            np.ascontiguousarray(vertices, dtype=np.float64), mesh.faces, p.corner_slots,
+            p.diag_slots, self.mass_type == "voronoi", with_laplacian, L_data, mass,
+            area_vectors)
+        return SurfaceGeometry(L_data if with_laplacian else None, mass, area_vectors,
+                               int(degenerate), int(first))
 
     def csr(self, data):
         """A CSR matrix with the pattern of ``L`` and values ``data``."""
@@ -385,7 +401,9 @@ class VertexFlow:
     def defects(self):
         """What is wrong with the current state: ``[(status, description)]``.
 
-        ``"degenerated"``: non-finite coordinates, or triangles whose area
+        ``"degenerated"``: non-finite coordinates, triangles of zero area
+        (which the compiled geometry reports instead of dividing by zero,
+        :attr:`SurfaceGeometry.degenerate`), or triangles whose area
         fell below ``1e-10`` x the mean area (a local collapse) or ``1e-12`` x
         the initial mean area (the surface shrinking to a point, as the DDFV
         scheme checks its diamonds). ``"inverted"``: triangles whose
@@ -397,6 +415,10 @@ class VertexFlow:
             bad = np.flatnonzero(~np.isfinite(self._X).all(axis=0))
             return [("degenerated", f"non-finite coordinates at {len(bad)} vertex(es), "
                      f"e.g. vertex {int(bad[0])}")]
+        g = self.geometry
+        if g.degenerate:
+            return [("degenerated", f"{g.degenerate} triangle(s) of zero area (no cotangent "
+                     f"weights), e.g. triangle {g.first_degenerate}")]
         area = self._triangle_checks[1]
         collapsed = np.flatnonzero(~(area > max(COLLAPSED * area.mean(),
                                                 1e-2 * COLLAPSED * self._area0)))
@@ -430,6 +452,22 @@ class CotanFlow(VertexFlow):
         Lumped mass matrix (see :func:`lumped_mass`).
     assembly : {"cached", "igl"}
         See the module docstring.
+    redistribution : {None, "area"}
+        ``"area"``: add the area-oriented tangential velocity ``v_T = grad
+        psi`` of :mod:`baselines.redistribution` (Mikula, Remesikova,
+        Sarkoci, Sevcovic 2014), explicitly: ``b = X^n + tau v_T^n`` in
+        (C3), the matrix unchanged (R3).
+    omega : float
+        Relaxation rate of the area ratios in (R2), ``>= 0`` (default
+        :data:`baselines.redistribution.OMEGA`).
+    max_shift : float or None
+        Largest change of an edge vector by the explicit tangential step
+        ``tau v_T``, as a fraction of the edge's length: ``v_T`` is scaled
+        by one factor for the whole mesh when needed (R4); None: no limit.
+    target : {"vertex", "triangle"}
+        Target covolume areas of (R2): all equal (``"vertex"``, default) or
+        those of equal-area triangles (``"triangle"``,
+        :func:`baselines.redistribution.target_shares`).
 
     Examples
     --------
@@ -441,12 +479,31 @@ class CotanFlow(VertexFlow):
     ((4, 4), (3, 4), 13.8564)
     """
 
-    def __init__(self, vertices, faces, tau, *, mass="barycentric", assembly="cached"):
+    def __init__(self, vertices, faces, tau, *, mass="barycentric", assembly="cached",
+                 redistribution=None, omega=OMEGA, max_shift=MAX_SHIFT,
+                 target="vertex"):
         if assembly not in ASSEMBLIES:
             raise ValueError(f"unknown assembly {assembly!r}; choose one of "
                              f"{', '.join(ASSEMBLIES)}")
+        if redistribution not in REDISTRIBUTIONS:
+            raise ValueError(f"unknown redistribution {redistribution!r}; choose None or "
+                             f"'area'")
+        if not (np.isfinite(omega) and omega >= 0):
+            raise ValueError(f"omega must be a finite number >= 0, got {omega!r}")
+        if max_shift is not None and not (np.isfinite(max_shift) and max_shift > 0):
+            raise ValueError(f"max_shift must be None or a positive number, got {max_shift!r}")
+        self.max_shift = None if max_shift is None else float(max_shift)
+        self.target = target
+        self._shares = target_shares(faces, len(vertices), target)
+        self.shift_factors = []
+        """Factor ``s <= 1`` of each step's tangential velocity (R4)."""
         self.assembly = assembly
+        self.redistribution = redistribution
+        self.omega = float(omega)
+        self.psi = None
+        """The potential of the last step's tangential velocity (R2), (n,)."""
         super().__init__(vertices, faces, tau, mass=mass)
+        self.timings["redistribution"] = 0.0
 
     def _needs_laplacian(self):
         return self.assembly == "cached"
@@ -465,14 +522,40 @@ class CotanFlow(VertexFlow):
     def _laplacian_data(self):
         return self.geometry.L_data
 
+    def tangential_velocity(self):
+        """``v_T = grad psi`` (R2) at the current state, (3, n); zero at fixed vertices.
+
+        Solves (R2) with the stiffness and mass of this step's system
+        and stores ``psi``.
+        """
+        clock = time.perf_counter()
+        L, mass = self.laplacian(), self._system_mass()
+        f = redistribution_source(L, mass, self._X, self.fixed, self.omega, self._shares)
+        self.psi = solve_potential(L, mass, f)
+        alpha, _ = tangential_velocity(self._X.T, self.faces, self.psi)
+        alpha[:, self.fixed] = 0.0
+        factor = 1.0
+        if self.max_shift is not None:
+            factor = shift_limit(self._X, self.mesh.edges, alpha, self.tau, self.max_shift)
+            alpha *= factor
+        self.shift_factors.append(factor)
+        self.timings["redistribution"] += time.perf_counter() - clock
+        return alpha
+
+    def _rhs(self):
+        if self.redistribution is None:
+            return self._X
+        return self._X + self.tau * self.tangential_velocity()     # (R3)
+
     def system(self):
         """``(A, b)``: ``A = I + tau diag(1/M^n) L^n`` (C3), CSR, rows of
-        boundary vertices = identity; ``b = X^n`` (3, n)."""
+        boundary vertices = identity; ``b = X^n`` (3, n), or ``X^n + tau
+        v_T^n`` with ``redistribution="area"`` (R3)."""
         if self.assembly == "igl":
             L = self.laplacian()
             L.data *= np.repeat(self.tau / self._system_mass(), np.diff(L.indptr))
             A = (L + sp.identity(L.shape[0], format="csr")).tocsr()
-            return (dirichlet_rows(A, self.fixed) if self.mesh.has_boundary else A), self._X
+            return (dirichlet_rows(A, self.fixed) if self.mesh.has_boundary else A), self._rhs()
         A = self.assembler.row_scaled(self._laplacian_data(), self.geometry.mass, self.tau,
                                       self.fixed)
-        return A, self._X
+        return A, self._rhs()

@@ -62,11 +62,21 @@ def cotan_geometry(V, faces, corner_slots, diag_slots, voronoi, with_laplacian,
         Lumped mass ``m_i``.
     area_vectors : (m, 3) float64 array, output
         ``N_t``; ``|N_t| = 2 |t|``.
+
+    Returns
+    -------
+    degenerate : int
+        Number of triangles with ``|N_t| = 0`` (or not finite). They add
+        nothing to ``L`` or the mass (their cotangents are undefined); the
+        caller reports them (never a division by zero here).
+    first : int
+        The first such triangle, ``-1`` if none.
     """
     m = faces.shape[0]
     if with_laplacian:
         L_data[:] = 0.0
     mass[:] = 0.0
+    degenerate, first = 0, -1
     for t in range(m):
         i0, i1, i2 = faces[t, 0], faces[t, 1], faces[t, 2]
         # edges leaving each corner: corner 0: u0 = x1 - x0, v0 = x2 - x0
@@ -76,6 +86,11 @@ def cotan_geometry(V, faces, corner_slots, diag_slots, voronoi, with_laplacian,
         nx, ny, nz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
         area_vectors[t, 0], area_vectors[t, 1], area_vectors[t, 2] = nx, ny, nz
         dbl = np.sqrt(nx * nx + ny * ny + nz * nz)              # 2 |t|
+        if not dbl > 0.0 or not np.isfinite(dbl):                 # zero area or NaN: no cotangents
+            if first < 0:
+                first = t
+            degenerate += 1
+            continue
         # u.v at each corner: 0: (x1-x0).(x2-x0); 1: (x2-x1).(x0-x1); 2: (x0-x2).(x1-x2)
         d0 = ax * bx + ay * by + az * bz
         d1 = -(cx * ax + cy * ay + cz * az)
@@ -115,6 +130,7 @@ def cotan_geometry(V, faces, corner_slots, diag_slots, voronoi, with_laplacian,
             mass[i0] += (s1 * c1 + s2 * c2) / 8.0
             mass[i1] += (s2 * c2 + s0 * c0) / 8.0
             mass[i2] += (s0 * c0 + s1 * c1) / 8.0
+    return degenerate, first
 
 
 @njit(cache=True)
@@ -132,6 +148,12 @@ def vertex_normals(faces, area_vectors, n, omega):
     area_vectors : (m, 3) float64 array
     n : int
     omega : (n, 3) float64 array, output
+        Zero at a vertex whose triangles all have zero area.
+
+    Returns
+    -------
+    int
+        Number of such vertices (never a division by zero here).
     """
     weight = np.zeros(n)
     omega[:] = 0.0
@@ -144,10 +166,16 @@ def vertex_normals(faces, area_vectors, n, omega):
             omega[i, 1] += ny
             omega[i, 2] += nz
             weight[i] += dbl
+    bare = 0
     for i in range(n):
+        if not weight[i] > 0.0:
+            omega[i, 0] = omega[i, 1] = omega[i, 2] = 0.0
+            bare += 1
+            continue
         omega[i, 0] /= weight[i]
         omega[i, 1] /= weight[i]
         omega[i, 2] /= weight[i]
+    return bare
 
 
 @njit(cache=True)
@@ -167,10 +195,20 @@ def row_scaled_system(L_data, indptr, diag_slots, mass, tau, fixed, A_data):
     tau : float
     fixed : (n,) bool array
     A_data : (nnz,) float64 array, output
+        A row whose mass is zero (every triangle at the vertex collapsed)
+        is written as an identity row (the vertex stays where it is).
+
+    Returns
+    -------
+    int
+        Number of rows with zero mass (never a division by zero here).
     """
+    bare = 0
     for i in range(len(mass)):
         lo, hi = indptr[i], indptr[i + 1]
-        if fixed[i]:
+        if not mass[i] > 0.0 and not fixed[i]:
+            bare += 1
+        if fixed[i] or not mass[i] > 0.0:
             for p in range(lo, hi):
                 A_data[p] = 0.0
             A_data[diag_slots[i]] = 1.0
@@ -179,6 +217,7 @@ def row_scaled_system(L_data, indptr, diag_slots, mass, tau, fixed, A_data):
         for p in range(lo, hi):
             A_data[p] = L_data[p] * s
         A_data[diag_slots[i]] += 1.0
+    return bare
 
 
 @njit(cache=True)
@@ -211,15 +250,24 @@ def bgn_system(L_data, indptr, diag_slots, mass, omega, X, tau, fixed, scaled, A
         Multiply row ``(c, k)`` by ``tau / m_k`` (exact: row scaling).
     A_data : (3 (nnz + 2 n),) float64 array, output
     b : (3, n) float64 array, output
+        Rows of a vertex with zero mass are written like Dirichlet rows.
+
+    Returns
+    -------
+    int
+        Number of non-fixed vertices with zero mass (never a division by zero).
     """
     n = len(mass)
     nnz = indptr[n]
+    bare = 0
     for c in range(3):
         for i in range(n):
             start = c * (nnz + 2 * n) + indptr[i] + 2 * i
             lo, hi = indptr[i], indptr[i + 1]
             length = hi - lo
-            if fixed[i]:
+            if c == 0 and not fixed[i] and not mass[i] > 0.0:
+                bare += 1
+            if fixed[i] or not mass[i] > 0.0:
                 for p in range(start, start + length + 2):
                     A_data[p] = 0.0
                 A_data[start + c + diag_slots[i] - lo] = 1.0
@@ -242,6 +290,7 @@ def bgn_system(L_data, indptr, diag_slots, mass, omega, X, tau, fixed, scaled, A
             A_data[base + diag_slots[i] - lo] += coef * wc * wc
             normal = omega[i, 0] * X[0, i] + omega[i, 1] * X[1, i] + omega[i, 2] * X[2, i]
             b[c, i] = coef * wc * normal
+    return bare
 
 
 @njit(cache=True)
@@ -277,3 +326,92 @@ def neighbour_cosines(area_vectors, face_neighbours, cosine, double_areas):
         double_areas[t] = dbl
         norm = dbl * np.sqrt(sx * sx + sy * sy + sz * sz)
         cosine[t] = (nx * sx + ny * sy + nz * sz) / norm if norm > 0.0 else np.nan
+
+
+@njit(cache=True)
+def vertex_gradients(V, faces, psi, alpha):
+    """Gradient of a P1 function at the vertices, lumped L2 projection.
+
+    For the hat-function expansion ``psi = sum_k psi_k phi_k`` the gradient
+    on triangle ``t`` is ``grad_t psi = sum_k psi_k grad phi_k`` with
+    ``grad phi_k = nu_t x e_k / (2 |t|)``, ``e_k = x_{k+2} - x_{k+1}`` the
+    edge opposite corner ``k`` (counter-clockwise about ``nu_t``). Its
+    lumped (barycentric) L2 projection onto P1 vectors is the
+    area-weighted mean over the triangles at each vertex::
+
+        alpha_i = sum_{t ni i} |t| grad_t psi / sum_{t ni i} |t|
+                = sum_t N_t x (sum_k psi_k e_k) / |N_t|  /  sum_t |N_t|
+
+    (``N_t = 2 |t| nu_t``), a combination of tangent vectors of the
+    triangles at ``i``, then projected onto the tangent plane of the
+    area-weighted vertex normal ``n_i = sum_t N_t / |sum_t N_t|``:
+    ``alpha_i - (alpha_i . n_i) n_i``. (Without the projection the mean of
+    the tilted triangle gradients has a normal part of order ``h |grad
+    psi| / R``, a motion that is not tangential; with it, the field is
+    exactly zero at a vertex fixed by a rotation of the mesh about
+    ``n_i``.) The tangential velocity ``v_T = grad psi`` of
+    :mod:`baselines.redistribution`.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    faces : (m, 3) int64 array
+    psi : (n,) float64 array
+    alpha : (n, 3) float64 array, output
+        Zero at a vertex whose triangles all have zero area.
+
+    Returns
+    -------
+    degenerate : int
+        Triangles of zero (or non-finite) area, skipped (never a division
+        by zero here).
+    first : int
+        The first of them, ``-1`` if none.
+    """
+    n = V.shape[0]
+    weight = np.zeros(n)
+    normal = np.zeros((n, 3))
+    alpha[:] = 0.0
+    degenerate, first = 0, -1
+    for t in range(faces.shape[0]):
+        i0, i1, i2 = faces[t, 0], faces[t, 1], faces[t, 2]
+        ax, ay, az = V[i1, 0] - V[i0, 0], V[i1, 1] - V[i0, 1], V[i1, 2] - V[i0, 2]
+        bx, by, bz = V[i2, 0] - V[i0, 0], V[i2, 1] - V[i0, 1], V[i2, 2] - V[i0, 2]
+        nx, ny, nz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+        dbl = np.sqrt(nx * nx + ny * ny + nz * nz)
+        if not dbl > 0.0 or not np.isfinite(dbl):
+            if first < 0:
+                first = t
+            degenerate += 1
+            continue
+        # sum_k psi_k e_k: e_0 = x2 - x1, e_1 = x0 - x2, e_2 = x1 - x0
+        p0, p1, p2 = psi[i0], psi[i1], psi[i2]
+        ex = p0 * (V[i2, 0] - V[i1, 0]) + p1 * (V[i0, 0] - V[i2, 0]) + p2 * (V[i1, 0] - V[i0, 0])
+        ey = p0 * (V[i2, 1] - V[i1, 1]) + p1 * (V[i0, 1] - V[i2, 1]) + p2 * (V[i1, 1] - V[i0, 1])
+        ez = p0 * (V[i2, 2] - V[i1, 2]) + p1 * (V[i0, 2] - V[i2, 2]) + p2 * (V[i1, 2] - V[i0, 2])
+        # N x E / |N| = 2 |t| grad_t psi
+        gx = (ny * ez - nz * ey) / dbl
+        gy = (nz * ex - nx * ez) / dbl
+        gz = (nx * ey - ny * ex) / dbl
+        for k in range(3):
+            i = faces[t, k]
+            alpha[i, 0] += gx
+            alpha[i, 1] += gy
+            alpha[i, 2] += gz
+            weight[i] += dbl
+            normal[i, 0] += nx
+            normal[i, 1] += ny
+            normal[i, 2] += nz
+    for i in range(n):
+        if not weight[i] > 0.0:
+            continue
+        ux, uy, uz = normal[i, 0], normal[i, 1], normal[i, 2]
+        length = np.sqrt(ux * ux + uy * uy + uz * uz)
+        if not length > 0.0:                        # normals cancel: no tangent plane
+            alpha[i, 0] = alpha[i, 1] = alpha[i, 2] = 0.0
+            continue
+        ux, uy, uz = ux / length, uy / length, uz / length
+        gx, gy, gz = alpha[i, 0] / weight[i], alpha[i, 1] / weight[i], alpha[i, 2] / weight[i]
+        d = gx * ux + gy * uy + gz * uz
+        alpha[i, 0], alpha[i, 1], alpha[i, 2] = gx - d * ux, gy - d * uy, gz - d * uz
+    return degenerate, first

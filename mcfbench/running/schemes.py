@@ -125,6 +125,12 @@ SCHEMES = {s.name: s for s in (
            {"mass": "voronoi"}, {"color": "C5", "marker": "<", "linestyle": "--"},
            "the cotangent scheme (Dziuk 1991), Voronoi (mixed) lumped mass (Meyer et al. 2003)",
            matrix="scaled-spd"),
+    Scheme("cotan-redistribute", "cotangent, area redistribution", "baselines.cotan:CotanFlow",
+           {"mass": "barycentric", "redistribution": "area", "target": "triangle"},
+           {"color": "tab:olive", "marker": "P", "linestyle": "--"},
+           "the cotangent scheme (Dziuk 1991) with the area-oriented tangential redistribution "
+           "of Mikula, Remesikova, Sarkoci, Sevcovic (2014), explicit, omega = 10, toward the "
+           "areas of equal-area triangles (half at a fixed boundary)", matrix="scaled-spd"),
     Scheme("cmcf", "conformalized MCF", "baselines.cmcf:CMCFFlow", {"mass": "barycentric"},
            {"color": "C6", "marker": ">", "linestyle": "-."},
            "conformalized mean curvature flow (Kazhdan, Solomon, Ben-Chen 2012): initial "
