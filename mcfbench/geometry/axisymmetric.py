@@ -466,9 +466,9 @@ def initial_meridian(shape, n, **params):
     shape : {"sphere", "torus", "dumbbell", "cylinder", "hemisphere", "angenent"}
         * ``sphere(radius=1)``: pole to pole, ends ``("axis", "axis")``;
         * ``torus(R=2, r=0.5)``: the circle ``(R + r cos v, r sin v)``, closed
-          (``mcfbench.surfaces.torus``);
+          (``mcfbench.geometry.shapes.torus``);
         * ``dumbbell()``: ``r = sqrt(dumbbell_profile(z))`` from the top pole to
-          the bottom one (``mcfbench.surfaces.dumbbell``), ``("axis", "axis")``;
+          the bottom one (``mcfbench.geometry.shapes.dumbbell``), ``("axis", "axis")``;
         * ``cylinder(radius=1, half_height=0.5)``: ``r = R`` from ``z = -h`` to
           ``h``, ``("fixed", "fixed")`` (the ``catenoid`` problem);
         * ``hemisphere(radius=1)``: pole to equator, ``("axis", "fixed")``;

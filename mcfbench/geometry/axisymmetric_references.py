@@ -93,7 +93,7 @@ def reference_numbers(problems=("torus", "dumbbell", "catenoid", "hemisphere", "
     time tolerances ten times tighter; pinch times add the spread of the
     asymptotic fits (:func:`pinch_time_tube`, :func:`pinch_time_neck`).
 
-    Problems (initial shapes of ``mcfbench.problems``):
+    Problems (initial shapes of ``mcfbench.running.problems``):
 
     * ``torus``: ``R = 2, r = 0.5``; ``volume``, ``area``, ``tube_radius``
       (``sqrt(cross-section / pi)``), ``max_height`` at ``times``; ``pinch_time``

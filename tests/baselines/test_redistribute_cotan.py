@@ -9,10 +9,11 @@ from baselines.cotan import CotanFlow
 from baselines.kernels import vertex_gradients
 from baselines.redistribution import (redistribution_source, shift_limit, solve_potential,
                                       target_shares)
-from mcfbench.driver import simulate
-from mcfbench.errors import SphereL2Error, eoc
-from mcfbench.solver import Solver
-from mcfbench.surfaces import cylinder, flat_lattice, icosphere
+from mcfbench.running.driver import simulate
+from mcfbench.geometry.exact import SphereL2Error, eoc
+from mcfbench.running.solver import Solver
+from mcfbench.geometry.shapes import cylinder, flat_lattice
+from mcfbench.geometry.spheres import icosphere
 
 EXACT = Solver(method="direct", rtol=1e-12)
 
@@ -222,7 +223,7 @@ def test_target_shares():
 def test_catenoid_level_1_with_either_target(target, radial_error, smallest_angle):
     # the uniform target cannot be met at the fixed boundary (half stars) and
     # leaves the interior squeezed; the equal-triangle target keeps cotan's angles
-    from mcfbench.studies import run
+    from mcfbench.running.run import run
 
     result, traj = run("cotan-redistribute", "catenoid", 1, target=target)
     assert traj.status == "ok" and traj.steps_done == 375
