@@ -82,6 +82,13 @@ SCHEMES = {s.name: s for s in (
           "DDFV with the tangential velocity eliminated (3.6)"),
     _ddfv("chord-eliminate", "DDFV, chord + elimination", "C4", "D", ":",
           "DDFV with chord |gamma| and the elimination (3.6)"),
+    _ddfv("redistribute", "DDFV, redistribution", "C8", "X", "-",
+          "DDFV with the area-oriented tangential redistribution of the journal version"),
+    _ddfv("chord-redistribute", "DDFV, chord + redistribution", "C9", "h", "--",
+          "DDFV with chord |gamma| and the area-oriented tangential redistribution"),
+    _ddfv("chord-redistribute-carried", "DDFV, chord + redistribution, T carried", "k", "*",
+          "-.", "DDFV with chord |gamma|, redistribution of the F-vertices and every "
+          "T-vertex carried by its triangle"),
     Scheme("cotan", "cotangent", "baselines.cotan:CotanFlow", {"mass": "barycentric"},
            {"color": "C3", "marker": "v", "linestyle": "-"},
            "the cotangent scheme (Dziuk 1991), barycentric lumped mass"),

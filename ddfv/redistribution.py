@@ -1,0 +1,260 @@
+"""Area-oriented tangential redistribution of the diamond mesh (journal version).
+
+The flow (1.1) is changed only by a tangential velocity ``v_T``, which
+moves points along the surface and leaves its shape alone::
+
+    d_t phi = h + v_T,      v_T = grad_G psi                                   (R1)
+
+(Tomek & Mikula, ESAIM: M2AN 53(6) (2019) 1797-1840, after Mikula,
+Remesikova, Sarkoci & Sevcovic, SIAM J. Sci. Comput. 36(4) (2014)
+A1384-A1414; their full texts were not available here: (R1)-(R5) are
+derived below and in ``ddfv/README.md``, section "Journal version").
+
+Derivation. With ``g`` the local area element and ``V = (d_t phi . N) N``
+the normal velocity, ``d_t ln g = div_G (d_t phi) = div_G v_T - h . V``
+(on a sphere of radius ``R(t)``: ``2 R'/R`` on both sides). The total area
+``A`` obeys ``d_t ln A = -<h . V>`` (``<.>`` the surface mean). Asking
+the relative density ``q = g N / A`` (``N`` the number of covolumes) to
+relax to 1 at rate ``omega``, ``d_t q = omega (1 - q)`` in ``ln`` form
+``d_t ln q = omega (1/q - 1)``, gives the surface Poisson problem::
+
+    Delta_G psi = h . V - <h . V> + omega (A / (N m_i) - 1)                   (R2)
+
+per covolume ``i`` of area ``m_i`` (the local area density is the
+covolume area). Integrated over covolume ``i`` with the scheme's own
+fluxes, ``-(K psi)_i ~ int_{V_i} Delta_G psi`` (2.9)::
+
+    K psi = -s,   s_i = m_i (h.V_i - <h.V>) + omega (A / N - m_i)             (R3)
+
+``K`` is the DDFV stiffness matrix of :mod:`ddfv.assembly`; its F-rows and
+its T-rows each sum to zero (every flux leaves one covolume of its family
+and enters another), so ``K psi = -s`` is solvable iff ``s`` sums to zero
+over the F-covolumes and over the T-covolumes (the means ``<h.V>`` and
+``A / N`` are taken per family), and ``psi`` is determined up to one
+constant on the F-vertices and one on the T-vertices, which no diamond
+gradient sees (the constants are pinned to 0 at one vertex of each family).
+
+On a fixed (Dirichlet) boundary no point may cross the boundary:
+``grad psi . nu = 0`` (Neumann), which is the scheme's covolume balance
+without the flux through the boundary edge (the T-row of a boundary
+diamond loses the reflected ghost of Section 2.2.5; the F-rows are those
+of the inner flux balance), and the boundary F-vertices neither move nor
+are driven (their target area is their own area, ``h.V = 0``).
+
+The velocity. The gradient of ``psi`` on diamond ``d`` is the tangent
+vector ``g_d = a u + b v`` in the plane of the diagonals with
+``g_d . u = psi_b - psi_a`` and ``g_d . v = psi_t2 - psi_t1`` (exact for an
+affine ``psi`` on a planar diamond; (2.7))::
+
+    [u.u  u.v] [a]   [psi_b - psi_a  ]
+    [u.v  v.v] [b] = [psi_t2 - psi_t1]                                         (R4)
+
+At a vertex, ``v_T`` is the mean of ``g_d`` over its diamonds weighted by
+their areas ``J_d / 2``, projected onto the tangent plane of the vertex
+normal ``N`` of :func:`ddfv.geometry.vertex_normals`::
+
+    v_T(i) = (I - N N^T) sum_d J_d g_d / sum_d J_d                            (R5)
+
+It enters the step explicitly, on the right-hand side (see
+:class:`ddfv.flow.Flow`), so the matrix, its pattern and the solver are
+those of the paper.
+
+Triangles carried by their T-vertex (:func:`carry_t_vertices`): a
+T-vertex keeps the barycentric coordinates ``lambda^0`` of its initial
+projection in its triangle and its height above the triangle's plane
+from the scheme; this is a tangential velocity of the T-vertices alone,
+applied at the end of the step (see ``ddfv/README.md``).
+"""
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+
+from .assembly import flux_coefficients
+
+#: default relaxation rate ``omega`` of (R2), in 1 / time
+OMEGA = 10.0
+
+
+def neumann_stiffness(assembler, geom):
+    """The DDFV stiffness ``K`` with the Neumann condition of (R3) on a boundary.
+
+    Parameters
+    ----------
+    assembler : ddfv.assembly.Assembler
+    geom : DiamondGeometry
+
+    Returns
+    -------
+    (n, n) scipy.sparse.csr_matrix
+        ``-(K psi)_i`` approximates ``int_{V_i} Delta_G psi`` (2.9) with no
+        flux through the boundary: the rows of boundary F-vertices are the
+        flux balance of their (cut) covolume, and a boundary diamond adds
+        nothing to the row of its T-vertex. Rows of each family sum to zero.
+    """
+    mesh = assembler._mesh
+    n = mesh.n_unknowns
+    K = assembler._matrix(geom, np.ones(n), 0.0)
+    if not mesh.has_boundary:
+        return K
+    bnd = np.flatnonzero(mesh.boundary)
+    a, b, t1 = (mesh.diamonds[bnd, k] for k in range(3))
+    _, _, alpha_hat, beta_hat = (np.asarray(c)[bnd] for c in flux_coefficients(geom))
+    row = mesh.n_f + t1
+    # the ghost T_t2 = F_a + F_b - T_t1 of Section 2.2.5, taken out again
+    ghost = sp.csr_matrix((np.concatenate([-(beta_hat + alpha_hat), beta_hat - alpha_hat,
+                                           2.0 * alpha_hat]),
+                           (np.tile(row, 3), np.concatenate([a, b, row]))), shape=(n, n))
+    return (K - ghost).tocsr()
+
+
+def redistribution_source(chi, hV, n_f, fixed=None, omega=OMEGA):
+    """The source ``s`` of (R3), per covolume: ``K psi = -s``.
+
+    Parameters
+    ----------
+    chi : (n_f + n_t,) float array
+        Covolume areas ``m_i``, F-vertices first.
+    hV : (n_f + n_t,) float array
+        ``h . V`` at every vertex (``H^2`` for mean curvature flow).
+    n_f : int
+    fixed : (n_f,) bool array, optional
+        Dirichlet F-vertices: no motion, no drive (``h.V = 0``, target area
+        their own).
+    omega : float
+        Relaxation rate of (R2) (1 / time).
+
+    Returns
+    -------
+    (n_f + n_t,) float array
+        ``s_i = m_i (h.V_i - <h.V>) + omega (A/N - m_i)``, the means taken
+        over each family (F, T) separately; sums to zero over each family.
+    """
+    chi = np.asarray(chi, dtype=float)
+    hV = np.array(hV, dtype=float)
+    target = np.empty_like(chi)
+    driven = np.ones(len(chi), dtype=bool)
+    if fixed is not None:
+        driven[:n_f] = ~np.asarray(fixed, dtype=bool)
+        hV[:n_f][~driven[:n_f]] = 0.0
+    for family in (slice(0, n_f), slice(n_f, len(chi))):
+        m, d = chi[family], driven[family]
+        mean_hV = np.dot(m, hV[family]) / m.sum()                      # <h.V>  (R2)
+        target[family] = np.where(d, m[d].sum() / max(d.sum(), 1), m)  # A / N  (R2)
+        hV[family] -= mean_hV
+    return chi * hV + omega * (target - chi)
+
+
+def tangential_potential(K, source, n_f):
+    """``psi`` of (R3): ``K psi = -source`` with ``psi = 0`` at one vertex per family.
+
+    Parameters
+    ----------
+    K : (n, n) sparse matrix
+        :func:`neumann_stiffness`.
+    source : (n,) float array
+        :func:`redistribution_source` (sums to zero over each family).
+    n_f : int
+
+    Returns
+    -------
+    (n,) float array
+        Pinned at the F-vertex 0 and the T-vertex 0: the rows of those two
+        are redundant (each family's rows sum to zero), so they are
+        replaced by ``psi = 0``; no diamond gradient sees the two constants.
+    """
+    n = K.shape[0]
+    pinned = np.array([0, n_f])
+    keep = np.ones(n)
+    keep[pinned] = 0.0
+    unit = np.zeros(n)
+    unit[pinned] = 1.0
+    M = (sp.diags(keep) @ K + sp.diags(unit)).tocsc()
+    rhs = -np.asarray(source, dtype=float) * keep
+    return splu(M).solve(rhs)
+
+
+def diamond_gradients(mesh, geom, psi):
+    """(3, n_d) the gradient ``g_d`` of ``psi`` on every diamond (R4).
+
+    Parameters
+    ----------
+    mesh : DiamondMesh
+    geom : DiamondGeometry
+        With the vectors ``u``, ``v``.
+    psi : (n_f + n_t,) float array
+
+    Returns
+    -------
+    (3, n_d) float array
+        ``g_d = a u + b v`` with ``g_d . u = psi_b - psi_a``,
+        ``g_d . v = psi_t2 - psi_t1`` (on a boundary diamond the missing
+        ``psi_t2`` is the reflection ``psi_a + psi_b - psi_t1``, as the
+        T-vertex, Section 2.2.5).
+    """
+    a, b, t1, t2 = mesh.diamonds.T
+    pf, pt = psi[:mesh.n_f], psi[mesh.n_f:]
+    du = pf[b] - pf[a]
+    p2 = np.where(t2 >= 0, pt[np.maximum(t2, 0)], pf[a] + pf[b] - pt[t1])
+    dv = p2 - pt[t1]
+    uu = np.einsum("ij,ij->j", geom.u, geom.u)
+    vv = np.einsum("ij,ij->j", geom.v, geom.v)
+    det = uu * vv - geom.uv ** 2                       # J^2 (2.8)
+    ca = (vv * du - geom.uv * dv) / det
+    cb = (uu * dv - geom.uv * du) / det
+    return ca * geom.u + cb * geom.v
+
+
+def vertex_gradients(mesh, geom, psi, normals):
+    """(3, n_f + n_t) the tangential velocity ``v_T = grad psi`` at every vertex (R5).
+
+    Parameters
+    ----------
+    mesh : DiamondMesh
+    geom : DiamondGeometry
+        With the vectors ``u``, ``v``.
+    psi : (n_f + n_t,) float array
+    normals : (3, n_f + n_t) float array
+        Unit vertex normals (:func:`ddfv.geometry.vertex_normals`).
+
+    Returns
+    -------
+    (3, n_f + n_t) float array
+        The ``J``-weighted mean of the diamond gradients of the vertex's
+        diamonds, projected onto its tangent plane.
+    """
+    n, n_f = mesh.n_unknowns, mesh.n_f
+    a, b, t1, t2 = mesh.diamonds.T
+    inner = t2 >= 0
+    corners = np.concatenate([a, b, n_f + t1, n_f + t2[inner]])
+    g = diamond_gradients(mesh, geom, psi) * geom.J
+    weights = np.concatenate([geom.J, geom.J, geom.J, geom.J[inner]])
+    total = np.bincount(corners, weights, minlength=n)
+    mean = np.stack([np.bincount(corners, np.concatenate([gk, gk, gk, gk[inner]]),
+                                 minlength=n) for gk in g]) / total
+    return mean - (mean * normals).sum(axis=0) * normals
+
+
+def carry_t_vertices(F, T, faces, lam):
+    """T-vertices moved tangentially to the barycentric coordinates ``lam`` of their triangle.
+
+    Parameters
+    ----------
+    F : (n_f, 3) float array
+    T : (n_t, 3) float array
+    faces : (n_t, 3) int array
+    lam : (n_t, 3) float array
+        Barycentric coordinates (rows sum to 1) to keep.
+
+    Returns
+    -------
+    (n_t, 3) float array
+        ``Q + ((T - Q) . n) n`` with ``Q = sum_k lam_k F_k`` and ``n`` the
+        unit normal of the triangle: the height of ``T`` above the plane of
+        its triangle is kept, its projection is put at ``Q``.
+    """
+    p = F[faces]                                            # (n_t, 3, 3)
+    Q = np.einsum("tk,tkj->tj", lam, p)
+    nrm = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+    return Q + np.einsum("ij,ij->i", T - Q, nrm)[:, None] * nrm
