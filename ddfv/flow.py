@@ -320,7 +320,7 @@ class Flow:
         fixed = mesh.boundary_vertices
         source = redistribution_source(covolumes, hV, mesh.n_f, fixed, self.omega)  # (R3)
         psi = tangential_potential(neumann_stiffness(self._assembler, geometry), source,
-                                   mesh.n_f)
+                                   mesh, covolumes)
         v = vertex_gradients(mesh, geometry, psi, N)              # (R4), (R5)
         v[:, :mesh.n_f][:, fixed] = 0.0
         return v

@@ -30,9 +30,10 @@ fluxes, ``-(K psi)_i ~ int_{V_i} Delta_G psi`` (2.9)::
 its T-rows each sum to zero (every flux leaves one covolume of its family
 and enters another), so ``K psi = -s`` is solvable iff ``s`` sums to zero
 over the F-covolumes and over the T-covolumes (the means ``<h.V>`` and
-``A / N`` are taken per family), and ``psi`` is determined up to one
-constant on the F-vertices and one on the T-vertices, which no diamond
-gradient sees (the constants are pinned to 0 at one vertex of each family).
+``A / N`` are taken per family), and ``psi`` is determined up to a
+two-dimensional kernel (on a closed surface one constant on the
+F-vertices and one on the T-vertices, which no diamond gradient sees),
+fixed in :func:`tangential_potential`.
 
 On a fixed (Dirichlet) boundary no point may cross the boundary:
 ``grad psi . nu = 0`` (Neumann), which is the scheme's covolume balance
@@ -89,8 +90,13 @@ def neumann_stiffness(assembler, geom):
     (n, n) scipy.sparse.csr_matrix
         ``-(K psi)_i`` approximates ``int_{V_i} Delta_G psi`` (2.9) with no
         flux through the boundary: the rows of boundary F-vertices are the
-        flux balance of their (cut) covolume, and a boundary diamond adds
-        nothing to the row of its T-vertex. Rows of each family sum to zero.
+        flux balance of their (cut) covolume through the dual curve
+        ``T_t1 -> S`` of each boundary diamond (the missing T-vertex is the
+        reflection ``F_a + F_b - T_t1``, Section 2.2.5, as in the geometry;
+        the curve is half of the reflected diamond's), and a boundary diamond adds nothing to
+        the row of its T-vertex. Rows of each family sum to zero; constants
+        on each family and affine functions on a planar mesh (chord
+        ``|gamma|``) are in the kernel.
     """
     mesh = assembler._mesh
     n = mesh.n_unknowns
@@ -99,13 +105,21 @@ def neumann_stiffness(assembler, geom):
         return K
     bnd = np.flatnonzero(mesh.boundary)
     a, b, t1 = (mesh.diamonds[bnd, k] for k in range(3))
-    _, _, alpha_hat, beta_hat = (np.asarray(c)[bnd] for c in flux_coefficients(geom))
+    alpha, beta, alpha_hat, beta_hat = (np.asarray(c)[bnd] for c in flux_coefficients(geom))
     row = mesh.n_f + t1
-    # the ghost T_t2 = F_a + F_b - T_t1 of Section 2.2.5, taken out again
-    ghost = sp.csr_matrix((np.concatenate([-(beta_hat + alpha_hat), beta_hat - alpha_hat,
-                                           2.0 * alpha_hat]),
-                           (np.tile(row, 3), np.concatenate([a, b, row]))), shape=(n, n))
-    return (K - ghost).tocsr()
+    # F-rows: the assembly leaves out the ghost T_t2 = F_a + F_b - T_t1 of Section
+    # 2.2.5 (its F-rows are Dirichlet rows) and its geometry measures the dual
+    # curve T_t1 -> S -> ghost; on the surface the curve ends at S, the edge
+    # midpoint: half of it. The flux balance needs
+    # flux_a = (alpha (psi_b - psi_a) - beta (psi_a + psi_b - 2 psi_t1)) / 2 = -flux_b.
+    # T-row: the ghost's flux through the boundary edge is taken out (Neumann).
+    rows = np.concatenate([a, a, b, b, row, row, row])
+    cols = np.concatenate([a, b, a, b, a, b, row])
+    vals = np.concatenate([(beta - alpha) / 2, (alpha + beta) / 2,
+                           (alpha - beta) / 2, -(alpha + beta) / 2,
+                           beta_hat + alpha_hat, alpha_hat - beta_hat, -2.0 * alpha_hat])
+    ghost = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+    return (K + ghost).tocsr()
 
 
 def redistribution_source(chi, hV, n_f, fixed=None, omega=OMEGA):
@@ -145,8 +159,8 @@ def redistribution_source(chi, hV, n_f, fixed=None, omega=OMEGA):
     return chi * hV + omega * (target - chi)
 
 
-def tangential_potential(K, source, n_f):
-    """``psi`` of (R3): ``K psi = -source`` with ``psi = 0`` at one vertex per family.
+def tangential_potential(K, source, mesh, chi):
+    """``psi`` of (R3): ``K psi = -source``, its two free constants fixed.
 
     Parameters
     ----------
@@ -154,24 +168,41 @@ def tangential_potential(K, source, n_f):
         :func:`neumann_stiffness`.
     source : (n,) float array
         :func:`redistribution_source` (sums to zero over each family).
-    n_f : int
+    mesh : DiamondMesh
+    chi : (n,) float array
+        Covolume areas (weights of the second condition below).
 
     Returns
     -------
     (n,) float array
-        Pinned at the F-vertex 0 and the T-vertex 0: the rows of those two
-        are redundant (each family's rows sum to zero), so they are
-        replaced by ``psi = 0``; no diamond gradient sees the two constants.
+        The F-rows and the T-rows of ``K`` each sum to zero, so ``K`` has a
+        two-dimensional kernel: on a closed surface a constant on the
+        F-vertices and another on the T-vertices (no diamond gradient sees
+        them); on a surface with boundary the reflected ghost of the boundary
+        diamonds couples the two families and the second kernel vector has a
+        gradient near the boundary. ``psi`` is fixed by ``psi = 0`` at
+        F-vertex 0 (the gradients do not see the constant) and by
+        ``sum_t chi_t (psi_t - mean of psi over the corners of t) = 0``: the
+        T-values are on average those of their triangles. Computed as one LU
+        factorisation of ``K`` with the rows of F-vertex 0 and T-vertex 0
+        replaced by ``psi = 0`` (both rows are sums of the others), one solve
+        for a particular solution and one for the kernel vector ``w``
+        (``w_F0 = 0``, ``w_T0 = 1``).
     """
-    n = K.shape[0]
+    n, n_f = K.shape[0], mesh.n_f
     pinned = np.array([0, n_f])
     keep = np.ones(n)
     keep[pinned] = 0.0
     unit = np.zeros(n)
     unit[pinned] = 1.0
-    M = (sp.diags(keep) @ K + sp.diags(unit)).tocsc()
-    rhs = -np.asarray(source, dtype=float) * keep
-    return splu(M).solve(rhs)
+    lu = splu((sp.diags(keep) @ K + sp.diags(unit)).tocsc())
+    psi = lu.solve(-np.asarray(source, dtype=float) * keep)
+    w = lu.solve(unit * (np.arange(n) == n_f))
+
+    def offset(x):      # sum_t chi_t (x_t - mean of x over the corners of t)
+        return np.dot(chi[n_f:], x[n_f:] - x[mesh.faces].mean(axis=1))
+
+    return psi - offset(psi) / offset(w) * w
 
 
 def diamond_gradients(mesh, geom, psi):

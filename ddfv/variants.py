@@ -19,6 +19,9 @@ scheme registry (``mcfbench/schemes.py``) names each one ``ddfv-<variant>``.
     T-vertices move with ``grad psi``.
 ``chord-redistribute``
     Chord-length ``|gamma|`` and the redistribution.
+``chord-carried``
+    Chord-length ``|gamma|`` and every T-vertex carried by its triangle,
+    no redistribution of the F-vertices.
 ``chord-redistribute-carried``
     Chord-length ``|gamma|``, the redistribution of the F-vertices, and
     every T-vertex carried by its triangle (kept at the barycentric
@@ -35,6 +38,7 @@ VARIANTS = {
     "chord-eliminate": {"dual_length": "chord", "tangential": "eliminate"},
     "redistribute": {"tangential": "redistribute"},
     "chord-redistribute": {"dual_length": "chord", "tangential": "redistribute"},
+    "chord-carried": {"dual_length": "chord", "t_motion": "carried"},
     "chord-redistribute-carried": {"dual_length": "chord", "tangential": "redistribute",
                                    "t_motion": "carried"},
 }
