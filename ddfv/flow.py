@@ -39,8 +39,8 @@ import numpy as np
 from .assembly import Assembler
 from .geometry import diamond_geometry, t_barycentric, vertex_normals
 from .kernels import check_threads, extrapolate_kernel, for_threads
-from .redistribution import (OMEGA, carry_t_vertices, neumann_stiffness,
-                             redistribution_source, tangential_potential, vertex_gradients)
+from .redistribution import (OMEGA, TangentialPotential, carry_t_vertices, neumann_stiffness,
+                             redistribution_source, vertex_gradients)
 from .t_vertices import initial_t_vertices
 from .topology import diamond_mesh, locality_order
 
@@ -168,6 +168,7 @@ class Flow:
         self._J0 = self._geometry.J.mean()
         #: barycentric coordinates kept by ``t_motion="carried"`` (own numbering)
         self._lambda0 = self._barycentric[0].copy() if t_motion == "carried" else None
+        self._potential = None      # the solver of (R3), kept along the flow
 
     @property
     def X(self):
@@ -319,8 +320,9 @@ class Flow:
         hV = (h * N).sum(axis=0) ** 2                            # h.V = H^2 (V = H N)
         fixed = mesh.boundary_vertices
         source = redistribution_source(covolumes, hV, mesh.n_f, fixed, self.omega)  # (R3)
-        psi = tangential_potential(neumann_stiffness(self._assembler, geometry), source,
-                                   mesh, covolumes)
+        if self._potential is None:
+            self._potential = TangentialPotential(mesh)
+        psi = self._potential(neumann_stiffness(self._assembler, geometry), source, covolumes)
         v = vertex_gradients(mesh, geometry, psi, N)              # (R4), (R5)
         v[:, :mesh.n_f][:, fixed] = 0.0
         return v

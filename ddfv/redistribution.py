@@ -159,50 +159,109 @@ def redistribution_source(chi, hV, n_f, fixed=None, omega=OMEGA):
     return chi * hV + omega * (target - chi)
 
 
+class TangentialPotential:
+    """Solver of (R3) along a flow: ``K psi = -s``, its two free constants fixed.
+
+    The F-rows and the T-rows of ``K`` each sum to zero, so ``K`` has a
+    two-dimensional kernel: on a closed surface a constant on the F-vertices
+    and another on the T-vertices (no diamond gradient sees them); on a
+    surface with boundary the reflected ghost of the boundary diamonds couples
+    the two families and the second kernel vector has a gradient near the
+    boundary. ``psi`` is fixed by ``psi = 0`` at F-vertex 0 (the gradients
+    do not see the constant) and by
+    ``sum_t chi_t (psi_t - mean of psi over the corners of t) = 0``: the
+    T-values are on average those of their triangles.
+
+    The rows of F-vertex 0 and T-vertex 0 of ``K`` (sums of the others) are
+    replaced by ``psi = 0``; the matrix ``M`` obtained is factorised
+    (sparse LU, ordering of ``A + A^T``) and the factors are kept: the next
+    systems, whose geometry moved by ``O(tau)``, are solved by iterative
+    refinement with the kept factors, ``x <- x + LU^{-1} (b - M x)`` from the
+    last solution, until ``|b - M x| <= rtol |b|``; when that takes more than
+    ``max_refinements`` passes the matrix is factorised again. One solve for
+    a particular solution and, on a surface with boundary, one for the
+    kernel vector ``w`` (``w_F0 = 0``, ``w_T0 = 1``; on a closed surface
+    ``w`` is 1 on the T-vertices, 0 on the F-vertices). ``psi`` needs no
+    more accuracy than the positions' solve: any tangential velocity leaves
+    the shape alone.
+
+    Parameters
+    ----------
+    mesh : DiamondMesh
+    rtol : float
+        Relative residual of each solve.
+    max_refinements : int
+    """
+
+    def __init__(self, mesh, rtol=1e-10, max_refinements=6):
+        self.mesh, self.rtol, self.max_refinements = mesh, rtol, max_refinements
+        n, n_f = mesh.n_unknowns, mesh.n_f
+        self._keep = np.ones(n)
+        self._keep[[0, n_f]] = 0.0
+        self._unit = 1.0 - self._keep
+        self._lu = None
+        self._last = None
+        #: number of factorisations and of refinement passes so far
+        self.factorisations = self.refinements = 0
+
+    def _solve(self, M, b, x):
+        if self._lu is not None and x is not None:
+            norm = np.linalg.norm(b)
+            for _ in range(self.max_refinements):
+                r = b - M @ x
+                if np.linalg.norm(r) <= self.rtol * norm:
+                    return x
+                x = x + self._lu.solve(r)
+                self.refinements += 1
+            if np.linalg.norm(b - M @ x) <= self.rtol * norm:
+                return x
+        self._lu = splu(M.tocsc(), permc_spec="MMD_AT_PLUS_A")
+        self.factorisations += 1
+        return self._lu.solve(b)
+
+    def __call__(self, K, source, chi):
+        """``psi`` with ``K psi = -source`` (:func:`neumann_stiffness`,
+        :func:`redistribution_source`; ``source`` sums to zero over each
+        family), ``chi`` the (n,) covolume areas.
+
+        Returns
+        -------
+        (n,) float array
+        """
+        n_f, faces = self.mesh.n_f, self.mesh.faces
+        M = (sp.diags(self._keep) @ K + sp.diags(self._unit)).tocsr()
+        psi0, w0 = (None, None) if self._last is None else self._last
+        psi = self._solve(M, -np.asarray(source, dtype=float) * self._keep, psi0)
+        if self.mesh.has_boundary:
+            w = self._solve(M, self._unit * (np.arange(len(self._unit)) == n_f), w0)
+        else:               # closed: the kernel vector is the constant on the T-vertices
+            w = np.r_[np.zeros(n_f), np.ones(self.mesh.n_t)]
+        self._last = psi, w
+
+        def offset(x):      # sum_t chi_t (x_t - mean of x over the corners of t)
+            return np.dot(chi[n_f:], x[n_f:] - x[faces].mean(axis=1))
+
+        return psi - offset(psi) / offset(w) * w
+
+
 def tangential_potential(K, source, mesh, chi):
-    """``psi`` of (R3): ``K psi = -source``, its two free constants fixed.
+    """``psi`` of (R3) in one call (see :class:`TangentialPotential`).
 
     Parameters
     ----------
     K : (n, n) sparse matrix
         :func:`neumann_stiffness`.
     source : (n,) float array
-        :func:`redistribution_source` (sums to zero over each family).
+        :func:`redistribution_source`.
     mesh : DiamondMesh
     chi : (n,) float array
-        Covolume areas (weights of the second condition below).
+        Covolume areas.
 
     Returns
     -------
     (n,) float array
-        The F-rows and the T-rows of ``K`` each sum to zero, so ``K`` has a
-        two-dimensional kernel: on a closed surface a constant on the
-        F-vertices and another on the T-vertices (no diamond gradient sees
-        them); on a surface with boundary the reflected ghost of the boundary
-        diamonds couples the two families and the second kernel vector has a
-        gradient near the boundary. ``psi`` is fixed by ``psi = 0`` at
-        F-vertex 0 (the gradients do not see the constant) and by
-        ``sum_t chi_t (psi_t - mean of psi over the corners of t) = 0``: the
-        T-values are on average those of their triangles. Computed as one LU
-        factorisation of ``K`` with the rows of F-vertex 0 and T-vertex 0
-        replaced by ``psi = 0`` (both rows are sums of the others), one solve
-        for a particular solution and one for the kernel vector ``w``
-        (``w_F0 = 0``, ``w_T0 = 1``).
     """
-    n, n_f = K.shape[0], mesh.n_f
-    pinned = np.array([0, n_f])
-    keep = np.ones(n)
-    keep[pinned] = 0.0
-    unit = np.zeros(n)
-    unit[pinned] = 1.0
-    lu = splu((sp.diags(keep) @ K + sp.diags(unit)).tocsc())
-    psi = lu.solve(-np.asarray(source, dtype=float) * keep)
-    w = lu.solve(unit * (np.arange(n) == n_f))
-
-    def offset(x):      # sum_t chi_t (x_t - mean of x over the corners of t)
-        return np.dot(chi[n_f:], x[n_f:] - x[mesh.faces].mean(axis=1))
-
-    return psi - offset(psi) / offset(w) * w
+    return TangentialPotential(mesh)(K, source, chi)
 
 
 def diamond_gradients(mesh, geom, psi):
