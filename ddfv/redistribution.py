@@ -33,7 +33,7 @@ over the F-covolumes and over the T-covolumes (the means ``<h.V>`` and
 ``A / N`` are taken per family), and ``psi`` is determined up to a
 two-dimensional kernel (on a closed surface one constant on the
 F-vertices and one on the T-vertices, which no diamond gradient sees),
-fixed in :func:`tangential_potential`.
+fixed in :class:`TangentialPotential`.
 
 On a fixed (Dirichlet) boundary no point may cross the boundary:
 ``grad psi . nu = 0`` (Neumann), which is the scheme's covolume balance
