@@ -286,3 +286,23 @@ def test_sliver_mesh_runs_with_carried_t_vertices_but_not_with_the_paper():
                     observers=[lambda f: monitor.append(f.t_min_barycentric())])
     assert ours.status == "ok" and flow.n == steps
     assert min(monitor) > 0.0
+
+
+def test_redistribution_on_a_flat_patch_keeps_it_flat_and_its_boundary_fixed():
+    """Fixed boundary: boundary F-vertices do not move, the patch stays in its plane,
+    the interior vertices move in it (omega = 100 over t = 0.1) and the F-covolumes
+    become more even."""
+    V, F = surfaces.flat_patch(level=1, jitter=0.3, seed=0)
+    opts = {**CARRIED, "omega": 100.0}
+    flow = Flow(V, F, 0.005, **opts)
+    fixed = flow.fixed
+    chi0 = flow.covolumes[:len(V)][~fixed]
+    traj = simulate(flow, 20, save_every=0, solver=Solver(rtol=1e-12))
+    assert traj.status == "ok"
+    np.testing.assert_array_equal(flow.F[fixed], V[fixed])
+    assert np.abs(flow.F[:, 2]).max() < 1e-13 and np.abs(flow.T[:, 2]).max() < 1e-13
+    assert np.linalg.norm(flow.F - V, axis=1).max() > 1e-3
+    chi = flow.covolumes[:len(V)][~fixed]
+    spread = lambda c: c.std() / c.mean()
+    assert spread(chi) < 0.8 * spread(chi0), (spread(chi0), spread(chi))
+    assert flow.t_min_barycentric() > 0.3
