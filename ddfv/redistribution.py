@@ -74,7 +74,7 @@ from scipy.sparse.linalg import splu
 from .assembly import flux_coefficients
 
 #: default relaxation rate ``omega`` of (R2), in 1 / time
-OMEGA = 10.0
+OMEGA = 1.0
 
 
 def neumann_stiffness(assembler, geom):
