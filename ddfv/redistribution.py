@@ -189,11 +189,13 @@ class TangentialPotential:
     ----------
     mesh : DiamondMesh
     rtol : float
-        Relative residual of each solve.
+        Relative residual of each solve (1e-7: an error of ``psi`` only
+        changes a tangential velocity, by ``rtol tau |v_T|`` per step, below
+        the positions' own solver tolerance).
     max_refinements : int
     """
 
-    def __init__(self, mesh, rtol=1e-10, max_refinements=6):
+    def __init__(self, mesh, rtol=1e-7, max_refinements=6):
         self.mesh, self.rtol, self.max_refinements = mesh, rtol, max_refinements
         n, n_f = mesh.n_unknowns, mesh.n_f
         self._keep = np.ones(n)
