@@ -38,9 +38,11 @@ fixed in :class:`TangentialPotential`.
 On a fixed (Dirichlet) boundary no point may cross the boundary:
 ``grad psi . nu = 0`` (Neumann), which is the scheme's covolume balance
 without the flux through the boundary edge (the T-row of a boundary
-diamond loses the reflected ghost of Section 2.2.5; the F-rows are those
-of the inner flux balance), and the boundary F-vertices neither move nor
-are driven (their target area is their own area, ``h.V = 0``).
+diamond loses the reflected ghost of Section 2.2.5; the F-rows of a
+boundary diamond take the flux through its dual curve ``T_t1 -> S`` only,
+with the ghost, :func:`neumann_stiffness`), and the boundary F-vertices
+neither move nor are driven (their target area is their own area,
+``h.V = 0``).
 
 The velocity. The gradient of ``psi`` on diamond ``d`` is the tangent
 vector ``g_d = a u + b v`` in the plane of the diagonals with
@@ -60,7 +62,7 @@ It enters the step explicitly, on the right-hand side (see
 :class:`ddfv.flow.Flow`), so the matrix, its pattern and the solver are
 those of the paper.
 
-Triangles carried by their T-vertex (:func:`carry_t_vertices`): a
+T-vertices carried by their triangles (:func:`carry_t_vertices`): a
 T-vertex keeps the barycentric coordinates ``lambda^0`` of its initial
 projection in its triangle and its height above the triangle's plane
 from the scheme; this is a tangential velocity of the T-vertices alone,
