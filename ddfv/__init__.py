@@ -4,7 +4,8 @@ The scheme of the paper, read in its order: :mod:`ddfv.topology` (the
 diamond mesh, 2.2.2) -> :mod:`ddfv.geometry` (per-diamond quantities,
 2.2.3-2.2.5) -> :mod:`ddfv.t_vertices` (initial T-vertices, Section 3) ->
 :mod:`ddfv.assembly` (the system (2.10)-(2.15)) -> :mod:`ddfv.flow`
-(semi-implicit steps (2.1), Dirichlet boundary (1.2), elimination (3.6))
+(semi-implicit steps (2.1), Dirichlet boundary (1.2), elimination (3.6),
+the journal version's tangential redistribution :mod:`ddfv.redistribution`)
 with its named :mod:`ddfv.variants`.
 
 This package is the scheme only: it imports nothing from the harness
@@ -16,7 +17,8 @@ Public API
 Flow(vertices, faces, tau, **options)
     One DDFV flow; ``flow.step(solve)`` advances one time step.
 VARIANTS, variant_options(name)
-    Named variants of the scheme (paper, chord, eliminate, chord-eliminate).
+    Named variants of the scheme (paper, chord, eliminate, chord-eliminate,
+    redistribute, chord-redistribute, chord-carried, chord-redistribute-carried).
 DiamondMesh, diamond_mesh(faces)
     The diamond mesh (Section 2.2.2).
 """

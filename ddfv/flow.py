@@ -39,11 +39,14 @@ import numpy as np
 from .assembly import Assembler
 from .geometry import diamond_geometry, t_barycentric, vertex_normals
 from .kernels import check_threads, extrapolate_kernel, for_threads
+from .redistribution import (OMEGA, TangentialPotential, carry_t_vertices, neumann_stiffness,
+                             redistribution_source, vertex_gradients)
 from .t_vertices import initial_t_vertices
 from .topology import diamond_mesh, locality_order
 
 WARM_STARTS = ("extrapolate", "previous")
-TANGENTIAL = ("none", "eliminate")
+TANGENTIAL = ("none", "eliminate", "redistribute")
+T_MOTIONS = ("scheme", "carried")
 
 
 def collapsed_cells(measure, threshold, cell, name=str):
@@ -82,9 +85,20 @@ class Flow:
         T-vertex initialisation (see :mod:`ddfv.t_vertices`).
     warm_start : {"extrapolate", "previous"}
         Initial guess of BiCGStab (see module docstring).
-    tangential : {"none", "eliminate"}
+    tangential : {"none", "eliminate", "redistribute"}
         ``"eliminate"`` removes the tangential part of the discrete mean
-        curvature vector from the velocity (3.6).
+        curvature vector from the velocity (3.6); ``"redistribute"`` adds
+        the area-oriented tangential velocity ``grad psi`` of
+        :mod:`ddfv.redistribution` (R1)-(R5), explicitly:
+        ``X^{n-1} + tau v_T^{n-1}`` on the right-hand side.
+    omega : float
+        Relaxation rate of the redistribution (R2), in 1 / time (default
+        :data:`ddfv.redistribution.OMEGA`).
+    t_motion : {"scheme", "carried"}
+        ``"carried"``: after each step every T-vertex is moved tangentially
+        back to the barycentric coordinates of its initial projection in its
+        triangle, keeping its height above the triangle's plane
+        (:func:`ddfv.redistribution.carry_t_vertices`).
     dual_length : {"broken", "chord"}
         Length of the dual curves ``|gamma|``: the paper's broken line (2.5)
         or the chord (see :func:`ddfv.geometry.diamond_geometry`).
@@ -104,7 +118,8 @@ class Flow:
     """
 
     def __init__(self, vertices, faces, tau, *, T0=None, t_init="paper",
-                 warm_start="extrapolate", tangential="none", dual_length="broken", threads=1):
+                 warm_start="extrapolate", tangential="none", dual_length="broken", threads=1,
+                 omega=OMEGA, t_motion="scheme"):
         if not (np.isfinite(tau) and tau > 0):
             raise ValueError(f"tau must be a positive number, got {tau!r}")
         if warm_start not in WARM_STARTS:
@@ -113,8 +128,14 @@ class Flow:
         if tangential not in TANGENTIAL:
             raise ValueError(f"unknown tangential {tangential!r}; choose one of "
                              f"{', '.join(TANGENTIAL)}")
+        if t_motion not in T_MOTIONS:
+            raise ValueError(f"unknown t_motion {t_motion!r}; choose one of "
+                             f"{', '.join(T_MOTIONS)}")
+        if not (np.isfinite(omega) and omega >= 0):
+            raise ValueError(f"omega must be a number >= 0, got {omega!r}")
         check_threads(threads)
         self.threads = threads
+        self.omega, self.t_motion = float(omega), t_motion
         self._faces = diamond_mesh(faces, len(vertices)).faces   # checked, as given
         n_f, n_t = len(vertices), len(self._faces)
         # the flow's own numbering (module docstring): position j holds the
@@ -145,6 +166,9 @@ class Flow:
         self._assembler = Assembler(self._mesh)
         self.timings = {"geometry": 0.0, "assembly": 0.0, "solve": 0.0}
         self._J0 = self._geometry.J.mean()
+        #: barycentric coordinates kept by ``t_motion="carried"`` (own numbering)
+        self._lambda0 = self._barycentric[0].copy() if t_motion == "carried" else None
+        self._potential = None      # the solver of (R3), kept along the flow
 
     @property
     def X(self):
@@ -191,7 +215,7 @@ class Flow:
         chi = np.empty(self._mesh.n_unknowns)
         geometry = diamond_geometry(self._mesh, self._X[:, :n_f].T, self._X[:, n_f:].T,
                                     self.dual_length, self.threads,
-                                    vectors=self.tangential == "eliminate",  # normals (3.6)
+                                    vectors=self.tangential != "none",  # normals, gradients
                                     covolumes=chi)
         return geometry, chi
 
@@ -260,6 +284,8 @@ class Flow:
             h = (self._X - (A @ self._X.T).T) / self.tau            # h^{n-1}
             N = vertex_normals(self._mesh, geometry)                  # N^{n-1}
             rhs = self._X - self.tau * (h - (h * N).sum(axis=0) * N)  # (3.6)
+        elif self.tangential == "redistribute":
+            rhs = self._X + self.tau * self._tangential_velocity(A, geometry, covolumes)
         x0 = self._X
         owned = False
         if self.warm_start == "extrapolate":
@@ -272,11 +298,34 @@ class Flow:
         else:
             X, info = solve(A, rhs, x0)
         self._tick("solve", clock)
-        self._X_prev, self._X = self._X, np.ascontiguousarray(X)
+        X = np.ascontiguousarray(X)
+        if self.t_motion == "carried":       # a tangential move of the T-vertices
+            n_f = self._mesh.n_f
+            X = X.copy()
+            X[:, n_f:] = carry_t_vertices(X[:, :n_f].T, X[:, n_f:].T, self._mesh.faces,
+                                          self._lambda0).T
+        self._X_prev, self._X = self._X, X
         self.n += 1
         for name in ("_state", "_barycentric"):
             self.__dict__.pop(name, None)
         return info
+
+    def _tangential_velocity(self, A, geometry, covolumes):
+        """(3, n) ``v_T = grad psi`` of the current state (R1)-(R5), zero at
+        Dirichlet F-vertices; ``A`` the step's matrix (its discrete Laplacian
+        gives ``h``, as in (3.6))."""
+        mesh = self._mesh
+        N = vertex_normals(mesh, geometry)
+        h = (self._X - (A @ self._X.T).T) / self.tau             # h^{n-1}, zero at fixed F
+        hV = (h * N).sum(axis=0) ** 2                            # h.V = H^2 (V = H N)
+        fixed = mesh.boundary_vertices
+        source = redistribution_source(covolumes, hV, mesh.n_f, fixed, self.omega)  # (R3)
+        if self._potential is None:
+            self._potential = TangentialPotential(mesh)
+        psi = self._potential(neumann_stiffness(self._assembler, geometry), source, covolumes)
+        v = vertex_gradients(mesh, geometry, psi, N)              # (R4), (R5)
+        v[:, :mesh.n_f][:, fixed] = 0.0
+        return v
 
     def _tick(self, phase, since):
         now = time.perf_counter()

@@ -13,6 +13,20 @@ scheme registry (``mcfbench/running/schemes.py``) names each one ``ddfv-<variant
     The paper's scheme with the tangential-velocity elimination (3.6).
 ``chord-eliminate``
     Both: chord-length ``|gamma|`` and the elimination (3.6).
+``redistribute``
+    The paper's scheme with the area-oriented tangential redistribution of
+    the journal version (:mod:`ddfv.redistribution`, (R1)-(R5)): F- and
+    T-vertices move with ``grad psi``.
+``chord-redistribute``
+    Chord-length ``|gamma|`` and the redistribution.
+``chord-carried``
+    Chord-length ``|gamma|`` and every T-vertex carried by its triangle,
+    no redistribution of the F-vertices.
+``chord-redistribute-carried``
+    Chord-length ``|gamma|``, the redistribution of the F-vertices, and
+    every T-vertex carried by its triangle (kept at the barycentric
+    coordinates of its initial, curvature-corrected position; see
+    ``ddfv/README.md``).
 
 The T-vertex initialisation is a separate setting (``t_init``).
 """
@@ -22,6 +36,11 @@ VARIANTS = {
     "chord": {"dual_length": "chord"},
     "eliminate": {"tangential": "eliminate"},
     "chord-eliminate": {"dual_length": "chord", "tangential": "eliminate"},
+    "redistribute": {"tangential": "redistribute"},
+    "chord-redistribute": {"dual_length": "chord", "tangential": "redistribute"},
+    "chord-carried": {"dual_length": "chord", "t_motion": "carried"},
+    "chord-redistribute-carried": {"dual_length": "chord", "tangential": "redistribute",
+                                   "t_motion": "carried"},
 }
 
 

@@ -10,12 +10,18 @@ from mcfbench.running.schemes import SCHEMES
 
 def test_variants_are_options_of_the_flow():
     V, F = icosphere(1)
-    expected = {"paper": ("broken", "none"), "chord": ("chord", "none"),
-                "eliminate": ("broken", "eliminate"), "chord-eliminate": ("chord", "eliminate")}
+    expected = {"paper": ("broken", "none", "scheme"), "chord": ("chord", "none", "scheme"),
+                "eliminate": ("broken", "eliminate", "scheme"),
+                "chord-eliminate": ("chord", "eliminate", "scheme"),
+                "redistribute": ("broken", "redistribute", "scheme"),
+                "chord-redistribute": ("chord", "redistribute", "scheme"),
+                "chord-carried": ("chord", "none", "carried"),
+                "chord-redistribute-carried": ("chord", "redistribute", "carried")}
     assert set(VARIANTS) == set(expected)
-    for name, (dual_length, tangential) in expected.items():
+    for name, (dual_length, tangential, t_motion) in expected.items():
         flow = Flow(V, F, 0.01, **variant_options(name))
-        assert (flow.dual_length, flow.tangential) == (dual_length, tangential)
+        assert (flow.dual_length, flow.tangential, flow.t_motion) == \
+            (dual_length, tangential, t_motion)
 
 
 def test_every_variant_is_a_registered_scheme():

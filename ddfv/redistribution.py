@@ -1,0 +1,354 @@
+"""Area-oriented tangential redistribution of the diamond mesh (journal version).
+
+The flow (1.1) is changed only by a tangential velocity ``v_T``, which
+moves points along the surface and leaves its shape alone::
+
+    d_t phi = h + v_T,      v_T = grad_G psi                                   (R1)
+
+(Tomek & Mikula, ESAIM: M2AN 53(6) (2019) 1797-1840, after Mikula,
+Remesikova, Sarkoci & Sevcovic, SIAM J. Sci. Comput. 36(4) (2014)
+A1384-A1414; their full texts were not available here: (R1)-(R5) are
+derived below and in ``ddfv/README.md``, section "Journal version").
+
+Derivation. With ``g`` the local area element and ``V = (d_t phi . N) N``
+the normal velocity, ``d_t ln g = div_G (d_t phi) = div_G v_T - h . V``
+(on a sphere of radius ``R(t)``: ``2 R'/R`` on both sides). The total area
+``A`` obeys ``d_t ln A = -<h . V>`` (``<.>`` the surface mean). Asking
+the relative density ``q = g N / A`` (``N`` the number of covolumes) to
+relax to 1 at rate ``omega``, ``d_t q = omega (1 - q)`` in ``ln`` form
+``d_t ln q = omega (1/q - 1)``, gives the surface Poisson problem::
+
+    Delta_G psi = h . V - <h . V> + omega (A / (N m_i) - 1)                   (R2)
+
+per covolume ``i`` of area ``m_i`` (the local area density is the
+covolume area). Integrated over covolume ``i`` with the scheme's own
+fluxes, ``-(K psi)_i ~ int_{V_i} Delta_G psi`` (2.9)::
+
+    K psi = -s,   s_i = m_i (h.V_i - <h.V>) + omega (A / N - m_i)             (R3)
+
+``K`` is the DDFV stiffness matrix of :mod:`ddfv.assembly`; its F-rows and
+its T-rows each sum to zero (every flux leaves one covolume of its family
+and enters another), so ``K psi = -s`` is solvable iff ``s`` sums to zero
+over the F-covolumes and over the T-covolumes (the means ``<h.V>`` and
+``A / N`` are taken per family), and ``psi`` is determined up to a
+two-dimensional kernel (on a closed surface one constant on the
+F-vertices and one on the T-vertices, which no diamond gradient sees),
+fixed in :class:`TangentialPotential`.
+
+On a fixed (Dirichlet) boundary no point may cross the boundary:
+``grad psi . nu = 0`` (Neumann), which is the scheme's covolume balance
+without the flux through the boundary edge (the T-row of a boundary
+diamond loses the reflected ghost of Section 2.2.5; the F-rows of a
+boundary diamond take the flux through its dual curve ``T_t1 -> S`` only,
+with the ghost, :func:`neumann_stiffness`), and the boundary F-vertices
+neither move nor are driven (their target area is their own area,
+``h.V = 0``).
+
+The velocity. The gradient of ``psi`` on diamond ``d`` is the tangent
+vector ``g_d = a u + b v`` in the plane of the diagonals with
+``g_d . u = psi_b - psi_a`` and ``g_d . v = psi_t2 - psi_t1`` (exact for an
+affine ``psi`` on a planar diamond; (2.7))::
+
+    [u.u  u.v] [a]   [psi_b - psi_a  ]
+    [u.v  v.v] [b] = [psi_t2 - psi_t1]                                         (R4)
+
+At a vertex, ``v_T`` is the mean of ``g_d`` over its diamonds weighted by
+their areas ``J_d / 2``, projected onto the tangent plane of the vertex
+normal ``N`` of :func:`ddfv.geometry.vertex_normals`::
+
+    v_T(i) = (I - N N^T) sum_d J_d g_d / sum_d J_d                            (R5)
+
+It enters the step explicitly, on the right-hand side (see
+:class:`ddfv.flow.Flow`), so the matrix, its pattern and the solver are
+those of the paper.
+
+T-vertices carried by their triangles (:func:`carry_t_vertices`): a
+T-vertex keeps the barycentric coordinates ``lambda^0`` of its initial
+projection in its triangle and its height above the triangle's plane
+from the scheme; this is a tangential velocity of the T-vertices alone,
+applied at the end of the step (see ``ddfv/README.md``).
+"""
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+
+from .assembly import flux_coefficients
+
+#: default relaxation rate ``omega`` of (R2), in 1 / time
+OMEGA = 1.0
+
+
+def neumann_stiffness(assembler, geom):
+    """The DDFV stiffness ``K`` with the Neumann condition of (R3) on a boundary.
+
+    Parameters
+    ----------
+    assembler : ddfv.assembly.Assembler
+    geom : DiamondGeometry
+
+    Returns
+    -------
+    (n, n) scipy.sparse.csr_matrix
+        ``-(K psi)_i`` approximates ``int_{V_i} Delta_G psi`` (2.9) with no
+        flux through the boundary: the rows of boundary F-vertices are the
+        flux balance of their (cut) covolume through the dual curve
+        ``T_t1 -> S`` of each boundary diamond (the missing T-vertex is the
+        reflection ``F_a + F_b - T_t1``, Section 2.2.5, as in the geometry;
+        the curve is half of the reflected diamond's), and a boundary diamond adds nothing to
+        the row of its T-vertex. Rows of each family sum to zero; constants
+        on each family and affine functions on a planar mesh (chord
+        ``|gamma|``) are in the kernel.
+    """
+    mesh = assembler._mesh
+    n = mesh.n_unknowns
+    K = assembler._matrix(geom, np.ones(n), 0.0)
+    if not mesh.has_boundary:
+        return K
+    bnd = np.flatnonzero(mesh.boundary)
+    a, b, t1 = (mesh.diamonds[bnd, k] for k in range(3))
+    alpha, beta, alpha_hat, beta_hat = (np.asarray(c)[bnd] for c in flux_coefficients(geom))
+    row = mesh.n_f + t1
+    # F-rows: the assembly leaves out the ghost T_t2 = F_a + F_b - T_t1 of Section
+    # 2.2.5 (its F-rows are Dirichlet rows) and its geometry measures the dual
+    # curve T_t1 -> S -> ghost; on the surface the curve ends at S, the edge
+    # midpoint: half of it. The flux balance needs
+    # flux_a = (alpha (psi_b - psi_a) - beta (psi_a + psi_b - 2 psi_t1)) / 2 = -flux_b.
+    # T-row: the ghost's flux through the boundary edge is taken out (Neumann).
+    rows = np.concatenate([a, a, b, b, row, row, row])
+    cols = np.concatenate([a, b, a, b, a, b, row])
+    vals = np.concatenate([(beta - alpha) / 2, (alpha + beta) / 2,
+                           (alpha - beta) / 2, -(alpha + beta) / 2,
+                           beta_hat + alpha_hat, alpha_hat - beta_hat, -2.0 * alpha_hat])
+    ghost = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+    return (K + ghost).tocsr()
+
+
+def redistribution_source(chi, hV, n_f, fixed=None, omega=OMEGA):
+    """The source ``s`` of (R3), per covolume: ``K psi = -s``.
+
+    Parameters
+    ----------
+    chi : (n_f + n_t,) float array
+        Covolume areas ``m_i``, F-vertices first.
+    hV : (n_f + n_t,) float array
+        ``h . V`` at every vertex (``H^2`` for mean curvature flow).
+    n_f : int
+    fixed : (n_f,) bool array, optional
+        Dirichlet F-vertices: no motion, no drive (``h.V = 0``, target area
+        their own).
+    omega : float
+        Relaxation rate of (R2) (1 / time).
+
+    Returns
+    -------
+    (n_f + n_t,) float array
+        ``s_i = m_i (h.V_i - <h.V>) + omega (A/N - m_i)``, the means taken
+        over each family (F, T) separately; sums to zero over each family.
+    """
+    chi = np.asarray(chi, dtype=float)
+    hV = np.array(hV, dtype=float)
+    target = np.empty_like(chi)
+    driven = np.ones(len(chi), dtype=bool)
+    if fixed is not None:
+        driven[:n_f] = ~np.asarray(fixed, dtype=bool)
+        hV[:n_f][~driven[:n_f]] = 0.0
+    for family in (slice(0, n_f), slice(n_f, len(chi))):
+        m, d = chi[family], driven[family]
+        mean_hV = np.dot(m, hV[family]) / m.sum()                      # <h.V>  (R2)
+        target[family] = np.where(d, m[d].sum() / max(d.sum(), 1), m)  # A / N  (R2)
+        hV[family] -= mean_hV
+    return chi * hV + omega * (target - chi)
+
+
+class TangentialPotential:
+    """Solver of (R3) along a flow: ``K psi = -s``, its two free constants fixed.
+
+    The F-rows and the T-rows of ``K`` each sum to zero, so ``K`` has a
+    two-dimensional kernel: on a closed surface a constant on the F-vertices
+    and another on the T-vertices (no diamond gradient sees them); on a
+    surface with boundary the reflected ghost of the boundary diamonds couples
+    the two families and the second kernel vector has a gradient near the
+    boundary. ``psi`` is fixed by ``psi = 0`` at F-vertex 0 (the gradients
+    do not see the constant) and by
+    ``sum_t chi_t (psi_t - mean of psi over the corners of t) = 0``: the
+    T-values are on average those of their triangles.
+
+    The rows of F-vertex 0 and T-vertex 0 of ``K`` (sums of the others) are
+    replaced by ``psi = 0``; the matrix ``M`` obtained is factorised
+    (sparse LU, ordering of ``A + A^T``) and the factors are kept: the next
+    systems, whose geometry moved by ``O(tau)``, are solved by iterative
+    refinement with the kept factors, ``x <- x + LU^{-1} (b - M x)`` from the
+    last solution, until ``|b - M x| <= rtol |b|``; when that takes more than
+    ``max_refinements`` passes the matrix is factorised again. One solve for
+    a particular solution and, on a surface with boundary, one for the
+    kernel vector ``w`` (``w_F0 = 0``, ``w_T0 = 1``; on a closed surface
+    ``w`` is 1 on the T-vertices, 0 on the F-vertices). ``psi`` needs no
+    more accuracy than the positions' solve: any tangential velocity leaves
+    the shape alone.
+
+    Parameters
+    ----------
+    mesh : DiamondMesh
+    rtol : float
+        Relative residual of each solve (1e-7: an error of ``psi`` only
+        changes a tangential velocity, by ``rtol tau |v_T|`` per step, below
+        the positions' own solver tolerance).
+    max_refinements : int
+    """
+
+    def __init__(self, mesh, rtol=1e-7, max_refinements=6):
+        self.mesh, self.rtol, self.max_refinements = mesh, rtol, max_refinements
+        n, n_f = mesh.n_unknowns, mesh.n_f
+        self._keep = np.ones(n)
+        self._keep[[0, n_f]] = 0.0
+        self._unit = 1.0 - self._keep
+        self._lu = None
+        self._last = None
+        #: number of factorisations and of refinement passes so far
+        self.factorisations = self.refinements = 0
+
+    def _solve(self, M, b, x):
+        if self._lu is not None and x is not None:
+            norm = np.linalg.norm(b)
+            for _ in range(self.max_refinements):
+                r = b - M @ x
+                if np.linalg.norm(r) <= self.rtol * norm:
+                    return x
+                x = x + self._lu.solve(r)
+                self.refinements += 1
+            if np.linalg.norm(b - M @ x) <= self.rtol * norm:
+                return x
+        self._lu = splu(M.tocsc(), permc_spec="MMD_AT_PLUS_A")
+        self.factorisations += 1
+        return self._lu.solve(b)
+
+    def __call__(self, K, source, chi):
+        """``psi`` with ``K psi = -source`` (:func:`neumann_stiffness`,
+        :func:`redistribution_source`; ``source`` sums to zero over each
+        family), ``chi`` the (n,) covolume areas.
+
+        Returns
+        -------
+        (n,) float array
+        """
+        n_f, faces = self.mesh.n_f, self.mesh.faces
+        M = (sp.diags(self._keep) @ K + sp.diags(self._unit)).tocsr()
+        psi0, w0 = (None, None) if self._last is None else self._last
+        psi = self._solve(M, -np.asarray(source, dtype=float) * self._keep, psi0)
+        if self.mesh.has_boundary:
+            w = self._solve(M, self._unit * (np.arange(len(self._unit)) == n_f), w0)
+        else:               # closed: the kernel vector is the constant on the T-vertices
+            w = np.r_[np.zeros(n_f), np.ones(self.mesh.n_t)]
+        self._last = psi, w
+
+        def offset(x):      # sum_t chi_t (x_t - mean of x over the corners of t)
+            return np.dot(chi[n_f:], x[n_f:] - x[faces].mean(axis=1))
+
+        return psi - offset(psi) / offset(w) * w
+
+
+def tangential_potential(K, source, mesh, chi):
+    """``psi`` of (R3) in one call (see :class:`TangentialPotential`).
+
+    Parameters
+    ----------
+    K : (n, n) sparse matrix
+        :func:`neumann_stiffness`.
+    source : (n,) float array
+        :func:`redistribution_source`.
+    mesh : DiamondMesh
+    chi : (n,) float array
+        Covolume areas.
+
+    Returns
+    -------
+    (n,) float array
+    """
+    return TangentialPotential(mesh)(K, source, chi)
+
+
+def diamond_gradients(mesh, geom, psi):
+    """(3, n_d) the gradient ``g_d`` of ``psi`` on every diamond (R4).
+
+    Parameters
+    ----------
+    mesh : DiamondMesh
+    geom : DiamondGeometry
+        With the vectors ``u``, ``v``.
+    psi : (n_f + n_t,) float array
+
+    Returns
+    -------
+    (3, n_d) float array
+        ``g_d = a u + b v`` with ``g_d . u = psi_b - psi_a``,
+        ``g_d . v = psi_t2 - psi_t1`` (on a boundary diamond the missing
+        ``psi_t2`` is the reflection ``psi_a + psi_b - psi_t1``, as the
+        T-vertex, Section 2.2.5).
+    """
+    a, b, t1, t2 = mesh.diamonds.T
+    pf, pt = psi[:mesh.n_f], psi[mesh.n_f:]
+    du = pf[b] - pf[a]
+    p2 = np.where(t2 >= 0, pt[np.maximum(t2, 0)], pf[a] + pf[b] - pt[t1])
+    dv = p2 - pt[t1]
+    uu = np.einsum("ij,ij->j", geom.u, geom.u)
+    vv = np.einsum("ij,ij->j", geom.v, geom.v)
+    det = uu * vv - geom.uv ** 2                       # J^2 (2.8)
+    ca = (vv * du - geom.uv * dv) / det
+    cb = (uu * dv - geom.uv * du) / det
+    return ca * geom.u + cb * geom.v
+
+
+def vertex_gradients(mesh, geom, psi, normals):
+    """(3, n_f + n_t) the tangential velocity ``v_T = grad psi`` at every vertex (R5).
+
+    Parameters
+    ----------
+    mesh : DiamondMesh
+    geom : DiamondGeometry
+        With the vectors ``u``, ``v``.
+    psi : (n_f + n_t,) float array
+    normals : (3, n_f + n_t) float array
+        Unit vertex normals (:func:`ddfv.geometry.vertex_normals`).
+
+    Returns
+    -------
+    (3, n_f + n_t) float array
+        The ``J``-weighted mean of the diamond gradients of the vertex's
+        diamonds, projected onto its tangent plane.
+    """
+    n, n_f = mesh.n_unknowns, mesh.n_f
+    a, b, t1, t2 = mesh.diamonds.T
+    inner = t2 >= 0
+    corners = np.concatenate([a, b, n_f + t1, n_f + t2[inner]])
+    g = diamond_gradients(mesh, geom, psi) * geom.J
+    weights = np.concatenate([geom.J, geom.J, geom.J, geom.J[inner]])
+    total = np.bincount(corners, weights, minlength=n)
+    mean = np.stack([np.bincount(corners, np.concatenate([gk, gk, gk, gk[inner]]),
+                                 minlength=n) for gk in g]) / total
+    return mean - (mean * normals).sum(axis=0) * normals
+
+
+def carry_t_vertices(F, T, faces, lam):
+    """T-vertices moved tangentially to the barycentric coordinates ``lam`` of their triangle.
+
+    Parameters
+    ----------
+    F : (n_f, 3) float array
+    T : (n_t, 3) float array
+    faces : (n_t, 3) int array
+    lam : (n_t, 3) float array
+        Barycentric coordinates (rows sum to 1) to keep.
+
+    Returns
+    -------
+    (n_t, 3) float array
+        ``Q + ((T - Q) . n) n`` with ``Q = sum_k lam_k F_k`` and ``n`` the
+        unit normal of the triangle: the height of ``T`` above the plane of
+        its triangle is kept, its projection is put at ``Q``.
+    """
+    p = F[faces]                                            # (n_t, 3, 3)
+    Q = np.einsum("tk,tkj->tj", lam, p)
+    nrm = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+    return Q + np.einsum("ij,ij->i", T - Q, nrm)[:, None] * nrm

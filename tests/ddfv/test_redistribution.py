@@ -1,0 +1,309 @@
+"""Tangential redistribution of the DDFV flow (ddfv/redistribution.py, journal version).
+
+The operators of (R3)-(R5) on planar and spherical meshes, the symmetry of
+the icosahedron, invariance of the flow, order 2 on the sphere, and a sliver
+mesh the paper's scheme cannot run.
+"""
+
+import numpy as np
+import pytest
+
+from ddfv import Flow, variant_options
+from ddfv.assembly import Assembler
+from ddfv.geometry import covolume_areas, diamond_geometry, vertex_normals
+from ddfv.redistribution import (carry_t_vertices, diamond_gradients, neumann_stiffness,
+                                 redistribution_source, tangential_potential,
+                                 vertex_gradients)
+from ddfv.t_vertices import initial_t_vertices
+from ddfv.topology import diamond_mesh
+from mcfbench import surfaces
+from mcfbench.driver import simulate
+from mcfbench.errors import SphereL2Error
+from mcfbench.solver import Solver
+
+CARRIED = variant_options("chord-redistribute-carried")
+
+
+def _setup(V, F, t_init="paper", dual_length="chord"):
+    mesh = diamond_mesh(F, len(V))
+    T = initial_t_vertices(V, mesh, t_init)
+    geom = diamond_geometry(mesh, V, T, dual_length)
+    chi = np.concatenate(covolume_areas(mesh, geom))
+    return mesh, T, geom, chi
+
+
+def _jittered_plane(seed=1):
+    """A flat irregular patch z = 0 (boundary fixed), T-vertices at barycentres."""
+    V, F = surfaces.flat_patch(level=1, jitter=0.3, seed=seed)
+    return V, F
+
+
+def _affine(P):
+    return 0.3 + 1.7 * P[:, 0] - 0.6 * P[:, 1]
+
+
+def test_diamond_and_vertex_gradients_are_exact_for_affine_functions_on_a_plane():
+    V, F = _jittered_plane()
+    mesh, T, geom, _ = _setup(V, F, "barycenter")
+    psi = np.r_[_affine(V), _affine(T)]
+    exact = np.array([1.7, -0.6, 0.0])
+    g = diamond_gradients(mesh, geom, psi)
+    np.testing.assert_allclose(g.T, np.broadcast_to(exact, g.T.shape), atol=1e-12)
+    N = np.zeros((3, mesh.n_unknowns))
+    N[2] = 1.0
+    v = vertex_gradients(mesh, geom, psi, N)
+    np.testing.assert_allclose(v.T, np.broadcast_to(exact, v.T.shape), atol=1e-12)
+
+
+def test_neumann_stiffness_balances_affine_functions_on_a_plane():
+    """Chord |gamma|: inside, the flux balance of an affine function is exact
+    (zero); at a boundary F-vertex it is the flux through the boundary half-edges
+    that the Neumann condition leaves out (the reflected ghost is exact for
+    affine functions), and T-rows of boundary triangles miss theirs."""
+    V, F = _jittered_plane()
+    mesh, T, geom, _ = _setup(V, F, "barycenter")
+    n_f = mesh.n_f
+    K = neumann_stiffness(Assembler(mesh), geom)
+    scale = np.abs(K).max()
+    r = K @ np.r_[_affine(V), _affine(T)]
+    g = np.array([1.7, -0.6, 0.0])
+    a, b, t1, _ = mesh.diamonds[mesh.boundary].T
+    assert np.cross(V[F[0, 1]] - V[F[0, 0]], V[F[0, 2]] - V[F[0, 0]])[2] > 0
+    # outward normal of the boundary edge a -> b of t1 (interior on the left): u x e_z
+    half = np.cross(V[b] - V[a], [0.0, 0.0, 1.0]) @ g / 2
+    expected = np.zeros(mesh.n_unknowns)
+    np.add.at(expected, a, half)
+    np.add.at(expected, b, half)
+    touching = np.zeros(mesh.n_unknowns, bool)
+    touching[n_f + t1] = True
+    np.testing.assert_allclose(r[~touching], expected[~touching], atol=1e-12 * scale)
+    assert np.abs(expected[:n_f][mesh.boundary_vertices]).max() > 1e-2
+    # the rows of each family sum to zero (conservation): solvability of (R3)
+    np.testing.assert_allclose(K[:n_f].sum(axis=0), 0.0, atol=1e-12 * scale)
+    np.testing.assert_allclose(K[n_f:].sum(axis=0), 0.0, atol=1e-12 * scale)
+
+
+def test_neumann_stiffness_kills_a_constant_per_family_on_a_closed_surface(noisy_sphere):
+    V, F = noisy_sphere
+    mesh, T, geom, _ = _setup(V, F)
+    K = neumann_stiffness(Assembler(mesh), geom)
+    psi = np.r_[np.full(mesh.n_f, 1.0), np.full(mesh.n_t, -2.5)]
+    np.testing.assert_allclose(K @ psi, 0.0, atol=1e-12 * np.abs(K).max())
+
+
+def _sphere_operators(level):
+    V, F = surfaces.icosphere(level)
+    mesh, T, geom, chi = _setup(V, F, "exact")
+    X = np.r_[V, T]
+    return mesh, geom, chi, X, neumann_stiffness(Assembler(mesh), geom)
+
+
+def test_poisson_solution_converges_at_order_two_on_the_sphere():
+    """Delta_G z = -2 z on the unit sphere: K psi = -chi (-2 z) gives psi = z up to a
+    constant per family. Measured (chord |gamma|), largest error at levels 1-4:
+    6.51e-3, 1.87e-3, 4.96e-4, 1.75e-4. (The pointwise Laplacian of z, -(K z)/chi,
+    does not converge in the maximum norm on the icosphere, 0.085-0.115 at levels
+    1-4, as usual for finite volumes on non-uniform meshes; its solution does.)"""
+    errors = []
+    for level in (2, 3):
+        mesh, geom, chi, X, K = _sphere_operators(level)
+        z, n_f = X[:, 2], mesh.n_f
+        psi = tangential_potential(K, chi * (-2 * z), mesh, chi)
+        e = [psi[f] - psi[f].mean() - (z[f] - z[f].mean())
+             for f in (slice(0, n_f), slice(n_f, None))]
+        errors.append(max(np.abs(x).max() for x in e))
+    assert errors[0] < 2.0e-3 and errors[1] < 5.2e-4
+    assert np.log2(errors[0] / errors[1]) > 1.8
+
+
+def test_vertex_gradient_of_a_coordinate_converges_on_the_sphere():
+    """grad_G z = e_z - z x; measured largest error at levels 1-4: 5.05e-2, 2.27e-2,
+    9.76e-3, 4.43e-3 (order ~1.2 in the maximum norm)."""
+    errors = []
+    for level in (2, 3):
+        mesh, geom, chi, X, K = _sphere_operators(level)
+        z = X[:, 2]
+        v = vertex_gradients(mesh, geom, z, vertex_normals(mesh, geom))
+        exact = np.array([0.0, 0.0, 1.0])[:, None] - z * X.T
+        errors.append(np.abs(v - exact).max())
+    assert errors[0] < 2.4e-2 and errors[1] < 1.0e-2
+
+
+def test_potential_solves_the_poisson_problem_on_the_sphere():
+    """K psi = -chi f with f = -2 z gives psi = z + constants per family."""
+    V, F = surfaces.icosphere(3)
+    mesh, T, geom, chi = _setup(V, F, "exact")
+    z = np.r_[V, T][:, 2]
+    K = neumann_stiffness(Assembler(mesh), geom)
+    f = -(K @ z)                         # the discrete source of psi = z, sums to 0 per family
+    psi = tangential_potential(K, f, mesh, chi)
+    n_f = mesh.n_f
+    np.testing.assert_allclose(psi[:n_f] - psi[0], z[:n_f] - z[0], atol=1e-10)
+    np.testing.assert_allclose(psi[n_f:] - psi[n_f], z[n_f:] - z[n_f], atol=1e-10)
+
+
+def test_potential_on_a_surface_with_boundary_is_the_affine_solution():
+    """Flat patch: psi = affine solves K psi = K affine; the fix of the kernel
+    returns it (up to the constant) on every vertex."""
+    V, F = _jittered_plane()
+    mesh, T, geom, chi = _setup(V, F, "barycenter")
+    K = neumann_stiffness(Assembler(mesh), geom)
+    exact = np.r_[_affine(V), _affine(T)]
+    psi = tangential_potential(K, -(K @ exact), mesh, chi)
+    # the T-values of an affine function are not exactly the corner means where
+    # T is not at the barycentre; here it is, so psi = exact up to the constant
+    np.testing.assert_allclose(psi - psi[0], exact - exact[0], atol=1e-9)
+
+
+def test_source_sums_to_zero_per_family_and_ignores_fixed_vertices():
+    rng = np.random.default_rng(0)
+    chi, hV = rng.random(30) + 0.5, rng.random(30)
+    fixed = np.zeros(12, bool)
+    fixed[:3] = True
+    s = redistribution_source(chi, hV, 12, fixed, omega=7.0)
+    assert abs(s[:12].sum()) < 1e-13 and abs(s[12:].sum()) < 1e-13
+    # a fixed vertex: no curvature drive, target its own area -> only the mean term
+    mean = np.dot(chi[:12], np.r_[np.zeros(3), hV[3:12]]) / chi[:12].sum()
+    np.testing.assert_allclose(s[:3], -chi[:3] * mean, rtol=1e-13)
+
+
+def _velocity(V, F, omega=10.0, level_tau=0.01):
+    flow = Flow(V, F, level_tau, tangential="redistribute", omega=omega, t_init="exact")
+    A = flow._assembler.system(flow._geometry, flow._chi, flow.tau)
+    v = flow._tangential_velocity(A, flow._geometry, flow._chi)
+    return flow, v
+
+
+def test_tangential_velocity_vanishes_on_the_icosahedron_by_symmetry():
+    V, F = surfaces.icosphere(0)
+    _, v = _velocity(V, F)
+    assert np.abs(v).max() < 1e-13
+
+
+def test_tangential_velocity_vanishes_at_the_icosahedral_vertices_of_the_icosphere():
+    """Level 2: the 12 vertices of valence 5 lie on 5-fold axes, where a symmetric
+    field's tangential part vanishes; elsewhere it does not (areas are not uniform)."""
+    V, F = surfaces.icosphere(2)
+    flow, v = _velocity(V, F)
+    valence = np.bincount(F.ravel(), minlength=len(V))
+    own = flow._external[:len(V)]                 # caller's vertex -> own column
+    speed = np.linalg.norm(v[:, own], axis=0)
+    assert speed[valence == 5].max() < 1e-12 * speed.max()
+    assert speed.max() > 1e-3
+
+
+def _rotation(seed=0):
+    q, _ = np.linalg.qr(np.random.default_rng(seed).normal(size=(3, 3)))
+    return q * np.sign(np.linalg.det(q))
+
+
+def _run(V, F, tau=0.002, steps=5, **options):
+    traj = simulate(Flow(V, F, tau, **options), steps, save_every=1,
+                    solver=Solver(rtol=1e-13, maxiter=1000))
+    return traj.frames["F"], traj.frames["T"]
+
+
+@pytest.mark.parametrize("variant", ["redistribute", "chord-redistribute-carried"])
+def test_flow_invariant_under_rigid_motion(bumpy, variant):
+    V, F = bumpy
+    Q, shift = _rotation(), np.array([0.3, -2.0, 1.5])
+    opts = variant_options(variant)
+    (F0, T0), (F1, T1) = _run(V, F, **opts), _run(V @ Q.T + shift, F, **opts)
+    np.testing.assert_allclose(F1, F0 @ Q.T + shift, atol=1e-10)
+    np.testing.assert_allclose(T1, T0 @ Q.T + shift, atol=1e-10)
+
+
+@pytest.mark.parametrize("variant", ["redistribute", "chord-redistribute-carried"])
+def test_flow_invariant_under_relabelling(bumpy, variant):
+    V, F = bumpy
+    rng = np.random.default_rng(5)
+    pv, pt = rng.permutation(len(V)), rng.permutation(len(F))
+    new_index = np.empty_like(pv)
+    new_index[pv] = np.arange(len(V))
+    F2 = np.roll(new_index[F[pt]], 1, axis=1)
+    opts = variant_options(variant)
+    (F0, T0), (F1, T1) = _run(V, F, **opts), _run(V[pv], F2, **opts)
+    np.testing.assert_allclose(F1, F0[:, pv], atol=1e-10)
+    np.testing.assert_allclose(T1, T0[:, pt], atol=1e-10)
+
+
+def test_carried_t_vertices_keep_their_barycentric_coordinates_and_height():
+    V, F = surfaces.random_bumpy_sphere()
+    mesh = diamond_mesh(F, len(V))
+    T = initial_t_vertices(V, mesh, "barycenter")
+    rng = np.random.default_rng(2)
+    lam = rng.random((len(F), 3)) + 0.1
+    lam /= lam.sum(axis=1, keepdims=True)
+    Tm = T + 0.01 * rng.normal(size=T.shape)
+    out = carry_t_vertices(V, Tm, F, lam)
+    from ddfv.geometry import t_barycentric
+    np.testing.assert_allclose(t_barycentric(V, out, F), lam, atol=1e-10)
+    p = V[F]
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    height = lambda X: np.einsum("ij,ij->i", X - p[:, 0], n)
+    np.testing.assert_allclose(height(out), height(Tm), atol=1e-13)
+
+
+def _sphere_error(level, options):
+    V, F = surfaces.icosphere(level)
+    tau = 0.04 / 4 ** (level - 1)
+    err = SphereL2Error(1.0)
+    traj = simulate(Flow(V, F, tau, **options), round(0.08 / tau), save_every=0,
+                    observers=[err], solver=Solver(rtol=1e-9))
+    assert traj.status == "ok"
+    return err.value
+
+
+@pytest.mark.parametrize("variant", ["chord-redistribute-carried", "redistribute"])
+def test_order_two_on_the_sphere(variant):
+    """Table 3.1 setting, levels 1-3 (measured: chord-redistribute-carried
+    1.3370e-2, 3.3508e-3, 8.3388e-4, EOC 1.996, 2.007; redistribute 1.3098e-2,
+    3.2535e-3, 7.9997e-4, EOC 2.009, 2.024)."""
+    e = [_sphere_error(level, variant_options(variant)) for level in (1, 2, 3)]
+    eoc = np.log2(np.array(e[:-1]) / np.array(e[1:]))
+    assert np.all((eoc > 1.9) & (eoc < 2.1)), (e, eoc)
+
+
+def _minimum_angle(V, F):
+    p = V[F]
+    e = [p[:, (k + 1) % 3] - p[:, k] for k in range(3)]
+    cos = [-(e[k] * e[k - 1]).sum(1) / np.linalg.norm(e[k], axis=1)
+           / np.linalg.norm(e[k - 1], axis=1) for k in range(3)]
+    return np.degrees(np.arccos(np.clip(cos, -1, 1))).min()
+
+
+def test_sliver_mesh_runs_with_carried_t_vertices_but_not_with_the_paper():
+    """Random points on the unit sphere, triangulated by their convex hull."""
+    V, F = surfaces.remeshed_sphere(162, seed=1)
+    assert _minimum_angle(V, F) < 2.0
+    h = np.linalg.norm(V[F[:, 1]] - V[F[:, 0]], axis=1).mean()
+    tau, steps = 0.1 * h**2, 20
+    paper = simulate(Flow(V, F, tau), steps, save_every=0, solver=Solver(method="direct"))
+    assert paper.status == "t_escaped"
+    monitor = []
+    flow = Flow(V, F, tau, **CARRIED)
+    ours = simulate(flow, steps, save_every=0, solver=Solver(method="direct"),
+                    observers=[lambda f: monitor.append(f.t_min_barycentric())])
+    assert ours.status == "ok" and flow.n == steps
+    assert min(monitor) > 0.0
+
+
+def test_redistribution_on_a_flat_patch_keeps_it_flat_and_its_boundary_fixed():
+    """Fixed boundary: boundary F-vertices do not move, the patch stays in its plane,
+    the interior vertices move in it (omega = 100 over t = 0.1) and the F-covolumes
+    become more even."""
+    V, F = surfaces.flat_patch(level=1, jitter=0.3, seed=0)
+    opts = {**CARRIED, "omega": 100.0}
+    flow = Flow(V, F, 0.005, **opts)
+    fixed = flow.fixed
+    chi0 = flow.covolumes[:len(V)][~fixed]
+    traj = simulate(flow, 20, save_every=0, solver=Solver(rtol=1e-12))
+    assert traj.status == "ok"
+    np.testing.assert_array_equal(flow.F[fixed], V[fixed])
+    assert np.abs(flow.F[:, 2]).max() < 1e-13 and np.abs(flow.T[:, 2]).max() < 1e-13
+    assert np.linalg.norm(flow.F - V, axis=1).max() > 1e-3
+    chi = flow.covolumes[:len(V)][~fixed]
+    spread = lambda c: c.std() / c.mean()
+    assert spread(chi) < 0.8 * spread(chi0), (spread(chi0), spread(chi))
+    assert flow.t_min_barycentric() > 0.3
