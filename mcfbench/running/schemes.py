@@ -122,7 +122,7 @@ SCHEMES = {s.name: s for s in (
           "DDFV with the area-oriented tangential redistribution of the journal version"),
     _ddfv("chord-redistribute", "DDFV, chord + redistribution", "C9", "h", "--",
           "DDFV with chord |gamma| and the area-oriented tangential redistribution"),
-    _ddfv("chord-carried", "DDFV, chord, T carried", "C5", "p", ":",
+    _ddfv("chord-carried", "DDFV, chord, T carried", "darkgreen", "p", ":",
           "DDFV with chord |gamma| and every T-vertex carried by its triangle"),
     _ddfv("chord-redistribute-carried", "DDFV, chord + redistribution, T carried", "k", "*",
           "-.", "DDFV with chord |gamma|, redistribution of the F-vertices and every "

@@ -34,19 +34,20 @@ def package_dir(name):
 # harness modules that present results (tables, plots, report, command line,
 # file handling) but do not change what a run computes: left out of the code
 # hash that decides when the pipeline redoes a run
-PRESENTATION_MODULES = ("matrix.py", "matrix_plots.py", "render.py", "figures.py", "tables.py",
-                        "plots.py", "report.py", "pipeline.py", "cli.py", "__main__.py",
-                        "records.py", "atomic.py", "provenance.py", "memory.py", "meshio.py")
+COMPUTING_LAYERS = ("geometry", "running", "studies")
+"""The harness's layers whose code determines what a run computes (the code hash):
+not ``presentation`` and ``storage`` (how results are shown and stored), nor the
+command line and the Snakemake glue at the top."""
 
 
 @functools.cache
-def source_hash(name, leave_out=()):
-    """Short SHA-256 of the Python sources of package ``name`` (paths and contents),
-    without the top-level modules named in ``leave_out``."""
+def source_hash(name, only=None):
+    """Short SHA-256 of the Python sources of package ``name`` (paths and contents);
+    with ``only``, of the files in those subpackages only."""
     digest = hashlib.sha256()
     root = package_dir(name)
     for path in sorted(root.rglob("*.py")):
-        if path.parent == root and path.name in leave_out:
+        if only is not None and path.relative_to(root).parts[0] not in only:
             continue
         digest.update(path.relative_to(root).as_posix().encode() + b"\0")
         digest.update(path.read_bytes() + b"\0")
@@ -55,8 +56,9 @@ def source_hash(name, leave_out=()):
 
 def code_hash():
     """``{package: hash}`` of the code that determines what a run computes: the
-    scheme packages and the harness without :data:`PRESENTATION_MODULES`."""
-    return {name: source_hash(name, PRESENTATION_MODULES if name == "mcfbench" else ())
+    scheme packages and the harness's :data:`COMPUTING_LAYERS`, so that a change of
+    a table, a plot or the report redoes no run."""
+    return {name: source_hash(name, COMPUTING_LAYERS if name == "mcfbench" else None)
             for name in SOURCE_PACKAGES if package_dir(name) is not None}
 
 

@@ -16,10 +16,11 @@ from ddfv.redistribution import (carry_t_vertices, diamond_gradients, neumann_st
                                  vertex_gradients)
 from ddfv.t_vertices import initial_t_vertices
 from ddfv.topology import diamond_mesh
-from mcfbench import surfaces
-from mcfbench.driver import simulate
-from mcfbench.errors import SphereL2Error
-from mcfbench.solver import Solver
+from mcfbench.geometry import surfaces
+from mcfbench.geometry.spheres import icosphere
+from mcfbench.running.driver import simulate
+from mcfbench.geometry.exact import SphereL2Error
+from mcfbench.running.solver import Solver
 
 CARRIED = variant_options("chord-redistribute-carried")
 
@@ -92,7 +93,7 @@ def test_neumann_stiffness_kills_a_constant_per_family_on_a_closed_surface(noisy
 
 
 def _sphere_operators(level):
-    V, F = surfaces.icosphere(level)
+    V, F = icosphere(level)
     mesh, T, geom, chi = _setup(V, F, "exact")
     X = np.r_[V, T]
     return mesh, geom, chi, X, neumann_stiffness(Assembler(mesh), geom)
@@ -131,7 +132,7 @@ def test_vertex_gradient_of_a_coordinate_converges_on_the_sphere():
 
 def test_potential_solves_the_poisson_problem_on_the_sphere():
     """K psi = -chi f with f = -2 z gives psi = z + constants per family."""
-    V, F = surfaces.icosphere(3)
+    V, F = icosphere(3)
     mesh, T, geom, chi = _setup(V, F, "exact")
     z = np.r_[V, T][:, 2]
     K = neumann_stiffness(Assembler(mesh), geom)
@@ -175,7 +176,7 @@ def _velocity(V, F, omega=10.0, level_tau=0.01):
 
 
 def test_tangential_velocity_vanishes_on_the_icosahedron_by_symmetry():
-    V, F = surfaces.icosphere(0)
+    V, F = icosphere(0)
     _, v = _velocity(V, F)
     assert np.abs(v).max() < 1e-13
 
@@ -183,7 +184,7 @@ def test_tangential_velocity_vanishes_on_the_icosahedron_by_symmetry():
 def test_tangential_velocity_vanishes_at_the_icosahedral_vertices_of_the_icosphere():
     """Level 2: the 12 vertices of valence 5 lie on 5-fold axes, where a symmetric
     field's tangential part vanishes; elsewhere it does not (areas are not uniform)."""
-    V, F = surfaces.icosphere(2)
+    V, F = icosphere(2)
     flow, v = _velocity(V, F)
     valence = np.bincount(F.ravel(), minlength=len(V))
     own = flow._external[:len(V)]                 # caller's vertex -> own column
@@ -246,7 +247,7 @@ def test_carried_t_vertices_keep_their_barycentric_coordinates_and_height():
 
 
 def _sphere_error(level, options):
-    V, F = surfaces.icosphere(level)
+    V, F = icosphere(level)
     tau = 0.04 / 4 ** (level - 1)
     err = SphereL2Error(1.0)
     traj = simulate(Flow(V, F, tau, **options), round(0.08 / tau), save_every=0,
