@@ -41,10 +41,10 @@ TEMPLATES = Path(__file__).with_name("templates")
 
 # (name, caption) of the figures of rule matrix_plots, in page order
 PAGE_FIGURES = (
-    ("errors", "Error of each problem's main metric against the mesh size h, every "
-               "scheme; slope-2 guides."),
-    ("work_precision", "Work-precision: the main error of every run against its CPU "
-                       "seconds (one core, the problem's solver rule)."),
+    ("errors", ("Error of each problem's main metric against the mesh size h, every "
+                "scheme; slope-2 guides.")),
+    ("work_precision", ("Work-precision: the main error of every run against its CPU "
+                        "seconds (one core, the problem's solver rule).")),
     ("quality", "Smallest angle (and the DDFV T monitor) against time, per problem."),
     ("pictures", "The final surfaces, scheme x problem (coarsest level)."),
 )

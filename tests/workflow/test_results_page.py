@@ -19,7 +19,11 @@ from pathlib import Path
 import pytest
 
 from mcfbench.presentation.documents import external_references
-from mcfbench.presentation.matrix_page import PAGE_FIGURES, problem_runs, write_matrix_page
+from mcfbench.presentation.matrix_page import (
+    PAGE_FIGURES,
+    problem_runs,
+    write_matrix_page,
+)
 from mcfbench.presentation.matrix_tables import read_long_table, read_summary
 
 pytestmark = pytest.mark.e2e
@@ -129,7 +133,7 @@ def _dump_dom(browser, path, fragment, profile):
     proc = subprocess.run(
         [browser, "--headless", "--disable-gpu", "--no-sandbox", "--no-first-run",
          f"--user-data-dir={profile}", "--dump-dom", f"{Path(path).as_uri()}#sort={fragment}"],
-        capture_output=True, text=True, timeout=120)
+        capture_output=True, text=True, timeout=120, check=False)
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert "</html>" in proc.stdout, proc.stderr[-2000:]
     return proc.stdout
@@ -145,7 +149,7 @@ def _frames(root):
 
 
 def test_page_is_one_self_contained_file(page):
-    root, plan = page
+    root, _ = page
     html = (root / "index.html").read_text()
     assert external_references(html) == []
     assert "<link" not in html and "<script src" not in html
