@@ -312,6 +312,7 @@ def test_snakemake_dry_run(tmp_path):
     counts = dict(line.split()[:2] for line in out.stdout.splitlines()
                   if len(line.split()) == 2 and line.split()[1].isdigit())
     assert int(counts["matrix_run"]) == runs
+    assert int(counts["matrix_page"]) == 1  # results/matrix/index.html
     assert int(counts["gallery_run"]) == len(SCHEMES)  # one mesh file, every scheme
     assert "gallery_mesh" not in counts  # a folder given: no generated meshes
 

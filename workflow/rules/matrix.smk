@@ -16,6 +16,8 @@
 #   tables/summary.md, .tex, .csv                problem x scheme
 #   figures/errors, quality, pictures (.png, .pdf)
 #   findings.md                                  written from the numbers only
+#   index.html                                   the results page: sortable tables, figures,
+#                                                findings, in one offline file
 
 from mcfbench.studies import matrix as _matrix
 from mcfbench.pipeline import alternatives as _alternatives
@@ -43,7 +45,12 @@ MATRIX_FIGURES = {
     for name in ("errors", "work_precision", "quality", "pictures")
     for ext in ("png", "pdf")
 }
-MATRIX_TARGETS = [*MATRIX_TABLES, *MATRIX_FIGURES.values(), "results/matrix/findings.md"]
+MATRIX_TARGETS = [
+    *MATRIX_TABLES,
+    *MATRIX_FIGURES.values(),
+    "results/matrix/findings.md",
+    "results/matrix/index.html",
+]
 
 
 rule matrix_run:
@@ -150,3 +157,33 @@ rule matrix_findings:
         "../envs/ddfv.yaml"
     script:
         "../scripts/matrix_findings.py"
+
+
+rule matrix_page:
+    """The results page: the tables (sortable), the figures and the findings in one
+    self-contained HTML file."""
+    input:
+        table="results/matrix/tables/matrix.csv",
+        summary="results/matrix/tables/summary.csv",
+        figures=[
+            MATRIX_FIGURES[f"{name}_png"]
+            for name in ("errors", "work_precision", "quality", "pictures")
+        ],
+        findings="results/matrix/findings.md",
+    output:
+        "results/matrix/index.html",
+    params:
+        plan=MATRIX,
+    benchmark:
+        "results/benchmarks/matrix/page.tsv",
+    log:
+        "results/logs/matrix/page.log",
+    localrule: True
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    conda:
+        "../envs/ddfv.yaml"
+    script:
+        "../scripts/matrix_page.py"
