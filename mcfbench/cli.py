@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ddfv.variants import VARIANTS
 from mcfbench.running.problems import PROBLEMS, Problem, get_problem
 from mcfbench.running.schemes import SCHEMES, get_scheme
 from mcfbench.running.solver import METHODS, ROBUST, Solver
@@ -62,8 +63,8 @@ def _level(text):
 def _common(parser, default_solver):
     parser.add_argument("--scheme", default="ddfv", choices=list(SCHEMES),
                         help="scheme (default: ddfv; see `schemes`)")
-    parser.add_argument("--variant", help="DDFV variant: same as --scheme ddfv-VARIANT "
-                        "(paper, chord, eliminate, chord-eliminate)")
+    parser.add_argument("--variant", choices=list(VARIANTS),
+                        help="DDFV variant: same as --scheme ddfv-VARIANT")
     parser.add_argument("--solver", choices=METHODS, default=default_solver,
                         help=f"linear solver (default: {default_solver})")
     parser.add_argument("--rtol", type=_positive_float, default=1e-9,

@@ -198,6 +198,8 @@ def planned_runs(plan, code="", root="results/matrix"):
 def job(settings, record, frames, log_path=None):
     """One run of the matrix: the record (:func:`mcfbench.storage.records.write_record`,
     with ``metric_names``) and the first and last frames (npz), both atomic.
+    ``log_path``: the job's log file (set up here); None logs to the logger that
+    the caller set up (:func:`series_job`, one log for a series).
 
     A run that ends with a ``solver_*`` status is run again with the scheme's robust
     solver (:attr:`mcfbench.running.schemes.Scheme.robust_solver`, ``direct``) at the
@@ -208,7 +210,7 @@ def job(settings, record, frames, log_path=None):
     from mcfbench.storage.atomic import save_npz
     from mcfbench.storage.records import write_record
 
-    log = setup_logging(log_path)
+    log = setup_logging(log_path) if log_path else logging.getLogger("pipeline")
     solver = Solver(method=settings["solver"]["method"], rtol=settings["solver"]["rtol"],
                     maxiter=settings["solver"]["maxiter"])
     log.info("%s on %s level %d, solver %s", settings["scheme"], settings["problem"],
@@ -228,6 +230,17 @@ def job(settings, record, frames, log_path=None):
         log.info("re-run with %s: %s%s", robust.solver, robust.status,
                  f" ({robust.message})" if robust.message else "")
     return result
+
+
+def series_job(settings, records, frames, log_path=None):
+    """The runs of one scheme on one problem's refinement series, coarsest first,
+    each :func:`job` (its record and frames written as soon as it is done): the
+    matrix's Snakemake job. One process per series instead of per run saves the
+    start-up of every run but one (importing the harness and loading the compiled
+    kernels, about 1 s each); a killed job redoes the whole series.
+    """
+    setup_logging(log_path)
+    return [job(s, r, f) for s, r, f in zip(settings, records, frames, strict=True)]
 
 
 def robust_rerun(settings, result, solver):

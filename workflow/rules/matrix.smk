@@ -53,35 +53,42 @@ MATRIX_TARGETS = [
 ]
 
 
-rule matrix_run:
-    """One scheme on one problem at one level: record and first/last frame."""
-    input:
-        kernels=ancient(KERNELS),
-    output:
-        record="results/matrix/runs/{problem}/{scheme}/level{level}.json",
-        frames="results/matrix/frames/{problem}/{scheme}/level{level}.npz",
-    params:
-        settings=lambda wildcards: MATRIX_RUNS[
-            _matrix.record_path(wildcards.problem, wildcards.scheme, wildcards.level)
-        ],
-    benchmark:
-        "results/benchmarks/matrix/{problem}/{scheme}/level{level}.tsv",
-    log:
-        "results/logs/matrix/{problem}/{scheme}/level{level}.log",
-    wildcard_constraints:
-        problem=_alternatives(MATRIX["problems"]),
-        scheme=_alternatives(MATRIX["schemes"]),
-        level=r"[1-9][0-9]*",
-    threads: 1
-    resources:
-        mem_mb=1500,
-        runtime=60,
-    # the finest levels first: long jobs start early and the two cores stay busy
-    priority: lambda wildcards: 1 + int(wildcards.level) - min(MATRIX["problems"][wildcards.problem])
-    conda:
-        "../envs/ddfv.yaml"
-    script:
-        "../scripts/matrix_run.py"
+# One job per (problem, scheme): the problem's whole refinement series in one
+# process (mcfbench.studies.matrix.series_job), one rule per problem since the
+# levels, hence the outputs, differ. Saves the start-up of every run but one
+# (about 1 s each); a killed job redoes its series.
+for _problem, _levels in MATRIX["problems"].items():
+    if not _levels:
+        continue
+
+    rule:
+        name:
+            f"matrix_run_{_problem}"
+        input:
+            kernels=ancient(KERNELS),
+        output:
+            records=[f"results/matrix/runs/{_problem}/{{scheme}}/level{k}.json" for k in _levels],
+            frames=[f"results/matrix/frames/{_problem}/{{scheme}}/level{k}.npz" for k in _levels],
+        params:
+            settings=lambda wildcards, problem=_problem, levels=_levels: [
+                MATRIX_RUNS[_matrix.record_path(problem, wildcards.scheme, k)] for k in levels
+            ],
+        benchmark:
+            f"results/benchmarks/matrix/{_problem}/{{scheme}}.tsv"
+        log:
+            f"results/logs/matrix/{_problem}/{{scheme}}.log",
+        wildcard_constraints:
+            scheme=_alternatives(MATRIX["schemes"]),
+        threads: 1
+        resources:
+            mem_mb=1500,
+            runtime=120,
+        # the longest series first: long jobs start early and the two cores stay busy
+        priority: len(_levels)
+        conda:
+            "../envs/ddfv.yaml"
+        script:
+            "../scripts/matrix_run.py"
 
 
 rule matrix_tables:

@@ -1,8 +1,10 @@
-"""One run of the benchmark matrix: record and first/last frame.
+"""One scheme on one problem's refinement series in the benchmark matrix: a
+record and first/last frame per level.
 
-Called by rule ``matrix_run`` (workflow/rules/matrix.smk); the settings come
-from ``params.settings`` (:func:`mcfbench.studies.matrix.run_settings`). The work is
-:func:`mcfbench.studies.matrix.job`.
+Called by the rules ``matrix_run_{problem}`` (workflow/rules/matrix.smk); the
+settings of each run come from ``params.settings``
+(:func:`mcfbench.studies.matrix.run_settings`). The work is
+:func:`mcfbench.studies.matrix.series_job`.
 """
 
 import os
@@ -14,5 +16,5 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
 
 from mcfbench.studies import matrix  # noqa: E402
 
-matrix.job(snakemake.params.settings, snakemake.output.record,  # noqa: F821
-           snakemake.output.frames, snakemake.log[0])  # noqa: F821
+matrix.series_job(snakemake.params.settings, snakemake.output.records,  # noqa: F821
+                  snakemake.output.frames, snakemake.log[0])  # noqa: F821
