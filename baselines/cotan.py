@@ -458,8 +458,11 @@ class CotanFlow(VertexFlow):
         Sarkoci, Sevcovic 2014), explicitly: ``b = X^n + tau v_T^n`` in
         (C3), the matrix unchanged (R3).
     omega : float
-        Relaxation rate of the area ratios in (R2), ``>= 0`` (default
-        :data:`baselines.redistribution.OMEGA`).
+        Relaxation rate of the area ratios in (R2), ``>= 0``, in 1 / time on a
+        surface of the unit sphere's area 4 pi (default
+        :data:`baselines.redistribution.OMEGA`): the rate used is
+        ``omega 4 pi / A_0``, ``A_0`` the initial area, so that the flow is
+        covariant under scaling (time scales as length squared).
     max_shift : float or None
         Largest change of an edge vector by the explicit tangential step
         ``tau v_T``, as a fraction of the edge's length: ``v_T`` is scaled
@@ -500,6 +503,7 @@ class CotanFlow(VertexFlow):
         self.assembly = assembly
         self.redistribution = redistribution
         self.omega = float(omega)
+        self._area_0 = None
         self.psi = None
         """The potential of the last step's tangential velocity (R2), (n,)."""
         super().__init__(vertices, faces, tau, mass=mass)
@@ -530,7 +534,10 @@ class CotanFlow(VertexFlow):
         """
         clock = time.perf_counter()
         L, mass = self.laplacian(), self._system_mass()
-        f = redistribution_source(L, mass, self._X, self.fixed, self.omega, self._shares)
+        if self._area_0 is None:                                 # the first step's state
+            self._area_0 = float(mass.sum())
+        rate = self.omega * 4.0 * np.pi / self._area_0           # scale-covariant omega
+        f = redistribution_source(L, mass, self._X, self.fixed, rate, self._shares)
         self.psi = solve_potential(L, mass, f)
         alpha, _ = tangential_velocity(self._X.T, self.faces, self.psi)
         alpha[:, self.fixed] = 0.0

@@ -92,8 +92,10 @@ class Flow:
         :mod:`ddfv.redistribution` (R1)-(R5), explicitly:
         ``X^{n-1} + tau v_T^{n-1}`` on the right-hand side.
     omega : float
-        Relaxation rate of the redistribution (R2), in 1 / time (default
-        :data:`ddfv.redistribution.OMEGA`).
+        Relaxation rate of the redistribution (R2), in 1 / time on a surface
+        of the unit sphere's area 4 pi (default :data:`ddfv.redistribution.OMEGA`):
+        the rate used is ``omega 4 pi / A_0``, ``A_0`` the initial area, so that
+        the flow is covariant under scaling (time scales as length squared).
     t_motion : {"scheme", "carried"}
         ``"carried"``: after each step every T-vertex is moved tangentially
         back to the barycentric coordinates of its initial projection in its
@@ -136,6 +138,7 @@ class Flow:
         check_threads(threads)
         self.threads = threads
         self.omega, self.t_motion = float(omega), t_motion
+        self._area_0 = None
         self._faces = diamond_mesh(faces, len(vertices)).faces   # checked, as given
         n_f, n_t = len(vertices), len(self._faces)
         # the flow's own numbering (module docstring): position j holds the
@@ -319,7 +322,10 @@ class Flow:
         h = (self._X - (A @ self._X.T).T) / self.tau             # h^{n-1}, zero at fixed F
         hV = (h * N).sum(axis=0) ** 2                            # h.V = H^2 (V = H N)
         fixed = mesh.boundary_vertices
-        source = redistribution_source(covolumes, hV, mesh.n_f, fixed, self.omega)  # (R3)
+        if self._area_0 is None:                                 # the first step's state
+            self._area_0 = float(covolumes[:mesh.n_f].sum())
+        rate = self.omega * 4.0 * np.pi / self._area_0           # scale-covariant omega
+        source = redistribution_source(covolumes, hV, mesh.n_f, fixed, rate)  # (R3)
         if self._potential is None:
             self._potential = TangentialPotential(mesh)
         psi = self._potential(neumann_stiffness(self._assembler, geometry), source, covolumes)

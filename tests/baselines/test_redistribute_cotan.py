@@ -179,8 +179,9 @@ def test_fixed_boundary_stays_and_velocity_vanishes_there():
 
 def test_area_ratios_relax_at_the_rate_omega():
     # icosphere(3) pulled towards the north pole (x + 0.6 e_z, normalised): the
-    # covolumes differ by 18x. (R1) makes ln q relax like exp(-omega t); measured
-    # std(ln q) 0.634 -> 0.267 at t = 0.1 with omega = 10 (exp(-1) 0.634 = 0.233),
+    # covolumes differ by 18x. (R1) makes ln q relax like exp(-omega_eff t),
+    # omega_eff = omega 4 pi / A_0 (scale-covariant); measured std(ln q) 0.634 ->
+    # 0.265 at t = 0.1 with omega = 10: 1.15 x the model's exp(-omega_eff t) 0.634,
     # while cotan keeps it (0.636) and the radius error stays that of cotan (5e-3)
     V, F = icosphere(3)
     V = V + np.array([0.0, 0.0, 0.6])
@@ -190,7 +191,7 @@ def test_area_ratios_relax_at_the_rate_omega():
         q = len(flow.mass) * flow.mass / flow.mass.sum()
         return np.std(np.log(q))
 
-    results = {}
+    results, area_0 = {}, CotanFlow(V, F, 0.0025).mass.sum()
     for name, flow in (("cotan", CotanFlow(V, F, 0.0025)), ("area", redistributing(V, F, 0.0025))):
         start = spread(flow)
         traj = simulate(flow, 40, solver=Solver(), save_every=0)
@@ -199,7 +200,8 @@ def test_area_ratios_relax_at_the_rate_omega():
         results[name] = (start, spread(flow), radius_error)
     assert results["cotan"][0] == pytest.approx(0.634, abs=1e-3)
     assert results["cotan"][1] == pytest.approx(0.636, abs=2e-3)
-    assert results["area"][1] == pytest.approx(0.267, abs=2e-3)
+    model = np.exp(-10.0 * 4.0 * np.pi / area_0 * 0.1)       # omega = 10, t = 0.1
+    assert model < results["area"][1] / results["area"][0] < 1.2 * model
     assert results["area"][2] < 1.2 * results["cotan"][2] < 6e-3
 
 
@@ -217,8 +219,8 @@ def test_target_shares():
 
 
 @pytest.mark.parametrize("target, radial_error, smallest_angle", [
-    ("vertex", 3.932e-3, 16.39),       # cotan: 3.437e-3, 25.59 degrees
-    ("triangle", 3.361e-3, 25.59),
+    ("vertex", 4.107e-3, 12.27),       # cotan: 3.437e-3, 25.59 degrees
+    ("triangle", 3.360e-3, 25.51),
 ])
 def test_catenoid_level_1_with_either_target(target, radial_error, smallest_angle):
     # the uniform target cannot be met at the fixed boundary (half stars) and
