@@ -21,7 +21,9 @@ from mcfbench.pipeline import check_keys
 # One BLAS thread per job, set once here: every job inherits it (local or
 # Slurm), before any of them imports numpy. The jobs' run records store these
 # variables (mcfbench.storage.provenance.BLAS_THREAD_VARIABLES).
-os.environ.update(dict.fromkeys(("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"), "1"))
+os.environ.update(
+    dict.fromkeys(("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"), "1")
+)
 
 min_version("9.0")
 
@@ -50,31 +52,31 @@ include: "workflow/rules/gallery.smk"
 
 rule all:
     default_target: True
-    localrule: True
     input:
         CONVERGENCE_TARGETS,
         FIGURE_TARGETS,
         REPORT_TARGETS,
+    localrule: True
 
 
 rule beyond:
-    """Target: level 6, the scheme variants and the stability study (slow)."""
-    localrule: True
     input:
         BEYOND_TARGETS,
+    """Target: level 6, the scheme variants and the stability study (slow)."""
+    localrule: True
 
 
 rule matrix:
+    input:
+        MATRIX_TARGETS,
     """Target: every scheme x every problem x its levels (config key `matrix`;
     about 15 minutes on 2 cores), tables, figures and findings in results/matrix/."""
     localrule: True
-    input:
-        MATRIX_TARGETS,
 
 
 rule gallery:
+    input:
+        GALLERY_TARGETS,
     """Target: every scheme on every mesh file (`--config meshes=DIR`; default the
     suite's own meshes), table and pictures in results/gallery/."""
     localrule: True
-    input:
-        GALLERY_TARGETS,

@@ -54,19 +54,19 @@ rule beyond_run:
         kernels=ancient(KERNELS),
     output:
         "results/beyond/runs/{study}/{scheme}/level{level}.json",
-    params:
-        settings=beyond_run_settings,
-    benchmark:
-        "results/benchmarks/beyond/{study}/{scheme}/level{level}.tsv",
     log:
         "results/logs/beyond/{study}/{scheme}/level{level}.log",
+    benchmark:
+        "results/benchmarks/beyond/{study}/{scheme}/level{level}.tsv"
+    priority: lambda wildcards: int(wildcards.level)
+    conda:
+        "../envs/ddfv.yaml"
     threads: THREADS
     resources:
         mem_mb=run_mem_mb,
         runtime=beyond_run_runtime,
-    priority: lambda wildcards: int(wildcards.level)
-    conda:
-        "../envs/ddfv.yaml"
+    params:
+        settings=beyond_run_settings,
     script:
         "../scripts/run_scheme.py"
 
@@ -77,19 +77,19 @@ rule beyond_time:
         kernels=ancient(KERNELS),
     output:
         "results/beyond/runs/time/{scheme}.json",
-    params:
-        settings=time_settings,
-    benchmark:
-        "results/benchmarks/beyond/time/{scheme}.tsv",
     log:
         "results/logs/beyond/time/{scheme}.log",
+    benchmark:
+        "results/benchmarks/beyond/time/{scheme}.tsv"
+    priority: 3
+    conda:
+        "../envs/ddfv.yaml"
     threads: THREADS
     resources:
         mem_mb=500,
         runtime=time_runtime,
-    priority: 3
-    conda:
-        "../envs/ddfv.yaml"
+    params:
+        settings=time_settings,
     script:
         "../scripts/beyond_time.py"
 
@@ -100,19 +100,19 @@ rule beyond_records:
         [path for runs in BEYOND_RUNS.values() for path in runs],
     output:
         "results/beyond/tables/records.json",
-    params:
-        expected={path: s for runs in BEYOND_RUNS.values() for path, s in runs.items()},
-    benchmark:
-        "results/benchmarks/beyond/records.tsv",
     log:
         "results/logs/beyond/records.log",
+    benchmark:
+        "results/benchmarks/beyond/records.tsv"
     localrule: True
+    conda:
+        "../envs/ddfv.yaml"
     threads: 1
     resources:
         mem_mb=500,
         runtime=5,
-    conda:
-        "../envs/ddfv.yaml"
+    params:
+        expected={path: s for runs in BEYOND_RUNS.values() for path, s in runs.items()},
     script:
         "../scripts/check_records.py"
 
@@ -141,22 +141,22 @@ rule beyond_tables:
         },
         t_monitor="results/beyond/tables/t_monitor.csv",
         provenance="results/beyond/tables/beyond.json",
+    log:
+        "results/logs/beyond/tables.log",
+    benchmark:
+        "results/benchmarks/beyond/tables.tsv"
+    localrule: True
+    conda:
+        "../envs/ddfv.yaml"
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
     params:
         expected={path: s for runs in BEYOND_RUNS.values() for path, s in runs.items()},
         beyond=BEYOND,
         paper_schemes=BEYOND_PAPER_SCHEMES,
         settings={k: config[k] for k in ("tau_level_1", "t_final", "rtol")},
-    benchmark:
-        "results/benchmarks/beyond/tables.tsv",
-    log:
-        "results/logs/beyond/tables.log",
-    localrule: True
-    threads: 1
-    resources:
-        mem_mb=1000,
-        runtime=5,
-    conda:
-        "../envs/ddfv.yaml"
     script:
         "../scripts/beyond_tables.py"
 
@@ -183,20 +183,20 @@ rule beyond_figures:
             )
             for key, path in BEYOND_FIGURES.items()
         },
-    params:
-        beyond=BEYOND,
-        t_final=config["t_final"],
-    benchmark:
-        "results/benchmarks/beyond/figures.tsv",
     log:
         "results/logs/beyond/figures.log",
+    benchmark:
+        "results/benchmarks/beyond/figures.tsv"
     localrule: True
+    conda:
+        "../envs/ddfv.yaml"
     threads: 1
     resources:
         mem_mb=1000,
         runtime=5,
-    conda:
-        "../envs/ddfv.yaml"
+    params:
+        beyond=BEYOND,
+        t_final=config["t_final"],
     script:
         "../scripts/beyond_plots.py"
 
@@ -215,21 +215,21 @@ rule beyond_findings:
             category="Beyond Table 3.1",
             labels={"table": "findings"},
         ),
+    log:
+        "results/logs/beyond/findings.log",
+    benchmark:
+        "results/benchmarks/beyond/findings.tsv"
+    localrule: True
+    conda:
+        "../envs/ddfv.yaml"
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
     params:
         beyond=BEYOND,
         paper_schemes=BEYOND_PAPER_SCHEMES,
         t_final=config["t_final"],
         tau_level_1=config["tau_level_1"],
-    benchmark:
-        "results/benchmarks/beyond/findings.tsv",
-    log:
-        "results/logs/beyond/findings.log",
-    localrule: True
-    threads: 1
-    resources:
-        mem_mb=500,
-        runtime=5,
-    conda:
-        "../envs/ddfv.yaml"
     script:
         "../scripts/beyond_findings.py"

@@ -32,7 +32,9 @@ def run_mem_mb(wildcards):
 
 
 def beyond_run_settings(wildcards):
-    return PIPELINE.beyond_run_settings(wildcards.study, wildcards.scheme, wildcards.level)
+    return PIPELINE.beyond_run_settings(
+        wildcards.study, wildcards.scheme, wildcards.level
+    )
 
 
 def beyond_run_runtime(wildcards):

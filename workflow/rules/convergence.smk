@@ -5,10 +5,10 @@
 
 
 rule convergence:
-    """Target: Table 3.1 (CSV, Markdown, LaTeX, provenance) and the convergence figure."""
-    localrule: True
     input:
         CONVERGENCE_TARGETS,
+    """Target: Table 3.1 (CSV, Markdown, LaTeX, provenance) and the convergence figure."""
+    localrule: True
 
 
 rule run_scheme:
@@ -17,21 +17,21 @@ rule run_scheme:
         kernels=ancient(KERNELS),
     output:
         "results/runs/{scheme}/level{level}.json",
-    params:
-        # includes the source hash of ddfv, baselines, mcfbench: changed code reruns it
-        settings=run_settings,
-    benchmark:
-        "results/benchmarks/runs/{scheme}/level{level}.tsv",
     log:
         "results/logs/runs/{scheme}/level{level}.log",
-    threads: THREADS
-    resources:
-        mem_mb=run_mem_mb,
-        runtime=run_runtime,
+    benchmark:
+        "results/benchmarks/runs/{scheme}/level{level}.tsv"
     # the long runs first, so that the short ones fill the other cores
     priority: lambda wildcards: int(wildcards.level)
     conda:
         "../envs/ddfv.yaml"
+    threads: THREADS
+    resources:
+        mem_mb=run_mem_mb,
+        runtime=run_runtime,
+    params:
+        # includes the source hash of ddfv, baselines, mcfbench: changed code reruns it
+        settings=run_settings,
     script:
         "../scripts/run_scheme.py"
 
@@ -42,19 +42,19 @@ rule convergence_records:
         PIPELINE.run_records(),
     output:
         "results/tables/convergence.records.json",
-    params:
-        expected=PIPELINE.expected_runs(),
-    benchmark:
-        "results/benchmarks/convergence_records.tsv",
     log:
         "results/logs/convergence_records.log",
+    benchmark:
+        "results/benchmarks/convergence_records.tsv"
     localrule: True
+    conda:
+        "../envs/ddfv.yaml"
     threads: 1
     resources:
         mem_mb=500,
         runtime=5,
-    conda:
-        "../envs/ddfv.yaml"
+    params:
+        expected=PIPELINE.expected_runs(),
     script:
         "../scripts/check_records.py"
 
@@ -74,22 +74,22 @@ rule convergence_table:
         md="results/tables/convergence.md",
         tex="results/tables/convergence.tex",
         provenance="results/tables/convergence.csv.json",
+    log:
+        "results/logs/convergence_table.log",
+    benchmark:
+        "results/benchmarks/convergence_table.tsv"
+    localrule: True
+    conda:
+        "../envs/ddfv.yaml"
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
     params:
         expected=PIPELINE.expected_runs(),
         schemes=SCHEMES,
         levels=LEVELS,
         settings=PIPELINE.convergence_settings(),
-    benchmark:
-        "results/benchmarks/convergence_table.tsv",
-    log:
-        "results/logs/convergence_table.log",
-    localrule: True
-    threads: 1
-    resources:
-        mem_mb=500,
-        runtime=5,
-    conda:
-        "../envs/ddfv.yaml"
     script:
         "../scripts/convergence_table.py"
 
@@ -106,18 +106,18 @@ rule convergence_figure:
             labels={"figure": "L2 error vs h"},
         ),
         pdf="results/figures/convergence.pdf",
-    params:
-        t_final=config["t_final"],
-    benchmark:
-        "results/benchmarks/convergence_figure.tsv",
     log:
         "results/logs/convergence_figure.log",
+    benchmark:
+        "results/benchmarks/convergence_figure.tsv"
     localrule: True
+    conda:
+        "../envs/ddfv.yaml"
     threads: 1
     resources:
         mem_mb=500,
         runtime=5,
-    conda:
-        "../envs/ddfv.yaml"
+    params:
+        t_final=config["t_final"],
     script:
         "../scripts/plot_convergence.py"

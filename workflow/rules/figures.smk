@@ -54,21 +54,21 @@ rule figure:
             category="Figures 3.1-3.8",
             labels={"figure": "{figure}", "type": "mesh quality"},
         ),
+    log:
+        "results/logs/figures/{figure}.log",
+    benchmark:
+        "results/benchmarks/figures/{figure}.tsv"
+    conda:
+        "../envs/ddfv.yaml"
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
     params:
         title=lambda wildcards: EXPERIMENTS[wildcards.figure].title,
         caption=lambda wildcards: EXPERIMENTS[wildcards.figure].caption,
         settings=lambda wildcards: EXPERIMENTS[wildcards.figure].describe(),
         # rerun when the experiment's definition changes
         config=lambda wildcards: EXPERIMENTS[wildcards.figure].config(),
-    benchmark:
-        "results/benchmarks/figures/{figure}.tsv",
-    log:
-        "results/logs/figures/{figure}.log",
-    threads: 1
-    resources:
-        mem_mb=1000,
-        runtime=5,
-    conda:
-        "../envs/ddfv.yaml"
     script:
         "../scripts/figure.py"

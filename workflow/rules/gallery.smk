@@ -61,21 +61,21 @@ if GALLERY["generated"]:
         `meshes` folder is given)."""
         output:
             "results/gallery/meshes/{mesh}",
-        params:
-            entry=lambda wildcards: GALLERY["generated"][wildcards.mesh],
-            code=MATRIX_CODE,
-        benchmark:
-            "results/benchmarks/gallery/meshes/{mesh}.tsv",
         log:
             "results/logs/gallery/meshes/{mesh}.log",
+        benchmark:
+            "results/benchmarks/gallery/meshes/{mesh}.tsv"
         wildcard_constraints:
             mesh=_alternatives(GALLERY["generated"]),
+        conda:
+            "../envs/ddfv.yaml"
         threads: 1
         resources:
             mem_mb=1000,
             runtime=10,
-        conda:
-            "../envs/ddfv.yaml"
+        params:
+            entry=lambda wildcards: GALLERY["generated"][wildcards.mesh],
+            code=MATRIX_CODE,
         script:
             "../scripts/gallery_mesh.py"
 
@@ -88,23 +88,23 @@ rule gallery_run:
     output:
         record="results/gallery/runs/{mesh}/{scheme}.json",
         frames="results/gallery/frames/{mesh}/{scheme}.npz",
-    params:
-        settings=lambda wildcards: GALLERY_RUNS[
-            f"results/gallery/runs/{wildcards.mesh}/{wildcards.scheme}.json"
-        ],
-    benchmark:
-        "results/benchmarks/gallery/{mesh}/{scheme}.tsv",
     log:
         "results/logs/gallery/{mesh}/{scheme}.log",
+    benchmark:
+        "results/benchmarks/gallery/{mesh}/{scheme}.tsv"
     wildcard_constraints:
         mesh=_alternatives(GALLERY["meshes"]),
         scheme=_alternatives(GALLERY["schemes"]),
+    conda:
+        "../envs/ddfv.yaml"
     threads: 1
     resources:
         mem_mb=2000,
         runtime=60,
-    conda:
-        "../envs/ddfv.yaml"
+    params:
+        settings=lambda wildcards: GALLERY_RUNS[
+            f"results/gallery/runs/{wildcards.mesh}/{wildcards.scheme}.json"
+        ],
     script:
         "../scripts/gallery_run.py"
 
@@ -116,20 +116,20 @@ rule gallery_table:
     output:
         md="results/gallery/table.md",
         csv="results/gallery/table.csv",
-    params:
-        expected=GALLERY_RUNS,
-        plan=GALLERY,
-    benchmark:
-        "results/benchmarks/gallery/table.tsv",
     log:
         "results/logs/gallery/table.log",
+    benchmark:
+        "results/benchmarks/gallery/table.tsv"
     localrule: True
+    conda:
+        "../envs/ddfv.yaml"
     threads: 1
     resources:
         mem_mb=1000,
         runtime=5,
-    conda:
-        "../envs/ddfv.yaml"
+    params:
+        expected=GALLERY_RUNS,
+        plan=GALLERY,
     script:
         "../scripts/gallery_table.py"
 
@@ -142,20 +142,20 @@ rule gallery_pictures:
     output:
         png="results/gallery/pictures.png",
         pdf="results/gallery/pictures.pdf",
-    params:
-        expected=GALLERY_RUNS,
-        plan=GALLERY,
-    benchmark:
-        "results/benchmarks/gallery/pictures.tsv",
     log:
         "results/logs/gallery/pictures.log",
+    benchmark:
+        "results/benchmarks/gallery/pictures.tsv"
     localrule: True
+    conda:
+        "../envs/ddfv.yaml"
     threads: 1
     resources:
         mem_mb=2000,
         runtime=10,
-    conda:
-        "../envs/ddfv.yaml"
+    params:
+        expected=GALLERY_RUNS,
+        plan=GALLERY,
     script:
         "../scripts/gallery_pictures.py"
 
@@ -167,18 +167,18 @@ rule gallery_movie:
         frames="results/gallery/frames/{mesh}/{scheme}.npz",
     output:
         gif="results/gallery/movies/{mesh}/{scheme}.gif",
-    benchmark:
-        "results/benchmarks/gallery/movies/{mesh}/{scheme}.tsv",
     log:
         "results/logs/gallery/movies/{mesh}/{scheme}.log",
+    benchmark:
+        "results/benchmarks/gallery/movies/{mesh}/{scheme}.tsv"
     wildcard_constraints:
         mesh=_alternatives(GALLERY["meshes"]),
         scheme=_alternatives(GALLERY["schemes"]),
+    conda:
+        "../envs/ddfv.yaml"
     threads: 1
     resources:
         mem_mb=1000,
         runtime=10,
-    conda:
-        "../envs/ddfv.yaml"
     script:
         "../scripts/gallery_movie.py"

@@ -6,20 +6,19 @@ rule compile_kernels:
     """Compile every scheme's and the solver's kernels once, before the run jobs."""
     output:
         KERNELS,
-    params:
-        # a code change compiles again (the cache is keyed by source file)
-        code=PIPELINE.code,
-        threads=THREADS,
-    benchmark:
-        "results/benchmarks/kernels.tsv",
     log:
         "results/logs/kernels.log",
+    benchmark:
+        "results/benchmarks/kernels.tsv"
+    conda:
+        "../envs/ddfv.yaml"
     threads: THREADS
     resources:
         mem_mb=500,
         runtime=10,
-    conda:
-        "../envs/ddfv.yaml"
+    params:
+        # a code change compiles again (the cache is keyed by source file)
+        code=PIPELINE.code,
+        threads=THREADS,
     script:
         "../scripts/compile_kernels.py"
-

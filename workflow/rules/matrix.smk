@@ -31,7 +31,9 @@ MATRIX_RUNS = _matrix.planned_runs(MATRIX, MATRIX_CODE)
 
 
 MATRIX_PROBLEM_TABLES = [
-    f"results/matrix/tables/{p}.{ext}" for p in MATRIX["problems"] for ext in ("md", "tex")
+    f"results/matrix/tables/{p}.{ext}"
+    for p in MATRIX["problems"]
+    for ext in ("md", "tex")
 ]
 MATRIX_TABLES = [
     "results/matrix/tables/matrix.csv",
@@ -67,26 +69,33 @@ for _problem, _levels in MATRIX["problems"].items():
         input:
             kernels=ancient(KERNELS),
         output:
-            records=[f"results/matrix/runs/{_problem}/{{scheme}}/level{k}.json" for k in _levels],
-            frames=[f"results/matrix/frames/{_problem}/{{scheme}}/level{k}.npz" for k in _levels],
-        params:
-            settings=lambda wildcards, problem=_problem, levels=_levels: [
-                MATRIX_RUNS[_matrix.record_path(problem, wildcards.scheme, k)] for k in levels
+            records=[
+                f"results/matrix/runs/{_problem}/{{scheme}}/level{k}.json"
+                for k in _levels
             ],
-        benchmark:
-            f"results/benchmarks/matrix/{_problem}/{{scheme}}.tsv"
+            frames=[
+                f"results/matrix/frames/{_problem}/{{scheme}}/level{k}.npz"
+                for k in _levels
+            ],
         log:
             f"results/logs/matrix/{_problem}/{{scheme}}.log",
+        benchmark:
+            f"results/benchmarks/matrix/{_problem}/{{scheme}}.tsv"
         wildcard_constraints:
             scheme=_alternatives(MATRIX["schemes"]),
-        threads: 1
-        resources:
-            mem_mb=1500,
-            runtime=120,
         # the longest series first: long jobs start early and the two cores stay busy
         priority: len(_levels)
         conda:
             "../envs/ddfv.yaml"
+        threads: 1
+        resources:
+            mem_mb=1500,
+            runtime=120,
+        params:
+            settings=lambda wildcards, problem=_problem, levels=_levels: [
+                MATRIX_RUNS[_matrix.record_path(problem, wildcards.scheme, k)]
+                for k in levels
+            ],
         script:
             "../scripts/matrix_run.py"
 
@@ -97,20 +106,20 @@ rule matrix_tables:
         list(MATRIX_RUNS),
     output:
         MATRIX_TABLES,
-    params:
-        expected=MATRIX_RUNS,
-        plan=MATRIX,
-    benchmark:
-        "results/benchmarks/matrix/tables.tsv",
     log:
         "results/logs/matrix/tables.log",
+    benchmark:
+        "results/benchmarks/matrix/tables.tsv"
     localrule: True
+    conda:
+        "../envs/ddfv.yaml"
     threads: 1
     resources:
         mem_mb=1500,
         runtime=10,
-    conda:
-        "../envs/ddfv.yaml"
+    params:
+        expected=MATRIX_RUNS,
+        plan=MATRIX,
     script:
         "../scripts/matrix_tables.py"
 
@@ -123,21 +132,21 @@ rule matrix_plots:
         frames=[f for _, f in _matrix.picture_runs(MATRIX).values()],
     output:
         **MATRIX_FIGURES,
-    params:
-        expected=MATRIX_RUNS,
-        plan=MATRIX,
-        pictures=_matrix.picture_runs(MATRIX),
-    benchmark:
-        "results/benchmarks/matrix/plots.tsv",
     log:
         "results/logs/matrix/plots.log",
+    benchmark:
+        "results/benchmarks/matrix/plots.tsv"
     localrule: True
+    conda:
+        "../envs/ddfv.yaml"
     threads: 1
     resources:
         mem_mb=2000,
         runtime=10,
-    conda:
-        "../envs/ddfv.yaml"
+    params:
+        expected=MATRIX_RUNS,
+        plan=MATRIX,
+        pictures=_matrix.picture_runs(MATRIX),
     script:
         "../scripts/matrix_plots.py"
 
@@ -149,19 +158,19 @@ rule matrix_findings:
         table="results/matrix/tables/matrix.csv",
     output:
         "results/matrix/findings.md",
-    params:
-        plan=MATRIX,
-    benchmark:
-        "results/benchmarks/matrix/findings.tsv",
     log:
         "results/logs/matrix/findings.log",
+    benchmark:
+        "results/benchmarks/matrix/findings.tsv"
     localrule: True
+    conda:
+        "../envs/ddfv.yaml"
     threads: 1
     resources:
         mem_mb=1000,
         runtime=5,
-    conda:
-        "../envs/ddfv.yaml"
+    params:
+        plan=MATRIX,
     script:
         "../scripts/matrix_findings.py"
 
@@ -179,18 +188,18 @@ rule matrix_page:
         findings="results/matrix/findings.md",
     output:
         "results/matrix/index.html",
-    params:
-        plan=MATRIX,
-    benchmark:
-        "results/benchmarks/matrix/page.tsv",
     log:
         "results/logs/matrix/page.log",
+    benchmark:
+        "results/benchmarks/matrix/page.tsv"
     localrule: True
+    conda:
+        "../envs/ddfv.yaml"
     threads: 1
     resources:
         mem_mb=1000,
         runtime=5,
-    conda:
-        "../envs/ddfv.yaml"
+    params:
+        plan=MATRIX,
     script:
         "../scripts/matrix_page.py"

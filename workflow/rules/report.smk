@@ -92,6 +92,7 @@ rule reproduction_report:
             }
         ),
     output:
+        **REPORT_TEX,
         md=report(
             f"{REPORT_DIR}/reproduction.md",
             caption="../report/report_markdown.rst",
@@ -110,22 +111,21 @@ rule reproduction_report:
             category="Reproduction report",
             labels={"file": "checks (JSON)"},
         ),
-        **REPORT_TEX,
-    params:
-        # results/, paper/ and results/beyond/ are found from the inputs
-        beyond_targets=BEYOND_RESULTS,
-        figures=FIGURES,
-    benchmark:
-        "results/benchmarks/report.tsv",
     log:
         "results/logs/report.log",
+    benchmark:
+        "results/benchmarks/report.tsv"
     localrule: True
+    conda:
+        "../envs/ddfv.yaml"
     threads: 1
     resources:
         mem_mb=1000,
         runtime=5,
-    conda:
-        "../envs/ddfv.yaml"
+    params:
+        # results/, paper/ and results/beyond/ are found from the inputs
+        beyond_targets=BEYOND_RESULTS,
+        figures=FIGURES,
     script:
         "../scripts/report.py"
 
@@ -139,16 +139,16 @@ rule report_pdf:
         figures=expand("results/figures/{figure}.pdf", figure=[*FIGURES, "convergence"]),
     output:
         pdf=f"{REPORT_DIR}/reproduction.pdf",
-    benchmark:
-        "results/benchmarks/report_pdf.tsv",
     log:
         "results/logs/report_pdf.log",
+    benchmark:
+        "results/benchmarks/report_pdf.tsv"
     localrule: True
+    conda:
+        "../envs/ddfv.yaml"
     threads: 1
     resources:
         mem_mb=1000,
         runtime=10,
-    conda:
-        "../envs/ddfv.yaml"
     script:
         "../scripts/report_pdf.py"
