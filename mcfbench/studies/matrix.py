@@ -19,6 +19,7 @@ The plots are in :mod:`mcfbench.presentation.matrix_plots`, the gallery of
 user meshes in :mod:`mcfbench.studies.gallery`.
 """
 
+import logging
 from pathlib import Path
 
 import numpy as np

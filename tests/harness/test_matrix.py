@@ -363,3 +363,21 @@ def test_cheapest_to_reach_reads_the_long_table():
     assert verdict["costs"] == {"a": 4.0, "b": 9.0}
     text = "\n".join(work_precision_section([verdict], {"a": "A"}))
     assert "**A** is the cheapest, 4 s (then b 9 s)" in text
+
+
+def test_series_job_writes_every_level_and_logs_to_one_file(tmp_path):
+    """One Snakemake job per (problem, scheme): every level's record and frames,
+    the same records as one job per run, one log for the series."""
+    plan = matrix.plan({"schemes": ["cotan"], "problems": {p: ([1, 2] if p == "sphere" else [])
+                                                           for p in PROBLEMS}})
+    runs = matrix.planned_runs(plan, code="test", root=str(tmp_path))
+    records = list(runs)
+    frames = [r.replace("/runs/", "/frames/").removesuffix(".json") + ".npz" for r in records]
+    log = tmp_path / "series.log"
+    results = matrix.series_job(list(runs.values()), records, frames, log)
+    assert [r.level for r in results] == [1, 2] and all(r.status == "ok" for r in results)
+    one = tmp_path / "one.json"
+    matrix.job(runs[records[1]], one, tmp_path / "one.npz")
+    assert read_record(records[1])["l2_error"] == read_record(one)["l2_error"]
+    text = log.read_text()
+    assert "sphere level 1" in text and "sphere level 2" in text
