@@ -60,23 +60,23 @@ rule all:
 
 
 rule beyond:
+    """Target: level 6, the scheme variants and the stability study (slow)."""
     input:
         BEYOND_TARGETS,
-    """Target: level 6, the scheme variants and the stability study (slow)."""
     localrule: True
 
 
 rule matrix:
-    input:
-        MATRIX_TARGETS,
     """Target: every scheme x every problem x its levels (config key `matrix`;
     about 15 minutes on 2 cores), tables, figures and findings in results/matrix/."""
+    input:
+        MATRIX_TARGETS,
     localrule: True
 
 
 rule gallery:
-    input:
-        GALLERY_TARGETS,
     """Target: every scheme on every mesh file (`--config meshes=DIR`; default the
     suite's own meshes), table and pictures in results/gallery/."""
+    input:
+        GALLERY_TARGETS,
     localrule: True

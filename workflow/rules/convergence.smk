@@ -5,9 +5,9 @@
 
 
 rule convergence:
+    """Target: Table 3.1 (CSV, Markdown, LaTeX, provenance) and the convergence figure."""
     input:
         CONVERGENCE_TARGETS,
-    """Target: Table 3.1 (CSV, Markdown, LaTeX, provenance) and the convergence figure."""
     localrule: True
 
 
