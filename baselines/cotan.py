@@ -65,7 +65,8 @@ import scipy.sparse as sp
 from .kernels import cotan_geometry, neighbour_cosines, row_scaled_system
 from .mesh import edge_mesh, laplacian_pattern
 from .redistribution import (MAX_SHIFT, OMEGA, REDISTRIBUTIONS, redistribution_source,
-                             shift_limit, solve_potential, tangential_velocity, target_shares)
+                             shift_limit, solve_potential, surface_components,
+                             tangential_velocity, target_shares)
 
 MASS_TYPES = {"barycentric": igl.MASSMATRIX_TYPE_BARYCENTRIC,
               "voronoi": igl.MASSMATRIX_TYPE_VORONOI}
@@ -495,6 +496,9 @@ class CotanFlow(VertexFlow):
             raise ValueError(f"omega must be a finite number >= 0, got {omega!r}")
         if max_shift is not None and not (np.isfinite(max_shift) and max_shift > 0):
             raise ValueError(f"max_shift must be None or a positive number, got {max_shift!r}")
+        if redistribution and (k := surface_components(faces, len(vertices))) > 1:
+            raise ValueError(f"the redistribution (R2) needs a connected surface; this one "
+                             f"has {k} components")
         self.max_shift = None if max_shift is None else float(max_shift)
         self.target = target
         self._shares = target_shares(faces, len(vertices), target)

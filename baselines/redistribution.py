@@ -222,3 +222,16 @@ def shift_limit(X, edges, alpha, tau, max_shift):
     if not moving.any():
         return 1.0
     return float(min(1.0, max_shift * np.min(length[moving] / change[moving])))
+
+
+def surface_components(faces, n_vertices):
+    """Number of connected components of the triangle mesh ``faces`` (m, 3): the
+    potential (R2) is pinned once and its source balances the whole surface's
+    area, so the redistribution is written for a connected surface."""
+    from scipy.sparse.csgraph import connected_components
+
+    f = np.asarray(faces)
+    rows, cols = f[:, [0, 1, 2]].ravel(), f[:, [1, 2, 0]].ravel()
+    graph = sp.coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n_vertices, n_vertices))
+    return connected_components(graph, directed=False)[0]
+

@@ -40,7 +40,7 @@ from .assembly import Assembler
 from .geometry import diamond_geometry, t_barycentric, vertex_normals
 from .kernels import check_threads, extrapolate_kernel, for_threads
 from .redistribution import (OMEGA, TangentialPotential, carry_t_vertices, neumann_stiffness,
-                             redistribution_source, vertex_gradients)
+                             redistribution_source, surface_components, vertex_gradients)
 from .t_vertices import initial_t_vertices
 from .topology import diamond_mesh, locality_order
 
@@ -140,6 +140,10 @@ class Flow:
         self.omega, self.t_motion = float(omega), t_motion
         self._area_0 = None
         self._faces = diamond_mesh(faces, len(vertices)).faces   # checked, as given
+        if tangential == "redistribute" and (k := surface_components(self._faces,
+                                                                       len(vertices))) > 1:
+            raise ValueError(f"the redistribution (R1)-(R5) needs a connected surface; this "
+                             f"one has {k} components")
         n_f, n_t = len(vertices), len(self._faces)
         # the flow's own numbering (module docstring): position j holds the
         # caller's vertex vertex_order[j] and triangle face_order[j]

@@ -352,3 +352,20 @@ def carry_t_vertices(F, T, faces, lam):
     nrm = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
     nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
     return Q + np.einsum("ij,ij->i", T - Q, nrm)[:, None] * nrm
+
+
+def surface_components(faces, n_vertices):
+    """Number of connected components of the triangle mesh ``faces`` (m, 3).
+
+    The redistribution's potential is defined up to one constant per family
+    and component, and its source balances the area of the whole surface;
+    both are written for a connected surface (:class:`ddfv.Flow` refuses
+    others with ``tangential="redistribute"``).
+    """
+    from scipy.sparse.csgraph import connected_components
+
+    f = np.asarray(faces)
+    rows, cols = f[:, [0, 1, 2]].ravel(), f[:, [1, 2, 0]].ravel()
+    graph = sp.coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n_vertices, n_vertices))
+    return connected_components(graph, directed=False)[0]
+

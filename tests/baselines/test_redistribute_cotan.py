@@ -266,3 +266,11 @@ def test_registry_entry():
     flow = get_scheme("cotan-redistribute").make(V, F, 0.01)
     assert isinstance(flow, CotanFlow) and flow.redistribution == "area"
     assert flow.omega == 10.0 and flow.max_shift is None and flow.target == "triangle"
+
+
+def test_redistribution_refuses_a_surface_of_two_components():
+    V, F = icosphere(1)
+    two = np.vstack([V, V + 3.0]), np.vstack([F, F + len(V)])
+    with pytest.raises(ValueError, match="needs a connected surface; this one has 2 components"):
+        CotanFlow(*two, 0.01, redistribution="area")
+    CotanFlow(*two, 0.01)                                          # plain cotan: fine

@@ -308,3 +308,14 @@ def test_redistribution_on_a_flat_patch_keeps_it_flat_and_its_boundary_fixed():
     spread = lambda c: c.std() / c.mean()
     assert spread(chi) < 0.8 * spread(chi0), (spread(chi0), spread(chi))
     assert flow.t_min_barycentric() > 0.3
+
+
+def test_redistribution_refuses_a_surface_of_two_components():
+    """The potential has one constant per family and component and the source
+    balances the whole area: two spheres are refused by name, not factorised
+    into a singular matrix (a 15-component mesh of the gallery raised)."""
+    V, F = icosphere(1)
+    two = np.vstack([V, V + 3.0]), np.vstack([F, F + len(V)])
+    with pytest.raises(ValueError, match="needs a connected surface; this one has 2 components"):
+        Flow(*two, 0.01, **variant_options("chord-redistribute-carried"))
+    Flow(*two, 0.01, **variant_options("chord-carried"))          # no redistribution: fine
