@@ -8,7 +8,8 @@ hand: ``mcfbench report``.
 
 from pathlib import Path
 
-from mcfbench.presentation.report import Sources, build, default_outputs
+from mcfbench.presentation.report import build, default_outputs
+from mcfbench.presentation.report_inputs import Sources
 from mcfbench.storage.logs import setup_logging
 from mcfbench.studies.figures import EXPERIMENTS
 
