@@ -236,7 +236,9 @@ def summary_table(table, problems=None, schemes=None):
                 continue
             ok = runs[runs["status"] == "ok"]
             failed = runs[runs["status"] != "ok"]
-            finished = ok[np.isfinite(ok["value"])]
+            # a value is measured when finite: a finished run's, or one taken before
+            # a later breakdown (the volume before a pinch)
+            finished = runs[np.isfinite(runs["value"])]
             finest = finished.iloc[-1] if len(finished) else None
             eoc_rows = finished[np.isfinite(finished["eoc"])]
             last_eoc = eoc_rows.iloc[-1] if len(eoc_rows) else None

@@ -381,3 +381,20 @@ def test_series_job_writes_every_level_and_logs_to_one_file(tmp_path):
     assert read_record(records[1])["l2_error"] == read_record(one)["l2_error"]
     text = log.read_text()
     assert "sphere level 1" in text and "sphere level 2" in text
+
+
+def test_summary_keeps_a_value_measured_before_a_later_breakdown():
+    """The torus's volume at t = 0.1 is measured before the run stops at the pinch:
+    the summary shows it and its EOC, and still names the breakdown."""
+    rows = [("cotan", 1, 0.0156, "solver_stagnated"), ("cotan", 2, 0.0039, "inverted")]
+    table = pd.DataFrame([{"scheme": s, "problem": "torus", "level": lv, "h": 0.1 / lv,
+                           "tau": 0.004, "steps": 50, "steps_done": 30, "metric": "volume_error",
+                           "value": v, "eoc": np.nan, "status": st, "t_failed": 0.13,
+                           "min_angle": 20.0, "max_flipped": 0, "t_min_barycentric": np.nan,
+                           "iterations": 10, "cpu_seconds": 1.0, "robust_status": "",
+                           "robust_value": np.nan, "robust_t_failed": np.nan}
+                          for s, lv, v, st in rows])
+    summary = matrix_tables.summary_table(matrix_tables.add_eoc(table))
+    (row,) = summary.to_dict("records")
+    assert row["finest_value"] == 0.0039 and row["eoc"] == pytest.approx(2.0, abs=1e-9)
+    assert row["runs_ok"] == 0 and row["status"] == "solver_stagnated"
