@@ -41,12 +41,14 @@ def _pct_or(value, metric):
 
 def _classify(row):
     """``order2``, ``converging``, ``not_converging``, ``exact`` (round-off),
-    ``broke_down`` or ``no_error``."""
-    if row["runs_ok"] < row["runs"]:
+    ``broke_down`` or ``no_error``. A row whose runs broke down but whose error was
+    measured on every level before (the volume before a pinch) is judged by it."""
+    values = [abs(float(v)) for v in str(row["values"]).split(";") if v]
+    measured = row["error"] and sum(np.isfinite(v) for v in values) == row["runs"]
+    if row["runs_ok"] < row["runs"] and not measured:
         return "broke_down"
     if not row["error"]:
         return "no_error"
-    values = [abs(float(v)) for v in str(row["values"]).split(";") if v]
     if values and all(np.isfinite(v) and v <= ROUNDOFF for v in values):
         return "exact"
     if not np.isfinite(row["eoc"]):

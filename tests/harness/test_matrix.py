@@ -398,3 +398,12 @@ def test_summary_keeps_a_value_measured_before_a_later_breakdown():
     (row,) = summary.to_dict("records")
     assert row["finest_value"] == 0.0039 and row["eoc"] == pytest.approx(2.0, abs=1e-9)
     assert row["runs_ok"] == 0 and row["status"] == "solver_stagnated"
+
+
+def test_a_pinch_after_the_measurement_is_judged_by_the_measured_error():
+    from mcfbench.presentation.matrix_findings import _classify as classify_row  # noqa: PLC2701
+
+    row = {"runs": 3, "runs_ok": 0, "error": True, "values": "0.164;0.0463;0.0129",
+           "eoc": 1.84}
+    assert classify_row(row) == "order2"
+    assert classify_row({**row, "values": "0.164;0.0463"}) == "broke_down"
