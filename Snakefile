@@ -68,7 +68,7 @@ rule beyond:
 
 rule matrix:
     """Target: every scheme x every problem x its levels (config key `matrix`;
-    about 15 minutes on 2 cores), tables, figures and findings in results/matrix/."""
+    about 20 minutes on 2 cores), tables, figures and findings in results/matrix/."""
     input:
         MATRIX_TARGETS,
     localrule: True

@@ -1,7 +1,7 @@
 # The benchmark matrix: every scheme x every problem x its refinement series
 # (issue "The benchmark matrix"). Not part of `rule all`:
 #
-#   snakemake --cores 2 matrix      # the default matrix: about 15 minutes on 2 cores
+#   snakemake --cores 2 matrix      # the default matrix: about 20 minutes on 2 cores
 #
 # Settings: the config key `matrix` (config/config.yaml), checked against the
 # registries mcfbench.running.schemes.SCHEMES and mcfbench.running.problems.PROBLEMS by
