@@ -107,7 +107,8 @@ def write_movie(arrays, out, *, title="", view=(20.0, -60.0), fps=4, size=4.0, d
         raise ValueError(f"{out}: the animation is a GIF; name it *.gif")
     ddfv = "F" in arrays
     F = np.asarray(arrays["F" if ddfv else "V"], dtype=float)
-    T = np.asarray(arrays["T"], dtype=float) if ddfv else None
+    # a DDFV run the scheme refused (status unsupported) kept its surface, no T-vertices
+    T = np.asarray(arrays["T"], dtype=float) if "T" in arrays else None
     faces, t = np.asarray(arrays["faces"]), np.asarray(arrays["t"], dtype=float)
     if len(t) == 0 or len(F) != len(t):
         raise ValueError(f"{out}: no frames to animate ({len(F)} frames, {len(t)} times)")
@@ -115,7 +116,7 @@ def write_movie(arrays, out, *, title="", view=(20.0, -60.0), fps=4, size=4.0, d
     status = str(arrays.get("status", "ok"))
     message = str(arrays.get("message", ""))
     statuses = frame_status(steps, status, int(arrays.get("failed_step", -1)))
-    centre, half = view_box([np.concatenate([F[k], T[k]]) if ddfv else F[k]
+    centre, half = view_box([np.concatenate([F[k], T[k]]) if T is not None else F[k]
                              for k in range(len(t))], view)
     fig, ax = plt.subplots(figsize=(size, size))
     fig.subplots_adjust(left=0.02, right=0.98, top=0.9, bottom=0.12)

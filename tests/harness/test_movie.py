@@ -113,3 +113,17 @@ def test_gallery_run_keeps_frames_for_its_movie(tmp_path):
     _, shown = _frames(tmp_path / "bad.gif")
     assert len(shown) == 1                                  # the status, in red
     assert ((shown[0][..., 0] > 150) & (shown[0][..., 1] < 90)).sum() > 50
+
+
+def test_refused_ddfv_run_still_gets_its_one_frame_movie(tmp_path):
+    """A DDFV scheme that refuses a surface (status unsupported) keeps the surface
+    as its frames, without T-vertices: the gallery's movie job drew none and raised."""
+    from mcfbench.presentation.movie import write_movie
+    from mcfbench.geometry.spheres import icosphere
+
+    V, F = icosphere(1)
+    out = tmp_path / "refused.gif"
+    write_movie({"F": np.stack([V, V]), "faces": F, "steps": np.array([0, 0]),
+                 "t": np.zeros(2), "status": "unsupported",
+                 "message": "unsupported at step 0 (t = 0): two components"}, out)
+    assert out.read_bytes()[:6] in (b"GIF89a", b"GIF87a")
