@@ -335,9 +335,8 @@ def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_ever
     -------
     result : RunResult
     frames : dict of arrays
-        The trajectory's frames (first and last), ``faces``, ``steps``, ``t``.
+        The trajectory's saved frames, ``faces``, ``steps``, ``t``.
     """
-
     scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
     problem = get_problem(problem) if isinstance(problem, str) else problem
     start = time.process_time()
