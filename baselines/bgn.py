@@ -140,39 +140,56 @@ class BGNFlow(VertexFlow):
     @property
     def omega(self):
         """(n, 3) mass-lumped vertex normals (B3) of the current surface."""
+        return self._normals(self.geometry)
+
+    def _normals(self, geometry):
+        """(n, 3) the normals (B3) of the surface of ``geometry``."""
         omega = np.empty((self.mesh.n_vertices, 3))
-        vertex_normals(self.faces, self.geometry.area_vectors, self.mesh.n_vertices, omega)
+        vertex_normals(self.faces, geometry.area_vectors, self.mesh.n_vertices, omega)
         return omega
 
     def laplacian(self):
         """The cotangent stiffness ``A`` (one coordinate) of the current surface, CSR."""
         return self.assembler.laplacian(self.geometry.L_data)
 
-    def system(self, scaling=None):
-        """``(A, b)`` of (B4) at the current state.
+    def system(self, at=None, base=None, dt=None, *, scaling=None):
+        """``(A, b)`` of (B4) with ``Gamma^m`` the surface ``at``.
+
+        The harness's integrators (``mcfbench.running.integrators``, (I1))
+        replace ``X^m`` by the base state ``B`` in the difference quotient of
+        (B1) and ``tau`` by ``dt``; the operators (``A``, ``omega``, the lumped
+        mass) are those of ``Gamma^m = at``. Default: the scheme's own step
+        from the current state.
 
         Parameters
         ----------
+        at, base : (3, n) float arrays, optional
+            ``X*`` and ``B`` (default ``X^m``).
+        dt : float, optional
+            Default ``tau``.
         scaling : {"mass", "none"}, optional
             Default: the flow's.
 
         Returns
         -------
         A : (3n, 3n) scipy.sparse.csr_matrix
-            ``A + P/tau`` (``"none"``) or ``diag(tau/m) A + Omega``
+            ``A + P/dt`` (``"none"``) or ``diag(dt/m) A + Omega``
             (``"mass"``), unknowns by components; Dirichlet rows identity.
         b : (3, n) float array
-            ``P X^m / tau`` (``"none"``) or ``Omega X^m`` (``"mass"``);
-            ``X^m`` at Dirichlet vertices.
+            ``P B / dt`` (``"none"``) or ``Omega B`` (``"mass"``); ``B`` at
+            Dirichlet vertices.
         """
         scaling = self.scaling if scaling is None else scaling
         if scaling not in SCALINGS:
             raise ValueError(f"unknown scaling {scaling!r}; choose one of {', '.join(SCALINGS)}")
-        g, p, n = self.geometry, self.assembler.pattern, self.mesh.n_vertices
+        return super().system(at, base, dt, scaling=scaling)
+
+    def _system(self, at, base, dt, scaling):
+        g, p, n = self.geometry_at(at), self.assembler.pattern, self.mesh.n_vertices
         data = np.empty(len(self._indices))
         b = np.empty((3, n))
-        bgn_system(g.L_data, p.indptr, p.diag_slots, g.mass, self.omega, self._X, self.tau,
-                   self.fixed, scaling == "mass", data, b)
+        bgn_system(g.L_data, p.indptr, p.diag_slots, g.mass, self._normals(g),
+                   np.ascontiguousarray(base), dt, self.fixed, scaling == "mass", data, b)
         A = sp.csr_matrix((data, self._indices, self._indptr), shape=(3 * n, 3 * n),
                           copy=False)
         return A, b

@@ -57,11 +57,11 @@ class CMCFFlow(CotanFlow):
     def _needs_laplacian(self):
         return False  # only the mass changes from step to step
 
-    def laplacian(self):
-        """``L^0`` (C2) of the initial surface, CSR (a fresh copy)."""
+    def laplacian(self, at=None):
+        """``L^0`` (C2) of the initial surface, CSR (a fresh copy), whatever the state."""
         if self.assembly == "igl":
             return self._L0.copy()
         return self.assembler.laplacian(self._L0_data.copy())
 
-    def _laplacian_data(self):
+    def _laplacian_data(self, geometry):
         return self._L0_data

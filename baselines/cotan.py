@@ -260,10 +260,9 @@ class VertexFlow:
     """What every vertex-based baseline shares (the ``mcfbench.running.flow.Flow`` contract).
 
     The state is the mesh vertices, stored by components ``X`` (3, n).
-    Subclasses implement :meth:`system`, the linear system of one step at
-    the current state; :meth:`step` solves it once from the warm start
-    ``2 X^{n-1} - X^{n-2}`` (``X^0`` at the first step) and accepts the
-    result.
+    Subclasses implement ``_system(at, base, dt)``, the linear system of
+    one step with the operators at a state (:meth:`system`); the harness's
+    integrator solves it and hands the result to :meth:`advance`.
 
     Parameters
     ----------
@@ -282,7 +281,8 @@ class VertexFlow:
         Current time level.
     tau : float
     timings : dict
-        Seconds spent in ``"assembly"`` (geometry and system) and ``"solve"``.
+        Seconds spent in ``"assembly"`` (geometry and system); the integrator
+        adds ``"solve"``.
     """
 
     def __init__(self, vertices, faces, tau, *, mass="barycentric"):
@@ -296,7 +296,6 @@ class VertexFlow:
         self.tau = float(tau)
         self.n = 0
         self._X = np.ascontiguousarray(V.T)
-        self._X_prev = self._X
         self.timings = {"assembly": 0.0, "solve": 0.0}
         # triangles already flipped against their neighbours at step 0
         self._flipped0 = ~(self._normal_agreement() >= 0.0)
@@ -355,36 +354,56 @@ class VertexFlow:
     def _needs_laplacian(self):
         return True
 
-    def system(self):
-        """``(A, b)`` of the step from the current state (implemented by subclasses)."""
-        raise NotImplementedError
+    @property
+    def state(self):
+        """(3, n) read-only view of ``X^n``: what :meth:`system` and :meth:`advance`
+        work with (the vertex-based schemes keep the caller's numbering)."""
+        return self.X
 
-    def step(self, solve):
-        """Advance one time step.
+    def geometry_at(self, at):
+        """:class:`SurfaceGeometry` of the state ``at`` (3, n) (the cached one of the
+        current state when ``at`` is it)."""
+        if at is self._X:
+            return self.geometry
+        return self.assembler.geometry(at.T, self._needs_laplacian())
+
+    def system(self, at=None, base=None, dt=None, **options):
+        """``(A, b)`` of one step with the operators at the state ``at``.
+
+        The step ``M(X*) (X - B) / dt + L(X*) X = M(X*) g(X*)`` of the harness's
+        integrators (``mcfbench.running.integrators``, (I1)) for ``X* = at``,
+        ``B = base``; by default the semi-implicit Euler step from the current
+        state (``at = base = X^n``, ``dt = tau``).
 
         Parameters
         ----------
-        solve : callable
-            ``solve(A, b, x0) -> (x, info)``; if it raises, the exception
-            propagates and the state stays at ``n``.
+        at, base : (3, n) float arrays, optional
+        dt : float, optional
+        **options
+            Passed to the subclass's ``_system``.
 
         Returns
         -------
-        info
-            What ``solve`` returned.
+        A : scipy.sparse.csr_matrix
+        b : (3, n) float array
         """
+        at = self._X if at is None else at
+        base = at if base is None else base
         clock = time.perf_counter()
-        A, b = self.system()
-        x0 = 2.0 * self._X - self._X_prev
-        now = time.perf_counter()
-        self.timings["assembly"] += now - clock
-        X, info = solve(A, b, x0)
-        self.timings["solve"] += time.perf_counter() - now
-        self._X_prev, self._X = self._X, np.ascontiguousarray(X, dtype=np.float64)
+        A, b = self._system(at, base, self.tau if dt is None else float(dt), **options)
+        self.timings["assembly"] += time.perf_counter() - clock
+        return A, b
+
+    def _system(self, at, base, dt):
+        """``(A, b)`` of :meth:`system` (implemented by subclasses)."""
+        raise NotImplementedError
+
+    def advance(self, X):
+        """Accept ``X`` (3, n) as the state ``n + 1``."""
+        self._X = np.require(X, np.float64, ["C", "W"])
         self.n += 1
         self.__dict__.pop("geometry", None)
         self.__dict__.pop("_triangle_checks", None)
-        return info
 
     @cached_property
     def _triangle_checks(self):
@@ -516,57 +535,60 @@ class CotanFlow(VertexFlow):
     def _needs_laplacian(self):
         return self.assembly == "cached"
 
-    def laplacian(self):
-        """The stiffness of this step's system, CSR: ``L^n`` (C2) of the current surface."""
+    def laplacian(self, at=None):
+        """The stiffness of the step at the state ``at`` (default the current one),
+        CSR: ``L`` (C2) of that surface."""
+        at = self._X if at is None else at
         if self.assembly == "igl":
-            return cotangent_laplacian(self._X.T, self.faces)
-        return self.assembler.laplacian(self.geometry.L_data)
+            return cotangent_laplacian(at.T, self.faces)
+        return self.assembler.laplacian(self._laplacian_data(self.geometry_at(at)))
 
-    def _system_mass(self):
+    def _system_mass(self, at):
         if self.assembly == "igl":
-            return lumped_mass(self._X.T, self.faces, self.mass_type)
-        return self.geometry.mass
+            return lumped_mass(at.T, self.faces, self.mass_type)
+        return self.geometry_at(at).mass
 
-    def _laplacian_data(self):
-        return self.geometry.L_data
+    def _laplacian_data(self, geometry):
+        return geometry.L_data
 
-    def tangential_velocity(self):
-        """``v_T = grad psi`` (R2) at the current state, (3, n); zero at fixed vertices.
+    def tangential_velocity(self, at=None, dt=None):
+        """``v_T = grad psi`` (R2) at the state ``at`` (default the current one), (3, n);
+        zero at fixed vertices.
 
-        Solves (R2) with the stiffness and mass of this step's system
-        and stores ``psi``.
+        Solves (R2) with the stiffness and mass of the system at ``at`` and
+        stores ``psi``; ``dt`` (default ``tau``) is the step the shift limit
+        (R4) applies to.
         """
+        at = self._X if at is None else at
+        dt = self.tau if dt is None else dt
         clock = time.perf_counter()
-        L, mass = self.laplacian(), self._system_mass()
+        L, mass = self.laplacian(at), self._system_mass(at)
         if self._area_0 is None:                                 # the first step's state
             self._area_0 = float(mass.sum())
         rate = self.omega * 4.0 * np.pi / self._area_0           # scale-covariant omega
-        f = redistribution_source(L, mass, self._X, self.fixed, rate, self._shares)
+        f = redistribution_source(L, mass, at, self.fixed, rate, self._shares)
         self.psi = solve_potential(L, mass, f)
-        alpha, _ = tangential_velocity(self._X.T, self.faces, self.psi)
+        alpha, _ = tangential_velocity(at.T, self.faces, self.psi)
         alpha[:, self.fixed] = 0.0
         factor = 1.0
         if self.max_shift is not None:
-            factor = shift_limit(self._X, self.mesh.edges, alpha, self.tau, self.max_shift)
+            factor = shift_limit(at, self.mesh.edges, alpha, dt, self.max_shift)
             alpha *= factor
         self.shift_factors.append(factor)
         self.timings["redistribution"] += time.perf_counter() - clock
         return alpha
 
-    def _rhs(self):
-        if self.redistribution is None:
-            return self._X
-        return self._X + self.tau * self.tangential_velocity()     # (R3)
-
-    def system(self):
-        """``(A, b)``: ``A = I + tau diag(1/M^n) L^n`` (C3), CSR, rows of
-        boundary vertices = identity; ``b = X^n`` (3, n), or ``X^n + tau
-        v_T^n`` with ``redistribution="area"`` (R3)."""
+    def _system(self, at, base, dt):
+        """``A = I + dt diag(1/M*) L*`` (C3) at ``at``, CSR, rows of boundary
+        vertices = identity; ``b = B``, or ``B + dt v_T*`` with
+        ``redistribution="area"`` (R3)."""
+        rhs = base
+        if self.redistribution is not None:
+            rhs = base + dt * self.tangential_velocity(at, dt)     # (R3)
         if self.assembly == "igl":
-            L = self.laplacian()
-            L.data *= np.repeat(self.tau / self._system_mass(), np.diff(L.indptr))
+            L = self.laplacian(at)
+            L.data *= np.repeat(dt / self._system_mass(at), np.diff(L.indptr))
             A = (L + sp.identity(L.shape[0], format="csr")).tocsr()
-            return (dirichlet_rows(A, self.fixed) if self.mesh.has_boundary else A), self._rhs()
-        A = self.assembler.row_scaled(self._laplacian_data(), self.geometry.mass, self.tau,
-                                      self.fixed)
-        return A, self._rhs()
+            return (dirichlet_rows(A, self.fixed) if self.mesh.has_boundary else A), rhs
+        g = self.geometry_at(at)
+        return self.assembler.row_scaled(self._laplacian_data(g), g.mass, dt, self.fixed), rhs

@@ -102,6 +102,7 @@ def sphere_systems(level):
     """``[(A, b, x0)]`` of the first two steps of the Table 3.1 run at ``level``."""
     from ddfv import Flow
     from mcfbench.geometry.spheres import icosphere
+    from mcfbench.running.integrators import Euler
 
     V, F = icosphere(level)
     flow = Flow(V, F, 0.04 / 4.0 ** (level - 1))
@@ -111,8 +112,9 @@ def sphere_systems(level):
         captured.append((A.tocsr(copy=True), np.array(b), np.array(x0)))
         return Solver()(A, b, x0)
 
-    flow.step(record)
-    flow.step(record)
+    stepper = Euler()
+    stepper.step(flow, record)
+    stepper.step(flow, record)
     return captured
 
 

@@ -1,9 +1,14 @@
-"""Semi-implicit time stepping (2.1) of the DDFV scheme: one flow, one step at a time.
+"""The DDFV scheme's flow: its state and the linear system of one time step at a state.
 
-One step solves ``(I + tau diag(1/chi^{n-1}) K^{n-1}) X^n = X^{n-1}``
-((2.10), (2.13)) for the stacked ``X = [F; T]`` (stored by components,
-shape (3, n_F + n_T)) as one block system; the linear solver is passed in
-by the caller (the paper uses BiCGStab, Section 3).
+The paper's semi-implicit step (2.1) solves
+``(I + tau diag(1/chi^{n-1}) K^{n-1}) X^n = X^{n-1}`` ((2.10), (2.13)) for
+the stacked ``X = [F; T]`` (stored by components, shape (3, n_F + n_T)) as
+one block system. :meth:`Flow.system` assembles that system with the
+operators at any state ``X*`` and the difference quotient from any base
+state ``B``; the time integrator that chooses them (the paper's Euler step,
+or BDF2), the initial guess and the linear solver (the paper uses
+BiCGStab, Section 3) belong to the caller (``mcfbench.running.integrators``),
+which then hands the solution to :meth:`Flow.advance`.
 
 Open surfaces: boundary F-vertices keep their position (1.2); see
 :mod:`ddfv.assembly`. With ``tangential="eliminate"`` the right-hand side
@@ -12,11 +17,6 @@ becomes ``X^{n-1} - tau (h - (h.N) N)`` (3.6), where
 scheme's own discrete Laplacian of the previous state (zero at Dirichlet
 vertices) and ``N`` the vertex normals of
 :func:`ddfv.geometry.vertex_normals`.
-
-Warm start: ``X^n`` is predicted by linear extrapolation
-``2 X^{n-1} - X^{n-2}`` (``X^0`` at the first step), whose residual is
-O(tau^2) instead of the O(tau) of ``X^{n-1}``; ``warm_start="previous"``
-starts from ``X^{n-1}`` (see ``ddfv/README.md``).
 
 Numbering: the flow stores its state in its own numbering of the vertices
 and triangles (:func:`ddfv.topology.locality_order`), in which neighbours
@@ -38,13 +38,12 @@ import numpy as np
 
 from .assembly import Assembler
 from .geometry import diamond_geometry, t_barycentric, vertex_normals
-from .kernels import check_threads, extrapolate_kernel, for_threads
+from .kernels import check_threads
 from .redistribution import (OMEGA, TangentialPotential, carry_t_vertices, neumann_stiffness,
                              redistribution_source, surface_components, vertex_gradients)
 from .t_vertices import initial_t_vertices
 from .topology import diamond_mesh, locality_order
 
-WARM_STARTS = ("extrapolate", "previous")
 TANGENTIAL = ("none", "eliminate", "redistribute")
 T_MOTIONS = ("scheme", "carried")
 
@@ -83,8 +82,6 @@ class Flow:
         Initial T-vertices; by default from ``t_init``.
     t_init : {"paper", "barycenter", "exact"}
         T-vertex initialisation (see :mod:`ddfv.t_vertices`).
-    warm_start : {"extrapolate", "previous"}
-        Initial guess of BiCGStab (see module docstring).
     tangential : {"none", "eliminate", "redistribute"}
         ``"eliminate"`` removes the tangential part of the discrete mean
         curvature vector from the velocity (3.6); ``"redistribute"`` adds
@@ -120,13 +117,10 @@ class Flow:
     """
 
     def __init__(self, vertices, faces, tau, *, T0=None, t_init="paper",
-                 warm_start="extrapolate", tangential="none", dual_length="broken", threads=1,
+                 tangential="none", dual_length="broken", threads=1,
                  omega=OMEGA, t_motion="scheme"):
         if not (np.isfinite(tau) and tau > 0):
             raise ValueError(f"tau must be a positive number, got {tau!r}")
-        if warm_start not in WARM_STARTS:
-            raise ValueError(f"unknown warm_start {warm_start!r}; choose one of "
-                             f"{', '.join(WARM_STARTS)}")
         if tangential not in TANGENTIAL:
             raise ValueError(f"unknown tangential {tangential!r}; choose one of "
                              f"{', '.join(TANGENTIAL)}")
@@ -165,11 +159,10 @@ class Flow:
                 raise ValueError(f"T0 must have shape {(n_t, 3)}, got {T.shape}")
             T = T[self._face_order]
         self.tau = float(tau)
-        self.warm_start, self.tangential = warm_start, tangential
+        self.tangential = tangential
         self.dual_length = dual_length
         self.n = 0
         self._X = np.ascontiguousarray(np.concatenate([F, T]).T)
-        self._X_prev = self._X
         self._assembler = Assembler(self._mesh)
         self.timings = {"geometry": 0.0, "assembly": 0.0, "solve": 0.0}
         self._J0 = self._geometry.J.mean()
@@ -215,12 +208,16 @@ class Flow:
 
     @cached_property
     def _state(self):
-        """``(geometry, chi)`` of the current state in one pass (own numbering): the
-        :class:`~ddfv.geometry.DiamondGeometry` and the (n_f + n_t,) covolume
-        areas ``chi^n``, F-vertices first."""
+        """:meth:`_geometry_at` of the current state, kept until the next step."""
+        return self._geometry_at(self._X)
+
+    def _geometry_at(self, X):
+        """``(geometry, chi)`` of the state ``X`` (3, n_f + n_t) in one pass (own
+        numbering): the :class:`~ddfv.geometry.DiamondGeometry` and the
+        (n_f + n_t,) covolume areas ``chi``, F-vertices first."""
         n_f = self._mesh.n_f
         chi = np.empty(self._mesh.n_unknowns)
-        geometry = diamond_geometry(self._mesh, self._X[:, :n_f].T, self._X[:, n_f:].T,
+        geometry = diamond_geometry(self._mesh, X[:, :n_f].T, X[:, n_f:].T,
                                     self.dual_length, self.threads,
                                     vectors=self.tangential != "none",  # normals, gradients
                                     covolumes=chi)
@@ -266,64 +263,84 @@ class Flow:
         """``{"F": (n_f, 3), "T": (n_t, 3)}`` copies of the current state."""
         return {"F": self.F, "T": self.T}
 
-    def step(self, solve):
-        """Advance one time step.
+    @property
+    def state(self):
+        """(3, n_f + n_t) ``[F^n; T^n]`` in the flow's own numbering (read-only view):
+        what :meth:`system` and :meth:`advance` work with."""
+        view = self._X.view()
+        view.flags.writeable = False
+        return view
+
+    def system(self, at=None, base=None, dt=None):
+        """The linear system of one step, assembled at the state ``at``.
+
+        The step of (2.1), (2.10)-(2.15) with its operators taken at ``at``
+        (``X*``) and the difference quotient taken from ``base`` (``B``)::
+
+            chi(X*) (X - B) / dt + K(X*) X = chi(X*) g(X*)
+
+        i.e. ``(I + dt diag(1/chi*) K*) X = B + dt g*``, ``g = 0`` (the paper),
+        ``-(h - (h.N) N)`` with ``h = -diag(1/chi*) K* X*`` (the elimination
+        (3.6)) or ``v_T`` (the redistribution, (R1)-(R5)). The paper's step is
+        ``at = base = X^{n-1}``, ``dt = tau``; the harness's integrators choose
+        them (``mcfbench.running.integrators``). Dirichlet rows: identity, right-hand
+        side ``B``.
 
         Parameters
         ----------
-        solve : callable
-            ``solve(A, b, x0) -> (x, info)`` for (3, n) blocks sharing the
-            (n, n) matrix ``A``; raises when it fails, which leaves the
-            state at ``n - 1``.
+        at, base : (3, n_f + n_t) float arrays, optional
+            In the flow's own numbering (:attr:`state`); default the current
+            state ``X^{n-1}``.
+        dt : float, optional
+            Default ``tau``.
 
         Returns
         -------
-        info
-            What ``solve`` returned.
+        A : (n, n) scipy.sparse.csr_matrix
+            Shared by the three components.
+        b : (3, n) float array
         """
+        at = self._X if at is None else at
+        base = at if base is None else base
+        dt = self.tau if dt is None else float(dt)
         clock = time.perf_counter()
-        geometry, covolumes = self._geometry, self._chi
-        self._tick("geometry", clock)
-        clock = time.perf_counter()
-        A = self._assembler.system(geometry, covolumes, self.tau, self.threads)
-        rhs = self._X
+        geometry, covolumes = self._state if at is self._X else self._geometry_at(at)
+        clock = self._tick("geometry", clock)
+        A = self._assembler.system(geometry, covolumes, dt, self.threads)
+        rhs = base
         if self.tangential == "eliminate":
-            h = (self._X - (A @ self._X.T).T) / self.tau            # h^{n-1}
-            N = vertex_normals(self._mesh, geometry)                  # N^{n-1}
-            rhs = self._X - self.tau * (h - (h * N).sum(axis=0) * N)  # (3.6)
+            h = (at - (A @ at.T).T) / dt                              # h*
+            N = vertex_normals(self._mesh, geometry)                  # N*
+            rhs = base - dt * (h - (h * N).sum(axis=0) * N)           # (3.6)
         elif self.tangential == "redistribute":
-            rhs = self._X + self.tau * self._tangential_velocity(A, geometry, covolumes)
-        x0 = self._X
-        owned = False
-        if self.warm_start == "extrapolate":
-            x0 = np.empty_like(self._X)        # 2 X^{n-1} - X^{n-2} in one new buffer
-            for_threads(extrapolate_kernel, self.threads)(self._X, self._X_prev, x0)
-            owned = True
-        clock = self._tick("assembly", clock)
-        if owned and getattr(solve, "can_overwrite_x0", False):   # may iterate in x0
-            X, info = solve(A, rhs, x0, overwrite_x0=True)
-        else:
-            X, info = solve(A, rhs, x0)
-        self._tick("solve", clock)
-        X = np.ascontiguousarray(X)
+            rhs = base + dt * self._tangential_velocity(at, A, dt, geometry, covolumes)
+        self._tick("assembly", clock)
+        return A, rhs
+
+    def advance(self, X):
+        """Accept ``X`` (3, n_f + n_t), own numbering, as the state ``n + 1``.
+
+        With ``t_motion="carried"`` every T-vertex is first carried back to
+        its initial barycentric coordinates in its triangle.
+        """
+        X = np.require(X, np.float64, ["C", "W"])   # the compiled passes take writable arrays
         if self.t_motion == "carried":       # a tangential move of the T-vertices
             n_f = self._mesh.n_f
             X = X.copy()
             X[:, n_f:] = carry_t_vertices(X[:, :n_f].T, X[:, n_f:].T, self._mesh.faces,
                                           self._lambda0).T
-        self._X_prev, self._X = self._X, X
+        self._X = X
         self.n += 1
         for name in ("_state", "_barycentric"):
             self.__dict__.pop(name, None)
-        return info
 
-    def _tangential_velocity(self, A, geometry, covolumes):
-        """(3, n) ``v_T = grad psi`` of the current state (R1)-(R5), zero at
-        Dirichlet F-vertices; ``A`` the step's matrix (its discrete Laplacian
-        gives ``h``, as in (3.6))."""
+    def _tangential_velocity(self, at, A, dt, geometry, covolumes):
+        """(3, n) ``v_T = grad psi`` (R1)-(R5) of the state ``at``, zero at
+        Dirichlet F-vertices; ``A`` the step's matrix at ``at`` with step ``dt``
+        (its discrete Laplacian gives ``h``, as in (3.6))."""
         mesh = self._mesh
         N = vertex_normals(mesh, geometry)
-        h = (self._X - (A @ self._X.T).T) / self.tau             # h^{n-1}, zero at fixed F
+        h = (at - (A @ at.T).T) / dt                             # h*, zero at fixed F
         hV = (h * N).sum(axis=0) ** 2                            # h.V = H^2 (V = H N)
         fixed = mesh.boundary_vertices
         if self._area_0 is None:                                 # the first step's state

@@ -304,20 +304,6 @@ def covolume_kernel(diamonds, quarters, order, starts, chi_f, chi_t):
         raise IndexError("diamond index out of range")
 
 
-@numba.njit("void(float64[:, ::1], float64[:, ::1], float64[:, ::1])", **_OPTIONS)
-def extrapolate_kernel(X, X_prev, out):
-    """``out = 2 X - X_prev`` in one pass: the warm start of :meth:`ddfv.flow.Flow.step`.
-
-    Parameters
-    ----------
-    X, X_prev : (k, n) float64 arrays
-    out : (k, n) float64 array, output
-    """
-    for q in range(X.shape[0]):
-        for i in numba.prange(X.shape[1]):
-            out[q, i] = X[q, i] * 2.0 - X_prev[q, i]
-
-
 @numba.njit("void(uint64[:, :], float64[:, :], float64[:, :], int64, float64[:, ::1])",
             **_OPTIONS)
 def vertex_normals_kernel(diamonds, u, v, n_f, out):

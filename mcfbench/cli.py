@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ddfv.variants import VARIANTS
+from mcfbench.running.integrators import INTEGRATORS
 from mcfbench.running.problems import PROBLEMS, Problem, get_problem
 from mcfbench.running.schemes import SCHEMES, get_scheme
 from mcfbench.running.solver import METHODS, ROBUST, Solver
@@ -73,8 +74,12 @@ def _common(parser, default_solver):
                         help="iterations allowed per step (default: 1000)")
     parser.add_argument("--t-init", choices=("paper", "barycenter", "exact"),
                         help="DDFV: T-vertex initialisation (default: paper)")
+    parser.add_argument("--integrator", choices=list(INTEGRATORS), default="euler",
+                        help="time integrator: the paper's semi-implicit Euler (default) "
+                             "or linearly implicit BDF2")
     parser.add_argument("--warm-start", choices=("extrapolate", "previous"),
-                        help="DDFV: initial guess of the solver (default: extrapolate)")
+                        default="extrapolate",
+                        help="initial guess of the solver: 2 X^n - X^{n-1} (default) or X^n")
     parser.add_argument("--on-defect", choices=("stop", "record"), default="stop",
                         help="an invalid state (T-vertex escaped, triangle inverted, mesh "
                              "degenerated) ends the run (stop, default) or is recorded")
@@ -165,8 +170,9 @@ def _scheme(args):
 def _options(args, scheme):
     """Run options: the solver and the DDFV-only settings that were given."""
     options = {"solver": Solver(args.solver, args.rtol, args.maxiter, threads=args.threads),
+               "integrator": args.integrator, "warm_start": args.warm_start,
                "on_defect": args.on_defect, "threads": args.threads}
-    ddfv_only = {"t_init": args.t_init, "warm_start": args.warm_start}
+    ddfv_only = {"t_init": args.t_init}
     given = {k: v for k, v in ddfv_only.items() if v is not None}
     if given and scheme.family != "ddfv":
         raise ValueError(f"--{next(iter(given)).replace('_', '-')} applies to the DDFV "
@@ -177,7 +183,8 @@ def _options(args, scheme):
 def _settings(args, scheme):
     return {"command": args.command, "scheme": scheme.name, "solver": args.solver,
             "rtol": args.rtol, "maxiter": args.maxiter, "t_init": args.t_init,
-            "warm_start": args.warm_start, "on_defect": args.on_defect,
+            "integrator": args.integrator, "warm_start": args.warm_start,
+            "on_defect": args.on_defect,
             "threads": args.threads}
 
 

@@ -16,6 +16,7 @@ import numpy as np
 
 from mcfbench.geometry.collapse import CollapseCheck
 from mcfbench.running.flow import FlowBreakdown
+from mcfbench.running.integrators import get_integrator
 from mcfbench.running.solver import Solver, SolverFailure
 
 ON_DEFECT = ("stop", "record")
@@ -94,8 +95,9 @@ class _NoBar:
         pass
 
 
-def simulate(flow, steps, *, solver=None, save_every=1, observers=(), on_defect="stop",
-             until=None, progress=False, collapse=True):
+def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrapolate",
+             save_every=1, observers=(), on_defect="stop", until=None, progress=False,
+             collapse=True):
     """Step ``flow`` ``steps`` times.
 
     Parameters
@@ -104,6 +106,11 @@ def simulate(flow, steps, *, solver=None, save_every=1, observers=(), on_defect=
     steps : int
     solver : mcfbench.running.solver.Solver, optional
         Default ``Solver()`` (BiCGStab, rtol 1e-9).
+    integrator : str
+        A name of :data:`mcfbench.running.integrators.INTEGRATORS`: ``"euler"``
+        (the paper's semi-implicit step) or ``"bdf2"``.
+    warm_start : {"extrapolate", "previous"}
+        The solver's initial guess (:class:`mcfbench.running.integrators.Euler`).
     save_every : int
         Keep every ``save_every``-th time level as a frame (the first and
         the last are always kept); ``0`` keeps only those two.
@@ -144,6 +151,7 @@ def simulate(flow, steps, *, solver=None, save_every=1, observers=(), on_defect=
     if on_defect not in ON_DEFECT:
         raise ValueError(f"unknown on_defect {on_defect!r}; choose one of {', '.join(ON_DEFECT)}")
     solver = Solver() if solver is None else solver
+    stepper = get_integrator(integrator, warm_start=warm_start)
     frames, steps_kept, iterations, defects = [], [], [], []
     seen = set()
     collapsed = CollapseCheck(flow.vertices, flow.faces) if collapse else None
@@ -191,7 +199,7 @@ def simulate(flow, steps, *, solver=None, save_every=1, observers=(), on_defect=
         for _ in range(int(steps) if broken is None else 0):
             try:
                 try:
-                    info = flow.step(solver)
+                    info = stepper.step(flow, solver)
                 except SolverFailure as err:
                     step = flow.n + 1
                     defects.append({"status": err.status, "step": step,

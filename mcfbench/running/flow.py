@@ -2,17 +2,21 @@
 
 A scheme is a class whose instances are one flow of one surface
 (:class:`Flow`); the harness builds it from ``(vertices, faces, tau,
-**options)``, steps it with the shared linear solver and checks every new
-state. The schemes (``ddfv``, ``baselines``) import nothing from the
-harness: the solver is passed to :meth:`Flow.step` as a function, and a
-scheme reports what is wrong with a state as plain ``(status, description)``
-pairs (:meth:`Flow.defects`), which the driver turns into one
+**options)``, steps it with one of its time integrators
+(:mod:`mcfbench.running.integrators`) and the shared linear solver, and
+checks every new state. The scheme provides the spatial part: its state
+and the linear system of one step with its operators assembled at a given
+state (:meth:`Flow.system`); the integrator chooses that state, solves and
+hands the solution back (:meth:`Flow.advance`). The schemes (``ddfv``,
+``baselines``) import nothing from the harness, and a scheme reports what
+is wrong with a state as plain ``(status, description)`` pairs
+(:meth:`Flow.defects`), which the driver turns into one
 :class:`FlowBreakdown` with one message format.
 
 The statuses a run can end with are :data:`mcfbench.storage.statuses.STATUSES`.
 """
 
-from typing import Callable, Protocol, runtime_checkable
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
@@ -44,6 +48,8 @@ class Flow(Protocol):
         surface (they sum to its area).
     fixed : (n,) bool array
         Dirichlet (boundary) vertices, held at their initial position.
+    timings : dict, optional
+        Seconds by phase; the integrator adds the solves' under ``"solve"``.
     """
 
     n: int
@@ -61,15 +67,31 @@ class Flow(Protocol):
     @property
     def l2_weights(self) -> np.ndarray: ...
 
-    def step(self, solve: Callable) -> object:
-        """Advance one time step.
+    @property
+    def state(self) -> np.ndarray:
+        """(3, n_points) the state ``X^n`` in the scheme's own numbering, read-only:
+        what :meth:`system` takes and :meth:`advance` gives back (the arrays a
+        scheme stores are never changed in place)."""
 
-        ``solve(A, b, x0) -> (x, info)`` solves ``A x = b`` for a (3, n)
-        block ``b`` from ``x0`` (``A`` an (n, n) matrix shared by the three
-        components or a (3n, 3n) matrix acting on ``b.ravel()``); it raises
-        when the solve fails, and the scheme lets that propagate with its
-        state unchanged. Returns ``info``.
+    def system(self, at, base, dt: float) -> tuple:
+        """The linear system ``A X = b`` of one step, its operators assembled at ``at``.
+
+        The step is ``M(X*) (X - B) / dt + L(X*) X = M(X*) g(X*)``
+        ((I1) of :mod:`mcfbench.running.integrators`) with ``X* = at``,
+        ``B = base`` (both (3, n_points), own numbering; ``None``: the current
+        state, whose geometry the scheme may already have), ``M`` the scheme's
+        mass-like operator, ``L`` its stiffness and ``g`` whatever it adds
+        explicitly (an elimination of tangential motion, a tangential
+        velocity); fixed points keep ``B``. ``A`` is an (n, n) matrix shared
+        by the three components or a (3n, 3n) one acting on ``b.ravel()``;
+        ``b`` is (3, n). The semi-implicit Euler step is ``at = base = None``
+        (the state), ``dt = tau``.
         """
+
+    def advance(self, X: np.ndarray) -> None:
+        """Accept ``X`` (3, n_points, own numbering), the solution of :meth:`system`,
+        as the state ``n + 1`` (a scheme may post-process it, e.g. carry its
+        DDFV T-vertices with their triangles)."""
 
     def defects(self) -> list:
         """What is wrong with the current state: ``[(status, description)]``.

@@ -80,8 +80,9 @@ class _Steady:
         return self.reached
 
 
-def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defect="stop",
-        save_every=0, samples=20, mesh=None, threads=1, progress=False, **options):
+def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrator="euler",
+        warm_start="extrapolate", on_defect="stop", save_every=0, samples=20, mesh=None,
+        threads=1, progress=False, **options):
     """Run ``scheme`` on ``problem`` at refinement ``level``.
 
     Parameters
@@ -93,6 +94,10 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defec
         Override the problem's time rule.
     solver : mcfbench.running.solver.Solver, optional
         Default: BiCGStab, rtol 1e-9 (the paper's).
+    integrator : {"euler", "bdf2"}
+        The time integrator (:mod:`mcfbench.running.integrators`).
+    warm_start : {"extrapolate", "previous"}
+        The solver's initial guess (:class:`mcfbench.running.integrators.Euler`).
     on_defect : {"stop", "record"}
         See :func:`mcfbench.running.driver.simulate`.
     save_every : int
@@ -128,7 +133,8 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defec
     until = _Steady(problem.steady_speed) if problem.steady_speed else None
     cpu, wall = time.process_time(), time.perf_counter()
     flow = scheme.make(V, F, tau, threads=threads, **options)
-    traj = simulate(flow, steps, solver=solver, save_every=save_every,
+    traj = simulate(flow, steps, solver=solver, integrator=integrator, warm_start=warm_start,
+                    save_every=save_every,
                     observers=[monitor, *observers], on_defect=on_defect, until=until,
                     progress=progress)
     monitor.final(flow)
@@ -147,7 +153,8 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, on_defec
         h=metrics.mean_edge_length(V, F), tau=tau, N=steps, steps_done=traj.steps_done,
         status=traj.status, message=traj.message, t_failed=traj.t_failed,
         t_end=flow.n * tau, steady=bool(until is not None and until.reached),
-        iterations=int(traj.iterations.sum()), solver=solver.method, cpu_seconds=cpu,
+        iterations=int(traj.iterations.sum()), solver=solver.method, integrator=integrator,
+        cpu_seconds=cpu,
         wall_seconds=wall, t_min_barycentric=_worst(np.min, monitor.t_monitor),
         min_angle=_worst(np.min, q["min_angle"]), max_aspect=_worst(np.max, q["max_aspect"]),
         max_flipped=_worst(np.max, q["flipped"]), metrics=values,
@@ -217,7 +224,7 @@ def _level_bar(levels, problem):
 
 
 def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_final=None,
-                     solver=None, **options):
+                     solver=None, integrator="euler", **options):
     """Error at ``t_final`` against a fine-``tau`` reference of the same scheme on one mesh.
 
     Parameters
@@ -232,17 +239,24 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
     t_final : float, optional
         Default: the problem's.
     solver : mcfbench.running.solver.Solver, optional
+    integrator : {"euler", "bdf2"}
+        The time integrator of every run, the reference's included.
     **options
         Options of the scheme's flow (passed to :func:`run`).
 
     Returns
     -------
     pandas.DataFrame
-        Columns ``tau, N, error, eoc, <metrics>, status``: ``error`` is
-        ``sqrt(sum_i w_i |X_i - X_i^ref|^2)`` at ``t_final`` over every point
-        of the state, ``w`` the scheme's quadrature weights of the
-        reference (DDFV: the covolumes chi / 2), ``eoc`` its order (3.1)
-        between successive rows.
+        Columns ``tau, N, error, eoc, volume_error, volume_eoc, <metrics>, status``:
+        ``error`` is ``sqrt(sum_i w_i |X_i - X_i^ref|^2)`` at ``t_final`` over
+        every point of the state, ``w`` the scheme's quadrature weights of
+        the reference (DDFV: the covolumes chi / 2); ``volume_error`` is
+        ``|vol(X) - vol(X^ref)|`` of the mesh (the volume between the two
+        surfaces: with the boundary held fixed it does not depend on the
+        origin), blind to tangential motion, which BGN's scheme
+        (:mod:`baselines.bgn`) sets anew at every step, so that its points
+        do not follow one time-continuous path; ``eoc``, ``volume_eoc``
+        their orders (3.1) between successive rows.
 
     Raises
     ------
@@ -251,26 +265,31 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
     """
     import pandas as pd
 
+    from mcfbench.geometry.metrics import volume
+
     def final(tau):
         result, traj = run(scheme, problem, level, tau=tau, t_final=t_final, solver=solver,
-                           **options)
+                           integrator=integrator, **options)
         X = np.concatenate([traj.frames[k][-1] for k in traj.frames]).T
-        return result, X
+        vertices = traj.frames["F" if "F" in traj.frames else "V"][-1]   # the mesh's
+        return result, X, volume(vertices, traj.faces)
 
-    ref_result, ref = final(min(taus) / reference_factor)
+    ref_result, ref, ref_volume = final(min(taus) / reference_factor)
     if ref_result.status != "ok":
         raise RuntimeError(f"reference run failed: {ref_result.message}")
     weights = _final_weights(scheme, problem, level, ref, t_final, options)
     rows = []
     for tau in taus:
-        result, X = final(tau)
+        result, X, vol = final(tau)
         ok = result.status == "ok"
         rows.append({"tau": tau, "N": result.N,
                      "error": float(np.sqrt(weights @ np.sum((X - ref) ** 2, axis=0)))
                      if ok else np.nan,
+                     "volume_error": abs(vol - ref_volume) if ok else np.nan,
                      **result.metrics, "status": result.status})
     table = pd.DataFrame(rows)
     table.insert(3, "eoc", eoc(table["error"].to_numpy()))
+    table.insert(5, "volume_eoc", eoc(table["volume_error"].to_numpy()))
     return table
 
 
@@ -314,18 +333,20 @@ class _Guarded:
             raise _Unsupported(str(err)) from err
 
 
-def _nan_result(scheme, problem, level, mesh, tau, steps, status, message, method, seconds):
+def _nan_result(scheme, problem, level, mesh, tau, steps, status, message, method, seconds,
+                integrator):
     V, F = mesh
     nan = float("nan")
     return RunResult(
         scheme=scheme.name, problem=problem.name, level=int(level), nV=len(V), nF=len(V),
         nT=0, h=metrics.mean_edge_length(V, F), tau=float(tau), N=int(steps), steps_done=0,
         status=status, message=message, t_failed=0.0, t_end=0.0, steady=False, iterations=0,
-        solver=method, cpu_seconds=seconds, wall_seconds=seconds, t_min_barycentric=nan,
-        min_angle=nan, max_aspect=nan, max_flipped=nan, metrics={}, series={})
+        solver=method, integrator=integrator, cpu_seconds=seconds, wall_seconds=seconds,
+        t_min_barycentric=nan, min_angle=nan, max_aspect=nan, max_flipped=nan, metrics={}, series={})
 
 
-def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_every=0):
+def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_every=0,
+               integrator="euler"):
     """:func:`run` for the studies that keep frames files (by default the first and the
     last, ``save_every=0``; see :func:`mcfbench.running.driver.simulate`); a scheme
     that refuses the surface gives status ``unsupported`` (the initial surface as both
@@ -342,14 +363,14 @@ def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_ever
     start = time.process_time()
     try:
         result, traj = run(_Guarded(scheme), problem, level, solver=solver,
-                           save_every=save_every, mesh=mesh, tau=tau)
+                           save_every=save_every, mesh=mesh, tau=tau, integrator=integrator)
     except _Unsupported as err:
         V, F = validate_mesh(*(problem.mesh(level) if mesh is None else mesh))
         tau = problem.tau(level, (V, F)) if tau is None else float(tau)
         steps = problem.time_steps(tau)
         result = _nan_result(scheme, problem, level, (V, F), tau, steps, "unsupported",
                              f"unsupported at step 0 (t = 0): {err}", solver.method,
-                             time.process_time() - start)
+                             time.process_time() - start, integrator)
         key = "F" if scheme.family == "ddfv" else "V"
         return result, {key: np.stack([V, V]), "faces": F, "steps": np.array([0, 0]),
                         "t": np.zeros(2)}

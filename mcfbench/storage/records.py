@@ -53,6 +53,8 @@ class RunResult:
         Total solver iterations.
     solver : str
         The solver's method.
+    integrator : str
+        The time integrator (:data:`mcfbench.running.integrators.INTEGRATORS`).
     cpu_seconds, wall_seconds : float
         Flow construction (T-vertex initialisation included), stepping and
         metrics.
@@ -87,6 +89,7 @@ class RunResult:
     steady: bool
     iterations: int
     solver: str
+    integrator: str
     cpu_seconds: float
     wall_seconds: float
     t_min_barycentric: float

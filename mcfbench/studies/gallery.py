@@ -190,7 +190,8 @@ def job(mesh_path, scheme, settings, record, frames, log_path=None):
         result = RunResult(scheme=scheme.name, problem="gallery", level=1, nV=0, nF=0, nT=0,
                            h=nan, tau=nan, N=settings["steps"], steps_done=0,
                            status="unsupported", message=message, t_failed=0.0, t_end=0.0,
-                           steady=False, iterations=0, solver=solver.method, cpu_seconds=0.0,
+                           steady=False, iterations=0, solver=solver.method,
+                           integrator="euler", cpu_seconds=0.0,
                            wall_seconds=0.0, t_min_barycentric=nan, min_angle=nan,
                            max_aspect=nan, max_flipped=nan)
         save_npz(frames, faces=np.zeros((0, 3), int), steps=np.zeros(0, int), t=np.zeros(0))

@@ -171,7 +171,7 @@ def test_source_sums_to_zero_per_family_and_ignores_fixed_vertices():
 def _velocity(V, F, omega=10.0, level_tau=0.01):
     flow = Flow(V, F, level_tau, tangential="redistribute", omega=omega, t_init="exact")
     A = flow._assembler.system(flow._geometry, flow._chi, flow.tau)
-    v = flow._tangential_velocity(A, flow._geometry, flow._chi)
+    v = flow._tangential_velocity(flow._X, A, flow.tau, flow._geometry, flow._chi)
     return flow, v
 
 

@@ -6,6 +6,7 @@ import pytest
 from mcfbench.geometry.spheres import icosphere, random_bumpy_sphere
 from mcfbench.running.driver import simulate
 from mcfbench.running.flow import Flow
+from mcfbench.running.integrators import Euler
 from mcfbench.running.schemes import SCHEMES, get_scheme
 
 
@@ -60,8 +61,9 @@ def _second_matrix(scheme, V, F):
         seen.append(A)
         return solver(A, b, x0)
 
-    flow.step(solve)
-    flow.step(solve)
+    stepper = Euler()
+    stepper.step(flow, solve)
+    stepper.step(flow, solve)
     return seen[-1]
 
 
