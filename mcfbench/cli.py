@@ -74,7 +74,7 @@ def _common(parser, default_solver):
                         help="iterations allowed per step (default: 1000)")
     parser.add_argument("--t-init", choices=("paper", "barycenter", "exact"),
                         help="DDFV: T-vertex initialisation (default: paper)")
-    parser.add_argument("--integrator", choices=list(INTEGRATORS), default="euler",
+    parser.add_argument("--integrator", choices=list(INTEGRATORS),
                         help="time integrator: the paper's semi-implicit Euler (default) "
                              "or linearly implicit BDF2")
     parser.add_argument("--warm-start", choices=("extrapolate", "previous"),
@@ -183,7 +183,7 @@ def _options(args, scheme):
 def _settings(args, scheme):
     return {"command": args.command, "scheme": scheme.name, "solver": args.solver,
             "rtol": args.rtol, "maxiter": args.maxiter, "t_init": args.t_init,
-            "integrator": args.integrator, "warm_start": args.warm_start,
+            "integrator": args.integrator or scheme.integrator, "warm_start": args.warm_start,
             "on_defect": args.on_defect,
             "threads": args.threads}
 

@@ -340,8 +340,11 @@ class Pipeline:
 
     @staticmethod
     def scheme_pattern():
-        """Regular expression of the registry's names, longest first."""
-        return alternatives(SCHEMES)
+        """Regular expression of the registry's names (longest first), each optionally
+        ``@<integrator>`` (:func:`mcfbench.running.schemes.get_scheme`)."""
+        from mcfbench.running.integrators import INTEGRATORS
+
+        return f"(?:{alternatives(SCHEMES)})(?:@(?:{alternatives(INTEGRATORS)}))?"
 
     # -- resources of the jobs (minutes, MB)
     @staticmethod

@@ -160,14 +160,14 @@ def matrix_page(matrix_dir, plan=None, title="Benchmark matrix: results"):
         :func:`mcfbench.studies.matrix.plan` of the run: problem and scheme
         order (default: that of ``matrix.csv``).
     """
-    from mcfbench.running.schemes import SCHEMES
+    from mcfbench.running.schemes import scheme_label
 
     root = Path(matrix_dir)
     table = read_long_table(root / "tables" / "matrix.csv")
     problems = [p for p in (plan["problems"] if plan else dict.fromkeys(table["problem"]))
                 if p in set(table["problem"])]
     schemes = list(plan["schemes"]) if plan else list(dict.fromkeys(table["scheme"]))
-    labels = {s: SCHEMES[s].label if s in SCHEMES else s for s in schemes}
+    labels = {s: scheme_label(s) for s in schemes}
     summary = read_summary(root / "tables" / "summary.csv")
     figures = []
     for name, caption in PAGE_FIGURES:

@@ -23,7 +23,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import FixedFormatter, FixedLocator, NullFormatter  # noqa: E402
 
-from mcfbench.running.schemes import SCHEMES  # noqa: E402
+from mcfbench.running.schemes import find_scheme  # noqa: E402
 
 EDGE = 1.0 / 3.0   # 1/3 - monitor at which a T-vertex reaches an edge of its triangle
 UNREGISTERED = {"color": "k", "marker": "x", "linestyle": "-"}
@@ -31,7 +31,7 @@ UNREGISTERED = {"color": "k", "marker": "x", "linestyle": "-"}
 
 def style(scheme):
     """``(label, line style dict)`` of ``scheme`` from the registry."""
-    entry = SCHEMES.get(scheme)
+    entry = find_scheme(scheme)
     if entry is None:
         return scheme, dict(UNREGISTERED)
     return entry.label, {**UNREGISTERED, **entry.style}

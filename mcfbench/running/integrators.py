@@ -51,12 +51,13 @@ class Euler:
 
     Attributes
     ----------
-    name : str
+    name, label : str
+        Registry key and name in tables and legends.
     order : int
         The order in time.
     """
 
-    name, order = "euler", 1
+    name, label, order = "euler", "Euler", 1
 
     def __init__(self, warm_start="extrapolate"):
         if warm_start not in WARM_STARTS:
@@ -113,7 +114,7 @@ class Euler:
 class BDF2(Euler):
     """Linearly implicit BDF2 (I2), its first step by Euler (see the module docstring)."""
 
-    name, order = "bdf2", 2
+    name, label, order = "bdf2", "BDF2", 2
 
     def evaluation(self, X, previous, tau):
         return 2.0 * X - previous, X + (X - previous) / 3.0, 2.0 * tau / 3.0

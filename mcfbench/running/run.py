@@ -80,7 +80,7 @@ class _Steady:
         return self.reached
 
 
-def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrator="euler",
+def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrator=None,
         warm_start="extrapolate", on_defect="stop", save_every=0, samples=20, mesh=None,
         threads=1, progress=False, **options):
     """Run ``scheme`` on ``problem`` at refinement ``level``.
@@ -94,8 +94,9 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
         Override the problem's time rule.
     solver : mcfbench.running.solver.Solver, optional
         Default: BiCGStab, rtol 1e-9 (the paper's).
-    integrator : {"euler", "bdf2"}
-        The time integrator (:mod:`mcfbench.running.integrators`).
+    integrator : {"euler", "bdf2"}, optional
+        The time integrator (:mod:`mcfbench.running.integrators`); default
+        the scheme's (:attr:`mcfbench.running.schemes.Scheme.integrator`).
     warm_start : {"extrapolate", "previous"}
         The solver's initial guess (:class:`mcfbench.running.integrators.Euler`).
     on_defect : {"stop", "record"}
@@ -122,6 +123,7 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
     """
     scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
     problem = get_problem(problem) if isinstance(problem, str) else problem
+    integrator = scheme.integrator if integrator is None else integrator
     V, F = validate_mesh(*(problem.mesh(level) if mesh is None else mesh))
     tau = problem.tau(level, (V, F)) if tau is None else float(tau)
     steps = problem.time_steps(tau, t_final)
@@ -224,7 +226,7 @@ def _level_bar(levels, problem):
 
 
 def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_final=None,
-                     solver=None, integrator="euler", **options):
+                     solver=None, integrator=None, **options):
     """Error at ``t_final`` against a fine-``tau`` reference of the same scheme on one mesh.
 
     Parameters
@@ -239,8 +241,9 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
     t_final : float, optional
         Default: the problem's.
     solver : mcfbench.running.solver.Solver, optional
-    integrator : {"euler", "bdf2"}
-        The time integrator of every run, the reference's included.
+    integrator : {"euler", "bdf2"}, optional
+        The time integrator of every run, the reference's included (default
+        the scheme's).
     **options
         Options of the scheme's flow (passed to :func:`run`).
 
@@ -325,6 +328,7 @@ class _Guarded:
     def __init__(self, scheme):
         self.scheme = scheme
         self.name, self.family, self.label = scheme.name, scheme.family, scheme.label
+        self.integrator = scheme.integrator
 
     def make(self, vertices, faces, tau, **options):
         try:
@@ -345,8 +349,7 @@ def _nan_result(scheme, problem, level, mesh, tau, steps, status, message, metho
         t_min_barycentric=nan, min_angle=nan, max_aspect=nan, max_flipped=nan, metrics={}, series={})
 
 
-def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_every=0,
-               integrator="euler"):
+def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_every=0):
     """:func:`run` for the studies that keep frames files (by default the first and the
     last, ``save_every=0``; see :func:`mcfbench.running.driver.simulate`); a scheme
     that refuses the surface gives status ``unsupported`` (the initial surface as both
@@ -363,14 +366,14 @@ def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_ever
     start = time.process_time()
     try:
         result, traj = run(_Guarded(scheme), problem, level, solver=solver,
-                           save_every=save_every, mesh=mesh, tau=tau, integrator=integrator)
+                           save_every=save_every, mesh=mesh, tau=tau)
     except _Unsupported as err:
         V, F = validate_mesh(*(problem.mesh(level) if mesh is None else mesh))
         tau = problem.tau(level, (V, F)) if tau is None else float(tau)
         steps = problem.time_steps(tau)
         result = _nan_result(scheme, problem, level, (V, F), tau, steps, "unsupported",
                              f"unsupported at step 0 (t = 0): {err}", solver.method,
-                             time.process_time() - start, integrator)
+                             time.process_time() - start, scheme.integrator)
         key = "F" if scheme.family == "ddfv" else "V"
         return result, {key: np.stack([V, V]), "faces": F, "steps": np.array([0, 0]),
                         "t": np.zeros(2)}

@@ -8,11 +8,19 @@ one entry of :data:`SCHEMES`. The flow class is named as
 
 The DDFV variants are entries ``ddfv``, ``ddfv-<variant>`` with the options
 of :data:`ddfv.variants.VARIANTS`.
+
+Every scheme is stepped by the paper's semi-implicit Euler step unless
+asked otherwise; ``<name>@<integrator>`` (e.g. ``cotan@bdf2``) names the
+scheme ``<name>`` stepped by another integrator of
+:data:`mcfbench.running.integrators.INTEGRATORS` (:func:`get_scheme`), so
+that a study lists it like any scheme (the matrix, the beyond study).
 """
 
 import importlib
 import inspect
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+
+from mcfbench.running.integrators import INTEGRATORS
 
 
 MATRICES = {
@@ -57,6 +65,10 @@ class Scheme:
         The shared solver's method that re-runs a run that ended with a
         ``solver_*`` status, to tell the solver's failure from the scheme's
         (the matrix study): :data:`mcfbench.running.solver.ROBUST`.
+    integrator : str
+        The time integrator its runs use unless told otherwise
+        (:data:`mcfbench.running.integrators.INTEGRATORS`; ``"euler"`` for
+        every registry entry, another for a name ``<name>@<integrator>``).
     """
 
     name: str
@@ -68,6 +80,7 @@ class Scheme:
     family: str = "vertex"
     matrix: str = "nonsymmetric"
     robust_solver: str = "direct"
+    integrator: str = "euler"
 
     def __post_init__(self):
         if self.matrix not in MATRICES:
@@ -152,16 +165,46 @@ SCHEMES = {s.name: s for s in (
 """Scheme name -> :class:`Scheme`."""
 
 
-def get_scheme(name):
-    """The registry entry ``name``.
+def get_scheme(name, registry=None):
+    """The registry entry ``name``, or ``<name>@<integrator>``: that entry stepped by
+    another integrator (its label says which; hollow markers).
+
+    Parameters
+    ----------
+    name : str
+    registry : dict, optional
+        Name -> :class:`Scheme` (default :data:`SCHEMES`).
 
     Raises
     ------
     ValueError
-        Unknown name, listing the known ones.
+        Unknown name or integrator, listing the known ones.
     """
-    try:
-        return SCHEMES[name]
-    except KeyError:
+    registry = SCHEMES if registry is None else registry
+    base, at, integrator = name.partition("@")
+    if base not in registry:
         raise ValueError(f"unknown scheme {name!r}; choose one of "
-                         f"{', '.join(SCHEMES)}") from None
+                         f"{', '.join(registry)} (or NAME@INTEGRATOR)")
+    entry = registry[base]
+    if not at:
+        return entry
+    if integrator not in INTEGRATORS:
+        raise ValueError(f"unknown integrator {integrator!r} in scheme {name!r}; choose one "
+                         f"of {', '.join(INTEGRATORS)}")
+    return replace(entry, name=name, integrator=integrator,
+                   label=f"{entry.label}, {INTEGRATORS[integrator].label}",
+                   style={**entry.style, "markerfacecolor": "none"})
+
+
+def find_scheme(name, registry=None):
+    """:func:`get_scheme`, or None for a name it does not know."""
+    try:
+        return get_scheme(name, registry)
+    except ValueError:
+        return None
+
+
+def scheme_label(name):
+    """The label of ``name`` in tables and legends (the name itself when unknown)."""
+    entry = find_scheme(name)
+    return name if entry is None else entry.label

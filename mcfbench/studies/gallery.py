@@ -206,13 +206,13 @@ def run_movie(record, frames, out, log_path=None):
     the breakdown on); a run without frames (its mesh refused) gives a one-frame GIF
     with the record's message."""
     from mcfbench.presentation.movie import write_movie, write_notice
-    from mcfbench.running.schemes import SCHEMES
+    from mcfbench.running.schemes import scheme_label
     from mcfbench.storage.records import read_record
     from mcfbench.studies.matrix import load_frames
 
     log = setup_logging(log_path)
     data = read_record(record)
-    scheme = SCHEMES[data["scheme"]].label if data["scheme"] in SCHEMES else data["scheme"]
+    scheme = scheme_label(data["scheme"])
     title = f"{scheme} on {data.get('mesh', Path(frames).parent.name)}"
     arrays = load_frames(frames)
     if not len(arrays["t"]):

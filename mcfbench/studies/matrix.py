@@ -95,7 +95,8 @@ def plan(section=None, schemes=None, problems=None):
     ----------
     section : dict, optional
         ``schemes`` ("all" or a list of :data:`mcfbench.running.schemes.SCHEMES`
-        names), ``problems`` (problem -> levels; a problem of the registry
+        names), ``with_integrators`` (integrator -> schemes also run with it,
+        as ``NAME@INTEGRATOR``), ``problems`` (problem -> levels; a problem of the registry
         not named runs at its registry levels, ``[]`` leaves it out),
         ``rtol``, ``maxiter``, ``solver`` (method of the refinement series),
         ``mesh_solver`` (method of the real-world-like meshes, ``"robust"``
@@ -107,8 +108,8 @@ def plan(section=None, schemes=None, problems=None):
     Returns
     -------
     dict
-        ``schemes`` (list), ``problems`` (name -> sorted levels, registry
-        order), ``rtol``, ``maxiter``, ``solver``, ``mesh_solver``.
+        ``schemes`` (list; those of ``with_integrators`` last), ``problems``
+        (name -> sorted levels, registry order), ``rtol``, ``maxiter``, ``solver``, ``mesh_solver``.
 
     Raises
     ------
@@ -116,6 +117,8 @@ def plan(section=None, schemes=None, problems=None):
         An unknown scheme, problem or solver, or bad levels, naming the key.
     """
     from mcfbench.running import solver as _solver
+    from mcfbench.running.integrators import INTEGRATORS
+    from mcfbench.running.schemes import find_scheme
 
     if schemes is None:
         from mcfbench.running.schemes import SCHEMES as schemes
@@ -127,10 +130,17 @@ def plan(section=None, schemes=None, problems=None):
         chosen = list(schemes)
     elif isinstance(chosen, str):
         chosen = [chosen]
-    unknown = [s for s in chosen if s not in schemes]
+    for integrator, names in (section.get("with_integrators") or {}).items():
+        if integrator not in INTEGRATORS or integrator == "euler":
+            raise ConfigError(f"config key 'matrix.with_integrators': unknown integrator "
+                              f"{integrator!r}; choose one of "
+                              f"{', '.join(i for i in INTEGRATORS if i != 'euler')}")
+        chosen = [*chosen, *(f"{name}@{integrator}" for name in names)]
+    unknown = [s for s in chosen if find_scheme(s, schemes) is None]
     if unknown:
         raise ConfigError(f"config key 'matrix.schemes': unknown scheme(s) {unknown}; the "
-                          f"registry mcfbench.running.schemes.SCHEMES has {list(schemes)}")
+                          f"registry mcfbench.running.schemes.SCHEMES has {list(schemes)}, "
+                          f"each also as NAME@INTEGRATOR ({', '.join(INTEGRATORS)})")
     overrides = section.get("problems") or {}
     unknown = [p for p in overrides if p not in problems]
     if unknown:
@@ -291,11 +301,11 @@ def problem_notes(problem, plan=None):
 
 def write_tables(table, out_dir, plan):
     """Write ``matrix.csv``, ``{problem}.md/.tex`` and ``summary.md/.tex/.csv``."""
-    from mcfbench.running.schemes import SCHEMES
+    from mcfbench.running.schemes import scheme_label
     from mcfbench.storage.atomic import write_text
 
     out = Path(out_dir)
-    labels = {s: SCHEMES[s].label if s in SCHEMES else s for s in plan["schemes"]}
+    labels = {s: scheme_label(s) for s in plan["schemes"]}
     problems = [p for p in plan["problems"] if p in set(table["problem"])]
     write_text(out / "matrix.csv", table.to_csv(index=False, float_format="%.10g"))
     for problem in problems:
@@ -335,11 +345,11 @@ def mesh_problems(plan):
 def findings(summary_csv, out, plan, long_csv=None):
     """``findings.md`` from ``summary.csv`` and, for the cost of accuracy, the long
     table ``matrix.csv`` (numbers from the tables only)."""
-    from mcfbench.running.schemes import SCHEMES
+    from mcfbench.running.schemes import scheme_label
     from mcfbench.storage.atomic import write_text
 
     summary = read_summary(summary_csv)
-    labels = {s: SCHEMES[s].label for s in plan["schemes"] if s in SCHEMES}
+    labels = {s: scheme_label(s) for s in plan["schemes"]}
     costs = cheapest_to_reach(read_long_table(long_csv)) if long_csv else ()
     text = matrix_findings(summary, labels, mesh_problems(plan),
                            source=Path(summary_csv).as_posix(), work_precision=costs)
