@@ -44,7 +44,12 @@ SPACE_COLUMNS = ["scheme", "label", "level", "h", "nV", "nF", "nT", "tau", "t_fi
 
 
 TIME_COLUMNS = ["scheme", "label", "level", "t_final", "reference_tau", "tau", "N", "error",
-                "order", "l2_error", "status", "message"]
+                "order", "volume_error", "volume_order", "l2_error", "status", "message"]
+
+
+INTEGRATOR_COLUMNS = ["scheme", "label", "integrator", "level", "tau", "N", "l2_euler",
+                      "l2_other", "l2_ratio", "cpu_euler", "cpu_other", "cost_ratio",
+                      "l2_other_at_euler_cpu", "equal_cpu_ratio"]
 
 
 SERIES_COLUMNS = ["study", "scheme", "label", "level", "tau", "t_final", "status", "n", "t",
@@ -143,18 +148,66 @@ def time_table(records):
                 "t_final": r["t_final"], "reference_tau": r["reference_tau"]}
         if r["outcome"] != "ok":
             parts.append(pd.DataFrame([{**base, "tau": np.nan, "N": np.nan, "error": np.nan,
-                                        "order": np.nan, "l2_error": np.nan,
+                                        "order": np.nan, "volume_error": np.nan,
+                                        "volume_order": np.nan, "l2_error": np.nan,
                                         "status": r["outcome"], "message": r["message"]}]))
             continue
         rows = pd.DataFrame(r["rows"])
-        for column in ("tau", "error", "l2_error"):
+        for column in ("tau", "error", "volume_error", "l2_error"):
             rows[column] = pd.to_numeric(rows[column], errors="coerce").astype(float)
         part = rows.assign(**base, message="")
         part["order"] = time_order(part["tau"], part["error"], part["status"])
+        part["volume_order"] = time_order(part["tau"], part["volume_error"], part["status"])
         parts.append(part)
     table = pd.concat(parts, ignore_index=True)
     table["N"] = table["N"].astype("Int64")
     return table[TIME_COLUMNS]
+
+
+def integrator_table(levels):
+    """Each scheme of the levels table that also ran as ``NAME@INTEGRATOR`` against
+    its Euler runs, per level (issue #22: the Table 3.1 setting with BDF2).
+
+    Columns: the two L2 errors (3.2) and ``l2_ratio`` (other / Euler); the CPU
+    seconds of the runs and ``cost_ratio``, the ratio of the CPU seconds per step
+    (both run the same steps); ``l2_other_at_euler_cpu``, the other integrator's
+    error at the Euler run's CPU time (log-log interpolation over the other
+    integrator's finished levels, NaN outside them) and ``equal_cpu_ratio`` (it /
+    the Euler error): the work-precision view.
+    """
+    rows = []
+    done = levels[levels["status"] == "ok"]
+    for name in dict.fromkeys(levels["scheme"]):
+        base, _, integrator = name.partition("@")
+        if not integrator or base not in set(levels["scheme"]):
+            continue
+        euler = done[done["scheme"] == base].set_index("level")
+        other = done[done["scheme"] == name].set_index("level")
+        curve = other.sort_values("cpu_seconds")
+        for level in sorted(set(euler.index) & set(other.index)):
+            e, o = euler.loc[level], other.loc[level]
+            at_cpu = np.exp(np.interp(np.log(e.cpu_seconds), np.log(curve["cpu_seconds"]),
+                                      np.log(curve["l2_error"]), left=np.nan, right=np.nan)) \
+                if len(curve) > 1 and e.cpu_seconds > 0 else np.nan
+            rows.append({"scheme": base, "label": label(base), "integrator": integrator,
+                         "level": level, "tau": e.tau, "N": e.N, "l2_euler": e.l2_error,
+                         "l2_other": o.l2_error, "l2_ratio": o.l2_error / e.l2_error,
+                         "cpu_euler": e.cpu_seconds, "cpu_other": o.cpu_seconds,
+                         "cost_ratio": (o.cpu_seconds / o.N) / (e.cpu_seconds / e.N),
+                         "l2_other_at_euler_cpu": at_cpu,
+                         "equal_cpu_ratio": at_cpu / e.l2_error})
+    return pd.DataFrame(rows, columns=INTEGRATOR_COLUMNS)
+
+
+def integrator_rows(table):
+    header = ["scheme", "integrator", "level", "tau", "L2 Euler", "L2 other", "ratio",
+              "CPU s Euler", "CPU s other", "cost/step ratio", "other at Euler's CPU",
+              "ratio at equal CPU"]
+    rows = [[r.label, r.integrator, str(r.level), sig(r.tau, 4), sci(r.l2_euler, 3),
+             sci(r.l2_other, 3), fix(r.l2_ratio, 3), sig(r.cpu_euler, 3), sig(r.cpu_other, 3),
+             fix(r.cost_ratio, 2), sci(r.l2_other_at_euler_cpu, 3), fix(r.equal_cpu_ratio, 3)]
+            for r in table.itertuples()]
+    return header, rows
 
 
 def beyond_tables(inputs, records, beyond, paper_schemes):
@@ -174,7 +227,8 @@ def beyond_tables(inputs, records, beyond, paper_schemes):
     Returns
     -------
     tables : dict
-        ``levels``, ``stability``, ``time_convergence``, ``space_convergence``.
+        ``levels``, ``stability``, ``time_convergence``, ``space_convergence``,
+        ``integrators`` (:func:`integrator_table`).
     series : pandas.DataFrame
         The T monitor of the levels and long runs (:func:`monitor_series`).
     """
@@ -192,6 +246,7 @@ def beyond_tables(inputs, records, beyond, paper_schemes):
         "space_convergence": space_table(space, beyond["space_study"]["schemes"],
                                          beyond["space_study"]["levels"]),
     }
+    tables["integrators"] = integrator_table(tables["levels"])
     series = pd.concat([monitor_series(levels, "levels"), monitor_series(long, "long_time")],
                        ignore_index=True)
     return tables, series
@@ -270,9 +325,11 @@ def stability_rows(table):
 
 
 def time_rows(table):
-    header = ["scheme", "tau", "N", "error at t_f", "order", "L2 (3.2)", "status"]
+    header = ["scheme", "tau", "N", "error at t_f", "order", "volume error", "order (volume)",
+              "L2 (3.2)", "status"]
     rows = [[label(r.scheme), sig(r.tau, 4), int_or(r.N), sci(r.error, 3), fix(r.order, 3),
-             sci(r.l2_error, 3), r.status] for r in table.itertuples()]
+             sci(r.volume_error, 3), fix(r.volume_order, 3), sci(r.l2_error, 3), r.status]
+            for r in table.itertuples()]
     return header, rows
 
 
@@ -323,8 +380,21 @@ def _beyond_descriptions(beyond, settings):
             f"a reference with tau = {time['taus'][-1] / time['reference_factor']:g} on "
             "the same mesh, weighted by the scheme's quadrature weights (DDFV: the "
             "covolumes chi / 2 over F- and T-vertices; mcfbench.running.run.time_convergence); "
-            "order: log(e_prev / e) / log(tau_prev / tau); L2 (3.2): against the exact "
-            "sphere (space + time error)."),
+            "order: log(e_prev / e) / log(tau_prev / tau); volume error: |vol - vol_ref|, "
+            "the volume between the two surfaces, blind to tangential motion (BGN moves its "
+            "points tangentially anew at every step, so only this error measures its time "
+            "error); L2 (3.2): against the exact sphere (space + time error). NAME, BDF2: "
+            "the scheme stepped by linearly implicit BDF2 (mcfbench.running.integrators)."),
+        "integrators": (
+            "The runs of the L2 table (the Table 3.1 setting) of every scheme that also ran "
+            "with another integrator (NAME@INTEGRATOR in `beyond.schemes`), level by level "
+            "against its Euler runs: the L2 errors (3.2) and their ratio, the CPU seconds "
+            "of each run (flow construction, steps, error; one core) and the ratio of the "
+            "CPU seconds per step, and the other integrator's L2 error at the Euler run's "
+            "CPU time (log-log interpolation between its levels; -- outside them) over "
+            "the Euler error: what the integrator buys at equal cost. Both integrators on "
+            "the same footing: same scheme, solver, rtol, machine and one core per job; "
+            "CPU seconds of jobs that ran side by side on a shared machine."),
         "space_convergence": (
             f"tau = {space['tau']:g} on every level, t_f = {space['t_final']:g}: the "
             "error (3.2) against the exact sphere with the time error made small; EOC "
@@ -382,6 +452,9 @@ def beyond_documents(tables, beyond, settings, paper_schemes):
                                        desc["space_convergence"],
                                        [("", space_rows(space, space_schemes))],
                                        notes["space_convergence"]),
+        "integrators": _markdown("Second order in time: each integrator against Euler on "
+                                 "the Table 3.1 setting", desc["integrators"],
+                                 [("", integrator_rows(tables["integrators"]))]),
     }
     tex = {
         "levels": _latex(desc["levels"], [
@@ -398,6 +471,9 @@ def beyond_documents(tables, beyond, settings, paper_schemes):
         "space_convergence": _latex(desc["space_convergence"], [
             ("Convergence in space.", "tab:beyond-space", space_rows(space, space_schemes))],
             notes["space_convergence"]),
+        "integrators": _latex(desc["integrators"], [
+            ("Integrators against Euler on the Table 3.1 setting.", "tab:beyond-integrators",
+             integrator_rows(tables["integrators"]))]),
     }
     return {name: {"csv": csv_text(table), "md": md[name], "tex": tex[name]}
             for name, table in tables.items()}

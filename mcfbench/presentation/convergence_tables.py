@@ -20,7 +20,7 @@ from mcfbench.presentation.formats import (
     tex_escape,
     tex_table,
 )
-from mcfbench.running.schemes import get_scheme
+from mcfbench.running.schemes import scheme_label as label  # the labels of every table
 
 # Table 3.1 as published: level -> (n_V, n_F, n_T, tau, N, L2 error, iter, EOC, CPU s)
 PUBLISHED = {
@@ -59,13 +59,6 @@ LEVEL_COLUMNS = ["scheme", "label", "level", "h", "nV", "nF", "nT", "tau", "N", 
                  "status", "t_failed", "t_min_barycentric", "paper_l2_error", "paper_eoc",
                  "paper_iterations", "paper_cpu_seconds", "l2_ratio", "message"]
 
-
-def label(scheme):
-    """The registry's label of ``scheme`` (the name itself if it is not registered)."""
-    try:
-        return get_scheme(scheme).label
-    except ValueError:
-        return scheme
 
 
 def eoc_column(levels, l2_error, status):

@@ -175,7 +175,8 @@ def synthetic_inputs(finest=()):
                                                         l2=2e-3 / 4 ** (lv - 1))
              for s in SCHEMES_USED for lv in (1, 2)}
     time_rows = [{"tau": t, "N": round(0.08 / t), "error": 0.3 * t, "eoc": None,
-                  "l2_error": 1e-3, "status": "ok"} for t in (0.01, 0.005, 0.0025)]
+                  "volume_error": 0.1 * t ** 2, "volume_eoc": None, "l2_error": 1e-3,
+                  "status": "ok"} for t in (0.01, 0.005, 0.0025)]
     base = {"level": 2, "t_final": 0.08, "reference_tau": 0.0025 / 8}
     time = {"beyond/time/ddfv.json": {"scheme": "ddfv", **base, "outcome": "ok",
                                       "message": "", "rows": time_rows},
@@ -289,6 +290,8 @@ def test_time_and_space_tables(tables):
     for scheme in ("ddfv", "cotan"):                     # any scheme has a time study
         np.testing.assert_allclose(time[time["scheme"] == scheme]["order"],
                                    [np.nan, 1.0, 1.0])
+        np.testing.assert_allclose(time[time["scheme"] == scheme]["volume_order"],
+                                   [np.nan, 2.0, 2.0])
     failed = time[time["scheme"] == "ddfv-chord"]
     assert len(failed) == 1 and failed["status"].iloc[0] == "reference_failed"
     space = tables[0]["space_convergence"]
@@ -540,3 +543,58 @@ def test_record_of_other_settings_is_refused(failing_record):
     assert config_hash(other) != config_hash(settings)
     with pytest.raises(RecordError, match="stale"):
         read_record(path, other)
+
+
+def test_integrator_table_compares_each_scheme_with_its_euler_runs():
+    """BDF2 errors 1/4 of Euler's at 1.2 x the cost per step; at equal CPU time the
+    BDF2 error interpolated log-log between its levels."""
+    from mcfbench.presentation.beyond_tables import integrator_table
+
+    rows = []
+    for level in (1, 2, 3):
+        N = 2 * 4 ** (level - 1)
+        for scheme, l2, cpu in (("cotan", 1e-2 / 4 ** level, 0.1 * 8 ** level),
+                                ("cotan@bdf2", 0.25e-2 / 4 ** level, 0.12 * 8 ** level)):
+            rows.append({"scheme": scheme, "level": level, "tau": 0.04 / 4 ** (level - 1),
+                         "N": N, "l2_error": l2, "cpu_seconds": cpu, "status": "ok"})
+    table = integrator_table(pd.DataFrame(rows)).set_index("level")
+    assert list(table["integrator"]) == ["bdf2"] * 3 and set(table["scheme"]) == {"cotan"}
+    np.testing.assert_allclose(table["l2_ratio"], 0.25)
+    np.testing.assert_allclose(table["cost_ratio"], 1.2)
+    # at Euler's CPU time 0.8 (level 1), BDF2 is between its levels 1 (0.96 s) ... below
+    # its coarsest level: no extrapolation
+    assert np.isnan(table.loc[1, "equal_cpu_ratio"])
+    # level 2: Euler 6.4 s; BDF2's error at 6.4 s on the line through (0.96, 6.25e-4)
+    # and (7.68, 1.5625e-4): slope log(1/4)/log(8)
+    expected = 6.25e-4 * (6.4 / 0.96) ** (np.log(0.25) / np.log(8))
+    assert table.loc[2, "l2_other_at_euler_cpu"] == pytest.approx(expected)
+    assert table.loc[2, "equal_cpu_ratio"] == pytest.approx(expected / 6.25e-4)
+
+
+def test_integrator_findings_read_the_orders_and_the_comparison():
+    from mcfbench.presentation.beyond_findings import integrator_section
+    from mcfbench.presentation.beyond_tables import integrator_table
+
+    taus = [0.01, 0.005, 0.0025]
+    rows = []
+    for scheme, point, volume in (("cotan", 1, 1), ("cotan@bdf2", 2, 2), ("bgn", 1, 1),
+                                  ("bgn@bdf2", 0.4, 2)):
+        errors, volumes = [t ** point for t in taus], [t ** volume for t in taus]
+        for tau, error, vol, order, vorder in zip(taus, errors, volumes,
+                                                  [np.nan, point, point],
+                                                  [np.nan, volume, volume]):
+            rows.append({"scheme": scheme, "tau": tau, "order": order,
+                         "volume_order": vorder, "status": "ok"})
+    time = pd.DataFrame(rows)
+    levels = pd.DataFrame([
+        {"scheme": s, "level": lv, "tau": 0.04 / 4 ** (lv - 1), "N": 2 * 4 ** (lv - 1),
+         "l2_error": l2 / 4 ** lv, "cpu_seconds": cpu * 8 ** lv, "status": "ok"}
+        for lv in (1, 2, 3) for s, l2, cpu in (("cotan", 1e-2, 0.1),
+                                               ("cotan@bdf2", 0.2e-2, 0.11))])
+    text = "\n".join(integrator_section(time, integrator_table(levels),
+                                        {"euler": 1, "bdf2": 2}))
+    assert "**euler** (order 1): pointwise order 1.00-1.00 for 2 of 2 schemes." in text
+    assert ("**bdf2** (order 2): pointwise order 2.00-2.00 for 1 of 2 schemes; by the volume "
+            "between the surfaces only: BGN (2.00; pointwise 0.40).") in text
+    assert ("cotangent with bdf2 (level 3): L2 0.20 x Euler's at 1.10 x the CPU per step, "
+            in text)

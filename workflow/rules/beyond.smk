@@ -23,7 +23,13 @@
 # Settings, record paths and resources: mcfbench.pipeline.Pipeline, through
 # workflow/rules/common.smk (BEYOND, BEYOND_RUNS, beyond_run_settings, ...).
 
-BEYOND_TABLE_NAMES = ["levels", "stability", "time_convergence", "space_convergence"]
+BEYOND_TABLE_NAMES = [
+    "levels",
+    "stability",
+    "time_convergence",
+    "space_convergence",
+    "integrators",
+]
 BEYOND_TABLES = {
     f"{name}_{ext}": f"results/beyond/tables/{name}.{ext}"
     for name in BEYOND_TABLE_NAMES
@@ -208,6 +214,7 @@ rule beyond_findings:
         stability=BEYOND_TABLES["stability_csv"],
         time=BEYOND_TABLES["time_convergence_csv"],
         space=BEYOND_TABLES["space_convergence_csv"],
+        integrators=BEYOND_TABLES["integrators_csv"],
     output:
         report(
             "results/beyond/findings.md",

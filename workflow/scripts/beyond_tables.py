@@ -1,10 +1,11 @@
 """Rule beyond_tables: the tables of the study beyond Table 3.1 from its records.
 
 Every record is checked first (:func:`mcfbench.storage.records.read_records`). Writes
-``levels``, ``stability``, ``time_convergence``, ``space_convergence`` (CSV,
-Markdown, LaTeX each; :func:`mcfbench.presentation.beyond_tables.beyond_tables`,
-:func:`mcfbench.presentation.beyond_tables.beyond_documents`), ``t_monitor.csv`` (the T monitor
-at every time level) and ``beyond.json`` (provenance), all together.
+``levels``, ``stability``, ``time_convergence``, ``space_convergence``,
+``integrators`` (CSV, Markdown, LaTeX each;
+:func:`mcfbench.presentation.beyond_tables.beyond_tables`,
+:func:`mcfbench.presentation.beyond_tables.beyond_documents`), ``t_monitor.csv``
+(the T monitor at every time level) and ``beyond.json`` (provenance), all together.
 """
 
 from mcfbench.pipeline import json_text, record_fields, sidecar
