@@ -150,7 +150,7 @@ class BGNFlow(VertexFlow):
 
     def laplacian(self):
         """The cotangent stiffness ``A`` (one coordinate) of the current surface, CSR."""
-        return self.assembler.laplacian(self.geometry.L_data)
+        return self.assembler.laplacian(self.geometry_at(self._X).L_data)
 
     def system(self, at=None, base=None, dt=None, *, scaling=None):
         """``(A, b)`` of (B4) with ``Gamma^m`` the surface ``at``.

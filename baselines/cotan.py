@@ -296,6 +296,7 @@ class VertexFlow:
         self.tau = float(tau)
         self.n = 0
         self._X = np.ascontiguousarray(V.T)
+        self._assembles_here = True      # where the last system was assembled (geometry)
         self.timings = {"assembly": 0.0, "solve": 0.0}
         # triangles already flipped against their neighbours at step 0
         self._flipped0 = ~(self._normal_agreement() >= 0.0)
@@ -348,8 +349,13 @@ class VertexFlow:
 
     @cached_property
     def geometry(self):
-        """:class:`SurfaceGeometry` of the current state."""
-        return self.assembler.geometry(self._X.T, self._needs_laplacian())
+        """:class:`SurfaceGeometry` of the current state. Its stiffness ``L_data`` is
+        computed only when the last step assembled its system at the state it started
+        from (Euler: the next step will again); after a step assembled elsewhere (BDF2,
+        at the extrapolated state) the checks and weights of the state need only the
+        mass and the area vectors, and :meth:`geometry_at` completes it on demand."""
+        return self.assembler.geometry(self._X.T,
+                                       self._needs_laplacian() and self._assembles_here)
 
     def _needs_laplacian(self):
         return True
@@ -363,9 +369,11 @@ class VertexFlow:
     def geometry_at(self, at):
         """:class:`SurfaceGeometry` of the state ``at`` (3, n) (the cached one of the
         current state when ``at`` is it)."""
-        if at is self._X:
-            return self.geometry
-        return self.assembler.geometry(at.T, self._needs_laplacian())
+        if at is not self._X:
+            return self.assembler.geometry(at.T, self._needs_laplacian())
+        if self.geometry.L_data is None and self._needs_laplacian():
+            self.geometry = self.assembler.geometry(at.T)       # the stiffness too
+        return self.geometry
 
     def system(self, at=None, base=None, dt=None, **options):
         """``(A, b)`` of one step with the operators at the state ``at``.
@@ -387,6 +395,7 @@ class VertexFlow:
         A : scipy.sparse.csr_matrix
         b : (3, n) float array
         """
+        self._assembles_here = at is None
         at = self._X if at is None else at
         base = at if base is None else base
         clock = time.perf_counter()
