@@ -31,7 +31,8 @@ from ddfv.variants import VARIANTS
 from mcfbench.running.problems import PROBLEMS, Problem, get_problem
 from mcfbench.running.schemes import SCHEMES, get_scheme
 from mcfbench.running.solver import METHODS, ROBUST, Solver
-from mcfbench.storage.atomic import check_writable, save_npz, write_json
+from mcfbench.storage.atomic import check_writable, write_json
+from mcfbench.storage.frames import save_frames
 from mcfbench.storage.memory import tune_malloc
 from mcfbench.storage.provenance import provenance
 
@@ -306,7 +307,7 @@ def _run(args):
 
         export_pvd(arrays, args.out, run_provenance(arrays))
     else:
-        save_npz(args.out, **arrays)
+        save_frames(args.out, arrays)
     print(f"wrote {args.out}: {len(traj.t)} frames, {traj.steps_done} steps, "
           f"{int(traj.iterations.sum())} solver iterations, smallest angle "
           f"{result.min_angle:.3g} deg"
