@@ -348,7 +348,7 @@ def _export(args):
 def _report(args):
     from mcfbench.presentation.report import ReportError, Sources, build
     from mcfbench.storage.logs import setup_logging
-    from mcfbench.studies.figures import EXPERIMENTS
+    from mcfbench.studies.figure_experiments import EXPERIMENTS
 
     sources = Sources(results=args.results, paper=args.paper, readme=args.readme,
                       out=args.out or args.results / "paper",

@@ -17,13 +17,10 @@ Settings
     the job, stored and hashed in the record, and recomputed by the
     aggregation to refuse stale records (:func:`mcfbench.storage.records.read_record`).
 Jobs
-    :func:`run_job`, :func:`time_job`, :func:`figure_job` run flows;
-    :func:`record_fields` says what the aggregations check in a record;
-    :func:`write_files` writes every output of a job at once.
+    :func:`run_job`, :func:`time_job` run flows;
+    :func:`record_fields` says what the aggregations check in a record.
 """
 
-import hashlib
-import json
 import math
 import re
 import time
@@ -32,33 +29,12 @@ from pathlib import Path
 from mcfbench.running.problems import get_problem
 from mcfbench.running.schemes import SCHEMES, get_scheme
 from mcfbench.running.solver import Solver
-from mcfbench.storage.atomic import json_value, save_npz, write_files, write_json
-from mcfbench.storage.provenance import code_hash, provenance
+from mcfbench.storage.atomic import write_json
+from mcfbench.storage.provenance import code_hash
 from mcfbench.storage.records import FIELDS, write_record
 from mcfbench.studies.config import ConfigError
 
 PROBLEM = "sphere"        # the problem of Table 3.1 and of the beyond study
-
-
-# -- logging and output ---------------------------------------------------------------
-
-
-def json_text(data):
-    """``data`` as indented standard JSON text (NaN as null), as :mod:`mcfbench.storage.atomic`."""
-    return json.dumps(json_value(data), indent=2, allow_nan=False) + "\n"
-
-
-def sidecar(settings, records, texts):
-    """Provenance of aggregated tables: the settings, per input record its hash,
-    commit, host and time, and the SHA-256 of every output text."""
-    data = provenance(settings)
-    data["inputs"] = {path: {key: rec["provenance"].get(key) for key in
-                             ("config_hash", "git_commit", "git_dirty", "host", "created",
-                              "blas_threads")}
-                      for path, rec in records.items()}
-    data["outputs"] = {str(path): hashlib.sha256(text.encode()).hexdigest()
-                       for path, text in texts.items()}
-    return data
 
 
 # -- the config ---------------------------------------------------------------------
@@ -492,84 +468,3 @@ def record_fields(settings):
     :func:`mcfbench.storage.records.read_records`): the time study's records
     have their own (:data:`TIME_FIELDS`), every other run record :data:`FIELDS`."""
     return TIME_FIELDS if settings.get("study") == "time" else FIELDS
-
-
-FIGURE_OUTPUTS = ("png", "pdf", "frames", "record", "csv", "plot")
-
-
-def figure_outputs(name, results="results"):
-    """Output paths of the figure ``name`` (those of workflow/rules/figures.smk)."""
-    root = Path(results)
-    return {"png": root / "figures" / f"{name}.png", "pdf": root / "figures" / f"{name}.pdf",
-            "frames": root / "runs" / "figures" / f"{name}.npz",
-            "record": root / "runs" / "figures" / f"{name}.json",
-            "csv": root / "diagnostics" / f"{name}.csv",
-            "plot": root / "diagnostics" / f"{name}.png"}
-
-
-def figure_job(name, outputs, log):
-    """Run the experiment of one figure (:mod:`mcfbench.studies.figures`) and draw it.
-
-    Writes the figure (PNG + PDF), the kept frames of every run (npz, keys
-    ``<run>.F``, ``<run>.T``, ``<run>.steps``, ``<run>.faces``,
-    ``<run>.iterations``), the per-step diagnostics of the DDFV runs (CSV
-    with a ``run`` column, and a plot) and a JSON record (status per run,
-    first violation, timings, provenance). A run that breaks down keeps its
-    frames and the figure is drawn from them with a note.
-    """
-    import pandas as pd
-
-    from mcfbench.geometry.quality import COLUMNS
-    from mcfbench.presentation.quality_plots import plot_quality
-    from mcfbench.presentation.render import DPI, rasterize_meshes
-    from mcfbench.studies.figures import (
-        EXPERIMENTS,
-        draw_experiment,
-        experiment_status,
-        run_experiment,
-    )
-
-    experiment = EXPERIMENTS[name]
-    wall = time.perf_counter()
-    results = run_experiment(experiment)
-    compute = time.perf_counter() - wall
-    arrays = {}
-    for key, r in results.items():
-        arrays.update({f"{key}.F": r.F, f"{key}.steps": r.steps, f"{key}.faces": r.faces,
-                       f"{key}.iterations": r.iterations})
-        if r.T is not None:
-            arrays[f"{key}.T"] = r.T
-    quality = {key: r for key, r in results.items() if r.quality is not None}
-    frames = [r.quality.assign(run=key) for key, r in quality.items()]
-    table = pd.concat(frames, ignore_index=True) if frames else \
-        pd.DataFrame(columns=["run", *COLUMNS])
-    plot = plot_quality({r.run.label or key: r.quality for key, r in quality.items()},
-                        title=f"{experiment.name}: {experiment.title}",
-                        marks=sorted({s.step for s in experiment.shots}))
-    draw = time.perf_counter()
-    figure = draw_experiment(experiment, results)
-    draw = time.perf_counter() - draw
-    rasterize_meshes(figure)
-    status = experiment_status(results)
-    record = {
-        "experiment": experiment.name, "title": experiment.title, "status": status,
-        "first_violation": {key: r.record()["first_violation"] for key, r in quality.items()},
-        "runs": {key: r.record() for key, r in results.items()},
-        "seconds": {"compute": round(compute, 3), "draw": round(draw, 3),
-                    "total": round(time.perf_counter() - wall, 3)},
-        "outputs": {k: str(v) for k, v in outputs.items()},
-        "provenance": provenance(experiment.config()),
-    }
-    save_npz(outputs["frames"], **arrays)
-    write_files({outputs["csv"]: table[["run", *COLUMNS]].to_csv(index=False),
-                 outputs["plot"]: (plot, {"dpi": DPI}), outputs["png"]: (figure, {"dpi": DPI}),
-                 outputs["pdf"]: (figure, {"dpi": 2 * DPI}),
-                 outputs["record"]: json_text(record)})
-    for key, r in results.items():
-        line = f"{experiment.name}/{key}: {r.status}, n = {int(r.steps[-1])}"
-        line += f" ({r.message})" if r.message else ""
-        violation = r.record()["violation"]
-        line += f"; first violation at {violation}" if violation else ""
-        (log.warning if r.status != "ok" else log.info)("%s", line)
-    log.info("%s: %s; compute %.1f s, draw %.1f s", experiment.name, status, compute, draw)
-    return status

@@ -19,7 +19,7 @@ Nothing here is a hand-typed result: the published values come from
 
 - ``results/tables/convergence.csv`` (+ ``.json``): Table 3.1 and the schemes,
 - ``results/runs/{scheme}/level{k}.json``: run records (status, provenance),
-- ``results/runs/figures/{figure}.json``, ``.npz``: the figures' runs,
+- ``results/runs/figures/{figure}.json`` and ``{figure}/<run>.npz``: the figures' runs,
 - ``results/figures/*.png``, ``results/diagnostics/*.png``: the images,
 - ``results/beyond/**``: the beyond-the-paper study, when present,
 - ``ddfv/README.md``: the section "Deviations and interpretations".
@@ -422,8 +422,8 @@ def _inputs(sources, context):
     for f in context["figures"]:
         name = f["name"]
         paths += [results / "figures" / f"{name}.png", results / "diagnostics" / f"{name}.png",
-                  results / "runs" / "figures" / f"{name}.json",
-                  results / "runs" / "figures" / f"{name}.npz"]
+                  results / "runs" / "figures" / f"{name}.json"]
+        paths += sorted((results / "runs" / "figures" / name).glob("*.npz"))
     if sources.beyond is not None and sources.beyond.is_dir():
         paths += sorted(p for p in sources.beyond.rglob("*") if p.is_file())
     root = results.parent

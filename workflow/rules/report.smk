@@ -70,7 +70,7 @@ REPORT_INPUTS = {
     "records": PIPELINE.run_records(),
     "figures": expand("results/figures/{figure}.png", figure=FIGURES),
     "figure_records": expand("results/runs/figures/{figure}.json", figure=FIGURES),
-    "frames": expand("results/runs/figures/{figure}.npz", figure=FIGURES),
+    "frames": expand("results/runs/figures/{figure}", figure=FIGURES),
     "diagnostics": expand("results/diagnostics/{figure}.png", figure=FIGURES),
     **REPORT_SOURCES,
 }

@@ -7,11 +7,12 @@ Markdown, LaTeX each; :func:`mcfbench.presentation.beyond_tables.beyond_tables`,
 at every time level) and ``beyond.json`` (provenance), all together.
 """
 
-from mcfbench.pipeline import json_text, record_fields, sidecar
+from mcfbench.pipeline import record_fields
 from mcfbench.presentation.beyond_tables import beyond_documents, beyond_tables
 from mcfbench.presentation.formats import csv_text
-from mcfbench.storage.atomic import write_files
+from mcfbench.storage.atomic import json_text, write_files
 from mcfbench.storage.logs import setup_logging
+from mcfbench.storage.provenance import sidecar
 from mcfbench.storage.records import read_records
 
 sm = snakemake  # noqa: F821

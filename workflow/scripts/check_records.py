@@ -6,8 +6,8 @@ job before it runs it). Writes the checksum of every record
 (:func:`mcfbench.storage.records.read_records`: checksum, schema, stale settings).
 """
 
-from mcfbench.pipeline import json_text, record_fields
-from mcfbench.storage.atomic import write_files
+from mcfbench.pipeline import record_fields
+from mcfbench.storage.atomic import json_text, write_files
 from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.records import read_records
 

@@ -7,10 +7,11 @@ naming the file. The tables are :func:`mcfbench.presentation.convergence_tables.
 together (:func:`mcfbench.storage.atomic.write_files`).
 """
 
-from mcfbench.pipeline import json_text, record_fields, sidecar
+from mcfbench.pipeline import record_fields
 from mcfbench.presentation.convergence_tables import convergence_documents, level_table
-from mcfbench.storage.atomic import write_files
+from mcfbench.storage.atomic import json_text, write_files
 from mcfbench.storage.logs import setup_logging
+from mcfbench.storage.provenance import sidecar
 from mcfbench.storage.records import read_records
 
 sm = snakemake  # noqa: F821
