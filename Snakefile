@@ -6,9 +6,10 @@
 #   snakemake --report results/report.html       # HTML report afterwards
 #
 # Settings: config/config.yaml (documented in config/README.md), validated
-# against workflow/schemas/config.schema.yaml and across keys (scheme names
-# against the registry mcfbench.running.schemes.SCHEMES, time steps; mcfbench.pipeline)
-# before any job runs. The logic of the rules is in the harness (mcfbench);
+# against workflow/schemas/config.schema.yaml, then each study's section
+# across keys (scheme names against the registry mcfbench.running.schemes.SCHEMES,
+# time steps; the plan of its module in mcfbench/studies/) when a target
+# needs it, before any job runs. The logic of the rules is in the harness (mcfbench);
 # workflow/scripts/*.py are thin adapters. Needs the packages installed:
 # `pip install -e .` in the repository.
 
@@ -62,7 +63,8 @@ rule all:
 rule beyond:
     """Target: level 6, the scheme variants and the stability study (slow)."""
     input:
-        BEYOND_TARGETS,
+        # the plan first: a bad value under `beyond` is named here
+        lambda wildcards: PLANS.checked("beyond", BEYOND_TARGETS),
     localrule: True
 
 

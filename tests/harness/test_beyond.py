@@ -1,4 +1,4 @@
-"""The study beyond Table 3.1 (workflow/rules/beyond.smk; mcfbench.pipeline, .tables,
+"""The study beyond Table 3.1 (workflow/rules/beyond.smk; mcfbench.studies.beyond, .tables,
 .plots, .beyond_findings).
 
 Runs that break down must end up as rows with their status, the time of
@@ -21,7 +21,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from mcfbench.pipeline import Pipeline, record_fields, run_job, time_job, used_schemes
+from mcfbench.pipeline import Plans, mem_mb
 from mcfbench.presentation.beyond_findings import beyond_findings as findings
 from mcfbench.presentation.beyond_tables import (
     beyond_documents,
@@ -42,7 +42,10 @@ from mcfbench.storage.atomic import write_files
 from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.provenance import config_hash
 from mcfbench.storage.records import RecordError, read_record, read_records
+from mcfbench.studies.beyond import levels_of, record_fields, time_job, used_schemes
 from mcfbench.studies.config import ConfigError
+from mcfbench.studies.convergence import job as run_job
+from mcfbench.studies.convergence import problem_of
 
 REPO = Path(__file__).resolve().parents[2]
 CONFIG = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
@@ -381,7 +384,7 @@ def test_default_config_passes_the_schema_and_the_checks():
 
     config = json.loads(json.dumps(CONFIG))
     validate(config, str(REPO / "workflow" / "schemas" / "config.schema.yaml"))
-    settings = Pipeline(config).beyond
+    settings = Plans(config).beyond
     assert settings["levels"] == [1, 2, 3, 4, 5, 6]
     assert settings["schemes"] == ["ddfv", "ddfv-chord", "ddfv-eliminate", "cotan"]
     assert settings["long_time"]["t_final"] == 0.15 and settings["long_time"]["level"] == 5
@@ -392,27 +395,28 @@ def test_default_config_passes_the_schema_and_the_checks():
     assert all(s in SCHEMES for s in used_schemes(settings))
     # the level-7 run is off by default
     assert settings["finest"] == {"level": 7, "rtol": 1e-11, "schemes": []}
-    assert not [p for p in Pipeline(config).beyond_runs()["levels"] if "level7" in p]
+    assert not [p for p in Plans(config).beyond_runs["levels"] if "level7" in p]
 
 
 def test_finest_level_adds_its_runs_only():
     config = json.loads(json.dumps(CONFIG))
     config["beyond"]["finest"]["schemes"] = ["ddfv-chord"]
-    pipeline = Pipeline(config)
-    runs = pipeline.beyond_runs()["levels"]
-    default = Pipeline(json.loads(json.dumps(CONFIG))).beyond_runs()["levels"]
+    pipeline = Plans(config)
+    runs = pipeline.beyond_runs["levels"]
+    default = Plans(json.loads(json.dumps(CONFIG))).beyond_runs["levels"]
     assert set(runs) - set(default) == {"results/runs/ddfv-chord/level7.json"}
     assert all(runs[p] == settings for p, settings in default.items())
     assert runs["results/runs/ddfv-chord/level7.json"] == pipeline.run_settings("ddfv-chord", 7)
     # the finest level's own tolerance; every other run keeps the top-level one
     assert runs["results/runs/ddfv-chord/level7.json"]["rtol"] == 1e-11
     assert {s["rtol"] for p, s in runs.items() if "level7" not in p} == {1e-9}
-    assert pipeline.beyond_levels("ddfv-chord") == [1, 2, 3, 4, 5, 6, 7]
-    assert pipeline.beyond_levels("ddfv") == [1, 2, 3, 4, 5, 6]
-    assert pipeline.problem.time_steps(pipeline.problem.tau(7)) == 8192
+    assert levels_of(pipeline.beyond, "ddfv-chord") == [1, 2, 3, 4, 5, 6, 7]
+    assert levels_of(pipeline.beyond, "ddfv") == [1, 2, 3, 4, 5, 6]
+    problem = problem_of(pipeline.convergence)
+    assert problem.time_steps(problem.tau(7)) == 8192
     # the job's Slurm resources cover the single-core estimate of an earlier session
     # (about 630 MB and 860 s) twice over
-    assert pipeline.mem_mb(7) >= 2 * 630 and pipeline.run_runtime(7) * 60 >= 2 * 860
+    assert mem_mb(7) >= 2 * 630 and pipeline.run_runtime(7) * 60 >= 2 * 860
 
 
 @pytest.mark.parametrize("path, value", [
@@ -464,7 +468,7 @@ def test_checks_across_keys_name_the_key(path, value, message):
         config["beyond"]["finest"]["schemes"] = ["ddfv-chord"]   # checked when on
     config["beyond"][path[0]][path[1]] = value
     with pytest.raises(ConfigError) as err:
-        Pipeline(config)
+        Plans(config).beyond
     assert message in str(err.value)
     if "unknown" in message:
         assert all(name in str(err.value) for name in SCHEMES)
@@ -473,7 +477,7 @@ def test_checks_across_keys_name_the_key(path, value, message):
 def test_time_study_takes_any_scheme():
     config = json.loads(json.dumps(CONFIG))
     config["beyond"]["time_study"]["schemes"] = ["cotan", "ddfv"]
-    assert Pipeline(config).beyond["time_study"]["schemes"] == ["cotan", "ddfv"]
+    assert Plans(config).beyond["time_study"]["schemes"] == ["cotan", "ddfv"]
 
 
 FINEST = "beyond={finest: {schemes: [ddfv-chord]}}"   # the command line of config/README.md
@@ -526,8 +530,8 @@ def test_dry_run_of_beyond_and_a_bad_value(tmp_path):
     assert level7 not in out["good"]
     assert procs["finest"].returncode == 0, out["finest"][-3000:]
     job = out["finest"].split(f"output: {level7}")[1].split("\n\n")[0]
-    pipeline = Pipeline(json.loads(json.dumps(CONFIG)))
-    assert f"runtime={pipeline.run_runtime(7)}, mem_mb={pipeline.mem_mb(7)}," in job, job
+    pipeline = Plans(json.loads(json.dumps(CONFIG)))
+    assert f"runtime={pipeline.run_runtime(7)}, mem_mb={mem_mb(7)}," in job, job
     assert jobs(out["finest"], "run_scheme") == jobs(out["good"], "run_scheme") + 1
     assert procs["bad_finest"].returncode != 0
     assert "config key 'beyond.finest.level': 6 is not above" in out["bad_finest"]

@@ -26,8 +26,9 @@ import pandas as pd
 import pytest
 import yaml
 
-from mcfbench.pipeline import Pipeline, solver_of
+from mcfbench.pipeline import Plans
 from mcfbench.storage.records import checksum
+from mcfbench.studies.convergence import solver_of
 
 pytestmark = pytest.mark.e2e
 
@@ -226,6 +227,28 @@ def test_bad_config_stops_before_any_job(tmp_path, env):
     assert not (work / "results").exists()
 
 
+def test_a_bad_beyond_value_stops_only_the_beyond_study(tmp_path, env):
+    """Each study checks its own config section when its rules join the job graph:
+    a time step that does not divide t_final under `beyond` stops `beyond` with the
+    key named, not the matrix nor Table 3.1 (dry runs)."""
+    work = copy_workflow(tmp_path / "work")
+    (work / "bad.yaml").write_text("beyond:\n  time_study:\n    taus: [0.3, 0.15]\n")
+    procs = {target: subprocess.Popen(
+        [sys.executable, "-m", "snakemake", "-n", target, "--configfile", "bad.yaml"],
+        cwd=work, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        for target in ("beyond", "matrix", "convergence")}
+    out = {target: proc.communicate(timeout=TIMEOUT)[0] for target, proc in procs.items()}
+    assert procs["beyond"].returncode != 0
+    assert "ConfigError: config key 'beyond.time_study.taus': t_final = 0.08 is not a " \
+        "whole multiple of tau = 0.3" in out["beyond"], out["beyond"][-2000:]
+    for target in ("matrix", "convergence"):
+        assert procs[target].returncode == 0, out[target][-2000:]
+        assert "beyond" not in out[target].split("Building DAG of jobs")[1]
+    # the matrix plans its own series jobs, no run of Table 3.1
+    assert "matrix_run_sphere" in out["matrix"] and "run_scheme" not in out["matrix"]
+    assert not (work / "results").exists()
+
+
 def test_threads_setting_reaches_the_rules_and_the_records(tmp_path, env):
     work = copy_workflow(tmp_path / "work")
     out = subprocess.run(
@@ -236,9 +259,9 @@ def test_threads_setting_reaches_the_rules_and_the_records(tmp_path, env):
     jobs = out.stdout.split("rule run_scheme:")[1:]
     assert len(jobs) == 2 and all("threads: 2" in job.split("\n\n")[0] for job in jobs)
     config = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
-    settings = Pipeline({**config, "threads": 2}).run_settings("ddfv", 1)
+    settings = Plans({**config, "threads": 2}).run_settings("ddfv", 1)
     assert settings["threads"] == 2 and solver_of(settings).threads == 2
-    assert Pipeline(config).run_settings("ddfv", 1)["threads"] == 1
+    assert Plans(config).run_settings("ddfv", 1)["threads"] == 1
 
 
 _ONE_STEP = ("import json; from mcfbench.running.run import run; "
