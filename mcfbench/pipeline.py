@@ -51,6 +51,31 @@ def check_keys(config, schema_path):
                           f"{', '.join(sorted(known))} (config/README.md)")
 
 
+def check_section(config, key, schema_path):
+    """Validate the config section ``key`` against its own schema (``schema_path``;
+    its defaults filled in), as Snakemake validates the whole config.
+
+    Raises
+    ------
+    ConfigError
+        Naming the key of the first bad value (``beyond.time_study.taus``) and
+        what is wrong with it.
+    """
+    from jsonschema.exceptions import ValidationError
+    from snakemake.exceptions import WorkflowError
+    from snakemake.utils import validate
+
+    try:
+        validate(config[key], str(schema_path))
+    except WorkflowError as err:
+        cause = err.__context__          # Snakemake raises it while handling jsonschema's
+        if not isinstance(cause, ValidationError):
+            raise
+        where = ".".join([key, *(str(p) for p in cause.absolute_path)])
+        raise ConfigError(f"config key {where!r}: {cause.message} (schema "
+                          f"{schema_path})") from None
+
+
 def alternatives(names):
     """A wildcard constraint matching exactly ``names`` (longest first)."""
     return "|".join(re.escape(n) for n in sorted(names, key=len, reverse=True))
@@ -63,11 +88,15 @@ class Plans:
     Parameters
     ----------
     config : dict
-        Snakemake's config after the schema check.
+        Snakemake's config after the schema check (``config.schema.yaml``).
+    schemas : str or Path
+        The folder of the schemas (``workflow/schemas``): the section ``beyond``
+        is checked against ``beyond.schema.yaml`` before its plan.
     """
 
-    def __init__(self, config):
+    def __init__(self, config, schemas):
         self.config = config
+        self.schemas = Path(schemas)
         self.code = code_hash()
         # threads of every run job and of the kernels' job: checked at once
         self.threads = check_threads(config)
@@ -79,7 +108,8 @@ class Plans:
 
     @cached_property
     def beyond(self):
-        """:func:`mcfbench.studies.beyond.plan` of the config."""
+        """:func:`mcfbench.studies.beyond.plan` of the config, after its schema."""
+        check_section(self.config, "beyond", self.schemas / "beyond.schema.yaml")
         return beyond.plan(self.config, self.convergence)
 
     @cached_property

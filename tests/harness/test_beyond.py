@@ -48,6 +48,7 @@ from mcfbench.studies.convergence import job as run_job
 from mcfbench.studies.convergence import problem_of
 
 REPO = Path(__file__).resolve().parents[2]
+SCHEMAS = REPO / "workflow" / "schemas"
 CONFIG = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
 SETTINGS = {"t_final": 0.08, "tau_level_1": 0.04, "rtol": 1e-9}
 
@@ -384,7 +385,7 @@ def test_default_config_passes_the_schema_and_the_checks():
 
     config = json.loads(json.dumps(CONFIG))
     validate(config, str(REPO / "workflow" / "schemas" / "config.schema.yaml"))
-    settings = Plans(config).beyond
+    settings = Plans(config, SCHEMAS).beyond
     assert settings["levels"] == [1, 2, 3, 4, 5, 6]
     assert settings["schemes"] == ["ddfv", "ddfv-chord", "ddfv-eliminate", "cotan"]
     assert settings["long_time"]["t_final"] == 0.15 and settings["long_time"]["level"] == 5
@@ -395,15 +396,15 @@ def test_default_config_passes_the_schema_and_the_checks():
     assert all(s in SCHEMES for s in used_schemes(settings))
     # the level-7 run is off by default
     assert settings["finest"] == {"level": 7, "rtol": 1e-11, "schemes": []}
-    assert not [p for p in Plans(config).beyond_runs["levels"] if "level7" in p]
+    assert not [p for p in Plans(config, SCHEMAS).beyond_runs["levels"] if "level7" in p]
 
 
 def test_finest_level_adds_its_runs_only():
     config = json.loads(json.dumps(CONFIG))
     config["beyond"]["finest"]["schemes"] = ["ddfv-chord"]
-    pipeline = Plans(config)
+    pipeline = Plans(config, SCHEMAS)
     runs = pipeline.beyond_runs["levels"]
-    default = Plans(json.loads(json.dumps(CONFIG))).beyond_runs["levels"]
+    default = Plans(json.loads(json.dumps(CONFIG)), SCHEMAS).beyond_runs["levels"]
     assert set(runs) - set(default) == {"results/runs/ddfv-chord/level7.json"}
     assert all(runs[p] == settings for p, settings in default.items())
     assert runs["results/runs/ddfv-chord/level7.json"] == pipeline.run_settings("ddfv-chord", 7)
@@ -419,30 +420,46 @@ def test_finest_level_adds_its_runs_only():
     assert mem_mb(7) >= 2 * 630 and pipeline.run_runtime(7) * 60 >= 2 * 860
 
 
-@pytest.mark.parametrize("path, value", [
-    (("beyond", "levels"), [8]),
-    (("beyond", "finest", "level"), 8),
-    (("beyond", "finest", "schemes"), "ddfv-chord"),
-    (("beyond", "finest", "extra"), 1),
-    (("beyond", "schemes"), ["DDFV"]),
-    (("beyond", "long_time", "t_final"), 0.3),
-    (("beyond", "time_study", "taus"), [0.01]),
-    (("beyond", "time_study", "reference_factor"), 1),
-    (("beyond", "space_study", "tau"), -1e-5),
-    (("beyond", "extra"), 1),
-    (("scheme_modules",), {"ddfv": "ddfv.sphere"}),      # the old key is gone
+@pytest.mark.parametrize("path, value, message", [
+    (("levels",), [8], "config key 'beyond.levels.0': 8 is not valid"),
+    (("finest", "level"), 8, "config key 'beyond.finest.level': 8 is not valid"),
+    (("finest", "schemes"), "ddfv-chord",
+     "config key 'beyond.finest.schemes': 'ddfv-chord' is not of type 'array'"),
+    (("finest", "extra"), 1, "config key 'beyond.finest': Additional properties"),
+    (("schemes",), ["DDFV"], "config key 'beyond.schemes.0': 'DDFV' does not match"),
+    (("long_time", "t_final"), 0.3,
+     "config key 'beyond.long_time.t_final': 0.3 is greater than or equal to"),
+    (("time_study", "taus"), [0.3], "config key 'beyond.time_study.taus': [0.3] is too short"),
+    (("time_study", "reference_factor"), 1,
+     "config key 'beyond.time_study.reference_factor': 1 is less than the minimum of 2"),
+    (("space_study", "tau"), -1e-5,
+     "config key 'beyond.space_study.tau': -1e-05 is less than or equal to the minimum of 0"),
+    (("extra",), 1, "config key 'beyond': Additional properties are not allowed ('extra'"),
 ])
-def test_schema_rejects_bad_beyond_values(path, value):
+def test_beyond_schema_names_the_bad_key(path, value, message):
+    """The section ``beyond`` has its own schema, checked with its plan (Plans.beyond),
+    not while Snakemake reads the workflow: the whole config passes the main schema."""
+    from snakemake.utils import validate
+
+    config = json.loads(json.dumps(CONFIG))
+    node = config["beyond"]
+    for key in path[:-1]:
+        node = node[key]
+    node[path[-1]] = value
+    validate(json.loads(json.dumps(config)), str(SCHEMAS / "config.schema.yaml"))
+    with pytest.raises(ConfigError) as err:
+        Plans(config, SCHEMAS).beyond
+    assert message in str(err.value)
+
+
+def test_main_schema_refuses_an_old_key():
     from snakemake.exceptions import WorkflowError
     from snakemake.utils import validate
 
     config = json.loads(json.dumps(CONFIG))
-    node = config
-    for key in path[:-1]:
-        node = node[key]
-    node[path[-1]] = value
+    config["scheme_modules"] = {"ddfv": "ddfv.sphere"}      # the old key is gone
     with pytest.raises(WorkflowError):
-        validate(config, str(REPO / "workflow" / "schemas" / "config.schema.yaml"))
+        validate(config, str(SCHEMAS / "config.schema.yaml"))
 
 
 @pytest.mark.parametrize("path, value, message", [
@@ -468,7 +485,7 @@ def test_checks_across_keys_name_the_key(path, value, message):
         config["beyond"]["finest"]["schemes"] = ["ddfv-chord"]   # checked when on
     config["beyond"][path[0]][path[1]] = value
     with pytest.raises(ConfigError) as err:
-        Plans(config).beyond
+        Plans(config, SCHEMAS).beyond
     assert message in str(err.value)
     if "unknown" in message:
         assert all(name in str(err.value) for name in SCHEMES)
@@ -477,7 +494,7 @@ def test_checks_across_keys_name_the_key(path, value, message):
 def test_time_study_takes_any_scheme():
     config = json.loads(json.dumps(CONFIG))
     config["beyond"]["time_study"]["schemes"] = ["cotan", "ddfv"]
-    assert Plans(config).beyond["time_study"]["schemes"] == ["cotan", "ddfv"]
+    assert Plans(config, SCHEMAS).beyond["time_study"]["schemes"] == ["cotan", "ddfv"]
 
 
 FINEST = "beyond={finest: {schemes: [ddfv-chord]}}"   # the command line of config/README.md
@@ -530,7 +547,7 @@ def test_dry_run_of_beyond_and_a_bad_value(tmp_path):
     assert level7 not in out["good"]
     assert procs["finest"].returncode == 0, out["finest"][-3000:]
     job = out["finest"].split(f"output: {level7}")[1].split("\n\n")[0]
-    pipeline = Plans(json.loads(json.dumps(CONFIG)))
+    pipeline = Plans(json.loads(json.dumps(CONFIG)), SCHEMAS)
     assert f"runtime={pipeline.run_runtime(7)}, mem_mb={mem_mb(7)}," in job, job
     assert jobs(out["finest"], "run_scheme") == jobs(out["good"], "run_scheme") + 1
     assert procs["bad_finest"].returncode != 0

@@ -33,6 +33,7 @@ from mcfbench.studies.convergence import solver_of
 pytestmark = pytest.mark.e2e
 
 REPO = Path(__file__).resolve().parents[2]
+SCHEMAS = REPO / "workflow" / "schemas"
 # the study's own target (rule all also builds the figures of another rule
 # file); targets before --config, which takes every following word
 RUN = ["--cores", "2", "convergence", "--config", "levels=[1,2]"]
@@ -229,23 +230,33 @@ def test_bad_config_stops_before_any_job(tmp_path, env):
 
 def test_a_bad_beyond_value_stops_only_the_beyond_study(tmp_path, env):
     """Each study checks its own config section when its rules join the job graph:
-    a time step that does not divide t_final under `beyond` stops `beyond` with the
-    key named, not the matrix nor Table 3.1 (dry runs)."""
+    a bad value under `beyond` (against its schema, or a time step that does not
+    divide t_final) stops `beyond` with the key named, not the matrix nor Table 3.1
+    (dry runs)."""
     work = copy_workflow(tmp_path / "work")
     (work / "bad.yaml").write_text("beyond:\n  time_study:\n    taus: [0.3, 0.15]\n")
-    procs = {target: subprocess.Popen(
-        [sys.executable, "-m", "snakemake", "-n", target, "--configfile", "bad.yaml"],
-        cwd=work, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-        for target in ("beyond", "matrix", "convergence")}
-    out = {target: proc.communicate(timeout=TIMEOUT)[0] for target, proc in procs.items()}
-    assert procs["beyond"].returncode != 0
+    bad = {"file": ["--configfile", "bad.yaml"],
+           "line": ["--config", "beyond={time_study: {taus: [0.3]}}"]}
+    runs = {(target, how): ["-n", target, *args] for target in ("beyond", "matrix", "convergence")
+            for how, args in bad.items()}
+    procs = {key: subprocess.Popen(
+        [sys.executable, "-m", "snakemake", *args], cwd=work, env=env,
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        for key, args in runs.items()}
+    out = {key: proc.communicate(timeout=TIMEOUT)[0] for key, proc in procs.items()}
+    assert procs["beyond", "file"].returncode != 0
     assert "ConfigError: config key 'beyond.time_study.taus': t_final = 0.08 is not a " \
-        "whole multiple of tau = 0.3" in out["beyond"], out["beyond"][-2000:]
+        "whole multiple of tau = 0.3" in out["beyond", "file"], out["beyond", "file"][-2000:]
+    assert procs["beyond", "line"].returncode != 0
+    assert "ConfigError: config key 'beyond.time_study.taus': ['0.3'] is too short" in \
+        out["beyond", "line"], out["beyond", "line"][-2000:]
     for target in ("matrix", "convergence"):
-        assert procs[target].returncode == 0, out[target][-2000:]
-        assert "beyond" not in out[target].split("Building DAG of jobs")[1]
+        for how in bad:
+            assert procs[target, how].returncode == 0, out[target, how][-2000:]
+            assert "beyond" not in out[target, how].split("Building DAG of jobs")[1]
     # the matrix plans its own series jobs, no run of Table 3.1
-    assert "matrix_run_sphere" in out["matrix"] and "run_scheme" not in out["matrix"]
+    assert "matrix_run_sphere" in out["matrix", "file"]
+    assert "run_scheme" not in out["matrix", "file"]
     assert not (work / "results").exists()
 
 
@@ -259,9 +270,9 @@ def test_threads_setting_reaches_the_rules_and_the_records(tmp_path, env):
     jobs = out.stdout.split("rule run_scheme:")[1:]
     assert len(jobs) == 2 and all("threads: 2" in job.split("\n\n")[0] for job in jobs)
     config = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
-    settings = Plans({**config, "threads": 2}).run_settings("ddfv", 1)
+    settings = Plans({**config, "threads": 2}, SCHEMAS).run_settings("ddfv", 1)
     assert settings["threads"] == 2 and solver_of(settings).threads == 2
-    assert Plans(config).run_settings("ddfv", 1)["threads"] == 1
+    assert Plans(config, SCHEMAS).run_settings("ddfv", 1)["threads"] == 1
 
 
 _ONE_STEP = ("import json; from mcfbench.running.run import run; "
@@ -298,7 +309,8 @@ def test_run_jobs_wait_for_one_kernel_compilation(tmp_path, env):
 
 
 SCRIPTS = REPO / "workflow" / "scripts"
-OWN_SCRIPTS = ["compile_kernels", "run_scheme", "beyond_time", "figure", "convergence_table", "plot_convergence",
+OWN_SCRIPTS = ["compile_kernels", "run_scheme", "beyond_run", "figure", "convergence_table",
+               "plot_convergence",
                "beyond_tables", "beyond_plots", "beyond_findings", "report", "report_pdf",
                "check_records"]
 
@@ -315,7 +327,7 @@ def test_scripts_are_thin_adapters_of_the_harness(name):
     local = {p.stem for p in SCRIPTS.glob("*.py")}
     assert not [m for m in imports if m.split(".")[0] in local], imports
     assert any(m.startswith("mcfbench") for m in imports)
-    if name in ("run_scheme", "beyond_time", "figure"):    # jobs that run flows
+    if name in ("run_scheme", "beyond_run", "figure"):    # jobs that run flows
         assert "tune_malloc()" in text
 
 

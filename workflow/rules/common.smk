@@ -7,7 +7,7 @@
 from mcfbench.pipeline import Plans, alternatives, mem_mb
 from mcfbench.running.schemes import SCHEMES as _SCHEMES
 
-PLANS = Plans(config)
+PLANS = Plans(config, f"{workflow.basedir}/workflow/schemas")
 # the config key `threads` (every run job), checked here
 THREADS = PLANS.threads
 # every compiled kernel in numba's cache before the run jobs (rule compile_kernels)
