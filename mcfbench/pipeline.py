@@ -7,11 +7,14 @@ what the rules need beside them:
 
 Config
     :func:`check_keys` refuses unknown top-level keys while Snakemake reads
-    the workflow. Each study checks its own section in its ``plan``, and
-    :class:`Plans` calls a plan only when a rule that needs it is in the
-    job graph: a bad value under ``beyond`` stops ``snakemake beyond`` with a
+    the workflow. Each study checks its own section in its ``plan``;
+    :class:`Plans` makes those of Table 3.1 and of the beyond study only when
+    a rule that needs them is in the job graph: a bad value under ``beyond``
+    stops ``snakemake beyond`` with a
     :class:`~mcfbench.studies.config.ConfigError` naming the key, not a run
-    of the matrix.
+    of the matrix. (The matrix and the gallery make their plans while
+    Snakemake reads ``workflow/rules/matrix.smk`` and ``gallery.smk``: their
+    rules are made from them.)
 Settings
     Everything that determines one run record (scheme, problem, level, tau,
     t_final, solver tolerance, the source hash of every package): passed to
