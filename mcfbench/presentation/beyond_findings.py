@@ -1,5 +1,6 @@
-"""The findings of the beyond study in words, from its tables (rule beyond_findings): every
-number is read from the tables."""
+"""The findings of the beyond study in words, from its tables and its verdicts
+(:func:`mcfbench.studies.beyond.findings`: which schemes stayed stable, the finest
+common level, the ranking): every number is read from the tables."""
 
 import numpy as np
 
@@ -32,7 +33,7 @@ def _breakdown(r):
 
 def stability_section(levels, stability, schemes, t_final):
     """Which schemes finished every run, and where the others broke down."""
-    lines, stable = ["## Which schemes stay stable", ""], []
+    lines = ["## Which schemes stay stable", ""]
     for scheme in schemes:
         runs = stability[stability["scheme"] == scheme]
         plain = levels[levels["scheme"] == scheme]
@@ -49,8 +50,6 @@ def stability_section(levels, stability, schemes, t_final):
             where.append(f"level{'s' if len(part) > 1 else ''} {_levels(part['level'])} "
                          f"to t = {t:g}")
         if len(failed) == 0:
-            if len(outside) == 0:
-                stable.append(scheme)
             text = head + "every run finished (" + "; ".join(where) + ")"
             if has_t:
                 text += (f"; the T monitor stayed at or above "
@@ -72,7 +71,7 @@ def stability_section(levels, stability, schemes, t_final):
                     text += f" (smallest T monitor {finished['t_min_barycentric'].min():.3f})"
                 text += "."
         lines.append(text)
-    return lines + [""], stable
+    return lines + [""]
 
 
 def accuracy_section(levels, paper_schemes):
@@ -95,17 +94,9 @@ def accuracy_section(levels, paper_schemes):
     return lines + [""]
 
 
-def finest_section(levels, schemes):
-    """The finest level every scheme ran, beyond the paper, and the finer levels
-    some schemes ran (``beyond.finest``): errors, orders and cost.
-
-    Returns
-    -------
-    lines : list of str
-    finest : int
-        The finest level every scheme of ``schemes`` ran.
-    """
-    finest = int(levels.groupby("scheme")["level"].max()[schemes].min())
+def finest_section(levels, schemes, finest):
+    """Level ``finest`` (the finest every scheme ran), beyond the paper, and the finer
+    levels some schemes ran (``beyond.finest``): errors, orders and cost."""
     deeper = levels[levels["level"] > finest]
     lines = [f"## Level {finest} (finest level run" +
              (f" by every scheme; level {_levels(deeper['level'].unique())} by "
@@ -124,7 +115,7 @@ def finest_section(levels, schemes):
             else:
                 lines.append(f"- {name}: no error, the run broke down: {_breakdown(r)} "
                              f"({cost} until then).")
-    return lines + [""], finest
+    return lines + [""]
 
 
 def cost_section(levels, schemes, reference, finest):
@@ -211,48 +202,42 @@ def order_section(levels, time, space, paper_schemes):
     return lines + [""]
 
 
-def summary(levels, stable, paper_schemes, finest):
-    """The verdict in two sentences."""
-    variants = [s for s in paper_schemes if s in stable]
-    unstable = [s for s in paper_schemes if s not in stable]
-    if not variants:
+def summary(verdict):
+    """The verdict (:func:`mcfbench.studies.beyond.findings`) in two sentences."""
+    if not verdict["variants"]:
         return ["## Summary", "", "No DDFV scheme finished every run.", ""]
-    rows = levels[(levels["level"] == finest) & levels["scheme"].isin(variants)]
-    rows = rows[rows["status"] == "ok"].sort_values("l2_error")
     text = (f"Stable (every run finished, no T-vertex left its triangle): "
-            f"{'; '.join(map(label, variants))}; not stable: "
-            f"{'; '.join(map(label, unstable)) or 'none'}.")
-    if len(rows):
-        best = rows.iloc[0]
-        text += f" On level {finest} the most accurate stable variant is {label(best.scheme)} " \
-                f"(L2 {sci(best.l2_error, 4)}"
-        others = [f"{label(r.scheme)} {r.l2_error / best.l2_error:.2f} x that" for r in
-                  rows.iloc[1:].itertuples()]
+            f"{'; '.join(map(label, verdict['variants']))}; not stable: "
+            f"{'; '.join(map(label, verdict['unstable'])) or 'none'}.")
+    if verdict["ranking"]:
+        (best, error), *rest = verdict["ranking"]
+        text += f" On level {verdict['finest']} the most accurate stable variant is " \
+                f"{label(best)} (L2 {sci(error, 4)}"
+        others = [f"{label(scheme)} {value / error:.2f} x that" for scheme, value in rest]
         text += ("; " + ", ".join(others) if others else "") + ")."
-    paper = levels[levels["scheme"].isin(variants) & np.isfinite(levels["l2_ratio"])]
-    if len(paper):
-        worst = paper.loc[(paper["l2_ratio"] - 1).abs().groupby(paper["scheme"]).idxmax()]
+    if verdict["deviations"]:
         text += " Largest deviation from the published errors (levels of Table 3.1): " + \
-            "; ".join(f"{label(r.scheme)} {pct(r.l2_ratio - 1, 1)} (level {r.level})"
-                      for r in worst.itertuples()) + "."
+            "; ".join(f"{label(scheme)} {pct(ratio - 1, 1)} (level {level})"
+                      for scheme, level, ratio in verdict["deviations"]) + "."
     return ["## Summary", "", text, ""]
 
 
-def beyond_findings(levels, stability, time, space, schemes, paper_schemes, t_final, tau_1):
+def beyond_findings(levels, stability, time, space, schemes, paper_schemes, t_final, tau_1,
+                    verdict):
     """The findings of the beyond study (Markdown) from its tables (DataFrames of
-    :func:`mcfbench.presentation.beyond_tables.beyond_tables`); ``schemes``: those of the level table,
+    :func:`mcfbench.presentation.beyond_tables.beyond_tables`) and its ``verdict``
+    (:func:`mcfbench.studies.beyond.findings`); ``schemes``: those of the level table,
     ``paper_schemes``: those compared with the published values."""
     parts = ["# Beyond Table 3.1: findings", "",
              "Generated by `mcfbench.presentation.beyond_findings.beyond_findings` from the tables in "
              "`results/beyond/tables/` (every number below is read from them). Shrinking "
              f"unit sphere, t_f = {t_final:g} unless stated, tau = {tau_1:g} / 4^(level-1).",
              ""]
-    stab, stable = stability_section(levels, stability, schemes, t_final)
-    fine, finest = finest_section(levels, schemes)
-    reference = paper_schemes[0] if paper_schemes else schemes[0]
-    parts += summary(levels, stable, paper_schemes, finest)
-    parts += stab + accuracy_section(levels, paper_schemes) + fine
-    parts += cost_section(levels, schemes, reference, finest)
+    finest = verdict["finest"]
+    parts += summary(verdict)
+    parts += stability_section(levels, stability, schemes, t_final)
+    parts += accuracy_section(levels, paper_schemes) + finest_section(levels, schemes, finest)
+    parts += cost_section(levels, schemes, verdict["reference"], finest)
     parts += order_section(levels, time, space, paper_schemes)
     parts += ["## Figures and tables", "",
               "![L2 error per level](figures/levels.png)", "",

@@ -24,8 +24,9 @@ Nothing here is a hand-typed result: the published values come from
 - ``results/beyond/**``: the beyond-the-paper study, when present,
 - ``ddfv/README.md``: the section "Deviations and interpretations".
 
-:func:`findings` writes the findings of the beyond study in words, every
-number and verdict read from its tables. Scheme names in the text are the
+The findings of the beyond study are worded by
+:mod:`mcfbench.presentation.beyond_findings` from its tables and the verdicts of
+:func:`mcfbench.studies.beyond.findings`. Scheme names in the text are the
 registry's labels (:data:`mcfbench.running.schemes.SCHEMES`); numbers are formatted
 and escaped by :mod:`mcfbench.presentation.formats`.
 
@@ -501,9 +502,3 @@ def build(sources, outputs=None, log=None):
             log.info("differs: %s", item)
         log.info("wrote %s", ", ".join(str(p) for p in outputs.values()))
     return context
-
-
-# -- PDF --------------------------------------------------------------------------------
-
-
-# == the findings of the beyond study (rule beyond_findings) ============================

@@ -11,8 +11,9 @@ The study protocol:
   (:func:`mcfbench.studies.convergence.job`);
 * :func:`aggregate`: the records into the tables and the T-monitor series
   (:mod:`mcfbench.presentation.beyond_tables`);
-* :func:`findings`: ``findings.md`` from the tables only
-  (:mod:`mcfbench.presentation.beyond_findings`).
+* :func:`findings`: the verdicts from the tables only (stable schemes, the
+  finest common level, the ranking), worded in ``findings.md`` by
+  :mod:`mcfbench.presentation.beyond_findings` (:func:`write_findings`).
 """
 
 import time
@@ -313,18 +314,73 @@ def aggregate(expected, inputs, plan, settings, paper, outputs, log):
              docs["stability"]["md"])
 
 
-def findings(tables, plan, paper, settings, out, log):
+def findings(levels, stability, schemes, paper):
+    """The verdicts of the study, from its tables only.
+
+    Parameters
+    ----------
+    levels, stability : pandas.DataFrame
+        The level and stability tables (:func:`aggregate`).
+    schemes : list
+        The schemes of the level table (``beyond.schemes``).
+    paper : list
+        The schemes compared with the published Table 3.1 (:func:`paper_schemes`).
+
+    Returns
+    -------
+    dict
+        ``stable``: the schemes whose every run finished with no T-vertex outside
+        its triangle (their runs of the stability table; of the level table for a
+        scheme without T-vertices); ``variants`` and ``unstable``: the schemes of
+        ``paper`` that are and are not stable; ``finest``: the finest level every
+        scheme ran; ``reference``: the scheme the costs are compared with (the
+        first of ``paper``, else of ``schemes``); ``ranking``: ``(scheme, L2
+        error)`` of the stable ``variants`` that finished level ``finest``, most
+        accurate first; ``deviations``: ``(scheme, level, L2 / published)`` of
+        each stable variant's largest deviation from the published errors.
+    """
+    import numpy as np
+
+    stable = []
+    for scheme in schemes:
+        runs = stability[stability["scheme"] == scheme]
+        if len(runs):
+            outside = np.isfinite(runs["t_exit"]).any()
+        else:                                   # no T-vertices: the level table's runs
+            runs, outside = levels[levels["scheme"] == scheme], False
+        if (runs["status"] == "ok").all() and not outside:
+            stable.append(scheme)
+    variants = [s for s in paper if s in stable]
+    finest = int(levels.groupby("scheme")["level"].max()[schemes].min())
+    rows = levels[(levels["level"] == finest) & levels["scheme"].isin(variants)]
+    rows = rows[rows["status"] == "ok"].sort_values("l2_error")
+    published = levels[levels["scheme"].isin(variants) & np.isfinite(levels["l2_ratio"])]
+    worst = published.loc[(published["l2_ratio"] - 1).abs().groupby(published["scheme"]).idxmax()] \
+        if len(published) else published
+    return {"stable": stable, "variants": variants,
+            "unstable": [s for s in paper if s not in stable], "finest": finest,
+            "reference": paper[0] if paper else schemes[0],
+            "ranking": [(r.scheme, float(r.l2_error)) for r in rows.itertuples()],
+            "deviations": [(r.scheme, int(r.level), float(r.l2_ratio))
+                           for r in worst.itertuples()]}
+
+
+def write_findings(tables, plan, paper, settings, out, log):
     """``findings.md`` from the tables only (``tables``: ``levels``, ``stability``,
-    ``time``, ``space`` -> CSV path; ``settings``: ``t_final``, ``tau_level_1``),
-    worded by :func:`mcfbench.presentation.beyond_findings.beyond_findings`."""
+    ``time``, ``space`` -> CSV path; ``settings``: ``t_final``, ``tau_level_1``): the
+    verdicts of :func:`findings` worded by
+    :func:`mcfbench.presentation.beyond_findings.beyond_findings`."""
     import pandas as pd
 
     from mcfbench.presentation.beyond_findings import beyond_findings
     from mcfbench.storage.atomic import write_files
 
-    frames = [pd.read_csv(tables[key]) for key in ("levels", "stability", "time", "space")]
-    text = beyond_findings(*frames, list(plan["schemes"]), list(paper),
-                           float(settings["t_final"]), float(settings["tau_level_1"]))
+    levels, stability, time_table, space = (pd.read_csv(tables[key]) for key in
+                                            ("levels", "stability", "time", "space"))
+    schemes, paper = list(plan["schemes"]), list(paper)
+    text = beyond_findings(levels, stability, time_table, space, schemes, paper,
+                           float(settings["t_final"]), float(settings["tau_level_1"]),
+                           findings(levels, stability, schemes, paper))
     write_files({str(out): text})
     log.info("wrote %s", out)
     return text

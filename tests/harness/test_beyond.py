@@ -22,7 +22,7 @@ import pytest
 import yaml
 
 from mcfbench.pipeline import Plans, mem_mb
-from mcfbench.presentation.beyond_findings import beyond_findings as findings
+from mcfbench.presentation.beyond_findings import beyond_findings
 from mcfbench.presentation.beyond_tables import (
     beyond_documents,
     beyond_tables,
@@ -42,6 +42,7 @@ from mcfbench.storage.atomic import write_files
 from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.provenance import config_hash
 from mcfbench.storage.records import RecordError, read_record, read_records
+from mcfbench.studies.beyond import findings as verdicts
 from mcfbench.studies.beyond import levels_of, record_fields, time_job, used_schemes
 from mcfbench.studies.config import ConfigError
 from mcfbench.studies.convergence import job as run_job
@@ -152,6 +153,12 @@ def test_eoc_column_only_between_finished_consecutive_levels():
 SCHEMES_USED = ["ddfv", "ddfv-chord", "cotan"]
 LEVELS = [1, 2, 3]
 PAPER = ["ddfv", "ddfv-chord"]
+
+
+def findings(levels, stability, time, space, schemes, paper, t_final, tau_1):
+    """The findings as the rule writes them: the study's verdicts in words."""
+    return beyond_findings(levels, stability, time, space, schemes, paper, t_final, tau_1,
+                           verdicts(levels, stability, schemes, paper))
 
 
 def synthetic_inputs(finest=()):
@@ -326,9 +333,16 @@ def test_documents_and_findings_follow_the_numbers(tables, tmp_path):
     assert "\\ensuremath{|}gamma\\ensuremath{|}" in docs["levels"]["tex"]
     for name, doc in docs.items():
         (tmp_path / f"{name}.csv").write_text(doc["csv"])
-    text = findings(*(pd.read_csv(tmp_path / f"{n}.csv") for n in (
-        "levels", "stability", "time_convergence", "space_convergence")), SCHEMES_USED,
-        PAPER, 0.08, 0.04)
+    read = [pd.read_csv(tmp_path / f"{n}.csv") for n in (
+        "levels", "stability", "time_convergence", "space_convergence")]
+    verdict = verdicts(read[0], read[1], SCHEMES_USED, PAPER)
+    ratio = 1.05 * 1.3e-2 / 4 ** 2 / 8.01e-4
+    assert verdict["stable"] == ["ddfv-chord", "cotan"] and verdict["finest"] == 3
+    assert verdict["variants"] == ["ddfv-chord"] and verdict["unstable"] == ["ddfv"]
+    assert verdict["reference"] == "ddfv"
+    (scheme, level, deviation), = verdict["deviations"]
+    assert (scheme, level) == ("ddfv-chord", 3) and deviation == pytest.approx(ratio, rel=1e-6)
+    text = findings(*read, SCHEMES_USED, PAPER, 0.08, 0.04)
     label = {s: SCHEMES[s].label for s in SCHEMES_USED}
     assert f"**{label['ddfv']}** (`ddfv`): broke down in 2 of 4 runs" in text
     assert "t_escaped at t = 0.03" in text
@@ -336,7 +350,6 @@ def test_documents_and_findings_follow_the_numbers(tables, tmp_path):
     assert (f"Stable (every run finished, no T-vertex left its triangle): "
             f"{label['ddfv-chord']}; not stable: {label['ddfv']}.") in text
     assert f"time, **{label['ddfv-chord']}**: no order (reference run failed" in text
-    ratio = 1.05 * 1.3e-2 / 4 ** 2 / 8.01e-4
     assert f"{label['ddfv-chord']} {100 * (ratio - 1):+.1f} %" in text
 
 
