@@ -7,14 +7,14 @@ what the rules need beside them:
 
 Config
     :func:`check_keys` refuses unknown top-level keys while Snakemake reads
-    the workflow. Each study checks its own section in its ``plan``;
-    :class:`Plans` makes those of Table 3.1 and of the beyond study only when
-    a rule that needs them is in the job graph: a bad value under ``beyond``
-    stops ``snakemake beyond`` with a
-    :class:`~mcfbench.studies.config.ConfigError` naming the key, not a run
-    of the matrix. (The matrix and the gallery make their plans while
-    Snakemake reads ``workflow/rules/matrix.smk`` and ``gallery.smk``: their
-    rules are made from them.)
+    the workflow. Each study checks its own section (its schema, then its
+    ``plan``) through :class:`Plans`: those of Table 3.1 and of the beyond
+    study only when a rule that needs them is in the job graph, those of the
+    matrix and the gallery while Snakemake reads their rule files (their rules
+    are made from them; a bad section leaves them without rules). A bad value
+    stops only the study's own target, with a
+    :class:`~mcfbench.studies.config.ConfigError` naming the key: a bad
+    ``beyond`` value stops ``snakemake beyond``, not the matrix.
 Settings
     Everything that determines one run record (scheme, problem, level, tau,
     t_final, solver tolerance, the source hash of every package): passed to
@@ -37,7 +37,7 @@ from mcfbench.running.problems import get_problem
 from mcfbench.running.schemes import SCHEMES
 from mcfbench.storage.atomic import write_json
 from mcfbench.storage.provenance import code_hash
-from mcfbench.studies import beyond, convergence
+from mcfbench.studies import beyond, convergence, gallery, matrix
 from mcfbench.studies.config import ConfigError, check_threads
 from mcfbench.studies.convergence import PROBLEM
 
@@ -68,6 +68,8 @@ def check_section(config, key, schema_path):
     from snakemake.exceptions import WorkflowError
     from snakemake.utils import validate
 
+    if config.get(key) is None:        # left out: the plan's own defaults
+        return
     try:
         validate(config[key], str(schema_path))
     except WorkflowError as err:
@@ -85,8 +87,10 @@ def alternatives(names):
 
 
 class Plans:
-    """The plans of Table 3.1 and of the beyond study for one config, each made
-    (and its config section checked) on first use.
+    """The plans of the studies for one config, each made (and its config section
+    checked) on first use: those of Table 3.1 and of the beyond study when a rule
+    that needs them joins the job graph, those of the matrix and the gallery while
+    Snakemake reads their rule files (:meth:`while_reading`).
 
     Parameters
     ----------
@@ -120,12 +124,35 @@ class Plans:
         """``{study: {record path: settings}}`` (:func:`mcfbench.studies.beyond.beyond_runs`)."""
         return beyond.beyond_runs(self.beyond, self.convergence, self.code)
 
+    @cached_property
+    def matrix(self):
+        """:func:`mcfbench.studies.matrix.plan` of the config, after its schema."""
+        check_section(self.config, "matrix", self.schemas / "matrix.schema.yaml")
+        return matrix.plan(self.config.get("matrix"))
+
+    @cached_property
+    def gallery(self):
+        """:func:`mcfbench.studies.gallery.plan` of the config (``gallery``,
+        ``meshes``), after its schema."""
+        check_section(self.config, "gallery", self.schemas / "gallery.schema.yaml")
+        return gallery.plan(self.config.get("gallery"), self.config.get("meshes"))
+
     def checked(self, study, targets):
-        """``targets`` once the plan of ``study`` (``"convergence"`` or ``"beyond"``)
-        is made: the input of the study's target rule, so that a bad config value
-        stops there with the :class:`~mcfbench.studies.config.ConfigError` naming it."""
+        """``targets`` once the plan of ``study`` is made: the input of the study's
+        target rule, so that a bad config value stops there with the
+        :class:`~mcfbench.studies.config.ConfigError` naming it."""
         getattr(self, study)
         return targets
+
+    def while_reading(self, study, empty):
+        """The plan of ``study`` (``"matrix"``, ``"gallery"``) for the rules made from
+        it while Snakemake reads the workflow, or ``empty`` when its config section is
+        bad: then the study has no rules and :meth:`checked` names the bad key when
+        its target is asked for."""
+        try:
+            return getattr(self, study)
+        except ConfigError:
+            return empty
 
     def beyond_run_settings(self, study, scheme, level):
         """Settings of one run of the long-time or the space study."""
