@@ -260,6 +260,29 @@ def test_a_bad_beyond_value_stops_only_the_beyond_study(tmp_path, env):
     assert not (work / "results").exists()
 
 
+def test_a_bad_matrix_or_gallery_value_stops_only_its_target(tmp_path, env):
+    """The matrix and the gallery check their sections while Snakemake reads their
+    rule files: a bad one leaves them without rules and stops only their own target,
+    naming the key (dry runs)."""
+    work = copy_workflow(tmp_path / "work")
+    (work / "bad.yaml").write_text("matrix:\n  schemes: [ddfv, fem]\ngallery:\n  C: -1\n")
+    procs = {target: subprocess.Popen(
+        [sys.executable, "-m", "snakemake", "-n", target, "--configfile", "bad.yaml"],
+        cwd=work, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        for target in ("matrix", "gallery", "beyond_tables", "convergence")}
+    out = {target: proc.communicate(timeout=TIMEOUT)[0] for target, proc in procs.items()}
+    assert procs["matrix"].returncode != 0
+    assert "ConfigError: config key 'matrix.schemes': unknown scheme(s) ['fem']" in \
+        out["matrix"], out["matrix"][-2000:]
+    assert procs["gallery"].returncode != 0
+    assert "ConfigError: config key 'gallery.C': -1 is less than or equal to the minimum " \
+        "of 0" in out["gallery"], out["gallery"][-2000:]
+    for target in ("beyond_tables", "convergence"):     # (`beyond` adds the report)
+        assert procs[target].returncode == 0, out[target][-2000:]
+        assert "run_scheme" in out[target] and "matrix_run" not in out[target]
+    assert not (work / "results").exists()
+
+
 def test_threads_setting_reaches_the_rules_and_the_records(tmp_path, env):
     work = copy_workflow(tmp_path / "work")
     out = subprocess.run(
