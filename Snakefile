@@ -6,9 +6,10 @@
 #   snakemake --report results/report.html       # HTML report afterwards
 #
 # Settings: config/config.yaml (documented in config/README.md), validated
-# against workflow/schemas/config.schema.yaml and across keys (scheme names
-# against the registry mcfbench.running.schemes.SCHEMES, time steps; mcfbench.pipeline)
-# before any job runs. The logic of the rules is in the harness (mcfbench);
+# against workflow/schemas/config.schema.yaml, then each study's section
+# across keys (scheme names against the registry mcfbench.running.schemes.SCHEMES,
+# time steps; the plan of its module in mcfbench/studies/) when a target
+# needs it, before any job runs. The logic of the rules is in the harness (mcfbench);
 # workflow/scripts/*.py are thin adapters. Needs the packages installed:
 # `pip install -e .` in the repository.
 
@@ -62,7 +63,8 @@ rule all:
 rule beyond:
     """Target: level 6, the scheme variants and the stability study (slow)."""
     input:
-        BEYOND_TARGETS,
+        # the plan first: a bad value under `beyond` is named here
+        lambda wildcards: PLANS.checked("beyond", BEYOND_TARGETS),
     localrule: True
 
 
@@ -70,7 +72,8 @@ rule matrix:
     """Target: every scheme x every problem x its levels (config key `matrix`;
     about 20 minutes on 2 cores), tables, figures and findings in results/matrix/."""
     input:
-        MATRIX_TARGETS,
+        # the plan first: a bad value under `matrix` is named here
+        lambda wildcards: PLANS.checked("matrix", MATRIX_TARGETS),
     localrule: True
 
 
@@ -78,5 +81,6 @@ rule gallery:
     """Target: every scheme on every mesh file (`--config meshes=DIR`; default the
     suite's own meshes), table and pictures in results/gallery/."""
     input:
-        GALLERY_TARGETS,
+        # the plan first: a bad value under `gallery` is named here
+        lambda wildcards: PLANS.checked("gallery", GALLERY_TARGETS),
     localrule: True

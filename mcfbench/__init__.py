@@ -6,7 +6,7 @@ one way (``studies -> presentation -> storage``, ``studies -> running ->
 geometry -> storage``):
 
 ``storage``
-    run records, statuses, provenance, atomic writes.
+    run records, statuses, provenance, atomic writes, frame files.
 ``geometry``
     surfaces, mesh intake and validation, metrics, exact solutions, monitors.
 ``running``
@@ -14,7 +14,8 @@ geometry -> storage``):
 ``presentation``
     number formats, tables, plots, pictures, the report.
 ``studies``
-    one module per study with the same protocol.
+    one module per study (Table 3.1, beyond, figures, matrix, gallery) with
+    the same protocol: ``plan``, ``job``, ``aggregate``, ``findings``.
 
 plus the command line (:mod:`mcfbench.cli`) and the Snakemake glue
 (:mod:`mcfbench.pipeline`).

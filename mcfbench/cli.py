@@ -32,7 +32,8 @@ from mcfbench.running.integrators import INTEGRATORS
 from mcfbench.running.problems import PROBLEMS, Problem, get_problem
 from mcfbench.running.schemes import SCHEMES, get_scheme
 from mcfbench.running.solver import METHODS, ROBUST, Solver
-from mcfbench.storage.atomic import check_writable, save_npz, write_json
+from mcfbench.storage.atomic import check_writable, write_json
+from mcfbench.storage.frames import save_frames
 from mcfbench.storage.memory import tune_malloc
 from mcfbench.storage.provenance import provenance
 
@@ -313,7 +314,7 @@ def _run(args):
 
         export_pvd(arrays, args.out, run_provenance(arrays))
     else:
-        save_npz(args.out, **arrays)
+        save_frames(args.out, arrays)
     print(f"wrote {args.out}: {len(traj.t)} frames, {traj.steps_done} steps, "
           f"{int(traj.iterations.sum())} solver iterations, smallest angle "
           f"{result.min_angle:.3g} deg"
@@ -354,7 +355,7 @@ def _export(args):
 def _report(args):
     from mcfbench.presentation.report import ReportError, Sources, build
     from mcfbench.storage.logs import setup_logging
-    from mcfbench.studies.figures import EXPERIMENTS
+    from mcfbench.studies.figure_experiments import EXPERIMENTS
 
     sources = Sources(results=args.results, paper=args.paper, readme=args.readme,
                       out=args.out or args.results / "paper",

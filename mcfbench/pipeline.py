@@ -1,188 +1,220 @@
-"""The Snakemake pipeline's logic: config checks, run settings, targets, jobs.
+"""The Snakemake glue: the checks of the whole config, the studies' plans, resources.
 
-The workflow (``Snakefile``, ``workflow/rules/*.smk``) holds target lists
-and input functions only; its scripts (``workflow/scripts/*.py``) are thin
-adapters that read Snakemake's inputs and params and call this module (or
-:mod:`mcfbench.presentation.formats`, :mod:`mcfbench.presentation.plots`, :mod:`mcfbench.presentation.report`).
+The workflow (``Snakefile``, ``workflow/rules/*.smk``) holds target lists and
+input functions only; its scripts (``workflow/scripts/*.py``) are thin
+adapters that call the study modules (:mod:`mcfbench.studies`). This module is
+what the rules need beside them:
 
 Config
-    :class:`Pipeline` checks the config (after the schema,
-    ``workflow/schemas/config.schema.yaml``) across keys while Snakemake
-    reads the workflow: every scheme name is one of the registry
-    :data:`mcfbench.running.schemes.SCHEMES`, every final time a whole multiple of
-    its time steps. A bad value raises :class:`ConfigError` naming the key.
+    :func:`check_keys` refuses unknown top-level keys while Snakemake reads
+    the workflow. Each study checks its own section (its schema, then its
+    ``plan``) through :class:`Plans`: those of Table 3.1 and of the beyond
+    study only when a rule that needs them is in the job graph, those of the
+    matrix and the gallery while Snakemake reads their rule files (their rules
+    are made from them; a bad section leaves them without rules). A bad value
+    stops only the study's own target, with a
+    :class:`~mcfbench.studies.config.ConfigError` naming the key: a bad
+    ``beyond`` value stops ``snakemake beyond``, not the matrix.
 Settings
     Everything that determines one run record (scheme, problem, level, tau,
     t_final, solver tolerance, the source hash of every package): passed to
     the job, stored and hashed in the record, and recomputed by the
     aggregation to refuse stale records (:func:`mcfbench.storage.records.read_record`).
-Jobs
-    :func:`run_job`, :func:`time_job`, :func:`figure_job` run flows;
-    :func:`record_fields` says what the aggregations check in a record;
-    :func:`write_files` writes every output of a job at once.
+Resources
+    :func:`mem_mb`, :func:`runtime_minutes` (generous, for Slurm).
+Kernels
+    :func:`compile_job` (rule ``compile_kernels``) fills numba's cache before
+    the run jobs start.
 """
 
-import hashlib
-import json
 import math
 import re
 import time
+from functools import cached_property
 from pathlib import Path
 
 from mcfbench.running.problems import get_problem
-from mcfbench.running.schemes import SCHEMES, get_scheme
-from mcfbench.running.solver import Solver
-from mcfbench.storage.atomic import json_value, save_npz, write_files, write_json
-from mcfbench.storage.provenance import code_hash, provenance
-from mcfbench.storage.records import FIELDS, write_record
-from mcfbench.studies.config import ConfigError
-
-PROBLEM = "sphere"        # the problem of Table 3.1 and of the beyond study
+from mcfbench.running.schemes import SCHEMES
+from mcfbench.storage.atomic import write_json
+from mcfbench.storage.provenance import code_hash
+from mcfbench.studies import beyond, convergence, gallery, matrix
+from mcfbench.studies.config import ConfigError, check_threads
+from mcfbench.studies.convergence import PROBLEM
 
 
-# -- logging and output ---------------------------------------------------------------
+def check_keys(config, schema_path):
+    """Refuse unknown top-level config keys in one line, naming them and the known
+    ones (Snakemake's schema check would print the whole schema after it)."""
+    import yaml
+
+    known = yaml.safe_load(Path(schema_path).read_text())["properties"]
+    unknown = sorted(set(config) - set(known))
+    if unknown:
+        raise ConfigError(f"unknown config key(s) {unknown}; known keys: "
+                          f"{', '.join(sorted(known))} (config/README.md)")
 
 
-def json_text(data):
-    """``data`` as indented standard JSON text (NaN as null), as :mod:`mcfbench.storage.atomic`."""
-    return json.dumps(json_value(data), indent=2, allow_nan=False) + "\n"
-
-
-def sidecar(settings, records, texts):
-    """Provenance of aggregated tables: the settings, per input record its hash,
-    commit, host and time, and the SHA-256 of every output text."""
-    data = provenance(settings)
-    data["inputs"] = {path: {key: rec["provenance"].get(key) for key in
-                             ("config_hash", "git_commit", "git_dirty", "host", "created",
-                              "blas_threads")}
-                      for path, rec in records.items()}
-    data["outputs"] = {str(path): hashlib.sha256(text.encode()).hexdigest()
-                       for path, text in texts.items()}
-    return data
-
-
-# -- the config ---------------------------------------------------------------------
-
-def check_schemes(key, names):
-    """``names`` as a list, every one a registry name.
+def check_section(config, key, schema_path):
+    """Validate the config section ``key`` against its own schema (``schema_path``;
+    its defaults filled in), as Snakemake validates the whole config.
 
     Raises
     ------
     ConfigError
-        Naming ``key``, the unknown names and every known scheme.
+        Naming the key of the first bad value (``beyond.time_study.taus``) and
+        what is wrong with it.
     """
-    names = list(names)
-    unknown = [s for s in names if s not in SCHEMES]
-    if unknown:
-        raise ConfigError(f"config key {key!r}: unknown scheme(s) {unknown}; known schemes "
-                          f"(mcfbench.running.schemes.SCHEMES): {', '.join(SCHEMES)}")
-    return names
+    from jsonschema.exceptions import ValidationError
+    from snakemake.exceptions import WorkflowError
+    from snakemake.utils import validate
 
-
-def _steps(key, problem, tau, t_final, what):
-    """``problem.time_steps``, its error as a ConfigError naming ``key``."""
+    if config.get(key) is None:        # left out: the plan's own defaults
+        return
     try:
-        return problem.time_steps(tau, t_final)
-    except ValueError as err:
-        raise ConfigError(f"config key{'s' if ' and ' in key else ''} {key}: {err} "
-                          f"({what} time step)") from None
+        validate(config[key], str(schema_path))
+    except WorkflowError as err:
+        cause = err.__context__          # Snakemake raises it while handling jsonschema's
+        if not isinstance(cause, ValidationError):
+            raise
+        where = ".".join([key, *(str(p) for p in cause.absolute_path)])
+        raise ConfigError(f"config key {where!r}: {cause.message} (schema "
+                          f"{schema_path})") from None
 
 
-def beyond_settings(config, problem):
-    """Check ``config["beyond"]`` against the other keys and normalise it.
+def alternatives(names):
+    """A wildcard constraint matching exactly ``names`` (longest first)."""
+    return "|".join(re.escape(n) for n in sorted(names, key=len, reverse=True))
+
+
+def scheme_pattern():
+    """The wildcard constraint of a scheme: a registry name (longest first),
+    optionally ``@<integrator>`` (:func:`mcfbench.running.schemes.get_scheme`)."""
+    from mcfbench.running.integrators import INTEGRATORS
+
+    return f"(?:{alternatives(SCHEMES)})(?:@(?:{alternatives(INTEGRATORS)}))?"
+
+
+class Plans:
+    """The plans of the studies for one config, each made (and its config section
+    checked) on first use: those of Table 3.1 and of the beyond study when a rule
+    that needs them joins the job graph, those of the matrix and the gallery while
+    Snakemake reads their rule files (:meth:`while_reading`).
 
     Parameters
     ----------
     config : dict
-        The whole config, already checked against the schema.
-    problem : mcfbench.running.problems.Problem
-        The sphere with the config's ``tau_level_1`` and ``t_final``.
-
-    Returns
-    -------
-    dict
-        ``levels`` (sorted ints), ``schemes``, ``finest`` (``level``,
-        ``rtol`` of its runs, ``schemes``: the schemes whose rows of the
-        L2/EOC table go on to that level; none by default), ``long_time`` (``level``, ``t_final``,
-        ``tau``, ``schemes``), ``time_study`` (``level``, ``taus``
-        (descending), ``reference_factor``, ``t_final``, ``schemes``) and
-        ``space_study`` (``levels``, ``tau``, ``t_final``, ``schemes``); times
-        as floats.
-
-    Raises
-    ------
-    ConfigError
-        An unknown scheme, a final time that is not a whole multiple of a
-        time step, a scheme of ``beyond.finest`` that is not one of
-        ``beyond.schemes``, or a finest level that is not above
-        ``beyond.levels``; the message names the key.
+        Snakemake's config after the schema check (``config.schema.yaml``).
+    schemas : str or Path
+        The folder of the schemas (``workflow/schemas``): the section ``beyond``
+        is checked against ``beyond.schema.yaml`` before its plan.
     """
-    beyond = config["beyond"]
-    t_final = problem.t_final
-    levels = sorted({int(level) for level in beyond["levels"]})
-    for level in levels:
-        _steps("'beyond.levels'", problem, problem.tau(level), t_final, f"the level-{level}")
-    schemes = check_schemes("beyond.schemes", beyond["schemes"])
-    finest = {"level": int(beyond["finest"]["level"]),
-              "rtol": float(beyond["finest"].get("rtol", config["rtol"])),
-              "schemes": check_schemes("beyond.finest.schemes", beyond["finest"]["schemes"])}
-    if not 0 < finest["rtol"] < 1:          # the schema lets NaN through
-        raise ConfigError(f"config key 'beyond.finest.rtol': must lie in (0, 1), got "
-                          f"{beyond['finest']['rtol']!r}")
-    if finest["schemes"]:
-        _check_finest(finest, levels, schemes, problem)
-    long, time_, space = beyond["long_time"], beyond["time_study"], beyond["space_study"]
-    long_level, long_t = int(long["level"]), float(long["t_final"])
-    _steps("'beyond.long_time.t_final'", problem, problem.tau(long_level), long_t,
-           f"the level-{long_level}")
-    taus = sorted({float(tau) for tau in time_["taus"]}, reverse=True)
-    time_t = float(time_.get("t_final", t_final))
-    for tau in taus:
-        _steps("'beyond.time_study.taus'", problem, tau, time_t, "a")
-    factor = int(time_["reference_factor"])
-    _steps("'beyond.time_study.reference_factor'", problem, taus[-1] / factor, time_t,
-           "the reference's")
-    space_tau, space_t = float(space["tau"]), float(space.get("t_final", t_final))
-    _steps("'beyond.space_study.tau'", problem, space_tau, space_t, "the")
-    return {
-        "levels": levels,
-        "schemes": schemes,
-        "finest": finest,
-        "long_time": {"level": long_level, "t_final": long_t, "tau": problem.tau(long_level),
-                      "schemes": check_schemes("beyond.long_time.schemes", long["schemes"])},
-        "time_study": {"level": int(time_["level"]), "taus": taus, "reference_factor": factor,
-                       "t_final": time_t,
-                       "schemes": check_schemes("beyond.time_study.schemes",
-                                                time_["schemes"])},
-        "space_study": {"levels": sorted({int(level) for level in space["levels"]}),
-                        "tau": space_tau, "t_final": space_t,
-                        "schemes": check_schemes("beyond.space_study.schemes",
-                                                 space["schemes"])},
-    }
+
+    def __init__(self, config, schemas):
+        self.config = config
+        self.schemas = Path(schemas)
+        self.code = code_hash()
+        # threads of every run job and of the kernels' job: checked at once
+        self.threads = check_threads(config)
+
+    @cached_property
+    def convergence(self):
+        """:func:`mcfbench.studies.convergence.plan` of the config."""
+        return convergence.plan(self.config)
+
+    @cached_property
+    def beyond(self):
+        """:func:`mcfbench.studies.beyond.plan` of the config, after its schema."""
+        check_section(self.config, "beyond", self.schemas / "beyond.schema.yaml")
+        return beyond.plan(self.config, self.convergence)
+
+    @cached_property
+    def beyond_runs(self):
+        """``{study: {record path: settings}}`` (:func:`mcfbench.studies.beyond.beyond_runs`)."""
+        return beyond.beyond_runs(self.beyond, self.convergence, self.code)
+
+    @cached_property
+    def matrix(self):
+        """:func:`mcfbench.studies.matrix.plan` of the config, after its schema."""
+        check_section(self.config, "matrix", self.schemas / "matrix.schema.yaml")
+        return matrix.plan(self.config.get("matrix"))
+
+    @cached_property
+    def gallery(self):
+        """:func:`mcfbench.studies.gallery.plan` of the config (``gallery``,
+        ``meshes``), after its schema."""
+        check_section(self.config, "gallery", self.schemas / "gallery.schema.yaml")
+        return gallery.plan(self.config.get("gallery"), self.config.get("meshes"))
+
+    def checked(self, study, targets):
+        """``targets`` once the plan of ``study`` is made: the input of the study's
+        target rule, so that a bad config value stops there with the
+        :class:`~mcfbench.studies.config.ConfigError` naming it."""
+        getattr(self, study)
+        return targets
+
+    def while_reading(self, study, empty):
+        """The plan of ``study`` (``"matrix"``, ``"gallery"``) for the rules made from
+        it while Snakemake reads the workflow, or ``empty`` when its config section is
+        bad: then the study has no rules and :meth:`checked` names the bad key when
+        its target is asked for."""
+        try:
+            return getattr(self, study)
+        except ConfigError:
+            return empty
+
+    def beyond_run_settings(self, study, scheme, level):
+        """Settings of one run of the long-time or the space study."""
+        return beyond.study_settings(self.beyond, self.convergence, study, scheme, level,
+                                     self.code)
+
+    def time_settings(self, scheme):
+        """Settings of the time study of one scheme."""
+        return beyond.time_settings(self.beyond, self.convergence, scheme, self.code)
+
+    def paper_schemes(self):
+        """The beyond study's schemes compared with the published Table 3.1."""
+        return beyond.paper_schemes(self.beyond)
+
+    def beyond_records(self):
+        """``{record path: settings}`` of every run of the beyond study."""
+        return {path: s for runs in self.beyond_runs.values() for path, s in runs.items()}
+
+    def run_settings(self, scheme, level):
+        """Settings of the record ``results/runs/{scheme}/level{level}.json``: Table
+        3.1's, or for a run of ``beyond.finest`` the beyond study's (its tolerance;
+        the only record of that folder that needs the beyond plan)."""
+        if beyond.is_finest_run(self.config, scheme, level):
+            return beyond.level_settings(self.beyond, self.convergence, scheme, level,
+                                         self.code)
+        return convergence.record_settings(self.convergence, scheme, level, self.code)
+
+    def convergence_records(self):
+        """``{record path: settings}`` of Table 3.1, schemes in config order."""
+        plan = self.convergence
+        return {convergence.run_record(s, lv): self.run_settings(s, lv)
+                for s in plan["schemes"] for lv in plan["levels"]}
+
+    def table_settings(self):
+        """The config as far as Table 3.1 depends on it."""
+        return convergence.table_settings(self.convergence)
+
+    def run_runtime(self, level):
+        """Slurm time limit of one run of ``level`` with Table 3.1's time step."""
+        problem = convergence.problem_of(self.convergence)
+        return runtime_minutes(level, problem.time_steps(problem.tau(int(level))))
+
+    def beyond_runtime(self, study, scheme, level):
+        """Slurm time limit of one run of the long-time or the space study."""
+        settings = self.beyond_run_settings(study, scheme, level)
+        return runtime_minutes(level, round(settings["t_final"] / settings["tau"]))
+
+    def time_runtime(self):
+        """Slurm time limit of the time study of one scheme."""
+        return runtime_minutes(self.beyond["time_study"]["level"],
+                               beyond.time_steps_total(self.beyond))
 
 
-def _check_finest(finest, levels, schemes, problem):
-    """``beyond.finest`` extends rows of the L2/EOC table: its schemes are some of
-    ``schemes``, its level is above ``levels`` and its time step divides t_final."""
-    others = [s for s in finest["schemes"] if s not in schemes]
-    if others:
-        raise ConfigError(f"config key 'beyond.finest.schemes': {others} not in "
-                          f"'beyond.schemes' {schemes} (the finest level continues their "
-                          "rows of the L2/EOC table)")
-    level = finest["level"]
-    if level <= levels[-1]:
-        raise ConfigError(f"config key 'beyond.finest.level': {level} is not above the "
-                          f"levels of 'beyond.levels' {levels}")
-    _steps("'beyond.finest.level'", problem, problem.tau(level), problem.t_final,
-           f"the level-{level}")
-
-
-def used_schemes(beyond):
-    """Every scheme the beyond study runs, in order of first appearance."""
-    names = list(beyond["schemes"])
-    for key in ("long_time", "time_study", "space_study"):
-        names += [s for s in beyond[key]["schemes"] if s not in names]
-    return names
+# -- resources of the jobs (minutes, MB) ----------------------------------------------
 
 
 def run_seconds(level, steps):
@@ -202,200 +234,7 @@ def mem_mb(level):
     return 500 + 100 * 4 ** max(int(level) - 5, 0)
 
 
-def alternatives(names):
-    """A wildcard constraint matching exactly ``names`` (longest first)."""
-    return "|".join(re.escape(n) for n in sorted(names, key=len, reverse=True))
-
-
-def check_keys(config, schema_path):
-    """Refuse unknown top-level config keys in one line, naming them and the known
-    ones (Snakemake's schema check would print the whole schema after it)."""
-    import yaml
-
-    known = yaml.safe_load(Path(schema_path).read_text())["properties"]
-    unknown = sorted(set(config) - set(known))
-    if unknown:
-        raise ConfigError(f"unknown config key(s) {unknown}; known keys: "
-                          f"{', '.join(sorted(known))} (config/README.md)")
-
-
-class Pipeline:
-    """The checked config and everything derived from it.
-
-    Parameters
-    ----------
-    config : dict
-        Snakemake's config after the schema check (``--config levels=[1,2]``
-        gives strings: normalised here).
-
-    Raises
-    ------
-    ConfigError
-        See :func:`check_schemes`, :func:`beyond_settings`, and a ``t_final``
-        that is not a whole multiple of every level's time step.
-    """
-
-    def __init__(self, config):
-        self.levels = sorted({int(level) for level in config["levels"]})
-        self.schemes = check_schemes("schemes", config["schemes"])
-        self.rtol = float(config["rtol"])
-        if not 0 < self.rtol < 1:          # the schema lets NaN through
-            raise ConfigError(f"config key 'rtol': must lie in (0, 1), got {config['rtol']!r}")
-        self.threads = config.get("threads", 1)
-        if isinstance(self.threads, bool) or not isinstance(self.threads, int) \
-                or self.threads < 1:
-            raise ConfigError(f"config key 'threads': a whole number >= 1, got "
-                              f"{self.threads!r}")
-        self.problem = get_problem(PROBLEM).with_settings(
-            tau_1=float(config["tau_level_1"]), t_final=float(config["t_final"]))
-        for level in self.levels:
-            _steps("'t_final' and 'tau_level_1'", self.problem, self.problem.tau(level),
-                   self.problem.t_final, f"the level-{level}")
-        self.beyond = beyond_settings(config, self.problem)
-        self.config = {**config, "levels": self.levels}
-        self.code = code_hash()
-
-    # -- settings of one record
-    def run_settings(self, scheme, level, *, study=None, tau=None, t_final=None):
-        """Everything that determines the run record of (scheme, level).
-
-        ``study``, ``tau`` and ``t_final`` override the convergence study's
-        settings (the studies beyond Table 3.1); without them the settings,
-        and so the hash, are those of Table 3.1.
-        """
-        level = int(level)
-        finest = self.beyond["finest"]
-        # the finest level's runs of beyond.finest: their own tolerance (config/README.md)
-        rtol = finest["rtol"] if study is None and level == finest["level"] \
-            and scheme in finest["schemes"] else self.rtol
-        settings = {"scheme": scheme, "problem": self.problem.name, "level": level,
-                    "tau": self.problem.tau(level) if tau is None else float(tau),
-                    "t_final": self.problem.t_final if t_final is None else float(t_final),
-                    "rtol": rtol, "threads": self.threads, "code": self.code}
-        return settings if study is None else {"study": study, **settings}
-
-    def beyond_run_settings(self, study, scheme, level):
-        """Settings of one run of the long-time or the space study."""
-        if study == "long_time":
-            return self.run_settings(scheme, level, study=study,
-                                     t_final=self.beyond["long_time"]["t_final"])
-        space = self.beyond["space_study"]
-        return self.run_settings(scheme, level, study=study, tau=space["tau"],
-                                 t_final=space["t_final"])
-
-    def time_settings(self, scheme):
-        """Settings of the time study of one scheme."""
-        study = self.beyond["time_study"]
-        return {"study": "time", "scheme": scheme, "problem": self.problem.name,
-                "level": study["level"], "taus": study["taus"],
-                "reference_factor": study["reference_factor"], "t_final": study["t_final"],
-                "rtol": self.rtol, "threads": self.threads, "code": self.code}
-
-    def convergence_settings(self):
-        """The config as far as Table 3.1 depends on it (not the other studies)."""
-        return {k: self.config[k] for k in ("levels", "schemes", "tau_level_1", "t_final",
-                                            "rtol")}
-
-    # -- record paths and targets
-    @staticmethod
-    def run_record(scheme, level):
-        return f"results/runs/{scheme}/level{level}.json"
-
-    def run_records(self):
-        """Run records of every (scheme, level), schemes in config order."""
-        return [self.run_record(s, level) for s in self.schemes for level in self.levels]
-
-    def expected_runs(self):
-        """``{record path: settings}`` of the convergence study."""
-        return {self.run_record(s, lv): self.run_settings(s, lv)
-                for s in self.schemes for lv in self.levels}
-
-    def beyond_levels(self, scheme):
-        """Levels of ``scheme`` in the L2/EOC table: ``beyond.levels``, and
-        ``beyond.finest.level`` for the schemes of ``beyond.finest``."""
-        finest = self.beyond["finest"]
-        return self.beyond["levels"] + ([finest["level"]] if scheme in finest["schemes"]
-                                        else [])
-
-    def beyond_runs(self):
-        """``{study: {record path: settings}}`` of the beyond study."""
-        b = self.beyond
-        return {
-            "levels": {self.run_record(s, lv): self.run_settings(s, lv)
-                       for s in b["schemes"] for lv in self.beyond_levels(s)},
-            "long_time": {
-                f"results/beyond/runs/long_time/{s}/level{b['long_time']['level']}.json":
-                    self.beyond_run_settings("long_time", s, b["long_time"]["level"])
-                for s in b["long_time"]["schemes"]},
-            "space": {f"results/beyond/runs/space/{s}/level{lv}.json":
-                      self.beyond_run_settings("space", s, lv)
-                      for s in b["space_study"]["schemes"] for lv in b["space_study"]["levels"]},
-            "time": {f"results/beyond/runs/time/{s}.json": self.time_settings(s)
-                     for s in b["time_study"]["schemes"]},
-        }
-
-    def paper_schemes(self):
-        """Schemes of the beyond study compared with the published Table 3.1: the DDFV ones."""
-        return [s for s in self.beyond["schemes"] if get_scheme(s).family == "ddfv"]
-
-    @staticmethod
-    def scheme_pattern():
-        """Regular expression of the registry's names (longest first), each optionally
-        ``@<integrator>`` (:func:`mcfbench.running.schemes.get_scheme`)."""
-        from mcfbench.running.integrators import INTEGRATORS
-
-        return f"(?:{alternatives(SCHEMES)})(?:@(?:{alternatives(INTEGRATORS)}))?"
-
-    # -- resources of the jobs (minutes, MB)
-    @staticmethod
-    def mem_mb(level):
-        return mem_mb(level)
-
-    def run_runtime(self, level):
-        return runtime_minutes(level, self.problem.time_steps(self.problem.tau(int(level))))
-
-    def beyond_runtime(self, study, scheme, level):
-        settings = self.beyond_run_settings(study, scheme, level)
-        return runtime_minutes(level, round(settings["t_final"] / settings["tau"]))
-
-    def time_runtime(self):
-        study = self.beyond["time_study"]
-        steps = sum(round(study["t_final"] / tau) for tau in study["taus"])
-        steps += round(study["t_final"] * study["reference_factor"] / study["taus"][-1])
-        return runtime_minutes(study["level"], steps)
-
-
-# -- jobs --------------------------------------------------------------------------
-
-def solver_of(settings):
-    """The shared solver with the settings' tolerance (``maxiter``, ``threads`` if given)."""
-    return Solver(rtol=settings["rtol"], **{k: settings[k] for k in ("maxiter", "threads")
-                                            if k in settings})
-
-
-def run_job(settings, output, log):
-    """One scheme on one level of the problem with ``settings``: its run record.
-
-    Returns
-    -------
-    mcfbench.storage.records.RunResult
-    """
-    from mcfbench.running.run import run
-
-    problem = get_problem(settings["problem"]).with_settings(t_final=settings["t_final"])
-    log.info("%s level %d: tau %g, t_final %g, rtol %g", settings["scheme"], settings["level"],
-             settings["tau"], settings["t_final"], settings["rtol"])
-    result, _ = run(settings["scheme"], problem, settings["level"], tau=settings["tau"],
-                    t_final=settings["t_final"], solver=solver_of(settings),
-                    threads=settings.get("threads", 1))
-    record = write_record(output, result, settings)
-    log.info("%s level %d: status %s, L2 error %.4e, %d iterations, %.3f s wall, "
-             "%.0f MB peak memory -> %s", result.scheme, result.level, result.status,
-             result.metrics.get("l2_error", math.nan), result.iterations, result.wall_seconds,
-             record["peak_rss_mb"], output)
-    if result.status != "ok":
-        log.warning("%s", result.message)
-    return result
+# -- the kernels ---------------------------------------------------------------------
 
 
 def warm_kernels(threads=1):
@@ -443,136 +282,3 @@ def compile_job(threads, output, log):
                         "methods": list(METHODS)})
     log.info("kernels of %d schemes and %d solver methods compiled or loaded in %.1f s -> %s",
              len(SCHEMES), len(METHODS), seconds, output)
-
-
-TIME_FIELDS = {"scheme": str, "level": int, "reference_tau": float, "t_final": float,
-               "outcome": str, "message": str, "rows": list, "wall_seconds": float,
-               "peak_rss_mb": float, "settings": dict, "provenance": dict, "checksum": str}
-"""Key -> type of a time-study record (:func:`time_job`)."""
-
-
-def time_job(settings, output, log):
-    """Time convergence of one scheme on one mesh (:func:`mcfbench.running.run.time_convergence`).
-
-    A reference run that breaks down does not fail the job: the record has
-    ``outcome = "reference_failed"``, the message and no rows; single runs
-    that break down are rows with their status.
-    """
-    from mcfbench.running.run import time_convergence
-
-    problem = get_problem(settings["problem"]).with_settings(t_final=settings["t_final"])
-    taus, factor = settings["taus"], settings["reference_factor"]
-    log.info("%s level %d: time_convergence(taus=%s, reference_factor=%d, t_final=%g, "
-             "rtol=%g)", settings["scheme"], settings["level"], taus, factor,
-             settings["t_final"], settings["rtol"])
-    wall = time.perf_counter()
-    try:
-        table = time_convergence(settings["scheme"], problem, settings["level"], taus,
-                                 reference_factor=factor, t_final=settings["t_final"],
-                                 solver=solver_of(settings),
-                                 threads=settings.get("threads", 1))
-        rows, outcome, message = table.to_dict("records"), "ok", ""
-    except RuntimeError as err:
-        rows, outcome, message = [], "reference_failed", str(err)
-    wall = time.perf_counter() - wall
-    record = write_record(output, {"scheme": settings["scheme"], "level": settings["level"],
-                                   "taus": taus, "reference_factor": factor,
-                                   "reference_tau": min(taus) / factor,
-                                   "t_final": settings["t_final"], "outcome": outcome,
-                                   "message": message, "rows": rows, "wall_seconds": wall},
-                          settings)
-    log.info("%s: %s in %.1f s, %.0f MB peak memory -> %s", settings["scheme"], outcome, wall,
-             record["peak_rss_mb"], output)
-    if outcome != "ok":
-        log.warning("%s", message)
-    for row in rows:
-        log.info("tau %-10g error %.4e eoc %.3f %s", row["tau"], row["error"], row["eoc"],
-                 row["status"])
-
-
-def record_fields(settings):
-    """The keys and types a record of ``settings`` must have (``required`` of
-    :func:`mcfbench.storage.records.read_records`): the time study's records
-    have their own (:data:`TIME_FIELDS`), every other run record :data:`FIELDS`."""
-    return TIME_FIELDS if settings.get("study") == "time" else FIELDS
-
-
-FIGURE_OUTPUTS = ("png", "pdf", "frames", "record", "csv", "plot")
-
-
-def figure_outputs(name, results="results"):
-    """Output paths of the figure ``name`` (those of workflow/rules/figures.smk)."""
-    root = Path(results)
-    return {"png": root / "figures" / f"{name}.png", "pdf": root / "figures" / f"{name}.pdf",
-            "frames": root / "runs" / "figures" / f"{name}.npz",
-            "record": root / "runs" / "figures" / f"{name}.json",
-            "csv": root / "diagnostics" / f"{name}.csv",
-            "plot": root / "diagnostics" / f"{name}.png"}
-
-
-def figure_job(name, outputs, log):
-    """Run the experiment of one figure (:mod:`mcfbench.studies.figures`) and draw it.
-
-    Writes the figure (PNG + PDF), the kept frames of every run (npz, keys
-    ``<run>.F``, ``<run>.T``, ``<run>.steps``, ``<run>.faces``,
-    ``<run>.iterations``), the per-step diagnostics of the DDFV runs (CSV
-    with a ``run`` column, and a plot) and a JSON record (status per run,
-    first violation, timings, provenance). A run that breaks down keeps its
-    frames and the figure is drawn from them with a note.
-    """
-    import pandas as pd
-
-    from mcfbench.geometry.quality import COLUMNS
-    from mcfbench.presentation.quality_plots import plot_quality
-    from mcfbench.presentation.render import DPI, rasterize_meshes
-    from mcfbench.studies.figures import (
-        EXPERIMENTS,
-        draw_experiment,
-        experiment_status,
-        run_experiment,
-    )
-
-    experiment = EXPERIMENTS[name]
-    wall = time.perf_counter()
-    results = run_experiment(experiment)
-    compute = time.perf_counter() - wall
-    arrays = {}
-    for key, r in results.items():
-        arrays.update({f"{key}.F": r.F, f"{key}.steps": r.steps, f"{key}.faces": r.faces,
-                       f"{key}.iterations": r.iterations})
-        if r.T is not None:
-            arrays[f"{key}.T"] = r.T
-    quality = {key: r for key, r in results.items() if r.quality is not None}
-    frames = [r.quality.assign(run=key) for key, r in quality.items()]
-    table = pd.concat(frames, ignore_index=True) if frames else \
-        pd.DataFrame(columns=["run", *COLUMNS])
-    plot = plot_quality({r.run.label or key: r.quality for key, r in quality.items()},
-                        title=f"{experiment.name}: {experiment.title}",
-                        marks=sorted({s.step for s in experiment.shots}))
-    draw = time.perf_counter()
-    figure = draw_experiment(experiment, results)
-    draw = time.perf_counter() - draw
-    rasterize_meshes(figure)
-    status = experiment_status(results)
-    record = {
-        "experiment": experiment.name, "title": experiment.title, "status": status,
-        "first_violation": {key: r.record()["first_violation"] for key, r in quality.items()},
-        "runs": {key: r.record() for key, r in results.items()},
-        "seconds": {"compute": round(compute, 3), "draw": round(draw, 3),
-                    "total": round(time.perf_counter() - wall, 3)},
-        "outputs": {k: str(v) for k, v in outputs.items()},
-        "provenance": provenance(experiment.config()),
-    }
-    save_npz(outputs["frames"], **arrays)
-    write_files({outputs["csv"]: table[["run", *COLUMNS]].to_csv(index=False),
-                 outputs["plot"]: (plot, {"dpi": DPI}), outputs["png"]: (figure, {"dpi": DPI}),
-                 outputs["pdf"]: (figure, {"dpi": 2 * DPI}),
-                 outputs["record"]: json_text(record)})
-    for key, r in results.items():
-        line = f"{experiment.name}/{key}: {r.status}, n = {int(r.steps[-1])}"
-        line += f" ({r.message})" if r.message else ""
-        violation = r.record()["violation"]
-        line += f"; first violation at {violation}" if violation else ""
-        (log.warning if r.status != "ok" else log.info)("%s", line)
-    log.info("%s: %s; compute %.1f s, draw %.1f s", experiment.name, status, compute, draw)
-    return status

@@ -1,5 +1,6 @@
-"""The findings of the beyond study in words, from its tables (rule beyond_findings): every
-number is read from the tables."""
+"""The findings of the beyond study in words, from its tables and its verdicts
+(:func:`mcfbench.studies.beyond.findings`: which schemes stayed stable, the finest
+common level, the ranking): every number is read from the tables."""
 
 import numpy as np
 
@@ -32,7 +33,7 @@ def _breakdown(r):
 
 def stability_section(levels, stability, schemes, t_final):
     """Which schemes finished every run, and where the others broke down."""
-    lines, stable = ["## Which schemes stay stable", ""], []
+    lines = ["## Which schemes stay stable", ""]
     for scheme in schemes:
         runs = stability[stability["scheme"] == scheme]
         plain = levels[levels["scheme"] == scheme]
@@ -49,8 +50,6 @@ def stability_section(levels, stability, schemes, t_final):
             where.append(f"level{'s' if len(part) > 1 else ''} {_levels(part['level'])} "
                          f"to t = {t:g}")
         if len(failed) == 0:
-            if len(outside) == 0:
-                stable.append(scheme)
             text = head + "every run finished (" + "; ".join(where) + ")"
             if has_t:
                 text += (f"; the T monitor stayed at or above "
@@ -72,7 +71,7 @@ def stability_section(levels, stability, schemes, t_final):
                     text += f" (smallest T monitor {finished['t_min_barycentric'].min():.3f})"
                 text += "."
         lines.append(text)
-    return lines + [""], stable
+    return lines + [""]
 
 
 def accuracy_section(levels, paper_schemes):
@@ -95,17 +94,9 @@ def accuracy_section(levels, paper_schemes):
     return lines + [""]
 
 
-def finest_section(levels, schemes):
-    """The finest level every scheme ran, beyond the paper, and the finer levels
-    some schemes ran (``beyond.finest``): errors, orders and cost.
-
-    Returns
-    -------
-    lines : list of str
-    finest : int
-        The finest level every scheme of ``schemes`` ran.
-    """
-    finest = int(levels.groupby("scheme")["level"].max()[schemes].min())
+def finest_section(levels, schemes, finest):
+    """Level ``finest`` (the finest every scheme ran), beyond the paper, and the finer
+    levels some schemes ran (``beyond.finest``): errors, orders and cost."""
     deeper = levels[levels["level"] > finest]
     lines = [f"## Level {finest} (finest level run" +
              (f" by every scheme; level {_levels(deeper['level'].unique())} by "
@@ -124,7 +115,7 @@ def finest_section(levels, schemes):
             else:
                 lines.append(f"- {name}: no error, the run broke down: {_breakdown(r)} "
                              f"({cost} until then).")
-    return lines + [""], finest
+    return lines + [""]
 
 
 def cost_section(levels, schemes, reference, finest):
@@ -211,110 +202,79 @@ def order_section(levels, time, space, paper_schemes):
     return lines + [""]
 
 
-ORDER_TOLERANCE = 0.3
-"""A measured order within this of an integrator's order is that order."""
-
-
-def _integrator(scheme):
-    """``(scheme without @, integrator name)`` (``euler`` without ``@``)."""
-    base, _, integrator = scheme.partition("@")
-    return base, integrator or "euler"
-
-
-def integrator_section(time, integrators, orders):
-    """What a second-order integrator buys: the measured orders in time of each
-    scheme with each integrator (median over the pairs of halved steps, pointwise and
-    by the volume between the surfaces), then the Table 3.1 setting (``integrators``,
-    :func:`mcfbench.presentation.beyond_tables.integrator_table`); ``orders``:
-    integrator name -> its order."""
+def integrator_section(verdict):
+    """What a second-order integrator buys, in words: ``verdict["time_orders"]`` and
+    ``verdict["integrators"]`` of :func:`mcfbench.studies.beyond.findings`."""
     lines = ["## Second order in time", ""]
-    done = time[time["status"] == "ok"]
-    verdict = {}
-    for scheme, part in done.groupby("scheme", sort=False):
-        base, integrator = _integrator(scheme)
-        point, volume = part["order"].median(), part["volume_order"].median()
-        expected = orders.get(integrator)
-        agrees = expected is not None and abs(point - expected) <= ORDER_TOLERANCE
-        by_volume = expected is not None and abs(volume - expected) <= ORDER_TOLERANCE
-        verdict.setdefault(integrator, []).append((base, point, volume, agrees, by_volume))
-    for integrator, rows in verdict.items():
-        point = [r for r in rows if r[3]]
-        volume_only = [r for r in rows if not r[3] and r[4]]
-        neither = [r for r in rows if not r[3] and not r[4]]
-        text = (f"- **{integrator}** (order {orders.get(integrator, '?')}): pointwise order "
-                f"{min(r[1] for r in point):.2f}-{max(r[1] for r in point):.2f} for "
-                f"{len(point)} of {len(rows)} schemes" if point else
-                f"- **{integrator}**: no scheme has its order pointwise")
+    for integrator, (order, rows) in verdict["time_orders"].items():
+        point = [r for r in rows if r["pointwise"]]
+        volume_only = [r for r in rows if not r["pointwise"] and r["by_volume"]]
+        neither = [r for r in rows if not r["pointwise"] and not r["by_volume"]]
+        text = (f"- **{integrator}** (order {order}): pointwise order "
+                f"{min(r['order'] for r in point):.2f}-{max(r['order'] for r in point):.2f} "
+                f"for {len(point)} of {len(rows)} schemes" if point else
+                f"- **{integrator}** (order {order}): no scheme has it pointwise")
         if volume_only:
             text += "; by the volume between the surfaces only: " + ", ".join(
-                f"{label(b)} ({v:.2f}; pointwise {p:.2f})" for b, p, v, _, _ in volume_only)
+                f"{label(r['scheme'])} ({r['volume_order']:.2f}; pointwise {r['order']:.2f})"
+                for r in volume_only)
         if neither:
-            text += "; neither: " + ", ".join(f"{label(b)} (pointwise {p:.2f}, volume "
-                                              f"{v:.2f})" for b, p, v, _, _ in neither)
+            text += "; neither: " + ", ".join(
+                f"{label(r['scheme'])} (pointwise {r['order']:.2f}, volume "
+                f"{r['volume_order']:.2f})" for r in neither)
         lines.append(text + ".")
-    lines.append("(Median over the pairs of halved time steps of the time table.)")
-    lines.append("")
-    if len(integrators):
-        finest = integrators.loc[integrators.groupby(["scheme", "integrator"])["level"]
-                                 .idxmax()]
+    if verdict["time_orders"]:
+        lines.append("(Median over the pairs of halved time steps of the time table.)")
+        lines.append("")
+    if verdict["integrators"]:
         lines.append("On the Table 3.1 setting (tau ~ h^2), finest level both ran: " + "; ".join(
-            f"{r.label} with {r.integrator} (level {r.level}): L2 {r.l2_ratio:.2f} x Euler's "
-            f"at {r.cost_ratio:.2f} x the CPU per step"
-            + (f", {r.equal_cpu_ratio:.2f} x Euler's at equal CPU time"
-               if np.isfinite(r.equal_cpu_ratio) else "")
-            for r in finest.itertuples()) + ".")
+            f"{r['label']} with {r['integrator']} (level {r['level']}): L2 "
+            f"{r['l2_ratio']:.2f} x Euler's at {r['cost_ratio']:.2f} x the CPU per step"
+            + (f", {r['equal_cpu_ratio']:.2f} x Euler's at equal CPU time"
+               if np.isfinite(r["equal_cpu_ratio"]) else "")
+            for r in verdict["integrators"]) + ".")
         lines.append("")
     return lines
 
 
-def summary(levels, stable, paper_schemes, finest):
-    """The verdict in two sentences."""
-    variants = [s for s in paper_schemes if s in stable]
-    unstable = [s for s in paper_schemes if s not in stable]
-    if not variants:
+def summary(verdict):
+    """The verdict (:func:`mcfbench.studies.beyond.findings`) in two sentences."""
+    if not verdict["variants"]:
         return ["## Summary", "", "No DDFV scheme finished every run.", ""]
-    rows = levels[(levels["level"] == finest) & levels["scheme"].isin(variants)]
-    rows = rows[rows["status"] == "ok"].sort_values("l2_error")
     text = (f"Stable (every run finished, no T-vertex left its triangle): "
-            f"{'; '.join(map(label, variants))}; not stable: "
-            f"{'; '.join(map(label, unstable)) or 'none'}.")
-    if len(rows):
-        best = rows.iloc[0]
-        text += f" On level {finest} the most accurate stable variant is {label(best.scheme)} " \
-                f"(L2 {sci(best.l2_error, 4)}"
-        others = [f"{label(r.scheme)} {r.l2_error / best.l2_error:.2f} x that" for r in
-                  rows.iloc[1:].itertuples()]
+            f"{'; '.join(map(label, verdict['variants']))}; not stable: "
+            f"{'; '.join(map(label, verdict['unstable'])) or 'none'}.")
+    if verdict["ranking"]:
+        (best, error), *rest = verdict["ranking"]
+        text += f" On level {verdict['finest']} the most accurate stable variant is " \
+                f"{label(best)} (L2 {sci(error, 4)}"
+        others = [f"{label(scheme)} {value / error:.2f} x that" for scheme, value in rest]
         text += ("; " + ", ".join(others) if others else "") + ")."
-    paper = levels[levels["scheme"].isin(variants) & np.isfinite(levels["l2_ratio"])]
-    if len(paper):
-        worst = paper.loc[(paper["l2_ratio"] - 1).abs().groupby(paper["scheme"]).idxmax()]
+    if verdict["deviations"]:
         text += " Largest deviation from the published errors (levels of Table 3.1): " + \
-            "; ".join(f"{label(r.scheme)} {pct(r.l2_ratio - 1, 1)} (level {r.level})"
-                      for r in worst.itertuples()) + "."
+            "; ".join(f"{label(scheme)} {pct(ratio - 1, 1)} (level {level})"
+                      for scheme, level, ratio in verdict["deviations"]) + "."
     return ["## Summary", "", text, ""]
 
 
 def beyond_findings(levels, stability, time, space, schemes, paper_schemes, t_final, tau_1,
-                    integrators=None, orders=None):
+                    verdict):
     """The findings of the beyond study (Markdown) from its tables (DataFrames of
-    :func:`mcfbench.presentation.beyond_tables.beyond_tables`); ``schemes``: those of the level table,
-    ``paper_schemes``: those compared with the published values; ``integrators``: the
-    integrator table, ``orders``: integrator name -> its order in time
-    (:func:`integrator_section`)."""
+    :func:`mcfbench.presentation.beyond_tables.beyond_tables`) and its ``verdict``
+    (:func:`mcfbench.studies.beyond.findings`); ``schemes``: those of the level table,
+    ``paper_schemes``: those compared with the published values."""
     parts = ["# Beyond Table 3.1: findings", "",
              "Generated by `mcfbench.presentation.beyond_findings.beyond_findings` from the tables in "
              "`results/beyond/tables/` (every number below is read from them). Shrinking "
              f"unit sphere, t_f = {t_final:g} unless stated, tau = {tau_1:g} / 4^(level-1).",
              ""]
-    stab, stable = stability_section(levels, stability, schemes, t_final)
-    fine, finest = finest_section(levels, schemes)
-    reference = paper_schemes[0] if paper_schemes else schemes[0]
-    parts += summary(levels, stable, paper_schemes, finest)
-    parts += stab + accuracy_section(levels, paper_schemes) + fine
-    parts += cost_section(levels, schemes, reference, finest)
+    finest = verdict["finest"]
+    parts += summary(verdict)
+    parts += stability_section(levels, stability, schemes, t_final)
+    parts += accuracy_section(levels, paper_schemes) + finest_section(levels, schemes, finest)
+    parts += cost_section(levels, schemes, verdict["reference"], finest)
     parts += order_section(levels, time, space, paper_schemes)
-    if integrators is not None:
-        parts += integrator_section(time, integrators, orders or {})
+    parts += integrator_section(verdict)
     parts += ["## Figures and tables", "",
               "![L2 error per level](figures/levels.png)", "",
               "![T monitor against time](figures/t_monitor.png)", "",

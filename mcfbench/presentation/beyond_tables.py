@@ -220,7 +220,7 @@ def beyond_tables(inputs, records, beyond, paper_schemes):
     records : dict
         Path -> record.
     beyond : dict
-        The normalised config key ``beyond`` (:func:`mcfbench.pipeline.beyond_settings`).
+        The normalised config key ``beyond`` (:func:`mcfbench.studies.beyond.plan`).
     paper_schemes : list of str
         Schemes compared with the published values.
 

@@ -3,8 +3,6 @@
 
 from pathlib import Path
 
-import numpy as np
-
 from mcfbench.presentation.convergence_tables import (
     label,
 )
@@ -16,17 +14,22 @@ from mcfbench.presentation.report_inputs import (
     rel,
 )
 from mcfbench.running.schemes import get_scheme
+from mcfbench.storage.frames import load_frames
 
 
-def _npz_sizes(path):
-    """``{run key: n_V}`` of a figure's frames (F- plus T-vertices)."""
-    if not Path(path).is_file():
-        return {}
-    with np.load(path) as z:
-        keys = {k.rsplit(".", 1)[0] for k in z.files}
-        return {k: int(z[f"{k}.F"].shape[1]) + (int(z[f"{k}.T"].shape[1])
-                                                 if f"{k}.T" in z.files else 0)
-                for k in sorted(keys) if f"{k}.F" in z.files}
+def _run_sizes(folder, keys):
+    """``{run key: n_V}`` of a figure's runs (F- plus T-vertices) from the frames
+    files in ``folder`` (``<key>.npz``, :mod:`mcfbench.storage.frames`); a run
+    without its file is left out."""
+    sizes = {}
+    for key in keys:
+        path = Path(folder) / f"{key}.npz"
+        if path.is_file():
+            frames = load_frames(path)
+            vertices = frames["F"] if "F" in frames else frames["V"]
+            sizes[key] = int(vertices.shape[1]) + (int(frames["T"].shape[1])
+                                                   if "T" in frames else 0)
+    return sizes
 
 
 def _claim_verdict(check, runs, last_panel):
@@ -75,7 +78,8 @@ def figures(sources, captions, experiments):
         diag = results / "diagnostics" / f"{name}.png"
         record_path = results / "runs" / "figures" / f"{name}.json"
         record = read_json(record_path)
-        sizes = _npz_sizes(results / "runs" / "figures" / f"{name}.npz")
+        sizes = _run_sizes(results / "runs" / "figures" / name,
+                           [run.key for run in experiment.runs])
         runs = []
         for run in experiment.runs:
             rec = (record or {}).get("runs", {}).get(run.key)

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from mcfbench.geometry.frame_fields import ddfv_frame_fields, vertex_frame_fields
+from mcfbench.storage.frames import load_frames
 from mcfbench.storage.paraview import Piece, write_pvd
 from mcfbench.storage.provenance import provenance
 from mcfbench.storage.records import load_json
@@ -35,25 +36,20 @@ RUN_KEYS = ("scheme", "status", "message", "failed_step")
 
 
 def load_frames_file(path):
-    """The arrays of a run's ``.npz`` as a dict, checked for frames.
+    """The arrays of a run's frames file (:func:`mcfbench.storage.frames.load_frames`),
+    checked for frames to export.
 
     Raises
     ------
     ValueError
-        Not readable as ``.npz``, no ``faces``/``t``, neither ``V`` nor
-        ``F`` and ``T``, or no frame (a gallery run whose mesh was refused);
-        the message names the file.
+        Not a frames file, no frame (a gallery run whose mesh was refused), or
+        ``F`` without ``T`` (a DDFV run that refused the surface); the message
+        names the file.
     """
-    path = Path(path)
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            arrays = {key: data[key] for key in data.files}
-    except (OSError, ValueError) as err:
-        raise ValueError(f"{path}: not a run's .npz ({err})") from None
-    if "t" in arrays and len(arrays["t"]) == 0:
+    arrays = load_frames(path)
+    if len(arrays["t"]) == 0:
         raise ValueError(f"{path}: the run has no frames (its mesh was refused; see its record)")
-    missing = [k for k in ("faces", "t") if k not in arrays]
-    if missing or not ("V" in arrays or {"F", "T"} <= set(arrays)):
+    if "V" not in arrays and "T" not in arrays:
         raise ValueError(f"{path}: not a run's frames file: it has {sorted(arrays)}, expected "
                          f"faces, t and V (or F and T)")
     return arrays

@@ -19,13 +19,14 @@ Nothing here is a hand-typed result: the published values come from
 
 - ``results/tables/convergence.csv`` (+ ``.json``): Table 3.1 and the schemes,
 - ``results/runs/{scheme}/level{k}.json``: run records (status, provenance),
-- ``results/runs/figures/{figure}.json``, ``.npz``: the figures' runs,
+- ``results/runs/figures/{figure}.json`` and ``{figure}/<run>.npz``: the figures' runs,
 - ``results/figures/*.png``, ``results/diagnostics/*.png``: the images,
 - ``results/beyond/**``: the beyond-the-paper study, when present,
 - ``ddfv/README.md``: the section "Deviations and interpretations".
 
-:func:`findings` writes the findings of the beyond study in words, every
-number and verdict read from its tables. Scheme names in the text are the
+The findings of the beyond study are worded by
+:mod:`mcfbench.presentation.beyond_findings` from its tables and the verdicts of
+:func:`mcfbench.studies.beyond.findings`. Scheme names in the text are the
 registry's labels (:data:`mcfbench.running.schemes.SCHEMES`); numbers are formatted
 and escaped by :mod:`mcfbench.presentation.formats`.
 
@@ -422,8 +423,8 @@ def _inputs(sources, context):
     for f in context["figures"]:
         name = f["name"]
         paths += [results / "figures" / f"{name}.png", results / "diagnostics" / f"{name}.png",
-                  results / "runs" / "figures" / f"{name}.json",
-                  results / "runs" / "figures" / f"{name}.npz"]
+                  results / "runs" / "figures" / f"{name}.json"]
+        paths += sorted((results / "runs" / "figures" / name).glob("*.npz"))
     if sources.beyond is not None and sources.beyond.is_dir():
         paths += sorted(p for p in sources.beyond.rglob("*") if p.is_file())
     root = results.parent
@@ -501,9 +502,3 @@ def build(sources, outputs=None, log=None):
             log.info("differs: %s", item)
         log.info("wrote %s", ", ".join(str(p) for p in outputs.values()))
     return context
-
-
-# -- PDF --------------------------------------------------------------------------------
-
-
-# == the findings of the beyond study (rule beyond_findings) ============================

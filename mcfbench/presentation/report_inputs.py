@@ -61,7 +61,7 @@ class Sources:
     relative to it. ``beyond_targets`` are the files of ``snakemake beyond``
     (for the regeneration commands); ``figures`` the figure names to show
     (default: every one of ``experiments``); ``experiments`` the figures'
-    experiments (:data:`mcfbench.studies.figures.EXPERIMENTS`), passed in by
+    experiments (:data:`mcfbench.studies.figure_experiments.EXPERIMENTS`), passed in by
     the caller because presentation imports no study.
     """
 

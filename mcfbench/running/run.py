@@ -82,7 +82,7 @@ class _Steady:
 
 def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrator=None,
         warm_start="extrapolate", on_defect="stop", save_every=0, samples=20, mesh=None,
-        threads=1, progress=False, **options):
+        threads=1, progress=False, observers=(), **options):
     """Run ``scheme`` on ``problem`` at refinement ``level``.
 
     Parameters
@@ -113,6 +113,9 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
         replaced by it when more than one.
     progress : bool
         A progress bar of the steps (:func:`mcfbench.running.driver.simulate`).
+    observers : sequence of callables
+        Called with the flow at every time level, after the run's own (the
+        figures' :class:`mcfbench.geometry.quality.MeshQuality`).
     **options
         Options of the scheme's flow class (override the registry's).
 
@@ -131,18 +134,18 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
     if threads != 1:
         solver = replace(solver, threads=threads)
     monitor = _Monitor(max(1, steps // max(1, samples)))
-    observers = problem.observers()
+    metric_observers = problem.observers()
     until = _Steady(problem.steady_speed) if problem.steady_speed else None
     cpu, wall = time.process_time(), time.perf_counter()
     flow = scheme.make(V, F, tau, threads=threads, **options)
     traj = simulate(flow, steps, solver=solver, integrator=integrator, warm_start=warm_start,
                     save_every=save_every,
-                    observers=[monitor, *observers], on_defect=on_defect, until=until,
-                    progress=progress)
+                    observers=[monitor, *metric_observers, *observers], on_defect=on_defect,
+                    until=until, progress=progress)
     monitor.final(flow)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
     values = {}
-    for observer in observers:
+    for observer in metric_observers:
         kept = traj.ok or getattr(observer, "keeps_before_breakdown", False)
         values.update({k: v if kept else float("nan") for k, v in observer.result().items()})
     if "pinch_time" in problem.reference:
@@ -346,27 +349,31 @@ def _nan_result(scheme, problem, level, mesh, tau, steps, status, message, metho
         nT=0, h=metrics.mean_edge_length(V, F), tau=float(tau), N=int(steps), steps_done=0,
         status=status, message=message, t_failed=0.0, t_end=0.0, steady=False, iterations=0,
         solver=method, integrator=integrator, cpu_seconds=seconds, wall_seconds=seconds,
-        t_min_barycentric=nan, min_angle=nan, max_aspect=nan, max_flipped=nan, metrics={}, series={})
+        t_min_barycentric=nan, min_angle=nan, max_aspect=nan, max_flipped=nan, metrics={},
+        series={})
 
 
-def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_every=0):
+def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_every=0,
+               on_defect="stop", observers=(), **options):
     """:func:`run` for the studies that keep frames files (by default the first and the
     last, ``save_every=0``; see :func:`mcfbench.running.driver.simulate`); a scheme
     that refuses the surface gives status ``unsupported`` (the initial surface as both
-    frames).
+    frames). ``on_defect``, ``observers`` and ``options`` (the scheme's) go to :func:`run`.
 
     Returns
     -------
     result : RunResult
     frames : dict of arrays
-        The trajectory's saved frames, ``faces``, ``steps``, ``t``.
+        The trajectory's saved frames, ``faces``, ``steps``, ``t``: the layout of
+        :mod:`mcfbench.storage.frames`.
     """
     scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
     problem = get_problem(problem) if isinstance(problem, str) else problem
     start = time.process_time()
     try:
         result, traj = run(_Guarded(scheme), problem, level, solver=solver,
-                           save_every=save_every, mesh=mesh, tau=tau)
+                           save_every=save_every, mesh=mesh, tau=tau, on_defect=on_defect,
+                           observers=observers, **options)
     except _Unsupported as err:
         V, F = validate_mesh(*(problem.mesh(level) if mesh is None else mesh))
         tau = problem.tau(level, (V, F)) if tau is None else float(tau)

@@ -59,9 +59,14 @@ def json_value(value):
     return value
 
 
+def json_text(data):
+    """``data`` as indented standard JSON text (NaN as ``null``, :func:`json_value`)."""
+    return json.dumps(json_value(data), indent=2, allow_nan=False) + "\n"
+
+
 def write_json(path, data):
     """Write ``data`` as indented standard JSON (NaN as ``null``) atomically."""
-    write_text(path, json.dumps(json_value(data), indent=2, allow_nan=False) + "\n")
+    write_text(path, json_text(data))
 
 
 def save_npz(path, **arrays):

@@ -147,3 +147,26 @@ def provenance(config=None):
         "config": config,
         "config_hash": config_hash(config),
     }
+
+
+def sidecar(settings, records, texts):
+    """Provenance of aggregated tables: the settings, per input record its hash,
+    commit, host and time, and the SHA-256 of every output text.
+
+    Parameters
+    ----------
+    settings : dict
+        What the tables depend on (:func:`provenance` of it).
+    records : dict
+        Record path -> record (:func:`mcfbench.storage.records.read_records`).
+    texts : dict
+        Output path -> its text.
+    """
+    data = provenance(settings)
+    data["inputs"] = {path: {key: rec["provenance"].get(key) for key in
+                             ("config_hash", "git_commit", "git_dirty", "host", "created",
+                              "blas_threads")}
+                      for path, rec in records.items()}
+    data["outputs"] = {str(path): hashlib.sha256(text.encode()).hexdigest()
+                       for path, text in texts.items()}
+    return data

@@ -1,6 +1,69 @@
-"""The one error of a bad config value, shared by every study and the Snakemake glue."""
+"""The one error of a bad config value, and the checks the studies share.
+
+Every study checks its own config section in its ``plan``; a bad value raises
+:class:`ConfigError` naming the key.
+"""
 
 
 class ConfigError(ValueError):
     """A config value the schema cannot check (a name against a registry, a time
     step, a level); the message names the key."""
+
+
+def check_schemes(key, names):
+    """``names`` as a list, every one a registry name or ``NAME@INTEGRATOR``
+    (:func:`mcfbench.running.schemes.get_scheme`).
+
+    Raises
+    ------
+    ConfigError
+        Naming ``key``, the unknown names and every known scheme.
+    """
+    from mcfbench.running.integrators import INTEGRATORS
+    from mcfbench.running.schemes import SCHEMES, find_scheme
+
+    names = list(names)
+    unknown = [s for s in names if find_scheme(s) is None]
+    if unknown:
+        raise ConfigError(f"config key {key!r}: unknown scheme(s) {unknown}; known schemes "
+                          f"(mcfbench.running.schemes.SCHEMES): {', '.join(SCHEMES)}, each "
+                          f"also as NAME@INTEGRATOR ({', '.join(INTEGRATORS)})")
+    return names
+
+
+def checked_steps(key, problem, tau, t_final, what):
+    """``problem.time_steps(tau, t_final)``, its error as a ConfigError naming ``key``
+    (``key`` quoted; two keys joined by `` and ``) and ``what`` time step it was."""
+    try:
+        return problem.time_steps(tau, t_final)
+    except ValueError as err:
+        raise ConfigError(f"config key{'s' if ' and ' in key else ''} {key}: {err} "
+                          f"({what} time step)") from None
+
+
+def check_rtol(key, value):
+    """``value`` as a float in (0, 1) (the schema lets NaN through).
+
+    Raises
+    ------
+    ConfigError
+        Naming ``key``.
+    """
+    rtol = float(value)
+    if not 0 < rtol < 1:
+        raise ConfigError(f"config key {key!r}: must lie in (0, 1), got {value!r}")
+    return rtol
+
+
+def check_threads(config):
+    """The config key ``threads`` (default 1): threads of every run job.
+
+    Raises
+    ------
+    ConfigError
+        Not a whole number >= 1.
+    """
+    threads = config.get("threads", 1)
+    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+        raise ConfigError(f"config key 'threads': a whole number >= 1, got {threads!r}")
+    return threads

@@ -1,395 +1,76 @@
-"""The experiments behind Figs. 3.1-3.8 of the paper, in one place.
+"""The figures' study: run the experiments of Figs. 3.1-3.8 and draw them.
 
-An :class:`Experiment` is one figure: the runs it needs (:class:`Run`:
-initial shape and its parameters, scheme, ``tau``, number of steps,
-tangential setting) and the panels to draw (:class:`Shot`: which run,
-which time level, zoom). ``EXPERIMENTS`` maps the figure name
-(``"fig_3_2"``) to it; :func:`mcfbench.pipeline.figure_job` runs one
-experiment with :func:`run_experiment` and draws it with
-:func:`draw_experiment`.
+The experiments (runs, panels, views, captions) are declared in
+:mod:`mcfbench.studies.figure_experiments` (``EXPERIMENTS``). The study
+protocol (``workflow/rules/figures.smk`` calls it):
 
-What a figure shows, so that its PNG can be read alone:
+* :func:`job`: one figure: its runs (:func:`run_experiment`, each
+  :func:`mcfbench.running.run.framed_run` with every kept frame, the mesh
+  quality monitor and ``on_defect="record"``), the figure, the frames, the
+  per-step diagnostics and the record, all written atomically.
 
-* every panel label gives the time level ``n``, ``n_V`` (DDFV: F- plus
-  T-vertices, the paper's count; the other schemes: the mesh vertices) and
-  ``tau`` (:data:`LABEL`); Fig. 3.1 has no time step and says so instead
-  of a ``tau``;
-* a legend below the panels names the primal edges (blue), the diamond
-  edges (red), the tracked cells and the detail region where drawn
-  (:func:`mcfbench.presentation.render.legend_handles`);
-* :class:`Track` (Fig. 3.4): a few diamond cells, chosen once, are filled
-  in amber in every panel of their run, and the details follow them
-  (``Zoom(at="tracked")``) with one half-width for all detail panels.
-
-Choices not stated in the paper (it gives only ``n_V``, ``tau`` for
-Figs. 3.2 and 3.5, and the time levels shown):
-
-* shapes and their parameters: see :mod:`mcfbench.geometry.surfaces` (bumpy sphere
-  with eight Gaussian bumps; cymling with flattening 0.4, 9 scallops of
-  10 %; cylinder ``R = 1``, ``h = 0.55``, 24 x 8 twisted quads; hemisphere
-  of radius 1 with 10 rings);
-* ``tau = 0.0025`` everywhere (the paper's value for Figs. 3.2 and 3.5,
-  assumed for the others);
-* the cymling's flattening is chosen so that, as in the paper, ``n = 12``
-  is the last level before the contracted diamond cells go wrong (a
-  T-vertex leaves its triangle at ``n = 13``);
-* Fig. 3.4 is seen from the viewpoint of Fig. 3.3; its tracked cells are
-  the five diamond cells of the two triangles of the visible diamond with
-  the smallest angle at ``n = 12`` (one of these triangles is the one whose
-  T-vertex leaves it at ``n = 13``);
-* with these choices the cylinder without elimination loses a T-vertex
-  from its triangle between ``n = 580`` and ``n = 640`` (at ``n = 592``),
-  as in Fig. 3.6.
+Drawing: :func:`experiment_panels` and :func:`draw_experiment`
+(:mod:`mcfbench.presentation.render`).
 """
 
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
-from mcfbench.geometry.mesh import validate_mesh
 from mcfbench.geometry.quality import MeshQuality, describe_violation, first_violation
 from mcfbench.geometry.surfaces import make_surface
-from mcfbench.running.driver import simulate
+from mcfbench.running.problems import Problem
+from mcfbench.running.run import framed_run
 from mcfbench.running.schemes import get_scheme
-
-TAU = 0.0025
-
-#: default panel label: ``{n}`` time level shown, ``{n_V}`` number of
-#: vertices (DDFV: F + T), ``{n_F}``, ``{n_T}``, ``{tau}``
-LABEL = "n = {n}\nn_V = {n_V}, \u03c4 = {tau:g}"
-
-
-@dataclass(frozen=True)
-class Run:
-    """One simulation.
-
-    Attributes
-    ----------
-    key : str
-        Name of the run inside its experiment.
-    shape : str
-        A name of :data:`mcfbench.geometry.surfaces.SURFACES`.
-    params : dict
-        Parameters of the shape generator.
-    tau : float
-    steps : int
-    save_every : int
-        Frames kept (every panel's time level must be a multiple).
-    scheme : str
-        A name of :data:`mcfbench.running.schemes.SCHEMES` (``ddfv-eliminate``: the
-        elimination (3.6)).
-    t_init : str
-        T-vertex initialisation (Section 3), DDFV schemes only.
-    label : str
-        Short description for legends.
-    """
-
-    key: str
-    shape: str
-    params: dict = field(default_factory=dict)
-    tau: float = TAU
-    steps: int = 0
-    save_every: int = 1
-    scheme: str = "ddfv"
-    t_init: str = "paper"
-    label: str = ""
-
-    def config(self):
-        return asdict(self)
-
-
-@dataclass(frozen=True)
-class Zoom:
-    """A detail of half-width ``half`` (in length units of the surface).
-
-    ``at`` is a 3-D point; ``"worst"``: the visible element worst by the
-    measure ``by`` (:func:`mcfbench.presentation.render.worst_element`: the diamond
-    with the smallest angle, or the T-vertex with the smallest barycentric
-    coordinate) at time level ``step`` (by default the panel's own),
-    followed to the panel's time level; or ``"tracked"``: the centre of the
-    experiment's tracked cells (:class:`Track`) at the panel's time level.
-    """
-
-    half: float
-    at: object = "worst"
-    step: int | None = None
-    by: str = "angle"
-
-
-@dataclass(frozen=True)
-class Track:
-    """Diamond cells of run ``run`` marked in every panel of that run.
-
-    At time level ``step`` the visible element worst by ``by`` is taken
-    (:func:`mcfbench.presentation.render.worst_element`): for ``"angle"`` the diamond
-    with the smallest angle, and the cells tracked are the diamonds of its
-    two triangles (:func:`mcfbench.presentation.render.tracked_cells`); for
-    ``"barycentric"`` the three diamonds of the triangle whose T-vertex is
-    nearest to leaving it. The same diamond indices are then filled in
-    every panel of the run.
-    """
-
-    run: str
-    step: int
-    by: str = "angle"
-
-
-@dataclass(frozen=True)
-class Shot:
-    """One panel: run ``run`` at time level ``step``.
-
-    ``label`` is a template (:data:`LABEL`) with ``{n}`` for the time level
-    shown, ``{n_V}``, ``{n_F}``, ``{n_T}`` and ``{tau}``. ``zoom`` shows
-    a detail; ``box`` outlines, in a full view, the region of a detail
-    shown in another panel (the :class:`Zoom` of that panel).
-    """
-
-    run: str
-    step: int
-    label: str = LABEL
-    zoom: Zoom | None = None
-    box: Zoom | None = None
-
-
-@dataclass(frozen=True)
-class Experiment:
-    """A figure: runs, panels, view and caption.
-
-    ``track`` marks the same diamond cells in every panel of its run
-    (:class:`Track`).
-    """
-
-    name: str
-    title: str
-    caption: str
-    runs: tuple
-    shots: tuple
-    view: tuple = (20.0, -60.0)
-    rows: int = 1
-    size: float = 2.6
-    aspect: float = 1.0
-    track: Track | None = None
-
-    def run(self, key):
-        for r in self.runs:
-            if r.key == key:
-                return r
-        raise KeyError(f"experiment {self.name} has no run {key!r}")
-
-    def config(self):
-        config = {"name": self.name, "runs": [r.config() for r in self.runs],
-                  "shots": [asdict(s) for s in self.shots], "view": list(self.view)}
-        if self.track is not None:
-            config["track"] = asdict(self.track)
-        return config
-
-    def describe(self):
-        """The runs as a reStructuredText bullet list (for report captions)."""
-        lines = []
-        for r in self.runs:
-            params = ", ".join(f"{k} = {v}" for k, v in r.params.items())
-            scheme = get_scheme(r.scheme)
-            what = f"{scheme.label} (``{scheme.name}``), shape ``{r.shape}`` ({params}), " \
-                   f"tau = {r.tau:g}, {r.steps} steps"
-            if scheme.family == "ddfv":
-                what += f", T-vertices ``{r.t_init}``"
-            lines.append(f"- ``{r.key}``: {what}")
-        steps = ", ".join(str(s.step) + (" (detail)" if s.zoom else "") for s in self.shots)
-        lines.append(f"- panels at n = {steps}; view elevation {self.view[0]:g}, "
-                     f"azimuth {self.view[1]:g} degrees")
-        if self.track is not None:
-            lines.append(f"- tracked diamond cells (amber) of run ``{self.track.run}``: those "
-                         f"around the visible element worst by {self.track.by} at "
-                         f"n = {self.track.step}")
-        return "\n".join(lines)
-
-
-def _shots(run, steps, **kw):
-    return tuple(Shot(run, n, **kw) for n in steps)
-
-
-_CYLINDER = dict(around=24, along=8, radius=1.0, half_height=0.55, diagonals="twisted")
-_CYMLING = dict(level=3, flattening=0.4, lobes=9, wave=0.1)
-_CYMLING_VIEW = (35.0, -60.0)    # Figs. 3.3, 3.4 and the cymling comparison
-_BUMPY = dict(level=3, amplitude=0.25, width=0.2)
-_RIM_ZOOM = Zoom(0.15, "tracked")
-_CYL_ZOOM = Zoom(0.25, "worst", 640, by="barycentric")
-_DETAIL = "n = {n} (detail)\nn_V = {n_V}, \u03c4 = {tau:g}"
-_CYLINDER_RUN = "n_V = 600 (216 F-vertices, 384 T-vertices), tau = 0.0025"
-
-EXPERIMENTS = {e.name: e for e in [
-    Experiment(
-        "fig_3_1", "Sphere discretisations for the DDFV method",
-        "Discretisations of the unit sphere used by the DDFV method, from left to "
-        "right n_V = 122, 482, 1922 and 7682 (icosphere levels 1 to 4; n_V counts the "
-        "F-vertices and the T-vertices), the initial meshes n = 0 (no time step). Blue: "
-        "the primal triangles (F-edges); red: the diamond mesh joining every F-vertex to "
-        "the T-vertices of its triangles, initialised as in Section 3.",
-        runs=tuple(Run(f"level{k}", "sphere", {"level": k}, steps=0,
-                       label=f"level {k}, n_V = {30 * 4**k + 2}") for k in (1, 2, 3, 4)),
-        shots=tuple(Shot(f"level{k}", 0, label=f"icosphere level {k}: n_V = {{n_V}}\n"
-                         "n = {n} (initial mesh, no time step)") for k in (1, 2, 3, 4)),
-        view=(20.0, -60.0), size=3.2),
-    Experiment(
-        "fig_3_2", "Bumpy sphere",
-        "Mean curvature flow of a bumpy sphere with n_V = 1922 and tau = 0.0025, "
-        "shown at time steps n = 0, 4, 12 and 32. The T-vertices follow the "
-        "F-vertices; none escapes from its triangle.",
-        runs=(Run("ddfv", "bumpy_sphere", _BUMPY, steps=32, save_every=4, label="DDFV"),),
-        shots=_shots("ddfv", (0, 4, 12, 32))),
-    Experiment(
-        "fig_3_3", "Cymling-like shape",
-        "Mean curvature flow of a cymling-like (pattypan squash) shape with "
-        "n_V = 1922 and tau = 0.0025, at time steps n = 0, 4, 8 and 12. The rim, "
-        "where the initial curvature is high, is where the diamond mesh deteriorates.",
-        runs=(Run("ddfv", "cymling", _CYMLING, steps=12, save_every=1, label="DDFV"),),
-        shots=_shots("ddfv", (0, 4, 8, 12)), view=_CYMLING_VIEW, aspect=0.7),
-    Experiment(
-        "fig_3_4", "Contraction of diamond cells (cymling, detail)",
-        "Detail of the cymling-like shape of Fig. 3.3 (n_V = 1922, tau = 0.0025, seen "
-        "from the same viewpoint) at its rim, the region of high initial curvature. "
-        "Left: the whole shape at n = 12, the dashed square marking the detail; then "
-        "the same diamond cells at n = 0, 8 and 12, all details at the same scale "
-        "(half-width 0.15) and centred on the tracked cells. Highlighted in amber in "
-        "every panel: the five diamond cells of the two triangles of the most "
-        "contracted diamond at n = 12 (the same cells in every panel). The cells "
-        "contract; one step later (n = 13) the T-vertex of one of these triangles "
-        "leaves it.",
-        runs=(Run("ddfv", "cymling", _CYMLING, steps=13, save_every=1, label="DDFV"),),
-        shots=(Shot("ddfv", 12, "n = {n} (whole shape)\nn_V = {n_V}, \u03c4 = {tau:g}",
-                    box=_RIM_ZOOM),
-               Shot("ddfv", 0, _DETAIL, zoom=_RIM_ZOOM),
-               Shot("ddfv", 8, _DETAIL, zoom=_RIM_ZOOM),
-               Shot("ddfv", 12, _DETAIL, zoom=_RIM_ZOOM)),
-        view=_CYMLING_VIEW, aspect=0.7, track=Track("ddfv", 12, "angle")),
-    Experiment(
-        "fig_3_5", "Cylinder to catenoid",
-        "Mean curvature flow of an open cylinder (radius 1, height 1.1) with both "
-        "boundary circles fixed, n_V = 600, tau = 0.0025, diamond mesh shown, at time "
-        "steps n = 0, 40, 100 and 200: the surface approaches the catenoid.",
-        runs=(Run("ddfv", "cylinder", _CYLINDER, steps=200, save_every=20, label="DDFV"),),
-        shots=_shots("ddfv", (0, 40, 100, 200)), view=(12.0, -60.0), aspect=0.8),
-    Experiment(
-        "fig_3_6", "Degeneration of the diamond mesh (cylinder)",
-        f"Continuation of the cylinder of Fig. 3.5 ({_CYLINDER_RUN}) without tangential "
-        "control. At n = 580 the T-vertices in the second row of triangles from each "
-        "boundary circle have drifted towards the edges of their triangles; by n = 640 "
-        "they have left them and the diamond mesh folds over (dark cells near the rims). "
-        "Right: the folded region at n = 640 "
-        "in detail. The run record gives the first step at which a T-vertex left its "
-        "triangle.",
-        runs=(Run("ddfv", "cylinder", _CYLINDER, steps=640, save_every=20,
-                  label="DDFV, no tangential control"),),
-        shots=(Shot("ddfv", 580), Shot("ddfv", 640, box=_CYL_ZOOM),
-               Shot("ddfv", 640, _DETAIL, zoom=_CYL_ZOOM)),
-        view=(12.0, -60.0), aspect=0.8),
-    Experiment(
-        "fig_3_7", "Cylinder with tangential velocity eliminated",
-        f"The cylinder of Fig. 3.5 ({_CYLINDER_RUN}) computed with the tangential "
-        "velocity eliminated (3.6), at time steps n = 0, 100, 200 and 640: the "
-        "T-vertices stay inside their triangles and the diamond mesh does not degenerate.",
-        runs=(Run("ddfv", "cylinder", _CYLINDER, steps=640, save_every=20,
-                  scheme="ddfv-eliminate", label="DDFV, elimination (3.6)"),),
-        shots=_shots("ddfv", (0, 100, 200, 640)), view=(12.0, -60.0), aspect=0.8),
-    Experiment(
-        "fig_3_8", "Hemisphere with fixed equator",
-        "Mean curvature flow of a hemisphere whose equator is held fixed, with the "
-        "tangential velocity eliminated (3.6), n_V = 931, tau = 0.0025, at time steps "
-        "n = 0, 40, 80 and 600: the surface flattens to the disk spanned by the equator.",
-        runs=(Run("ddfv", "hemisphere", {"rings": 10}, steps=600, save_every=40,
-                  scheme="ddfv-eliminate", label="DDFV, elimination (3.6)"),),
-        shots=_shots("ddfv", (0, 40, 80, 600)), view=(25.0, -60.0), aspect=0.75),
-    Experiment(
-        "fig_3_6_cotan", "Cylinder: DDFV and the cotangent scheme",
-        "The cylinder of Figs. 3.5-3.6 (tau = 0.0025; n_V = 600 for DDFV; the cotangent "
-        "scheme has the n_V = 216 F-vertices only) at n = 200, 580 and 640: top, DDFV "
-        "without tangential control; bottom, the cotangent scheme (baselines/cotan.py) "
-        "with the same fixed boundary circles. Both approach the catenoid; the cotangent "
-        "mesh has no T-vertices to drift and stays regular.",
-        runs=(Run("ddfv", "cylinder", _CYLINDER, steps=640, save_every=20, label="DDFV"),
-              Run("cotan", "cylinder", _CYLINDER, steps=640, save_every=20,
-                  scheme="cotan", label="cotangent")),
-        shots=(_shots("ddfv", (200, 580, 640), label="DDFV, " + LABEL)
-               + _shots("cotan", (200, 580, 640), label="cotangent, " + LABEL)),
-        rows=2, view=(12.0, -60.0), aspect=0.8),
-    Experiment(
-        "fig_3_4_cotan", "Cymling: DDFV and the cotangent scheme",
-        "The cymling-like shape of Fig. 3.3 (tau = 0.0025) at n = 0, 8 and 12: top, "
-        "DDFV (n_V = 1922); bottom, the cotangent scheme (baselines/cotan.py) on the same "
-        "n_V = 642 F-vertices. The mesh contracts at the rim in both.",
-        runs=(Run("ddfv", "cymling", _CYMLING, steps=12, save_every=1, label="DDFV"),
-              Run("cotan", "cymling", _CYMLING, steps=12, save_every=1,
-                  scheme="cotan", label="cotangent")),
-        shots=(_shots("ddfv", (0, 8, 12), label="DDFV, " + LABEL)
-               + _shots("cotan", (0, 8, 12), label="cotangent, " + LABEL)),
-        rows=2, view=_CYMLING_VIEW, aspect=0.7),
-]}
-"""Figure name -> :class:`Experiment`."""
-
-PAPER_FIGURES = tuple(f"fig_3_{k}" for k in range(1, 9))
-
-
-def validate(experiment):
-    """Check that the experiment can be drawn from what its runs keep.
-
-    Every panel's time level (and those of its zoom, box and of the
-    tracked cells) is computed and kept as a frame, runs and schemes
-    exist, a ``"tracked"`` zoom has a :class:`Track` of its run, and every
-    label template has only the fields of :data:`LABEL`.
-
-    Raises
-    ------
-    ValueError
-    """
-    from mcfbench.presentation.render import WORST_MEASURES
-
-    def kept(run, step, what):
-        if step > run.steps or (step % run.save_every and step != run.steps):
-            raise ValueError(f"{experiment.name}: time level {step} of run {run.key} "
-                             f"({what}) is not kept (steps {run.steps}, "
-                             f"save_every {run.save_every})")
-
-    for run in experiment.runs:
-        get_scheme(run.scheme)
-    track = experiment.track
-    if track is not None:
-        kept(experiment.run(track.run), track.step, "tracked cells")
-        if track.by not in WORST_MEASURES:
-            raise ValueError(f"{experiment.name}: unknown track measure {track.by!r}")
-    for shot in experiment.shots:
-        run = experiment.run(shot.run)
-        kept(run, shot.step, "panel")
-        for zoom in (shot.zoom, shot.box):
-            if zoom is None:
-                continue
-            if zoom.step is not None:
-                kept(run, zoom.step, "zoom")
-            if zoom.at == "tracked" and (track is None or track.run != shot.run):
-                raise ValueError(f"{experiment.name}: a zoom at the tracked cells needs a "
-                                 f"Track of run {shot.run}")
-        try:
-            shot.label.format(n=0, n_V=0, n_F=0, n_T=0, tau=1.0)
-        except (KeyError, IndexError, ValueError) as err:
-            raise ValueError(f"{experiment.name}: bad panel label {shot.label!r} "
-                             f"({err!r}); fields n, n_V, n_F, n_T, tau") from None
+from mcfbench.running.solver import Solver
+from mcfbench.storage.records import RunResult
+from mcfbench.studies.figure_experiments import EXPERIMENTS, Run, validate
 
 
 @dataclass
 class FigureRun:
-    """Frames and record of one :class:`Run`."""
+    """One :class:`~mcfbench.studies.figure_experiments.Run` done: its result, its
+    frames (the layout of :mod:`mcfbench.storage.frames`) and its mesh quality
+    (``None`` when the scheme refused the surface)."""
 
     run: Run
-    F: np.ndarray           # (frames, n_f, 3)
-    T: np.ndarray | None    # (frames, n_t, 3); None for the vertex schemes
-    steps: np.ndarray
-    faces: np.ndarray
-    iterations: np.ndarray
-    status: str
-    message: str
-    failed_step: int
-    wall_seconds: float
+    result: RunResult
+    frames: dict
     quality: object = None  # pandas.DataFrame of mcfbench.geometry.quality.MeshQuality
+
+    @property
+    def F(self):
+        """(frames, n_f, 3): the F-vertices (DDFV) or the vertices."""
+        return self.frames["F"] if "F" in self.frames else self.frames["V"]
+
+    @property
+    def T(self):
+        """(frames, n_t, 3) T-vertices; None for the vertex schemes."""
+        return self.frames.get("T")
+
+    @property
+    def steps(self):
+        return self.frames["steps"]
+
+    @property
+    def faces(self):
+        return self.frames["faces"]
+
+    @property
+    def status(self):
+        return self.result.status
+
+    @property
+    def message(self):
+        return self.result.message
+
+    @property
+    def failed_step(self):
+        """Time level of the first defect or breakdown, ``-1`` when ``ok``."""
+        r = self.result
+        return -1 if r.status == "ok" else round(r.t_failed / r.tau)
 
     def frame(self, step):
         """Index of the last kept frame at or before ``step``."""
@@ -405,51 +86,46 @@ class FigureRun:
             "failed_step": int(self.failed_step),
             "last_step": int(self.steps[-1]),
             "frames": [int(s) for s in self.steps],
-            "iterations": int(np.sum(self.iterations)),
-            "wall_seconds": round(self.wall_seconds, 3),
+            "iterations": int(self.result.iterations),
+            "wall_seconds": round(self.result.wall_seconds, 3),
             "first_violation": violation,
             "violation": "" if self.quality is None else describe_violation(self.quality),
         }
 
 
-def run_one(run):
-    """Simulate one :class:`Run`.
+def figure_run(run):
+    """One :class:`~mcfbench.studies.figure_experiments.Run` through
+    :func:`mcfbench.running.run.framed_run`: the shape's mesh, ``run.steps`` steps
+    of ``run.tau``, every ``run.save_every``-th frame kept.
 
     The run goes on past an invalid state (``on_defect="record"``: the
     figures show what happens after a T-vertex leaves its triangle), and
     its status says what went wrong first; a breakdown of the solver ends
     it, keeping the frames computed before. The mesh quality of every time
     level is recorded (:class:`mcfbench.geometry.quality.MeshQuality`: diamond and
-    primal monitors for DDFV, primal ones for the other schemes). A scheme that refuses the
-    surface (ValueError) gives ``status = "unsupported"`` with the initial
-    surface as the only frame.
+    primal monitors for DDFV, primal ones for the other schemes). A scheme that
+    refuses the surface gives ``status = "unsupported"`` with the initial surface
+    as its frames.
 
     Returns
     -------
     FigureRun
     """
     scheme = get_scheme(run.scheme)
-    V, faces = validate_mesh(*make_surface(run.shape, **run.params))
-    start = time.perf_counter()
     options = {"t_init": run.t_init} if scheme.family == "ddfv" else {}
-    try:
-        flow = scheme.make(V, faces, run.tau, **options)
-    except ValueError as err:
-        return FigureRun(run, V[None], None, np.array([0]), faces, np.array([], int),
-                         "unsupported", str(err), -1, time.perf_counter() - start)
     quality = MeshQuality()   # diamond and primal monitors (DDFV), primal (the others)
-    traj = simulate(flow, run.steps, save_every=run.save_every, on_defect="record",
-                    observers=[quality])
-    frames = traj.frames
-    return FigureRun(run, frames.get("F", frames.get("V")), frames.get("T"), traj.steps,
-                     traj.faces, traj.iterations, traj.status, traj.message, traj.failed_step,
-                     time.perf_counter() - start, quality.frame())
+    result, frames = framed_run(scheme, Problem.user_mesh(run.shape, run.steps), 0,
+                                solver=Solver(), mesh=make_surface(run.shape, **run.params),
+                                tau=run.tau, save_every=run.save_every, on_defect="record",
+                                observers=[quality], **options)
+    return FigureRun(run, result, frames,
+                     None if result.status == "unsupported" else quality.frame())
 
 
 def run_experiment(experiment):
-    """:func:`run_one` for every run of the experiment: ``{key: FigureRun}``."""
+    """:func:`figure_run` for every run of the experiment: ``{key: FigureRun}``."""
     validate(experiment)
-    return {run.key: run_one(run) for run in experiment.runs}
+    return {run.key: figure_run(run) for run in experiment.runs}
 
 
 def experiment_status(results):
@@ -570,3 +246,91 @@ def _short(text, width=34):
     import textwrap
 
     return "\n".join(textwrap.wrap(text, width)[:3])
+
+
+# ---------------------------------------------------------------- the job
+
+FIGURE_OUTPUTS = ("png", "pdf", "frames", "record", "csv", "plot")
+"""The outputs of one figure's job (those of ``workflow/rules/figures.smk``)."""
+
+
+def figure_outputs(name, results="results"):
+    """Output paths of the figure ``name``: the figure (``png``, ``pdf``), the
+    folder of its runs' frames (``frames``: ``<run key>.npz`` each), its record,
+    the diagnostics (``csv``) and their plot."""
+    root = Path(results)
+    return {"png": root / "figures" / f"{name}.png", "pdf": root / "figures" / f"{name}.pdf",
+            "frames": root / "runs" / "figures" / name,
+            "record": root / "runs" / "figures" / f"{name}.json",
+            "csv": root / "diagnostics" / f"{name}.csv",
+            "plot": root / "diagnostics" / f"{name}.png"}
+
+
+def frames_file(folder, key):
+    """The frames file of run ``key`` in a figure's frames folder."""
+    return Path(folder) / f"{key}.npz"
+
+
+def job(name, outputs, log):
+    """Run the experiment of one figure (:data:`EXPERIMENTS`) and draw it.
+
+    Writes the figure (PNG + PDF), the kept frames of every run (one frames
+    file per run in the folder ``outputs["frames"]``,
+    :func:`mcfbench.storage.frames.save_frames`), the per-step diagnostics of
+    the runs (CSV with a ``run`` column, and a plot) and a JSON record (status
+    per run, first violation, timings, provenance). A run that breaks down
+    keeps its frames and the figure is drawn from them with a note.
+
+    Returns
+    -------
+    str
+        The figure's status (:func:`experiment_status`).
+    """
+    import pandas as pd
+
+    from mcfbench.geometry.quality import COLUMNS
+    from mcfbench.presentation.quality_plots import plot_quality
+    from mcfbench.presentation.render import DPI, rasterize_meshes
+    from mcfbench.storage.atomic import json_text, write_files
+    from mcfbench.storage.frames import save_frames
+    from mcfbench.storage.provenance import provenance
+
+    experiment = EXPERIMENTS[name]
+    wall = time.perf_counter()
+    results = run_experiment(experiment)
+    compute = time.perf_counter() - wall
+    quality = {key: r for key, r in results.items() if r.quality is not None}
+    frames = [r.quality.assign(run=key) for key, r in quality.items()]
+    table = pd.concat(frames, ignore_index=True) if frames else \
+        pd.DataFrame(columns=["run", *COLUMNS])
+    plot = plot_quality({r.run.label or key: r.quality for key, r in quality.items()},
+                        title=f"{experiment.name}: {experiment.title}",
+                        marks=sorted({s.step for s in experiment.shots}))
+    draw = time.perf_counter()
+    figure = draw_experiment(experiment, results)
+    draw = time.perf_counter() - draw
+    rasterize_meshes(figure)
+    status = experiment_status(results)
+    record = {
+        "experiment": experiment.name, "title": experiment.title, "status": status,
+        "first_violation": {key: r.record()["first_violation"] for key, r in quality.items()},
+        "runs": {key: r.record() for key, r in results.items()},
+        "seconds": {"compute": round(compute, 3), "draw": round(draw, 3),
+                    "total": round(time.perf_counter() - wall, 3)},
+        "outputs": {k: str(v) for k, v in outputs.items()},
+        "provenance": provenance(experiment.config()),
+    }
+    for key, r in results.items():
+        save_frames(frames_file(outputs["frames"], key), r.frames)
+    write_files({outputs["csv"]: table[["run", *COLUMNS]].to_csv(index=False),
+                 outputs["plot"]: (plot, {"dpi": DPI}), outputs["png"]: (figure, {"dpi": DPI}),
+                 outputs["pdf"]: (figure, {"dpi": 2 * DPI}),
+                 outputs["record"]: json_text(record)})
+    for key, r in results.items():
+        line = f"{experiment.name}/{key}: {r.status}, n = {int(r.steps[-1])}"
+        line += f" ({r.message})" if r.message else ""
+        violation = r.record()["violation"]
+        line += f"; first violation at {violation}" if violation else ""
+        (log.warning if r.status != "ok" else log.info)("%s", line)
+    log.info("%s: %s; compute %.1f s, draw %.1f s", experiment.name, status, compute, draw)
+    return status

@@ -160,7 +160,7 @@ def job(mesh_path, scheme, settings, record, frames, log_path=None):
     from mcfbench.geometry.mesh_files import read_mesh
     from mcfbench.running.schemes import get_scheme
     from mcfbench.running.solver import Solver
-    from mcfbench.storage.atomic import save_npz
+    from mcfbench.storage.frames import save_frames
     from mcfbench.storage.records import write_record
 
     log = setup_logging(log_path)
@@ -182,7 +182,7 @@ def job(mesh_path, scheme, settings, record, frames, log_path=None):
                  scheme.name, mesh_path, len(V), len(F), tau, settings["steps"], solver.method)
         result, arrays = framed_run(scheme, problem, 1, solver=solver, mesh=(V, F), tau=tau,
                                     save_every=max(1, settings["steps"] // MOVIE_FRAMES))
-        save_npz(frames, **arrays)
+        save_frames(frames, arrays)
     if result is None:
         from mcfbench.storage.records import RunResult
 
@@ -194,7 +194,8 @@ def job(mesh_path, scheme, settings, record, frames, log_path=None):
                            integrator="euler", cpu_seconds=0.0,
                            wall_seconds=0.0, t_min_barycentric=nan, min_angle=nan,
                            max_aspect=nan, max_flipped=nan)
-        save_npz(frames, faces=np.zeros((0, 3), int), steps=np.zeros(0, int), t=np.zeros(0))
+        save_frames(frames, {"faces": np.zeros((0, 3), int), "steps": np.zeros(0, int),
+                             "t": np.zeros(0)})
     write_record(record, result, settings, metric_names=[], **extra)
     log.info("%s: %s, %d/%d steps", scheme.name, result.status, result.steps_done, result.N)
     return result
@@ -207,8 +208,8 @@ def run_movie(record, frames, out, log_path=None):
     with the record's message."""
     from mcfbench.presentation.movie import write_movie, write_notice
     from mcfbench.running.schemes import scheme_label
+    from mcfbench.storage.frames import load_frames
     from mcfbench.storage.records import read_record
-    from mcfbench.studies.matrix import load_frames
 
     log = setup_logging(log_path)
     data = read_record(record)

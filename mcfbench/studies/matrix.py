@@ -22,8 +22,6 @@ user meshes in :mod:`mcfbench.studies.gallery`.
 import logging
 from pathlib import Path
 
-import numpy as np
-
 from mcfbench.presentation.matrix_findings import cheapest_to_reach, matrix_findings
 from mcfbench.presentation.matrix_tables import (
     TIMING_NOTE,
@@ -218,7 +216,7 @@ def job(settings, record, frames, log_path=None):
     :func:`robust_fields` (``robust_status`` empty when there was no re-run); the
     frames stay those of the run itself."""
     from mcfbench.running.solver import Solver
-    from mcfbench.storage.atomic import save_npz
+    from mcfbench.storage.frames import save_frames
     from mcfbench.storage.records import write_record
 
     log = setup_logging(log_path) if log_path else logging.getLogger("pipeline")
@@ -229,7 +227,7 @@ def job(settings, record, frames, log_path=None):
     result, arrays = framed_run(settings["scheme"], settings["problem"], settings["level"],
                              solver=solver)
     robust = robust_rerun(settings, result, solver)
-    save_npz(frames, **arrays)
+    save_frames(frames, arrays)
     write_record(record, result, settings, metric_names=list(result.metrics),
                  **robust_fields(robust))
     log.info("%s; %d/%d steps, %s, %.1f s CPU -> %s", result.status, result.steps_done,
@@ -355,12 +353,6 @@ def findings(summary_csv, out, plan, long_csv=None):
                            source=Path(summary_csv).as_posix(), work_precision=costs)
     write_text(out, text)
     return text
-
-
-def load_frames(path):
-    """The arrays of a frames file as a dict."""
-    with np.load(path) as data:
-        return {key: data[key] for key in data.files}
 
 
 def picture_runs(plan, root="results/matrix"):

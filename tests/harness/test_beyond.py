@@ -1,4 +1,4 @@
-"""The study beyond Table 3.1 (workflow/rules/beyond.smk; mcfbench.pipeline, .tables,
+"""The study beyond Table 3.1 (workflow/rules/beyond.smk; mcfbench.studies.beyond, .tables,
 .plots, .beyond_findings).
 
 Runs that break down must end up as rows with their status, the time of
@@ -21,8 +21,8 @@ import pandas as pd
 import pytest
 import yaml
 
-from mcfbench.pipeline import Pipeline, record_fields, run_job, time_job, used_schemes
-from mcfbench.presentation.beyond_findings import beyond_findings as findings
+from mcfbench.pipeline import Plans, mem_mb
+from mcfbench.presentation.beyond_findings import beyond_findings
 from mcfbench.presentation.beyond_tables import (
     beyond_documents,
     beyond_tables,
@@ -42,9 +42,14 @@ from mcfbench.storage.atomic import write_files
 from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.provenance import config_hash
 from mcfbench.storage.records import RecordError, read_record, read_records
+from mcfbench.studies.beyond import findings as verdicts
+from mcfbench.studies.beyond import levels_of, record_fields, time_job, used_schemes
 from mcfbench.studies.config import ConfigError
+from mcfbench.studies.convergence import job as run_job
+from mcfbench.studies.convergence import problem_of
 
 REPO = Path(__file__).resolve().parents[2]
+SCHEMAS = REPO / "workflow" / "schemas"
 CONFIG = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
 SETTINGS = {"t_final": 0.08, "tau_level_1": 0.04, "rtol": 1e-9}
 
@@ -148,6 +153,12 @@ def test_eoc_column_only_between_finished_consecutive_levels():
 SCHEMES_USED = ["ddfv", "ddfv-chord", "cotan"]
 LEVELS = [1, 2, 3]
 PAPER = ["ddfv", "ddfv-chord"]
+
+
+def findings(levels, stability, time, space, schemes, paper, t_final, tau_1):
+    """The findings as the rule writes them: the study's verdicts in words."""
+    return beyond_findings(levels, stability, time, space, schemes, paper, t_final, tau_1,
+                           verdicts(levels, stability, schemes, paper))
 
 
 def synthetic_inputs(finest=()):
@@ -325,9 +336,16 @@ def test_documents_and_findings_follow_the_numbers(tables, tmp_path):
     assert "\\ensuremath{|}gamma\\ensuremath{|}" in docs["levels"]["tex"]
     for name, doc in docs.items():
         (tmp_path / f"{name}.csv").write_text(doc["csv"])
-    text = findings(*(pd.read_csv(tmp_path / f"{n}.csv") for n in (
-        "levels", "stability", "time_convergence", "space_convergence")), SCHEMES_USED,
-        PAPER, 0.08, 0.04)
+    read = [pd.read_csv(tmp_path / f"{n}.csv") for n in (
+        "levels", "stability", "time_convergence", "space_convergence")]
+    verdict = verdicts(read[0], read[1], SCHEMES_USED, PAPER)
+    ratio = 1.05 * 1.3e-2 / 4 ** 2 / 8.01e-4
+    assert verdict["stable"] == ["ddfv-chord", "cotan"] and verdict["finest"] == 3
+    assert verdict["variants"] == ["ddfv-chord"] and verdict["unstable"] == ["ddfv"]
+    assert verdict["reference"] == "ddfv"
+    (scheme, level, deviation), = verdict["deviations"]
+    assert (scheme, level) == ("ddfv-chord", 3) and deviation == pytest.approx(ratio, rel=1e-6)
+    text = findings(*read, SCHEMES_USED, PAPER, 0.08, 0.04)
     label = {s: SCHEMES[s].label for s in SCHEMES_USED}
     assert f"**{label['ddfv']}** (`ddfv`): broke down in 2 of 4 runs" in text
     assert "t_escaped at t = 0.03" in text
@@ -335,7 +353,6 @@ def test_documents_and_findings_follow_the_numbers(tables, tmp_path):
     assert (f"Stable (every run finished, no T-vertex left its triangle): "
             f"{label['ddfv-chord']}; not stable: {label['ddfv']}.") in text
     assert f"time, **{label['ddfv-chord']}**: no order (reference run failed" in text
-    ratio = 1.05 * 1.3e-2 / 4 ** 2 / 8.01e-4
     assert f"{label['ddfv-chord']} {100 * (ratio - 1):+.1f} %" in text
 
 
@@ -384,7 +401,7 @@ def test_default_config_passes_the_schema_and_the_checks():
 
     config = json.loads(json.dumps(CONFIG))
     validate(config, str(REPO / "workflow" / "schemas" / "config.schema.yaml"))
-    settings = Pipeline(config).beyond
+    settings = Plans(config, SCHEMAS).beyond
     assert settings["levels"] == [1, 2, 3, 4, 5, 6]
     assert settings["schemes"] == ["ddfv", "ddfv-chord", "ddfv-eliminate", "cotan"]
     assert settings["long_time"]["t_final"] == 0.15 and settings["long_time"]["level"] == 5
@@ -395,53 +412,70 @@ def test_default_config_passes_the_schema_and_the_checks():
     assert all(s in SCHEMES for s in used_schemes(settings))
     # the level-7 run is off by default
     assert settings["finest"] == {"level": 7, "rtol": 1e-11, "schemes": []}
-    assert not [p for p in Pipeline(config).beyond_runs()["levels"] if "level7" in p]
+    assert not [p for p in Plans(config, SCHEMAS).beyond_runs["levels"] if "level7" in p]
 
 
 def test_finest_level_adds_its_runs_only():
     config = json.loads(json.dumps(CONFIG))
     config["beyond"]["finest"]["schemes"] = ["ddfv-chord"]
-    pipeline = Pipeline(config)
-    runs = pipeline.beyond_runs()["levels"]
-    default = Pipeline(json.loads(json.dumps(CONFIG))).beyond_runs()["levels"]
+    pipeline = Plans(config, SCHEMAS)
+    runs = pipeline.beyond_runs["levels"]
+    default = Plans(json.loads(json.dumps(CONFIG)), SCHEMAS).beyond_runs["levels"]
     assert set(runs) - set(default) == {"results/runs/ddfv-chord/level7.json"}
     assert all(runs[p] == settings for p, settings in default.items())
     assert runs["results/runs/ddfv-chord/level7.json"] == pipeline.run_settings("ddfv-chord", 7)
     # the finest level's own tolerance; every other run keeps the top-level one
     assert runs["results/runs/ddfv-chord/level7.json"]["rtol"] == 1e-11
     assert {s["rtol"] for p, s in runs.items() if "level7" not in p} == {1e-9}
-    assert pipeline.beyond_levels("ddfv-chord") == [1, 2, 3, 4, 5, 6, 7]
-    assert pipeline.beyond_levels("ddfv") == [1, 2, 3, 4, 5, 6]
-    assert pipeline.problem.time_steps(pipeline.problem.tau(7)) == 8192
+    assert levels_of(pipeline.beyond, "ddfv-chord") == [1, 2, 3, 4, 5, 6, 7]
+    assert levels_of(pipeline.beyond, "ddfv") == [1, 2, 3, 4, 5, 6]
+    problem = problem_of(pipeline.convergence)
+    assert problem.time_steps(problem.tau(7)) == 8192
     # the job's Slurm resources cover the single-core estimate of an earlier session
     # (about 630 MB and 860 s) twice over
-    assert pipeline.mem_mb(7) >= 2 * 630 and pipeline.run_runtime(7) * 60 >= 2 * 860
+    assert mem_mb(7) >= 2 * 630 and pipeline.run_runtime(7) * 60 >= 2 * 860
 
 
-@pytest.mark.parametrize("path, value", [
-    (("beyond", "levels"), [8]),
-    (("beyond", "finest", "level"), 8),
-    (("beyond", "finest", "schemes"), "ddfv-chord"),
-    (("beyond", "finest", "extra"), 1),
-    (("beyond", "schemes"), ["DDFV"]),
-    (("beyond", "long_time", "t_final"), 0.3),
-    (("beyond", "time_study", "taus"), [0.01]),
-    (("beyond", "time_study", "reference_factor"), 1),
-    (("beyond", "space_study", "tau"), -1e-5),
-    (("beyond", "extra"), 1),
-    (("scheme_modules",), {"ddfv": "ddfv.sphere"}),      # the old key is gone
+@pytest.mark.parametrize("path, value, message", [
+    (("levels",), [8], "config key 'beyond.levels.0': 8 is not valid"),
+    (("finest", "level"), 8, "config key 'beyond.finest.level': 8 is not valid"),
+    (("finest", "schemes"), "ddfv-chord",
+     "config key 'beyond.finest.schemes': 'ddfv-chord' is not of type 'array'"),
+    (("finest", "extra"), 1, "config key 'beyond.finest': Additional properties"),
+    (("schemes",), ["DDFV"], "config key 'beyond.schemes.0': 'DDFV' does not match"),
+    (("long_time", "t_final"), 0.3,
+     "config key 'beyond.long_time.t_final': 0.3 is greater than or equal to"),
+    (("time_study", "taus"), [0.3], "config key 'beyond.time_study.taus': [0.3] is too short"),
+    (("time_study", "reference_factor"), 1,
+     "config key 'beyond.time_study.reference_factor': 1 is less than the minimum of 2"),
+    (("space_study", "tau"), -1e-5,
+     "config key 'beyond.space_study.tau': -1e-05 is less than or equal to the minimum of 0"),
+    (("extra",), 1, "config key 'beyond': Additional properties are not allowed ('extra'"),
 ])
-def test_schema_rejects_bad_beyond_values(path, value):
+def test_beyond_schema_names_the_bad_key(path, value, message):
+    """The section ``beyond`` has its own schema, checked with its plan (Plans.beyond),
+    not while Snakemake reads the workflow: the whole config passes the main schema."""
+    from snakemake.utils import validate
+
+    config = json.loads(json.dumps(CONFIG))
+    node = config["beyond"]
+    for key in path[:-1]:
+        node = node[key]
+    node[path[-1]] = value
+    validate(json.loads(json.dumps(config)), str(SCHEMAS / "config.schema.yaml"))
+    with pytest.raises(ConfigError) as err:
+        Plans(config, SCHEMAS).beyond
+    assert message in str(err.value)
+
+
+def test_main_schema_refuses_an_old_key():
     from snakemake.exceptions import WorkflowError
     from snakemake.utils import validate
 
     config = json.loads(json.dumps(CONFIG))
-    node = config
-    for key in path[:-1]:
-        node = node[key]
-    node[path[-1]] = value
+    config["scheme_modules"] = {"ddfv": "ddfv.sphere"}      # the old key is gone
     with pytest.raises(WorkflowError):
-        validate(config, str(REPO / "workflow" / "schemas" / "config.schema.yaml"))
+        validate(config, str(SCHEMAS / "config.schema.yaml"))
 
 
 @pytest.mark.parametrize("path, value, message", [
@@ -467,7 +501,7 @@ def test_checks_across_keys_name_the_key(path, value, message):
         config["beyond"]["finest"]["schemes"] = ["ddfv-chord"]   # checked when on
     config["beyond"][path[0]][path[1]] = value
     with pytest.raises(ConfigError) as err:
-        Pipeline(config)
+        Plans(config, SCHEMAS).beyond
     assert message in str(err.value)
     if "unknown" in message:
         assert all(name in str(err.value) for name in SCHEMES)
@@ -476,7 +510,7 @@ def test_checks_across_keys_name_the_key(path, value, message):
 def test_time_study_takes_any_scheme():
     config = json.loads(json.dumps(CONFIG))
     config["beyond"]["time_study"]["schemes"] = ["cotan", "ddfv"]
-    assert Pipeline(config).beyond["time_study"]["schemes"] == ["cotan", "ddfv"]
+    assert Plans(config, SCHEMAS).beyond["time_study"]["schemes"] == ["cotan", "ddfv"]
 
 
 FINEST = "beyond={finest: {schemes: [ddfv-chord]}}"   # the command line of config/README.md
@@ -529,8 +563,8 @@ def test_dry_run_of_beyond_and_a_bad_value(tmp_path):
     assert level7 not in out["good"]
     assert procs["finest"].returncode == 0, out["finest"][-3000:]
     job = out["finest"].split(f"output: {level7}")[1].split("\n\n")[0]
-    pipeline = Pipeline(json.loads(json.dumps(CONFIG)))
-    assert f"runtime={pipeline.run_runtime(7)}, mem_mb={pipeline.mem_mb(7)}," in job, job
+    pipeline = Plans(json.loads(json.dumps(CONFIG)), SCHEMAS)
+    assert f"runtime={pipeline.run_runtime(7)}, mem_mb={mem_mb(7)}," in job, job
     assert jobs(out["finest"], "run_scheme") == jobs(out["good"], "run_scheme") + 1
     assert procs["bad_finest"].returncode != 0
     assert "config key 'beyond.finest.level': 6 is not above" in out["bad_finest"]
@@ -574,6 +608,7 @@ def test_integrator_table_compares_each_scheme_with_its_euler_runs():
 def test_integrator_findings_read_the_orders_and_the_comparison():
     from mcfbench.presentation.beyond_findings import integrator_section
     from mcfbench.presentation.beyond_tables import integrator_table
+    from mcfbench.studies.beyond import findings as verdicts
 
     taus = [0.01, 0.005, 0.0025]
     rows = []
@@ -591,8 +626,11 @@ def test_integrator_findings_read_the_orders_and_the_comparison():
          "l2_error": l2 / 4 ** lv, "cpu_seconds": cpu * 8 ** lv, "status": "ok"}
         for lv in (1, 2, 3) for s, l2, cpu in (("cotan", 1e-2, 0.1),
                                                ("cotan@bdf2", 0.2e-2, 0.11))])
-    text = "\n".join(integrator_section(time, integrator_table(levels),
-                                        {"euler": 1, "bdf2": 2}))
+    table = levels.assign(l2_ratio=np.nan)
+    verdict = verdicts(table, pd.DataFrame(columns=["scheme", "status", "t_exit"]),
+                       ["cotan", "cotan@bdf2"], [], time, integrator_table(levels))
+    assert [r["pointwise"] for r in verdict["time_orders"]["bdf2"][1]] == [True, False]
+    text = "\n".join(integrator_section(verdict))
     assert "**euler** (order 1): pointwise order 1.00-1.00 for 2 of 2 schemes." in text
     assert ("**bdf2** (order 2): pointwise order 2.00-2.00 for 1 of 2 schemes; by the volume "
             "between the surfaces only: BGN (2.00; pointwise 0.40).") in text

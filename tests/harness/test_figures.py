@@ -1,5 +1,6 @@
-"""The experiments of Figs. 3.1-3.8 (mcfbench/studies/figures.py): definitions, tracked
-cells, panels and the diagnostics of their runs."""
+"""The experiments of Figs. 3.1-3.8 (mcfbench/studies/figure_experiments.py) and their
+study (mcfbench/studies/figures.py): definitions, tracked cells, panels, the figure job's
+frames files and the diagnostics of their runs."""
 
 import dataclasses
 import logging
@@ -13,7 +14,7 @@ import pytest
 from mcfbench.geometry.surfaces import make_surface
 from mcfbench.presentation.render import cells_centre, cells_points, project
 from mcfbench.running.schemes import SCHEMES, get_scheme
-from mcfbench.studies.figures import (
+from mcfbench.studies.figure_experiments import (
     EXPERIMENTS,
     LABEL,
     PAPER_FIGURES,
@@ -22,11 +23,15 @@ from mcfbench.studies.figures import (
     Shot,
     Track,
     Zoom,
+    validate,
+)
+from mcfbench.studies.figures import (
     draw_experiment,
     experiment_panels,
+    figure_outputs,
+    job,
     run_experiment,
     tracked,
-    validate,
 )
 
 
@@ -194,19 +199,17 @@ def test_default_label_has_the_time_level_size_and_step():
 
 @pytest.fixture(scope="module")
 def small_comparison(tmp_path_factory):
-    """fig_3_6_cotan shortened to 4 steps, through the pipeline's figure job."""
-    from mcfbench import pipeline
-
+    """fig_3_6_cotan shortened to 4 steps, through the figure job."""
     base = EXPERIMENTS["fig_3_6_cotan"]
     runs = tuple(dataclasses.replace(r, steps=4, save_every=2) for r in base.runs)
     shots = tuple(dataclasses.replace(s, step=4) for s in base.shots[::3])
     experiment = dataclasses.replace(base, name="small_cotan", runs=runs, shots=shots)
     validate(experiment)
     out = tmp_path_factory.mktemp("figure")
-    outputs = pipeline.figure_outputs("small_cotan", out)
+    outputs = figure_outputs("small_cotan", out)
     EXPERIMENTS["small_cotan"] = experiment
     try:
-        pipeline.figure_job("small_cotan", outputs, logging.getLogger("test"))
+        job("small_cotan", outputs, logging.getLogger("test"))
     finally:
         del EXPERIMENTS["small_cotan"]
     return experiment, outputs
@@ -240,3 +243,21 @@ def test_figure_job_writes_the_figure_and_a_two_run_diagnostics_plot(small_compa
     assert set(record["runs"]) == {"ddfv", "cotan"}
     assert record["first_violation"] == {"ddfv": None, "cotan": None}
     assert record["status"] == "ok"
+
+
+def test_figure_job_keeps_one_frames_file_per_run_in_the_common_layout(small_comparison):
+    from mcfbench.storage.frames import load_frames
+
+    experiment, outputs = small_comparison
+    ddfv = load_frames(outputs["frames"] / "ddfv.npz")
+    cotan = load_frames(outputs["frames"] / "cotan.npz")
+    # every second of 4 steps kept; the cylinder's 216 F-vertices and 384 triangles
+    for frames in (ddfv, cotan):
+        assert frames["steps"].tolist() == [0, 2, 4]
+        np.testing.assert_allclose(frames["t"], [0, 0.005, 0.01])
+        assert frames["faces"].shape == (384, 3)
+    assert ddfv["F"].shape == (3, 216, 3) and ddfv["T"].shape == (3, 384, 3)
+    assert cotan["V"].shape == (3, 216, 3) and "T" not in cotan
+    # the boundary circles stay where they were
+    np.testing.assert_array_equal(cotan["V"][-1][np.abs(cotan["V"][0][:, 2]) == 0.55],
+                                  cotan["V"][0][np.abs(cotan["V"][0][:, 2]) == 0.55])

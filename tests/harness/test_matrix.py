@@ -17,6 +17,7 @@ import pytest
 from mcfbench.presentation import matrix_findings, matrix_tables
 from mcfbench.running.problems import PROBLEMS
 from mcfbench.running.schemes import SCHEMES
+from mcfbench.storage.frames import load_frames
 from mcfbench.storage.records import FIELDS, read_record, read_records, write_record
 from mcfbench.storage.statuses import STATUSES
 from mcfbench.studies import gallery, matrix
@@ -92,7 +93,7 @@ def test_tiny_records_and_frames(tiny):
             assert record["t_failed"] == pytest.approx(record["steps_done"] * record["tau"],
                                                        abs=2 * record["tau"])
         assert record["metric_names"]
-        frames = matrix.load_frames(path.replace("/runs/", "/frames/")
+        frames = load_frames(path.replace("/runs/", "/frames/")
                                     .removesuffix(".json") + ".npz")
         assert len(frames["steps"]) == 2 and frames["steps"][0] == 0
         assert frames["steps"][-1] == record["steps_done"]
@@ -139,7 +140,7 @@ def test_tiny_plots(tiny):
     figs = root / "figures"
     error_figure(table, [figs / "errors.png"], problems, schemes)
     quality_figure(list(read_records(runs).values()), [figs / "quality.png"], problems, schemes)
-    entries = {key: (read_record(r), matrix.load_frames(f))
+    entries = {key: (read_record(r), load_frames(f))
                for key, (r, f) in matrix.picture_runs(plan, str(root)).items()}
     picture_grid(entries, [figs / "pictures.png"], problems, schemes)
     drawn = work_precision_figure(table, [figs / "work_precision.png"], problems, schemes)

@@ -26,7 +26,8 @@ import yaml
 from mcfbench.presentation import documents, report, report_inputs
 from mcfbench.presentation.convergence_tables import PUBLISHED
 from mcfbench.running.schemes import SCHEMES
-from mcfbench.studies.figures import EXPERIMENTS, PAPER_FIGURES
+from mcfbench.storage.frames import save_frames
+from mcfbench.studies.figure_experiments import EXPERIMENTS, PAPER_FIGURES
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -110,14 +111,16 @@ def figure_record(name):
             "provenance": dict(PROVENANCE)}
 
 
-def figure_frames(path, name):
-    arrays = {}
+def figure_frames(folder, name):
+    """One frames file per run of the figure (mcfbench.storage.frames), one frame each."""
     for run in EXPERIMENTS[name].runs:
         sizes = {"bumpy_sphere": (642, 1280), "cylinder": (216, 384)}[run.shape]
-        arrays[f"{run.key}.F"] = np.zeros((1, sizes[0], 3))
-        if SCHEMES[run.scheme].family == "ddfv":
-            arrays[f"{run.key}.T"] = np.zeros((1, sizes[1], 3))
-    np.savez(path, **arrays)
+        ddfv = SCHEMES[run.scheme].family == "ddfv"
+        arrays = {"F" if ddfv else "V": np.zeros((1, sizes[0], 3)),
+                  "faces": np.zeros((0, 3), int), "steps": np.zeros(1, int), "t": np.zeros(1)}
+        if ddfv:
+            arrays["T"] = np.zeros((1, sizes[1], 3))
+        save_frames(folder / f"{run.key}.npz", arrays)
 
 
 @pytest.fixture
@@ -141,7 +144,7 @@ def results(tmp_path):
         write_png(root / "figures" / f"{name}.png", 10 + i)
         write_png(root / "diagnostics" / f"{name}.png", 20 + i)
         (root / "runs" / "figures" / f"{name}.json").write_text(json.dumps(figure_record(name)))
-        figure_frames(root / "runs" / "figures" / f"{name}.npz", name)
+        figure_frames(root / "runs" / "figures" / name, name)
     return root
 
 

@@ -26,12 +26,14 @@ import pandas as pd
 import pytest
 import yaml
 
-from mcfbench.pipeline import Pipeline, solver_of
+from mcfbench.pipeline import Plans
 from mcfbench.storage.records import checksum
+from mcfbench.studies.convergence import solver_of
 
 pytestmark = pytest.mark.e2e
 
 REPO = Path(__file__).resolve().parents[2]
+SCHEMAS = REPO / "workflow" / "schemas"
 # the study's own target (rule all also builds the figures of another rule
 # file); targets before --config, which takes every following word
 RUN = ["--cores", "2", "convergence", "--config", "levels=[1,2]"]
@@ -226,6 +228,61 @@ def test_bad_config_stops_before_any_job(tmp_path, env):
     assert not (work / "results").exists()
 
 
+def test_a_bad_beyond_value_stops_only_the_beyond_study(tmp_path, env):
+    """Each study checks its own config section when its rules join the job graph:
+    a bad value under `beyond` (against its schema, or a time step that does not
+    divide t_final) stops `beyond` with the key named, not the matrix nor Table 3.1
+    (dry runs)."""
+    work = copy_workflow(tmp_path / "work")
+    (work / "bad.yaml").write_text("beyond:\n  time_study:\n    taus: [0.3, 0.15]\n")
+    bad = {"file": ["--configfile", "bad.yaml"],
+           "line": ["--config", "beyond={time_study: {taus: [0.3]}}"]}
+    runs = {(target, how): ["-n", target, *args] for target in ("beyond", "matrix", "convergence")
+            for how, args in bad.items()}
+    procs = {key: subprocess.Popen(
+        [sys.executable, "-m", "snakemake", *args], cwd=work, env=env,
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        for key, args in runs.items()}
+    out = {key: proc.communicate(timeout=TIMEOUT)[0] for key, proc in procs.items()}
+    assert procs["beyond", "file"].returncode != 0
+    assert "ConfigError: config key 'beyond.time_study.taus': t_final = 0.08 is not a " \
+        "whole multiple of tau = 0.3" in out["beyond", "file"], out["beyond", "file"][-2000:]
+    assert procs["beyond", "line"].returncode != 0
+    assert "ConfigError: config key 'beyond.time_study.taus': ['0.3'] is too short" in \
+        out["beyond", "line"], out["beyond", "line"][-2000:]
+    for target in ("matrix", "convergence"):
+        for how in bad:
+            assert procs[target, how].returncode == 0, out[target, how][-2000:]
+            assert "beyond" not in out[target, how].split("Building DAG of jobs")[1]
+    # the matrix plans its own series jobs, no run of Table 3.1
+    assert "matrix_run_sphere" in out["matrix", "file"]
+    assert "run_scheme" not in out["matrix", "file"]
+    assert not (work / "results").exists()
+
+
+def test_a_bad_matrix_or_gallery_value_stops_only_its_target(tmp_path, env):
+    """The matrix and the gallery check their sections while Snakemake reads their
+    rule files: a bad one leaves them without rules and stops only their own target,
+    naming the key (dry runs)."""
+    work = copy_workflow(tmp_path / "work")
+    (work / "bad.yaml").write_text("matrix:\n  schemes: [ddfv, fem]\ngallery:\n  C: -1\n")
+    procs = {target: subprocess.Popen(
+        [sys.executable, "-m", "snakemake", "-n", target, "--configfile", "bad.yaml"],
+        cwd=work, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        for target in ("matrix", "gallery", "beyond_tables", "convergence")}
+    out = {target: proc.communicate(timeout=TIMEOUT)[0] for target, proc in procs.items()}
+    assert procs["matrix"].returncode != 0
+    assert "ConfigError: config key 'matrix.schemes': unknown scheme(s) ['fem']" in \
+        out["matrix"], out["matrix"][-2000:]
+    assert procs["gallery"].returncode != 0
+    assert "ConfigError: config key 'gallery.C': -1 is less than or equal to the minimum " \
+        "of 0" in out["gallery"], out["gallery"][-2000:]
+    for target in ("beyond_tables", "convergence"):     # (`beyond` adds the report)
+        assert procs[target].returncode == 0, out[target][-2000:]
+        assert "run_scheme" in out[target] and "matrix_run" not in out[target]
+    assert not (work / "results").exists()
+
+
 def test_threads_setting_reaches_the_rules_and_the_records(tmp_path, env):
     work = copy_workflow(tmp_path / "work")
     out = subprocess.run(
@@ -236,9 +293,9 @@ def test_threads_setting_reaches_the_rules_and_the_records(tmp_path, env):
     jobs = out.stdout.split("rule run_scheme:")[1:]
     assert len(jobs) == 2 and all("threads: 2" in job.split("\n\n")[0] for job in jobs)
     config = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
-    settings = Pipeline({**config, "threads": 2}).run_settings("ddfv", 1)
+    settings = Plans({**config, "threads": 2}, SCHEMAS).run_settings("ddfv", 1)
     assert settings["threads"] == 2 and solver_of(settings).threads == 2
-    assert Pipeline(config).run_settings("ddfv", 1)["threads"] == 1
+    assert Plans(config, SCHEMAS).run_settings("ddfv", 1)["threads"] == 1
 
 
 _ONE_STEP = ("import json; from mcfbench.running.run import run; "
@@ -275,7 +332,8 @@ def test_run_jobs_wait_for_one_kernel_compilation(tmp_path, env):
 
 
 SCRIPTS = REPO / "workflow" / "scripts"
-OWN_SCRIPTS = ["compile_kernels", "run_scheme", "beyond_time", "figure", "convergence_table", "plot_convergence",
+OWN_SCRIPTS = ["compile_kernels", "run_scheme", "beyond_run", "figure", "convergence_table",
+               "plot_convergence",
                "beyond_tables", "beyond_plots", "beyond_findings", "report", "report_pdf",
                "check_records"]
 
@@ -292,7 +350,7 @@ def test_scripts_are_thin_adapters_of_the_harness(name):
     local = {p.stem for p in SCRIPTS.glob("*.py")}
     assert not [m for m in imports if m.split(".")[0] in local], imports
     assert any(m.startswith("mcfbench") for m in imports)
-    if name in ("run_scheme", "beyond_time", "figure"):    # jobs that run flows
+    if name in ("run_scheme", "beyond_run", "figure"):    # jobs that run flows
         assert "tune_malloc()" in text
 
 

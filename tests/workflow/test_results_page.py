@@ -25,6 +25,7 @@ from mcfbench.presentation.matrix_page import (
     write_matrix_page,
 )
 from mcfbench.presentation.matrix_tables import read_long_table, read_summary
+from mcfbench.storage.frames import load_frames
 
 pytestmark = pytest.mark.e2e
 
@@ -80,7 +81,7 @@ def page(tmp_path_factory):
     work_precision_figure(table, [figures / "work_precision.png"], problems, schemes)
     quality_figure(list(read_records(runs).values()), [figures / "quality.png"], problems,
                    schemes)
-    entries = {key: (read_record(r), matrix.load_frames(f))
+    entries = {key: (read_record(r), load_frames(f))
                for key, (r, f) in matrix.picture_runs(plan, str(root)).items()}
     picture_grid(entries, [figures / "pictures.png"], problems, schemes)
     size = write_matrix_page(root, root / "index.html", plan)

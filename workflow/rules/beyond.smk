@@ -6,7 +6,8 @@
 #   snakemake --cores 2 beyond --config 'beyond={finest: {schemes: [ddfv-chord]}}'
 #
 # Settings: the config key `beyond` (config/README.md), checked by
-# mcfbench.pipeline.beyond_settings. Four studies, all under results/beyond/
+# mcfbench.studies.beyond.plan when a rule of this file joins the job graph
+# (a bad value stops `snakemake beyond`, not the other targets). Four studies, all under results/beyond/
 # (results/README.md), for any scheme of the registry mcfbench.running.schemes.SCHEMES:
 #
 # - levels: every scheme on every level with tau ~ h^2 as in Table 3.1, and
@@ -20,8 +21,8 @@
 #
 # Runs that break down are records like any other (status, t_failed, the T
 # monitor of every time level reached); the tables show them as such.
-# Settings, record paths and resources: mcfbench.pipeline.Pipeline, through
-# workflow/rules/common.smk (BEYOND, BEYOND_RUNS, beyond_run_settings, ...).
+# Settings, record paths and resources: mcfbench.studies.beyond through
+# mcfbench.pipeline.Plans (PLANS of workflow/rules/common.smk).
 
 BEYOND_TABLE_NAMES = [
     "levels",
@@ -74,7 +75,7 @@ rule beyond_run:
     params:
         settings=beyond_run_settings,
     script:
-        "../scripts/run_scheme.py"
+        "../scripts/beyond_run.py"
 
 
 rule beyond_time:
@@ -97,13 +98,13 @@ rule beyond_time:
     params:
         settings=time_settings,
     script:
-        "../scripts/beyond_time.py"
+        "../scripts/beyond_run.py"
 
 
 rule beyond_records:
     """Check every run record of the beyond study (a bad one stops here: the tables stay)."""
     input:
-        [path for runs in BEYOND_RUNS.values() for path in runs],
+        lambda wildcards: list(PLANS.beyond_records()),
     output:
         "results/beyond/tables/records.json",
     log:
@@ -118,7 +119,7 @@ rule beyond_records:
         mem_mb=500,
         runtime=5,
     params:
-        expected={path: s for runs in BEYOND_RUNS.values() for path, s in runs.items()},
+        expected=lambda wildcards: PLANS.beyond_records(),
     script:
         "../scripts/check_records.py"
 
@@ -127,10 +128,10 @@ rule beyond_tables:
     """The tables of the beyond study and the T monitor series."""
     input:
         checked="results/beyond/tables/records.json",
-        levels=list(BEYOND_RUNS["levels"]),
-        long_time=list(BEYOND_RUNS["long_time"]),
-        space=list(BEYOND_RUNS["space"]),
-        time=list(BEYOND_RUNS["time"]),
+        levels=lambda wildcards: list(PLANS.beyond_runs["levels"]),
+        long_time=lambda wildcards: list(PLANS.beyond_runs["long_time"]),
+        space=lambda wildcards: list(PLANS.beyond_runs["space"]),
+        time=lambda wildcards: list(PLANS.beyond_runs["time"]),
     output:
         **{
             key: (
@@ -159,9 +160,9 @@ rule beyond_tables:
         mem_mb=1000,
         runtime=5,
     params:
-        expected={path: s for runs in BEYOND_RUNS.values() for path, s in runs.items()},
-        beyond=BEYOND,
-        paper_schemes=BEYOND_PAPER_SCHEMES,
+        expected=lambda wildcards: PLANS.beyond_records(),
+        beyond=lambda wildcards: PLANS.beyond,
+        paper_schemes=lambda wildcards: PLANS.paper_schemes(),
         settings={k: config[k] for k in ("tau_level_1", "t_final", "rtol")},
     script:
         "../scripts/beyond_tables.py"
@@ -201,7 +202,7 @@ rule beyond_figures:
         mem_mb=1000,
         runtime=5,
     params:
-        beyond=BEYOND,
+        beyond=lambda wildcards: PLANS.beyond,
         t_final=config["t_final"],
     script:
         "../scripts/beyond_plots.py"
@@ -234,8 +235,8 @@ rule beyond_findings:
         mem_mb=500,
         runtime=5,
     params:
-        beyond=BEYOND,
-        paper_schemes=BEYOND_PAPER_SCHEMES,
+        beyond=lambda wildcards: PLANS.beyond,
+        paper_schemes=lambda wildcards: PLANS.paper_schemes(),
         t_final=config["t_final"],
         tau_level_1=config["tau_level_1"],
     script:

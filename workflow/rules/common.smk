@@ -1,52 +1,44 @@
 # Target lists and input functions shared by the rules. The logic behind them
-# (checks of the config across keys, the settings of every run record, the
-# resources of the jobs) is mcfbench.pipeline.Pipeline: a bad value stops
-# Snakemake here, before any job, with a message naming the config key.
+# is in the study modules (mcfbench.studies.convergence, .beyond), reached
+# through mcfbench.pipeline.Plans: each study's config section is checked
+# (its plan made) when a rule that needs it joins the job graph, so a bad
+# value stops only the targets that use it, with a message naming the key.
 
-from mcfbench.pipeline import Pipeline
+from mcfbench.pipeline import Plans, mem_mb, scheme_pattern
 
-PIPELINE = Pipeline(config)
-LEVELS = PIPELINE.levels
-SCHEMES = PIPELINE.schemes
-# the config key `beyond`, checked and normalised
-BEYOND = PIPELINE.beyond
-THREADS = PIPELINE.threads
-# {study: {record path: settings}} of the beyond study (workflow/rules/beyond.smk)
-BEYOND_RUNS = PIPELINE.beyond_runs()
-# schemes of the beyond study compared with the published Table 3.1 (DDFV family)
-BEYOND_PAPER_SCHEMES = PIPELINE.paper_schemes()
+PLANS = Plans(config, f"{workflow.basedir}/workflow/schemas")
+# the config key `threads` (every run job), checked here
+THREADS = PLANS.threads
 # every compiled kernel in numba's cache before the run jobs (rule compile_kernels)
 KERNELS = "results/logs/kernels.json"
 
 
 def run_settings(wildcards):
-    return PIPELINE.run_settings(wildcards.scheme, wildcards.level)
+    return PLANS.run_settings(wildcards.scheme, wildcards.level)
 
 
 def run_runtime(wildcards):
-    return PIPELINE.run_runtime(wildcards.level)
+    return PLANS.run_runtime(wildcards.level)
 
 
 def run_mem_mb(wildcards):
-    return PIPELINE.mem_mb(wildcards.level)
+    return mem_mb(wildcards.level)
 
 
 def beyond_run_settings(wildcards):
-    return PIPELINE.beyond_run_settings(
-        wildcards.study, wildcards.scheme, wildcards.level
-    )
+    return PLANS.beyond_run_settings(wildcards.study, wildcards.scheme, wildcards.level)
 
 
 def beyond_run_runtime(wildcards):
-    return PIPELINE.beyond_runtime(wildcards.study, wildcards.scheme, wildcards.level)
+    return PLANS.beyond_runtime(wildcards.study, wildcards.scheme, wildcards.level)
 
 
 def time_settings(wildcards):
-    return PIPELINE.time_settings(wildcards.scheme)
+    return PLANS.time_settings(wildcards.scheme)
 
 
 def time_runtime(wildcards):
-    return PIPELINE.time_runtime()
+    return PLANS.time_runtime()
 
 
 TABLES = [
@@ -62,8 +54,8 @@ CONVERGENCE_FIGURES = [
 CONVERGENCE_TARGETS = TABLES + CONVERGENCE_FIGURES
 
 
-# every scheme of the registry has run records on request (the beyond study
-# runs schemes that `schemes` does not list)
+# every scheme of the registry, also as NAME@INTEGRATOR, has run records on
+# request (the beyond study runs schemes that `schemes` does not list)
 wildcard_constraints:
-    scheme=PIPELINE.scheme_pattern(),
+    scheme=scheme_pattern(),
     level=r"[1-9][0-9]*",

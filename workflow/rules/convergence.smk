@@ -7,7 +7,8 @@
 rule convergence:
     """Target: Table 3.1 (CSV, Markdown, LaTeX, provenance) and the convergence figure."""
     input:
-        CONVERGENCE_TARGETS,
+        # the plan first: a bad value of Table 3.1's keys is named here
+        lambda wildcards: PLANS.checked("convergence", CONVERGENCE_TARGETS),
     localrule: True
 
 
@@ -39,7 +40,7 @@ rule run_scheme:
 rule convergence_records:
     """Check every run record of Table 3.1 (a bad one stops here: the tables stay)."""
     input:
-        PIPELINE.run_records(),
+        lambda wildcards: list(PLANS.convergence_records()),
     output:
         "results/tables/convergence.records.json",
     log:
@@ -54,7 +55,7 @@ rule convergence_records:
         mem_mb=500,
         runtime=5,
     params:
-        expected=PIPELINE.expected_runs(),
+        expected=lambda wildcards: PLANS.convergence_records(),
     script:
         "../scripts/check_records.py"
 
@@ -63,7 +64,7 @@ rule convergence_table:
     """Table 3.1 with the paper's values and the baselines side by side."""
     input:
         checked="results/tables/convergence.records.json",
-        records=PIPELINE.run_records(),
+        records=lambda wildcards: list(PLANS.convergence_records()),
     output:
         csv=report(
             "results/tables/convergence.csv",
@@ -86,10 +87,10 @@ rule convergence_table:
         mem_mb=500,
         runtime=5,
     params:
-        expected=PIPELINE.expected_runs(),
-        schemes=SCHEMES,
-        levels=LEVELS,
-        settings=PIPELINE.convergence_settings(),
+        expected=lambda wildcards: PLANS.convergence_records(),
+        schemes=lambda wildcards: PLANS.convergence["schemes"],
+        levels=lambda wildcards: PLANS.convergence["levels"],
+        settings=lambda wildcards: PLANS.table_settings(),
     script:
         "../scripts/convergence_table.py"
 

@@ -1,12 +1,12 @@
 # Figures 3.1-3.8 of the paper (and two comparisons with the cotangent
 # baseline): one job per figure runs its experiment and draws it. What each
 # figure computes (shape, parameters, scheme, tau, steps, panels) is defined
-# in one place, mcfbench/studies/figures.py (EXPERIMENTS); the job is
-# mcfbench.pipeline.figure_job; this file only maps the registry to files.
+# in one place, mcfbench/studies/figure_experiments.py (EXPERIMENTS); the job
+# is mcfbench.studies.figures.job; this file only maps the registry to files.
 #
 #   snakemake --cores 2 results/figures/fig_3_6.png   # one figure
 
-from mcfbench.studies.figures import EXPERIMENTS
+from mcfbench.studies.figure_experiments import EXPERIMENTS
 
 FIGURES = list(EXPERIMENTS)
 
@@ -15,7 +15,7 @@ FIGURES = list(EXPERIMENTS)
 FIGURE_FILES = [
     "results/figures/{figure}.png",
     "results/figures/{figure}.pdf",
-    "results/runs/figures/{figure}.npz",
+    "results/runs/figures/{figure}",
     "results/runs/figures/{figure}.json",
     "results/diagnostics/{figure}.csv",
     "results/diagnostics/{figure}.png",
@@ -30,7 +30,7 @@ wildcard_constraints:
 rule figure:
     """Run the experiment of one figure (mcfbench/studies/figures.py) and draw it.
 
-    Writes the figure, the kept frames, per-step mesh-quality diagnostics
+    Writes the figure, the kept frames (one file per run), per-step mesh-quality diagnostics
     (CSV and plot) and a JSON record with the status of every run. A run
     that breaks down keeps its frames and the job still succeeds; the
     record and a note in the figure say what happened.
@@ -45,7 +45,7 @@ rule figure:
             labels={"figure": "{figure}", "type": "surfaces"},
         ),
         pdf="results/figures/{figure}.pdf",
-        frames="results/runs/figures/{figure}.npz",
+        frames=directory("results/runs/figures/{figure}"),
         record="results/runs/figures/{figure}.json",
         csv="results/diagnostics/{figure}.csv",
         plot=report(

@@ -17,12 +17,12 @@
 # frames/{mesh}/{scheme}.npz (about 20 frames), movies/{mesh}/{scheme}.gif,
 # table.md, table.csv, pictures.png, pictures.pdf.
 
-from mcfbench.studies import gallery as _gallery
-
-GALLERY = _gallery.plan(config.get("gallery"), config.get("meshes"))
+# the plan; without meshes (no runs) when the section `gallery` or `meshes` is
+# bad: then `snakemake gallery` names the bad key (rule gallery)
+GALLERY = PLANS.while_reading("gallery", {"meshes": {}, "generated": {}, "schemes": []})
 GALLERY_SETTINGS = {
     "study": "gallery",
-    **{k: GALLERY[k] for k in ("C", "steps", "solver", "rtol", "maxiter")},
+    **{k: GALLERY.get(k) for k in ("C", "steps", "solver", "rtol", "maxiter")},
     "code": MATRIX_CODE,
 }
 # {record path: settings} of every run

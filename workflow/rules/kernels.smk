@@ -18,7 +18,7 @@ rule compile_kernels:
         runtime=10,
     params:
         # a code change compiles again (the cache is keyed by source file)
-        code=PIPELINE.code,
+        code=PLANS.code,
         threads=THREADS,
     script:
         "../scripts/compile_kernels.py"

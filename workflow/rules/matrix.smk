@@ -5,7 +5,8 @@
 #
 # Settings: the config key `matrix` (config/config.yaml), checked against the
 # registries mcfbench.running.schemes.SCHEMES and mcfbench.running.problems.PROBLEMS by
-# mcfbench.studies.matrix.plan before any job runs. Everything but the rules
+# mcfbench.studies.matrix.plan (after workflow/schemas/matrix.schema.yaml)
+# before any job runs. Everything but the rules
 # is in mcfbench/studies/matrix.py (tables, findings) and mcfbench/presentation/matrix_plots.py.
 #
 # Outputs under results/matrix/:
@@ -21,11 +22,12 @@
 
 from mcfbench.studies import matrix as _matrix
 from mcfbench.pipeline import alternatives as _alternatives
-from mcfbench.storage.provenance import code_hash as _code_hash
 
-MATRIX = _matrix.plan(config.get("matrix"))
+# the plan; without problems (no rules) when the section `matrix` is bad: then
+# `snakemake matrix` names the bad key (rule matrix), the other targets run
+MATRIX = PLANS.while_reading("matrix", {"schemes": [], "problems": {}})
 # a run is redone when the code that computes it changes (not the tables or plots)
-MATRIX_CODE = _code_hash()
+MATRIX_CODE = PLANS.code
 # {record path: settings} of every run
 MATRIX_RUNS = _matrix.planned_runs(MATRIX, MATRIX_CODE)
 

@@ -67,10 +67,9 @@ REPORT_INPUTS = {
     "table": "results/tables/convergence.csv",
     "table_provenance": "results/tables/convergence.csv.json",
     "convergence_figure": "results/figures/convergence.png",
-    "records": PIPELINE.run_records(),
     "figures": expand("results/figures/{figure}.png", figure=FIGURES),
     "figure_records": expand("results/runs/figures/{figure}.json", figure=FIGURES),
-    "frames": expand("results/runs/figures/{figure}.npz", figure=FIGURES),
+    "frames": expand("results/runs/figures/{figure}", figure=FIGURES),
     "diagnostics": expand("results/diagnostics/{figure}.png", figure=FIGURES),
     **REPORT_SOURCES,
 }
@@ -83,6 +82,7 @@ rule reproduction_report:
         unpack(
             lambda wildcards: {
                 **REPORT_INPUTS,
+                "records": list(PLANS.convergence_records()),
                 "beyond": (
                     BEYOND_RESULTS
                     if "beyond"

@@ -3,13 +3,14 @@
 A separate job, so that a bad record stops the pipeline here and the tables
 of the previous good run stay in place (Snakemake removes the outputs of a
 job before it runs it). Writes the checksum of every record
-(:func:`mcfbench.storage.records.read_records`: checksum, schema, stale settings).
+(:func:`mcfbench.storage.records.read_records`: checksum, schema, stale settings;
+the fields of :func:`mcfbench.studies.beyond.record_fields`).
 """
 
-from mcfbench.pipeline import json_text, record_fields
-from mcfbench.storage.atomic import write_files
+from mcfbench.storage.atomic import json_text, write_files
 from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.records import read_records
+from mcfbench.studies.beyond import record_fields
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

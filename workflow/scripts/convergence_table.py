@@ -1,26 +1,13 @@
 """Rule convergence_table: Table 3.1 from the run records (CSV, Markdown, LaTeX, provenance).
 
-Every record is checked first (:func:`mcfbench.storage.records.read_records`: checksum,
-schema, stale settings); one bad record stops the aggregation with a message
-naming the file. The tables are :func:`mcfbench.presentation.convergence_tables.level_table` and
-:func:`mcfbench.presentation.convergence_tables.convergence_documents`; all four files are written
-together (:func:`mcfbench.storage.atomic.write_files`).
+The job is :func:`mcfbench.studies.convergence.aggregate`: every record checked
+first, one bad record stops it with a message naming the file; all four files
+written together.
 """
 
-from mcfbench.pipeline import json_text, record_fields, sidecar
-from mcfbench.presentation.convergence_tables import convergence_documents, level_table
-from mcfbench.storage.atomic import write_files
 from mcfbench.storage.logs import setup_logging
-from mcfbench.storage.records import read_records
+from mcfbench.studies.convergence import aggregate
 
 sm = snakemake  # noqa: F821
-log = setup_logging(sm.log[0])
-settings = dict(sm.params.settings)
-records = read_records(dict(sm.params.expected), log, required=record_fields)
-table = level_table({(r["scheme"], r["level"]): r for r in records.values()},
-                    list(sm.params.schemes), [int(level) for level in sm.params.levels])
-docs = convergence_documents(table, list(sm.params.schemes), settings)
-texts = {str(sm.output[key]): docs[key] for key in ("csv", "md", "tex")}
-provenance = sidecar({"rule": "convergence_table", **settings}, records, texts)
-write_files({**texts, str(sm.output.provenance): json_text(provenance)})
-log.info("wrote %s\n%s", ", ".join(texts), docs["md"])
+aggregate(dict(sm.params.expected), list(sm.params.schemes), list(sm.params.levels),
+          dict(sm.params.settings), sm.output, setup_logging(sm.log[0]))

@@ -14,8 +14,8 @@ from mcfbench.presentation.matrix_plots import (
     work_precision_figure,
 )
 from mcfbench.presentation.matrix_tables import read_long_table
+from mcfbench.storage.frames import load_frames
 from mcfbench.storage.records import read_record, read_records
-from mcfbench.studies.matrix import load_frames
 
 sm = snakemake  # noqa: F821
 logging.basicConfig(filename=sm.log[0], level=logging.INFO, force=True)

@@ -11,7 +11,7 @@ from pathlib import Path
 from mcfbench.presentation.report import build, default_outputs
 from mcfbench.presentation.report_inputs import Sources
 from mcfbench.storage.logs import setup_logging
-from mcfbench.studies.figures import EXPERIMENTS
+from mcfbench.studies.figure_experiments import EXPERIMENTS
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

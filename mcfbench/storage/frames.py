@@ -1,0 +1,65 @@
+"""The one frame-file layout: the kept frames of one run in one ``.npz``.
+
+Keys (every study's frames file, the ``run`` command's ``--out``):
+
+* ``V`` (frames, n, 3): the vertices of a vertex scheme, or ``F`` (frames,
+  n_f, 3) and ``T`` (frames, n_t, 3): the F- and T-vertices of a DDFV scheme
+  (``F`` alone when the scheme refused the surface: the initial surface);
+* ``faces`` (m, 3), ``steps`` (frames,) the time levels kept, ``t`` (frames,)
+  their times;
+* anything else the writer adds (the ``run`` command: status, provenance).
+
+A run whose mesh was refused before any frame (the gallery) has empty
+``faces``, ``steps`` and ``t`` and no vertices. :func:`save_frames` writes
+(atomically, :func:`mcfbench.storage.atomic.save_npz`), :func:`load_frames`
+reads; both check the layout.
+"""
+
+from pathlib import Path
+
+import numpy as np
+
+from mcfbench.storage.atomic import save_npz
+
+REQUIRED = ("faces", "steps", "t")
+"""Keys of every frames file."""
+
+
+def check_frames(arrays, path):
+    """Raise ValueError naming ``path`` unless ``arrays`` has the layout.
+
+    Raises
+    ------
+    ValueError
+        A key of :data:`REQUIRED` missing, or frames (``t`` not empty)
+        without ``V`` or ``F``.
+    """
+    missing = [key for key in REQUIRED if key not in arrays]
+    if missing or (len(arrays["t"]) and not ("V" in arrays or "F" in arrays)):
+        raise ValueError(f"{path}: not a run's frames file: it has {sorted(arrays)}, expected "
+                         f"faces, steps, t and V (or F and T)")
+
+
+def save_frames(path, frames):
+    """Write one run's frames (:func:`check_frames`) atomically to ``path``."""
+    check_frames(frames, path)
+    save_npz(path, **frames)
+
+
+def load_frames(path):
+    """The arrays of one run's frames file as a dict.
+
+    Raises
+    ------
+    ValueError
+        Not readable as ``.npz``, or not the layout (:func:`check_frames`);
+        the message names the file.
+    """
+    path = Path(path)
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {key: data[key] for key in data.files}
+    except (OSError, ValueError) as err:
+        raise ValueError(f"{path}: not a run's .npz ({err})") from None
+    check_frames(arrays, path)
+    return arrays
