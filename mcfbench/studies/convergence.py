@@ -18,6 +18,7 @@ import math
 
 from mcfbench.running.problems import get_problem
 from mcfbench.studies.config import (
+    ConfigError,
     check_rtol,
     check_schemes,
     check_threads,
@@ -40,18 +41,23 @@ def plan(config):
     Returns
     -------
     dict
-        ``levels`` (sorted ints), ``schemes``, ``rtol``, ``threads``,
-        ``tau_level_1``, ``t_final`` (floats).
+        ``levels`` (sorted ints), ``schemes`` (each scheme with every integrator
+        of ``integrators``: ``NAME`` for Euler, ``NAME@INTEGRATOR`` else),
+        ``rtol``, ``threads``, ``tau_level_1``, ``t_final`` (floats).
 
     Raises
     ------
     mcfbench.studies.config.ConfigError
-        An unknown scheme, ``rtol`` outside (0, 1), ``threads`` not a whole
+        An unknown scheme or integrator, ``integrators`` without ``euler``,
+        ``rtol`` outside (0, 1), ``threads`` not a whole
         number >= 1, or a ``t_final`` that is not a whole multiple of every
         level's time step; the message names the key.
     """
+    schemes = check_schemes("schemes", config["schemes"])
+    integrators = check_integrators(config.get("integrators", ["euler"]))
     checked = {"levels": sorted({int(level) for level in config["levels"]}),
-               "schemes": check_schemes("schemes", config["schemes"]),
+               "schemes": [s if i == "euler" else f"{s}@{i}" for i in integrators
+                           for s in schemes],
                "rtol": check_rtol("rtol", config["rtol"]), "threads": check_threads(config),
                "tau_level_1": float(config["tau_level_1"]),
                "t_final": float(config["t_final"])}
@@ -60,6 +66,27 @@ def plan(config):
         checked_steps("'t_final' and 'tau_level_1'", problem, problem.tau(level),
                       problem.t_final, f"the level-{level}")
     return checked
+
+
+def check_integrators(names):
+    """The config key ``integrators``: known names, ``euler`` among them (the paper's
+    step, which the report compares with the published table).
+
+    Raises
+    ------
+    mcfbench.studies.config.ConfigError
+    """
+    from mcfbench.running.integrators import INTEGRATORS
+
+    names = list(names)
+    unknown = [n for n in names if n not in INTEGRATORS]
+    if unknown:
+        raise ConfigError(f"config key 'integrators': unknown integrator(s) {unknown}; "
+                          f"choose from {', '.join(INTEGRATORS)}")
+    if "euler" not in names:
+        raise ConfigError("config key 'integrators': must include euler, the paper's step "
+                          "(the report compares its rows with the published Table 3.1)")
+    return names
 
 
 def problem_of(plan):

@@ -83,3 +83,13 @@ def test_variants_converge_at_second_order_and_are_recorded(scheme):
 def test_unknown_scheme_is_named():
     with pytest.raises(ValueError, match="unknown scheme 'fast'; choose one of ddfv, "):
         sphere_run(1, "fast")
+
+
+def test_integrators_key_adds_the_bdf2_rows_of_every_scheme():
+    from mcfbench.studies.convergence import plan
+
+    config = {"levels": [1, 2], "schemes": ["ddfv", "cotan"], "rtol": 1e-9,
+              "tau_level_1": 0.04, "t_final": 0.08}
+    assert plan(config)["schemes"] == ["ddfv", "cotan"]
+    both = plan({**config, "integrators": ["euler", "bdf2"]})
+    assert both["schemes"] == ["ddfv", "cotan", "ddfv@bdf2", "cotan@bdf2"]

@@ -212,6 +212,9 @@ BAD_CONFIGS = {  # --config value -> expected part of the message
     "rtol=nan": "config key 'rtol': must lie in (0, 1), got nan",
     "threads=0": "schema['properties']['threads']",
     "foo=1": "unknown config key(s) ['foo']; known keys: beyond, gallery,",
+    "integrators=[bdf2]": "config key 'integrators': must include euler",
+    "integrators=[euler,bdf3]": "config key 'integrators': unknown integrator(s) ['bdf3']",
+    "schemes=[ddfv@bdf3]": "config key 'schemes': unknown scheme(s) ['ddfv@bdf3']",
 }
 
 
