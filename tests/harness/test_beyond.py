@@ -403,13 +403,15 @@ def test_default_config_passes_the_schema_and_the_checks():
     validate(config, str(REPO / "workflow" / "schemas" / "config.schema.yaml"))
     settings = Plans(config, SCHEMAS).beyond
     assert settings["levels"] == [1, 2, 3, 4, 5, 6]
-    assert settings["schemes"] == ["ddfv", "ddfv-chord", "ddfv-eliminate", "cotan"]
+    assert settings["schemes"] == ["ddfv", "ddfv-chord", "ddfv-eliminate", "cotan",
+                                   "ddfv@bdf2", "cotan@bdf2"]
+    # the time study: every scheme of the registry with each integrator
+    assert settings["time_study"]["schemes"] == [*SCHEMES, *(f"{s}@bdf2" for s in SCHEMES)]
     assert settings["long_time"]["t_final"] == 0.15 and settings["long_time"]["level"] == 5
     assert settings["time_study"]["taus"] == sorted(settings["time_study"]["taus"],
                                                     reverse=True)
     assert settings["space_study"]["tau"] == pytest.approx(0.04 / 4 ** 6)
-    assert used_schemes(settings)[-1] == "cotan"
-    assert all(s in SCHEMES for s in used_schemes(settings))
+    assert all(s.partition("@")[0] in SCHEMES for s in used_schemes(settings))
     # the level-7 run is off by default
     assert settings["finest"] == {"level": 7, "rtol": 1e-11, "schemes": []}
     assert not [p for p in Plans(config, SCHEMAS).beyond_runs["levels"] if "level7" in p]
