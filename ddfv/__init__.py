@@ -15,7 +15,9 @@ This package is the scheme only: it imports nothing from the harness
 Public API
 ----------
 Flow(vertices, faces, tau, **options)
-    One DDFV flow; ``flow.step(solve)`` advances one time step.
+    One DDFV flow; ``flow.system(at, base, dt)`` is the linear system of one
+    time step with its operators at the state ``at`` (the paper's step:
+    ``flow.system()``), ``flow.advance(X)`` accepts its solution.
 VARIANTS, variant_options(name)
     Named variants of the scheme (paper, chord, eliminate, chord-eliminate,
     redistribute, chord-redistribute, chord-carried, chord-redistribute-carried).

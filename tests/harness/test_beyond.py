@@ -404,7 +404,7 @@ def test_default_config_passes_the_schema_and_the_checks():
     settings = Plans(config, SCHEMAS).beyond
     assert settings["levels"] == [1, 2, 3, 4, 5, 6]
     assert settings["schemes"] == ["ddfv", "ddfv-chord", "ddfv-eliminate", "cotan",
-                                   "ddfv@bdf2", "cotan@bdf2"]
+                                   "ddfv@bdf2", "ddfv-chord@bdf2", "cotan@bdf2"]
     # the time study: every scheme of the registry with each integrator
     assert settings["time_study"]["schemes"] == [*SCHEMES, *(f"{s}@bdf2" for s in SCHEMES)]
     assert settings["long_time"]["t_final"] == 0.15 and settings["long_time"]["level"] == 5
