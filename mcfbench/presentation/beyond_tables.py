@@ -333,6 +333,31 @@ def time_rows(table):
     return header, rows
 
 
+def order_rows(table):
+    """The time table as scheme x integrator: the median order (pointwise and by
+    volume) over the pairs of halved steps, one row per scheme, one column pair per
+    integrator (``NAME@INTEGRATOR`` rows; Euler without ``@``)."""
+    done = table[table["status"] == "ok"]
+    split = done["scheme"].str.partition("@")
+    done = done.assign(base=split[0], integrator=split[2].replace("", "euler"))
+    integrators = list(dict.fromkeys(done["integrator"]))
+    medians = done.groupby(["base", "integrator"], sort=False)[["order", "volume_order"]] \
+        .median()
+    header = ["scheme"] + [f"{i} {kind}" for i in integrators
+                           for kind in ("order", "order (volume)")]
+    rows = []
+    for base in dict.fromkeys(done["base"]):
+        row = [label(base)]
+        for integrator in integrators:
+            if (base, integrator) in medians.index:
+                r = medians.loc[(base, integrator)]
+                row += [fix(r["order"], 2), fix(r["volume_order"], 2)]
+            else:
+                row += [MISSING, MISSING]
+        rows.append(row)
+    return header, rows
+
+
 def space_rows(table, schemes):
     header = ["level", "h", "N"]
     for s in schemes:
@@ -446,7 +471,10 @@ def beyond_documents(tables, beyond, settings, paper_schemes):
                                desc["stability"], [("", stability_rows(stability))],
                                notes["stability"]),
         "time_convergence": _markdown("Convergence in time (fixed mesh)",
-                                      desc["time_convergence"], [("", time_rows(time))],
+                                      desc["time_convergence"], [
+                                          ("Median order by scheme and integrator",
+                                           order_rows(time)),
+                                          ("Every run", time_rows(time))],
                                       notes["time_convergence"]),
         "space_convergence": _markdown("Convergence in space (fixed time step)",
                                        desc["space_convergence"],
@@ -466,6 +494,8 @@ def beyond_documents(tables, beyond, settings, paper_schemes):
                                                  stability_rows(stability))],
                             notes["stability"]),
         "time_convergence": _latex(desc["time_convergence"], [
+            ("Median order in time by scheme and integrator.", "tab:beyond-time-orders",
+             order_rows(time)),
             (f"Convergence in time ({time_labels}).", "tab:beyond-time", time_rows(time))],
             notes["time_convergence"]),
         "space_convergence": _latex(desc["space_convergence"], [

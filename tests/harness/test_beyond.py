@@ -638,3 +638,17 @@ def test_integrator_findings_read_the_orders_and_the_comparison():
             "between the surfaces only: BGN (2.00; pointwise 0.40).") in text
     assert ("cotangent with bdf2 (level 3): L2 0.20 x Euler's at 1.10 x the CPU per step, "
             in text)
+
+
+def test_order_table_has_a_row_per_scheme_and_a_column_pair_per_integrator():
+    from mcfbench.presentation.beyond_tables import order_rows
+    from mcfbench.presentation.formats import MISSING
+
+    rows = [{"scheme": s, "order": o, "volume_order": v, "status": "ok"}
+            for s, o, v in (("cotan", np.nan, np.nan), ("cotan", 1.0, 1.1), ("cotan", 1.2, 1.1),
+                            ("cotan@bdf2", 2.0, 2.0), ("bgn@bdf2", 0.3, 2.1))]
+    header, body = order_rows(pd.DataFrame(rows))
+    assert header == ["scheme", "euler order", "euler order (volume)", "bdf2 order",
+                      "bdf2 order (volume)"]
+    assert body[0] == [SCHEMES["cotan"].label, "1.10", "1.10", "2.00", "2.00"]
+    assert body[1] == [SCHEMES["bgn"].label, MISSING, MISSING, "0.30", "2.10"]
