@@ -27,6 +27,8 @@ Kernels
     the run jobs start.
 """
 
+import hashlib
+import json
 import math
 import re
 import time
@@ -115,6 +117,16 @@ class Plans:
         self.code = code_hash()
         # threads of every run job and of the kernels' job: checked at once
         self.threads = check_threads(config)
+
+    @property
+    def kernels(self):
+        """The output of the kernels' compile job, named by the code it compiled:
+        ``results/logs/kernels/<digest of the code hash>.json``. A code change is a
+        new file, so the run jobs that take it as input wait for the new compilation
+        and run in the same invocation (with the code in the job's params instead,
+        Snakemake reran only the compile job and reported the target done)."""
+        digest = hashlib.sha256(json.dumps(self.code, sort_keys=True).encode()).hexdigest()
+        return f"results/logs/kernels/{digest[:16]}.json"
 
     @cached_property
     def convergence(self):

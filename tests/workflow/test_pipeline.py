@@ -15,6 +15,7 @@ is installed but not running. These local runs do not use Slurm, so a
 """
 
 import json
+import re
 import os
 import shutil
 import subprocess
@@ -331,7 +332,26 @@ def test_run_jobs_wait_for_one_kernel_compilation(tmp_path, env):
     assert out.stdout.count("rule compile_kernels:") == 1
     jobs = [job.split("\n\n")[0] for job in out.stdout.split("rule run_scheme:")[1:]]
     assert len(jobs) == 10
-    assert all("input: results/logs/kernels.json" in job for job in jobs), jobs[0]
+    assert all(re.search(r"input: results/logs/kernels/[0-9a-f]{16}\.json", job)
+               for job in jobs), jobs[0]
+
+
+def test_a_code_change_compiles_and_reruns_in_one_invocation(tmp_path, env):
+    """The kernels' file is named by the code hash: after a change of a scheme's
+    source the dry run plans the compilation and the runs it redoes together."""
+    work = copy_workflow(tmp_path / "work")
+    shutil.copytree(REPO / "baselines", work / "baselines", ignore=IGNORE)  # ours to change
+    env = {**env, "PYTHONPATH": os.pathsep.join([str(work), env["PYTHONPATH"]])}
+    target = ["--cores", "1", "convergence", "--config", "levels=[1]", "schemes=[cotan]"]
+    code, out = snakemake(work, env, *target)
+    assert code == 0, out[-3000:]
+    with open(work / "baselines" / "cotan.py", "a") as source:
+        source.write("\n# a change of the scheme's source\n")
+    dry = subprocess.run([sys.executable, "-m", "snakemake", "-n", *target], cwd=work, env=env,
+                         capture_output=True, text=True, timeout=TIMEOUT)
+    assert dry.returncode == 0, dry.stdout[-2000:]
+    assert dry.stdout.count("rule compile_kernels:") == 1
+    assert dry.stdout.count("rule run_scheme:") == 1      # before: compile_kernels alone
 
 
 SCRIPTS = REPO / "workflow" / "scripts"

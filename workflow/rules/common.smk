@@ -9,8 +9,9 @@ from mcfbench.pipeline import Plans, mem_mb, scheme_pattern
 PLANS = Plans(config, f"{workflow.basedir}/workflow/schemas")
 # the config key `threads` (every run job), checked here
 THREADS = PLANS.threads
-# every compiled kernel in numba's cache before the run jobs (rule compile_kernels)
-KERNELS = "results/logs/kernels.json"
+# every compiled kernel in numba's cache before the run jobs (rule compile_kernels),
+# one file per version of the code
+KERNELS = PLANS.kernels
 
 
 def run_settings(wildcards):

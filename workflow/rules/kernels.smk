@@ -1,7 +1,9 @@
 # Every compiled (numba) kernel into numba's cache once, before the run jobs:
 # the rules that run schemes take KERNELS (common.smk) as an `ancient` input,
 # so a fresh clone's first pipeline run compiles once instead of once per
-# job, and a rerun of this rule alone does not rerun them.
+# job, and a rerun of this rule alone does not rerun them. KERNELS is named by
+# the code hash: a code change compiles again, in the same invocation as the
+# runs it redoes.
 rule compile_kernels:
     """Compile every scheme's and the solver's kernels once, before the run jobs."""
     output:
@@ -17,8 +19,6 @@ rule compile_kernels:
         mem_mb=500,
         runtime=10,
     params:
-        # a code change compiles again (the cache is keyed by source file)
-        code=PLANS.code,
         threads=THREADS,
     script:
         "../scripts/compile_kernels.py"
