@@ -25,6 +25,7 @@ from mcfbench.presentation.formats import (
     tex_inline,
     tex_table,
 )
+from mcfbench.running.schemes import split_name
 
 MONITOR_COLUMNS = ["t_reached", "t_monitor_start", "t_monitor_end", "t_exit"]
 
@@ -178,8 +179,8 @@ def integrator_table(levels):
     rows = []
     done = levels[levels["status"] == "ok"]
     for name in dict.fromkeys(levels["scheme"]):
-        base, _, integrator = name.partition("@")
-        if not integrator or base not in set(levels["scheme"]):
+        base, integrator = split_name(name)
+        if name == base or base not in set(levels["scheme"]):
             continue
         euler = done[done["scheme"] == base].set_index("level")
         other = done[done["scheme"] == name].set_index("level")
@@ -338,8 +339,9 @@ def order_rows(table):
     volume) over the pairs of halved steps, one row per scheme, one column pair per
     integrator (``NAME@INTEGRATOR`` rows; Euler without ``@``)."""
     done = table[table["status"] == "ok"]
-    split = done["scheme"].str.partition("@")
-    done = done.assign(base=split[0], integrator=split[2].replace("", "euler"))
+    parts = [split_name(name) for name in done["scheme"]]
+    done = done.assign(base=[base for base, _ in parts],
+                       integrator=[integrator for _, integrator in parts])
     integrators = list(dict.fromkeys(done["integrator"]))
     medians = done.groupby(["base", "integrator"], sort=False)[["order", "volume_order"]] \
         .median()

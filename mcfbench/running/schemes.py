@@ -22,7 +22,6 @@ from dataclasses import dataclass, field, replace
 
 from mcfbench.running.integrators import INTEGRATORS
 
-
 MATRICES = {
     "nonsymmetric": "BiCGStab (the paper's) or a sparse LU (`direct`): the matrix is not "
                     "symmetric, nor a diagonal scaling of a symmetric one",
@@ -165,6 +164,19 @@ SCHEMES = {s.name: s for s in (
 """Scheme name -> :class:`Scheme`."""
 
 
+def split_name(name):
+    """``(registry name, integrator)`` of a scheme name: ``"cotan@bdf2"`` ->
+    ``("cotan", "bdf2")``, ``"cotan"`` -> ``("cotan", "euler")``."""
+    base, _, integrator = name.partition("@")
+    return base, integrator or "euler"
+
+
+def joined_name(base, integrator):
+    """The scheme name of ``base`` stepped by ``integrator`` (:func:`split_name`'s
+    inverse): ``base`` itself for Euler, else ``base@integrator``."""
+    return base if integrator == "euler" else f"{base}@{integrator}"
+
+
 def get_scheme(name, registry=None):
     """The registry entry ``name``, or ``<name>@<integrator>``: that entry stepped by
     another integrator (its label says which; hollow markers).
@@ -181,12 +193,12 @@ def get_scheme(name, registry=None):
         Unknown name or integrator, listing the known ones.
     """
     registry = SCHEMES if registry is None else registry
-    base, at, integrator = name.partition("@")
+    base, integrator = split_name(name)
     if base not in registry:
         raise ValueError(f"unknown scheme {name!r}; choose one of "
                          f"{', '.join(registry)} (or NAME@INTEGRATOR)")
     entry = registry[base]
-    if not at:
+    if name == base:
         return entry
     if integrator not in INTEGRATORS:
         raise ValueError(f"unknown integrator {integrator!r} in scheme {name!r}; choose one "

@@ -382,13 +382,13 @@ def findings(levels, stability, schemes, paper, time=None, integrators=None):
 def _time_orders(time):
     """``time_orders`` of :func:`findings`."""
     from mcfbench.running.integrators import INTEGRATORS
+    from mcfbench.running.schemes import split_name
 
     verdict = {}
     if time is None:
         return verdict
     for scheme, part in time[time["status"] == "ok"].groupby("scheme", sort=False):
-        base, _, name = scheme.partition("@")
-        name = name or "euler"
+        base, name = split_name(scheme)
         order = INTEGRATORS[name].order
         point, volume = float(part["order"].median()), float(part["volume_order"].median())
         verdict.setdefault(name, (order, []))[1].append(

@@ -17,6 +17,7 @@ line's ``sphere-table``).
 import math
 
 from mcfbench.running.problems import get_problem
+from mcfbench.running.schemes import joined_name
 from mcfbench.studies.config import (
     ConfigError,
     check_rtol,
@@ -56,8 +57,7 @@ def plan(config):
     schemes = check_schemes("schemes", config["schemes"])
     integrators = check_integrators(config.get("integrators", ["euler"]))
     checked = {"levels": sorted({int(level) for level in config["levels"]}),
-               "schemes": [s if i == "euler" else f"{s}@{i}" for i in integrators
-                           for s in schemes],
+               "schemes": [joined_name(s, i) for i in integrators for s in schemes],
                "rtol": check_rtol("rtol", config["rtol"]), "threads": check_threads(config),
                "tau_level_1": float(config["tau_level_1"]),
                "t_final": float(config["t_final"])}

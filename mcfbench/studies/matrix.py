@@ -116,7 +116,7 @@ def plan(section=None, schemes=None, problems=None):
     """
     from mcfbench.running import solver as _solver
     from mcfbench.running.integrators import INTEGRATORS
-    from mcfbench.running.schemes import find_scheme
+    from mcfbench.running.schemes import find_scheme, joined_name
 
     if schemes is None:
         from mcfbench.running.schemes import SCHEMES as schemes
@@ -133,7 +133,7 @@ def plan(section=None, schemes=None, problems=None):
             raise ConfigError(f"config key 'matrix.with_integrators': unknown integrator "
                               f"{integrator!r}; choose one of "
                               f"{', '.join(i for i in INTEGRATORS if i != 'euler')}")
-        chosen = [*chosen, *(f"{name}@{integrator}" for name in names)]
+        chosen = [*chosen, *(joined_name(name, integrator) for name in names)]
     unknown = [s for s in chosen if find_scheme(s, schemes) is None]
     if unknown:
         raise ConfigError(f"config key 'matrix.schemes': unknown scheme(s) {unknown}; the "

@@ -109,3 +109,13 @@ def test_unknown_matrix_kind_is_refused():
 
     with pytest.raises(ValueError, match="unknown matrix kind 'spd'"):
         Scheme("x", "x", "baselines.cotan:CotanFlow", matrix="spd")
+
+
+@pytest.mark.parametrize("name, parts", [("cotan", ("cotan", "euler")),
+                                         ("cotan@bdf2", ("cotan", "bdf2"))])
+def test_scheme_names_split_and_join_back(name, parts):
+    from mcfbench.running.schemes import joined_name, split_name
+
+    assert split_name(name) == parts
+    assert joined_name(*parts) == name
+    assert get_scheme(name).integrator == parts[1]
