@@ -361,17 +361,46 @@ def flipped_triangles(vertices, faces, reference_normals=None, neighbours=None):
     V, F = _mesh(vertices, faces)
     N = triangle_normals(V, F)
     if reference_normals is None:
-        t1, t2 = edge_neighbours(F) if neighbours is None else neighbours
-        reference = np.column_stack([
-            np.bincount(t1, N[t2, c], minlength=len(F)) + np.bincount(t2, N[t1, c],
-                                                                     minlength=len(F))
-            for c in range(3)])
+        reference = _neighbour_normals(N, F, neighbours)
     else:
         reference = np.asarray(reference_normals, dtype=float)
         if reference.shape != N.shape:
             raise ValueError(f"reference_normals must have shape {N.shape} (one per "
                              f"triangle), got {reference.shape}")
     return int((np.einsum("ij,ij->i", N, reference) < 0).sum())
+
+
+def neighbour_cosines(vertices, faces, neighbours=None):
+    """(m,) cosine of the angle between each triangle's normal and the sum of the
+    normals of its edge-neighbours (their area-weighted mean normal).
+
+    Negative for a triangle folded over its neighbours (the test of
+    :func:`flipped_triangles`); NaN for a degenerate triangle or neighbours whose
+    normals cancel.
+
+    Examples
+    --------
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
+    >>> neighbour_cosines(V, [[0, 1, 2], [1, 3, 2]]).tolist()
+    [1.0, 1.0]
+    >>> neighbour_cosines(V, [[0, 1, 2], [1, 2, 3]]).tolist()
+    [-1.0, -1.0]
+    """
+    V, F = _mesh(vertices, faces)
+    N = triangle_normals(V, F)
+    R = _neighbour_normals(N, F, neighbours)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.einsum("ij,ij->i", N, R) / (np.linalg.norm(N, axis=1)
+                                              * np.linalg.norm(R, axis=1))
+
+
+def _neighbour_normals(N, F, neighbours):
+    """(m, 3) sum of the normals ``N`` of each triangle's edge-neighbours."""
+    t1, t2 = edge_neighbours(F) if neighbours is None else neighbours
+    return np.column_stack([
+        np.bincount(t1, N[t2, c], minlength=len(F)) + np.bincount(t2, N[t1, c],
+                                                                 minlength=len(F))
+        for c in range(3)])
 
 
 def quality(vertices, faces, neighbours=None):

@@ -3,9 +3,12 @@
 :func:`simulate` steps a :class:`~mcfbench.running.flow.Flow` with the shared
 linear solver, checks every state it reaches (the initial one included)
 through :class:`mcfbench.geometry.collapse.CollapseCheck` (a component shrunk to a
-point or a line, before the scheme assembles a matrix on it) and
-:meth:`Flow.defects`, calls observers at every time level and keeps
-frames. Every way a run can end is one :class:`~mcfbench.running.flow.FlowBreakdown`
+point or a line, before the scheme assembles a matrix on it),
+:meth:`Flow.defects` (what the scheme knows is wrong with its state) and
+:class:`mcfbench.geometry.invariants.FlowInvariants` (what every mean
+curvature flow must do: the area never grows, the mesh does not fold; a
+solver failure on a mesh whose quality collapsed is the mesh's verdict),
+calls observers at every time level and keeps frames. Every way a run can end is one :class:`~mcfbench.running.flow.FlowBreakdown`
 with one message format, ``"{status} at step {n} (t = {t}): {detail}"``.
 """
 
@@ -15,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mcfbench.geometry.collapse import CollapseCheck
+from mcfbench.geometry.invariants import FlowInvariants
 from mcfbench.running.flow import FlowBreakdown
 from mcfbench.running.integrators import get_integrator
 from mcfbench.running.solver import Solver, SolverFailure
@@ -97,7 +101,7 @@ class _NoBar:
 
 def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrapolate",
              save_every=1, observers=(), on_defect="stop", until=None, progress=False,
-             collapse=True):
+             collapse=True, invariants=True):
     """Step ``flow`` ``steps`` times.
 
     Parameters
@@ -138,6 +142,15 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
         (:class:`mcfbench.geometry.collapse.CollapseCheck`): status
         ``degenerated`` naming the component. It ends the run in both
         ``on_defect`` modes (there is no surface left to step).
+    invariants : bool
+        Check every state of the mesh (``flow.vertices``, ``flow.faces``)
+        against what mean curvature flow must do
+        (:class:`mcfbench.geometry.invariants.FlowInvariants`): the area may not
+        grow (``area_grew``) and no triangle may fold that was not folded at
+        step 0 (``inverted``); these are defects like the scheme's own. A
+        solver failure on a mesh whose smallest angle collapsed ends the run
+        as ``degenerated`` (the mesh's verdict), naming the angle and since
+        when. Off only for toy flows that are not mean curvature flows.
 
     Returns
     -------
@@ -155,6 +168,7 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
     frames, steps_kept, iterations, defects = [], [], [], []
     seen = set()
     collapsed = CollapseCheck(flow.vertices, flow.faces) if collapse else None
+    invariant = FlowInvariants(flow.vertices, flow.faces) if invariants else None
 
     def save():
         steps_kept.append(flow.n)
@@ -168,7 +182,10 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
             defects.append({"status": "degenerated", "step": flow.n,
                             "time": flow.n * flow.tau, "detail": detail})
             raise FlowBreakdown("degenerated", flow.n, flow.n * flow.tau, detail)
-        for status, detail in flow.defects():
+        found = flow.defects()
+        if invariant is not None:
+            found = [*found, *invariant(flow.vertices, flow.n)]
+        for status, detail in found:
             if status in seen:
                 continue
             seen.add(status)
@@ -202,9 +219,13 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
                     info = stepper.step(flow, solver)
                 except SolverFailure as err:
                     step = flow.n + 1
-                    defects.append({"status": err.status, "step": step,
-                                    "time": step * flow.tau, "detail": str(err)})
-                    raise FlowBreakdown(err.status, step, step * flow.tau, str(err)) from None
+                    status, detail = err.status, str(err)
+                    collapse = invariant.quality_collapse() if invariant is not None else None
+                    if collapse is not None:
+                        status, detail = "degenerated", f"{collapse}; then {detail}"
+                    defects.append({"status": status, "step": step,
+                                    "time": step * flow.tau, "detail": detail})
+                    raise FlowBreakdown(status, step, step * flow.tau, detail) from None
                 iterations.append(info.iterations)
                 check()
             except FlowBreakdown as err:

@@ -11,21 +11,30 @@ Statuses
 ``solver_stagnated``
     The residual stopped decreasing above the tolerance.
 ``degenerated``
-    Non-finite coordinates or collapsed cells (diamonds, triangles), or a
+    Non-finite coordinates or collapsed cells (diamonds, triangles), a
     connected component that shrank to a point or a line (the driver's check
-    before every solve, :mod:`mcfbench.geometry.collapse`).
+    before every solve, :mod:`mcfbench.geometry.collapse`), or a linear solver
+    that failed on a mesh whose smallest angle had collapsed
+    (:meth:`mcfbench.geometry.invariants.FlowInvariants.quality_collapse`: the
+    mesh's verdict, not the solver's).
 ``t_escaped``
     A T-vertex left its triangle (DDFV, Section 2.2.2 of the paper): its
     projection onto the plane of the triangle has a negative barycentric
     coordinate.
 ``inverted``
-    A triangle's normal flipped against its neighbours (the surface folded).
+    A triangle's normal flipped against its neighbours (the surface folded):
+    checked on the mesh of every scheme by the driver
+    (:mod:`mcfbench.geometry.invariants`).
+``area_grew``
+    The area of the mesh grew beyond a measured tolerance above its smallest
+    earlier value: mean curvature flow never increases the area
+    (:mod:`mcfbench.geometry.invariants`).
 ``unsupported``
     The scheme refused the input (e.g. a surface with boundary for a scheme
     that has none); nothing was computed.
 """
 
 STATUSES = ("ok", "solver_failed", "solver_breakdown", "solver_stagnated", "degenerated",
-            "t_escaped", "inverted", "unsupported")
+            "t_escaped", "inverted", "area_grew", "unsupported")
 SOLVER_STATUSES = ("solver_failed", "solver_breakdown", "solver_stagnated")
-STATE_STATUSES = ("degenerated", "t_escaped", "inverted")
+STATE_STATUSES = ("degenerated", "t_escaped", "inverted", "area_grew")

@@ -44,6 +44,7 @@ class Decay:
 
 
 V0 = np.arange(12.0).reshape(4, 3) + 1.0
+V0[:, 2] **= 2        # not collinear: the two triangles have an area, which shrinks
 FACES = np.array([[0, 1, 2], [0, 2, 3]])
 
 

@@ -1,0 +1,238 @@
+"""What every mean curvature flow must do, checked on every state of every run.
+
+Mean curvature flow is the gradient flow of the area: on a closed surface,
+and on one whose boundary is held fixed,
+
+    d|Gamma| / dt = - int_Gamma H^2  <=  0,
+
+so the area never grows; and a flow of an embedded surface does not fold
+it over itself. A discrete flow that violates either has stopped being a
+mean curvature flow, whatever its solver says: a tangential motion added
+explicitly can make the area grow tenfold while every linear solve
+converges. :class:`FlowInvariants` checks both on the mesh of every state
+(the mesh vertices of every scheme, DDFV's F-vertices included), for every
+scheme of the registry and any added later, through the driver
+(:func:`mcfbench.running.driver.simulate`):
+
+``area_grew``
+    The area of the mesh exceeds the smallest area of the earlier states by
+    more than :data:`AREA_TOL` of it.
+``inverted``
+    A triangle's normal points against the mean normal of its
+    edge-neighbours (:func:`mcfbench.geometry.metrics.neighbour_cosines`)
+    and did not at step 0.
+
+It also follows the smallest angle of the mesh, so that a linear solver
+that fails on a mesh whose quality collapsed is reported as the mesh's
+verdict (:meth:`FlowInvariants.quality_collapse`), not the solver's.
+
+Why the tolerance is what it is: Dziuk's cotangent scheme and BGN's scheme
+decrease the discrete area unconditionally (Dziuk 1991; Barrett, Garcke,
+Nuernberg 2008, Theorem 2.1), but DDFV's mesh of F-vertices is not the
+surface whose energy its scheme decreases, and second-order time stepping
+gives no such estimate. ``benchmarks/area_fluctuation.py`` measures the
+largest growth of the area over its running minimum of every scheme of the
+registry, with both integrators, on the problems with an exact or
+reference answer (levels 1-2): it is at most 1.6e-4 (the paper's DDFV
+schemes on the catenoid near its steady state); every other run's area
+decreases to round-off. :data:`AREA_TOL` is six times that, and a hundred
+times below the smallest growth of the broken runs that motivated the
+check (a factor 2.5).
+"""
+
+import numpy as np
+
+from mcfbench.geometry.metrics import edge_neighbours, neighbour_cosines
+
+AREA_TOL = 1e-3
+"""Largest relative growth of the area over its smallest earlier value."""
+
+ANGLE_COLLAPSE = 0.1
+"""The mesh's quality has collapsed when its smallest angle is below this fraction of
+its initial smallest angle and below :data:`ANGLE_FLOOR`."""
+
+ANGLE_FLOOR = 1.0
+"""Degrees: a smallest angle above this never counts as a collapse."""
+
+
+class FlowInvariants:
+    """The invariant checks of one flow: its initial mesh, the smallest area so far.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+        The initial state's mesh vertices.
+    faces : (m, 3) int array
+        Consistently oriented triangles.
+    area_tol : float
+        :data:`AREA_TOL`.
+
+    Examples
+    --------
+    >>> from mcfbench.geometry.spheres import icosphere
+    >>> V, F = icosphere(1)
+    >>> check = FlowInvariants(V, F)
+    >>> check(0.9 * V, 1)
+    []
+    >>> [(status, detail)] = check(V, 2)
+    >>> status
+    'area_grew'
+    >>> print(detail)
+    the area grew to 11.7 at step 2, 0.235 above its smallest value 9.45 (step 1): mean curvature flow never increases the area (tolerance 0.001)
+    """
+
+    def __init__(self, vertices, faces, *, area_tol=AREA_TOL):
+        self.faces = np.asarray(faces, dtype=np.int64)
+        self.area_tol = float(area_tol)
+        self.neighbours = tuple(np.asarray(t, dtype=np.int64)
+                                for t in edge_neighbours(self.faces))
+        V = np.asarray(vertices, dtype=float)
+        self._work = np.empty((3, len(self.faces), 3))
+        self.folded0 = ~(neighbour_cosines(V, self.faces, self.neighbours) >= 0.0)
+        self._skip = self.folded0.astype(np.uint8)
+        area, angle, _ = self.measure(V)
+        self.smallest_area, self.smallest_area_step = area, 0
+        self.angle0 = self.angle = angle
+        self.angle_step = 0
+        self.collapsed_since = None
+
+    @property
+    def angle_threshold(self):
+        """Degrees below which the smallest angle counts as collapsed."""
+        return min(ANGLE_FLOOR, ANGLE_COLLAPSE * self.angle0)
+
+    def __call__(self, vertices, step):
+        """The invariants the state ``vertices`` of time level ``step`` violates.
+
+        Returns
+        -------
+        list of (status, detail)
+            ``status`` ``"inverted"`` or ``"area_grew"``; ``detail`` names the
+            triangle or the growth. Empty for a state that keeps both.
+        """
+        V = np.asarray(vertices, dtype=float)
+        area, self.angle, folded = self.measure(V)
+        self.angle_step = int(step)
+        if not self.angle >= self.angle_threshold:
+            if self.collapsed_since is None:
+                self.collapsed_since = int(step)
+        else:
+            self.collapsed_since = None
+        violations = []
+        if folded:
+            violations.append(("inverted", self._folded(V)))
+        if area > self.smallest_area * (1.0 + self.area_tol):
+            growth = area / self.smallest_area - 1.0 if self.smallest_area > 0 else np.inf
+            violations.append(("area_grew", (
+                f"the area grew to {area:.3g} at step {int(step)}, {growth:.3g} above its "
+                f"smallest value {self.smallest_area:.3g} (step {self.smallest_area_step}): "
+                f"mean curvature flow never increases the area (tolerance {self.area_tol:g})")))
+        elif area < self.smallest_area:
+            self.smallest_area, self.smallest_area_step = area, int(step)
+        return violations
+
+    def measure(self, vertices):
+        """Area, smallest angle (degrees) and the number of triangles folded that
+        were not at step 0, of the state ``vertices`` (n, 3): one compiled pass over
+        the triangles and one over the pairs of edge-neighbours."""
+        V = np.ascontiguousarray(vertices, dtype=np.float64)
+        area, tangent, folded = _kernel()(V, self.faces, *self.neighbours, self._skip,
+                                          self._work)
+        return float(area), float(np.degrees(np.arctan(tangent))), int(folded)
+
+    def _folded(self, V):
+        """The sentence on the triangles folded now and not at step 0."""
+        cosine = neighbour_cosines(V, self.faces, self.neighbours)
+        folded = np.flatnonzero(~(cosine >= 0.0) & ~self.folded0)
+        worst = int(folded[np.argmin(cosine[folded])])
+        return (f"triangle {worst} folded against its neighbours (cosine "
+                f"{cosine[worst]:.3g} with their mean normal; {len(folded)} triangle(s) "
+                "folded that were not at step 0)")
+
+    def quality_collapse(self):
+        """The sentence on a collapsed mesh quality of the last state checked, or None.
+
+        The smallest angle counts as collapsed below :attr:`angle_threshold`
+        (:data:`ANGLE_COLLAPSE` times the initial one, at most :data:`ANGLE_FLOOR`
+        degrees); the sentence says since when.
+        """
+        if self.collapsed_since is None:
+            return None
+        return (f"the mesh degenerated: smallest angle {self.angle:.3g} degrees at step "
+                f"{self.angle_step} ({self.angle0:.3g} at step 0), below "
+                f"{self.angle_threshold:.3g} since step {self.collapsed_since}")
+
+
+_KERNEL = None
+
+
+def _kernel():
+    """The compiled passes of :meth:`FlowInvariants.measure` (numba imported and the
+    kernel loaded from its cache on first use)."""
+    global _KERNEL
+    if _KERNEL is not None:
+        return _KERNEL
+    import numba
+
+    @numba.njit(cache=True, nogil=True, error_model="numpy")
+    def invariants_kernel(V, F, t1, t2, skip, work):
+        """Total area; the smallest tangent of the smallest angles of the triangles
+        (the smallest angle of a triangle, opposite its shortest side, is at most 60
+        degrees, so its tangent ``|u x v| / (u . v)`` is increasing in it); the
+        number of triangles ``t`` with ``skip[t] == 0`` whose normal ``n_t = (b - a) x
+        (c - a)`` has ``n_t . sum_s n_s < 0`` over its edge-neighbours ``s``
+        (``work[0]``: the normals, ``work[1]``, ``work[2]``: the sums). NaN
+        propagates to the area and the tangent."""
+        m = F.shape[0]
+        N = work[0]
+        R = work[1]
+        S = work[2]
+        area = 0.0
+        tangent = np.inf
+        for t in range(m):
+            i0, i1, i2 = F[t, 0], F[t, 1], F[t, 2]
+            a0, a1, a2 = V[i1, 0] - V[i0, 0], V[i1, 1] - V[i0, 1], V[i1, 2] - V[i0, 2]
+            b0, b1, b2 = V[i2, 0] - V[i1, 0], V[i2, 1] - V[i1, 1], V[i2, 2] - V[i1, 2]
+            c0, c1, c2 = V[i0, 0] - V[i2, 0], V[i0, 1] - V[i2, 1], V[i0, 2] - V[i2, 2]
+            # n = (x1 - x0) x (x2 - x0) = a x (-c)
+            n0 = c1 * a2 - c2 * a1
+            n1 = c2 * a0 - c0 * a2
+            n2 = c0 * a1 - c1 * a0
+            N[t, 0] = n0
+            N[t, 1] = n1
+            N[t, 2] = n2
+            twice = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+            area += 0.5 * twice
+            la = a0 * a0 + a1 * a1 + a2 * a2
+            lb = b0 * b0 + b1 * b1 + b2 * b2
+            lc = c0 * c0 + c1 * c1 + c2 * c2
+            # the two sides at the smallest angle: the two longest
+            if lb <= la and lb <= lc:
+                dot = -(a0 * c0 + a1 * c1 + a2 * c2)     # corner 0: a and -c
+            elif lc <= la:
+                dot = -(a0 * b0 + a1 * b1 + a2 * b2)     # corner 1: -a and b
+            else:
+                dot = -(b0 * c0 + b1 * c1 + b2 * c2)     # corner 2: -b and c
+            tan = twice / dot if dot > 0 else (0.0 if twice == twice else twice)
+            if tangent == tangent and (tan < tangent or tan != tan):
+                tangent = tan
+        R[:, :] = 0.0
+        S[:, :] = 0.0
+        for k in range(t1.shape[0]):
+            p, q = t1[k], t2[k]
+            R[p, 0] += N[q, 0]
+            R[p, 1] += N[q, 1]
+            R[p, 2] += N[q, 2]
+            S[q, 0] += N[p, 0]
+            S[q, 1] += N[p, 1]
+            S[q, 2] += N[p, 2]
+        folded = 0
+        for t in range(m):
+            d = N[t, 0] * (R[t, 0] + S[t, 0]) + N[t, 1] * (R[t, 1] + S[t, 1]) \
+                + N[t, 2] * (R[t, 2] + S[t, 2])
+            if d < 0 and skip[t] == 0:
+                folded += 1
+        return area, tangent, folded
+
+    _KERNEL = invariants_kernel
+    return _KERNEL
