@@ -15,9 +15,9 @@
 
 import os
 
-from snakemake.utils import min_version, validate
+from snakemake.utils import min_version
 
-from mcfbench.pipeline import check_keys
+from mcfbench.pipeline import check_config, message_only
 
 # One BLAS thread per job, set once here: every job inherits it (local or
 # Slurm), before any of them imports numpy. The jobs' run records store these
@@ -32,8 +32,9 @@ min_version("9.0")
 configfile: "config/config.yaml"
 
 
-check_keys(config, "workflow/schemas/config.schema.yaml")
-validate(config, "workflow/schemas/config.schema.yaml")
+# a bad value ends Snakemake with one message naming the key, no traceback
+with message_only():
+    check_config(config, "workflow/schemas/config.schema.yaml")
 
 
 report: "workflow/report/workflow.rst"

@@ -36,6 +36,19 @@ from mcfbench.storage.atomic import check_writable, write_json
 from mcfbench.storage.frames import save_frames
 from mcfbench.storage.memory import tune_malloc
 from mcfbench.storage.provenance import provenance
+from mcfbench.storage.records import FIELDS
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser, with a short error: one usage line (the positional
+    arguments, no option list), the message, and where the options are."""
+
+    def error(self, message):
+        words = [a.dest.upper() + (" ..." if a.nargs == argparse.PARSER else "")
+                 for a in self._actions if not a.option_strings]
+        self.exit(2, f"usage: {self.prog} [options] {' '.join(words)}\n"
+                     f"{self.prog}: error: {message}\n"
+                     f"see `{self.prog} --help`\n")
 
 
 def _positive_float(text):
@@ -90,7 +103,7 @@ def _common(parser, default_solver):
 
 
 def build_parser():
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="python -m mcfbench",
         description="Benchmark of mean curvature flow schemes (DDFV and baselines).")
     commands = parser.add_subparsers(dest="command", required=True)
@@ -116,8 +129,9 @@ def build_parser():
     step.add_argument("--tau-edge", type=_positive_float, metavar="C",
                       help="time step C * (mean edge length)^2")
     flow.add_argument("--steps", type=_level, required=True, help="number of time steps")
-    flow.add_argument("--save-every", type=_count, default=1,
-                      help="keep every K-th step as a frame (0: first and last only)")
+    flow.add_argument("--save-every", type=_count, default=1, metavar="K",
+                      help="keep every K-th step as a frame (default: 1, every step; "
+                           "0: first and last only)")
     flow.add_argument("--out", type=Path, required=True,
                       help="output file: .npz (the frames and the run's data) or .pvd (a "
                            "ParaView collection, one .vtu per frame in the folder OUT/)")
@@ -151,8 +165,12 @@ def main(argv=None):
     tune_malloc()
     try:
         return COMMANDS[args.command](args)
-    except (ValueError, FileNotFoundError) as err:
+    except ValueError as err:
         print(f"error: {err}", file=sys.stderr)
+        return 2
+    except OSError as err:          # "FILE: Permission denied", not "[Errno 13] ..."
+        text = f"{err.filename}: {err.strerror}" if err.filename and err.strerror else err
+        print(f"error: {text}", file=sys.stderr)
         return 2
 
 
@@ -205,6 +223,7 @@ def _sphere_table(args):
 
 
 def _study(args):
+    from mcfbench.presentation.matrix_tables import is_error
     from mcfbench.running.run import level_sweep
 
     scheme, problem = _scheme(args), get_problem(args.problem)
@@ -212,10 +231,12 @@ def _study(args):
         check_writable(args.csv)
     table = level_sweep(scheme.name, problem, args.levels, progress=_terminal(),
                         **_options(args, scheme))
+    metrics = [c for c in table.columns if c not in FIELDS and not c.startswith("eoc_")]
+    # an order of convergence only of an error (its exact value zero), as in the matrix
+    table = table.drop(columns=[f"eoc_{m}" for m in metrics if not is_error(m)])
     columns = ["level", "nV", "h", "tau", "N", "steps_done", "status",
-               *[c for c in table.columns if c.startswith("eoc_")],
-               *[c for c in table.columns if c not in _NOT_METRICS and
-                 not c.startswith("eoc_")], "iterations", "min_angle", "cpu_seconds"]
+               *[c for c in table.columns if c.startswith("eoc_")], *metrics,
+               "iterations", "min_angle", "cpu_seconds"]
     print(f"{scheme.label} on {problem.label} ({problem.exact})")
     print(table[list(dict.fromkeys(columns))].to_string(index=False, float_format="%.4g"))
     if args.csv:
@@ -223,12 +244,6 @@ def _study(args):
                                      "levels": args.levels})
     _print_failures(table)
     return 0 if (table["status"] == "ok").all() else 1
-
-
-_NOT_METRICS = {"scheme", "problem", "level", "nV", "nF", "nT", "h", "tau", "N", "steps_done",
-                "status", "message", "t_failed", "t_end", "steady", "iterations", "solver",
-                "cpu_seconds", "wall_seconds", "t_min_barycentric", "min_angle", "max_aspect",
-                "max_flipped"}
 
 
 def _write_csv(path, table, config):
@@ -333,15 +348,23 @@ def _run(args):
 
 
 def _export(args):
-    from mcfbench.presentation.paraview_export import export_file, load_frames_file
+    from mcfbench.presentation.paraview_export import (
+        RUN_KEYS,
+        export_file,
+        load_frames_file,
+        run_provenance,
+    )
 
     check_writable(args.out)
     if args.out.suffix == ".gif":
         from mcfbench.presentation.movie import write_movie
 
         arrays = load_frames_file(args.source)
-        scheme = str(arrays["scheme"]) if "scheme" in arrays else args.source.parent.name
-        write_movie(arrays, args.out, title=f"{scheme}: {args.source.name}")
+        # the status as the .pvd export reads it: the .npz's own, or its record's
+        run = run_provenance(arrays, args.source)
+        scheme = run.get("scheme", args.source.parent.name)
+        write_movie({**arrays, **{key: run[key] for key in RUN_KEYS if key in run}}, args.out,
+                    title=f"{scheme}: {args.source.name}")
         print(f"wrote {args.out}: {len(arrays['t'])} frames")
         return 0
     if args.out.suffix != ".pvd":
@@ -370,14 +393,16 @@ def _report(args):
 
 
 def _schemes(args):
+    width = max(map(len, SCHEMES))
     for scheme in SCHEMES.values():
-        print(f"{scheme.name:22s} {scheme.description}")
+        print(f"{scheme.name:{width}}  {scheme.description}")
     return 0
 
 
 def _problems(args):
+    width = max(map(len, PROBLEMS))
     for problem in PROBLEMS.values():
-        print(f"{problem.name:12s} {problem.label}: {problem.exact}")
+        print(f"{problem.name:{width}}  {problem.label}: {problem.exact}")
     return 0
 
 

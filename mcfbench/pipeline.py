@@ -6,15 +6,17 @@ adapters that call the study modules (:mod:`mcfbench.studies`). This module is
 what the rules need beside them:
 
 Config
-    :func:`check_keys` refuses unknown top-level keys while Snakemake reads
-    the workflow. Each study checks its own section (its schema, then its
+    :func:`check_config` checks the top-level keys while Snakemake reads the
+    workflow. Each study checks its own section (its schema, then its
     ``plan``) through :class:`Plans`: those of Table 3.1 and of the beyond
     study only when a rule that needs them is in the job graph, those of the
     matrix and the gallery while Snakemake reads their rule files (their rules
     are made from them; a bad section leaves them without rules). A bad value
     stops only the study's own target, with a
     :class:`~mcfbench.studies.config.ConfigError` naming the key: a bad
-    ``beyond`` value stops ``snakemake beyond``, not the matrix.
+    ``beyond`` value stops ``snakemake beyond``, not the matrix. In the workflow
+    (:class:`WorkflowPlans`, :func:`message_only`) the message is printed without
+    a traceback.
 Settings
     Everything that determines one run record (scheme, problem, level, tau,
     t_final, solver tolerance, the source hash of every package): passed to
@@ -32,7 +34,8 @@ import json
 import math
 import re
 import time
-from functools import cached_property
+from contextlib import contextmanager
+from functools import cached_property, wraps
 from pathlib import Path
 
 from mcfbench.running.problems import get_problem
@@ -44,9 +47,16 @@ from mcfbench.studies.config import ConfigError, check_threads
 from mcfbench.studies.convergence import PROBLEM
 
 
-def check_keys(config, schema_path):
-    """Refuse unknown top-level config keys in one line, naming them and the known
-    ones (Snakemake's schema check would print the whole schema after it)."""
+def check_config(config, schema_path):
+    """Check the whole config against its schema (``schema_path``; its defaults
+    filled in): unknown top-level keys in one line, naming them and the known ones,
+    then the first bad value named by its key (Snakemake's schema check would print
+    the whole schema after either).
+
+    Raises
+    ------
+    ConfigError
+    """
     import yaml
 
     known = yaml.safe_load(Path(schema_path).read_text())["properties"]
@@ -54,11 +64,12 @@ def check_keys(config, schema_path):
     if unknown:
         raise ConfigError(f"unknown config key(s) {unknown}; known keys: "
                           f"{', '.join(sorted(known))} (config/README.md)")
+    _validate(config, schema_path, [])
 
 
 def check_section(config, key, schema_path):
     """Validate the config section ``key`` against its own schema (``schema_path``;
-    its defaults filled in), as Snakemake validates the whole config.
+    its defaults filled in), as :func:`check_config` the whole config.
 
     Raises
     ------
@@ -66,21 +77,66 @@ def check_section(config, key, schema_path):
         Naming the key of the first bad value (``beyond.time_study.taus``) and
         what is wrong with it.
     """
+    if config.get(key) is None:        # left out: the plan's own defaults
+        return
+    _validate(config[key], schema_path, [key])
+
+
+def _validate(data, schema_path, where):
+    """Snakemake's schema check of ``data`` (defaults filled in), its error as a
+    ConfigError naming the key below ``where`` (a list of keys)."""
     from jsonschema.exceptions import ValidationError
     from snakemake.exceptions import WorkflowError
     from snakemake.utils import validate
 
-    if config.get(key) is None:        # left out: the plan's own defaults
-        return
     try:
-        validate(config[key], str(schema_path))
+        validate(data, str(schema_path))
     except WorkflowError as err:
         cause = err.__context__          # Snakemake raises it while handling jsonschema's
         if not isinstance(cause, ValidationError):
             raise
-        where = ".".join([key, *(str(p) for p in cause.absolute_path)])
-        raise ConfigError(f"config key {where!r}: {cause.message} (schema "
+        key = ".".join([*where, *(str(p) for p in cause.absolute_path)])
+        raise ConfigError(f"config key {key!r}: {cause.message} (schema "
                           f"{schema_path})") from None
+
+
+@contextmanager
+def message_only():
+    """In the workflow: a :class:`~mcfbench.studies.config.ConfigError` ends
+    Snakemake with its message alone (exit status 1).
+
+    Snakemake prints an error raised while it reads the Snakefile with the lines
+    of its traceback, and wraps one of an input function in an
+    ``InputFunctionException`` with a traceback; ``SystemExit`` is not an
+    ``Exception``, so neither catches it: Python prints its message to standard
+    error and exits.
+    """
+    try:
+        yield
+    except ConfigError as err:
+        raise SystemExit(f"ConfigError: {err}") from None
+
+
+class WorkflowPlans:
+    """:class:`Plans` for the rules (``PLANS`` of ``workflow/rules/common.smk``): its
+    attributes and methods, with a ConfigError turned into a message without
+    traceback (:func:`message_only`)."""
+
+    def __init__(self, config, schemas):
+        with message_only():
+            self._plans = Plans(config, schemas)
+
+    def __getattr__(self, name):
+        with message_only():
+            value = getattr(self._plans, name)
+        if not callable(value):
+            return value
+
+        @wraps(value)
+        def checked(*args, **kwargs):
+            with message_only():
+                return value(*args, **kwargs)
+        return checked
 
 
 def alternatives(names):

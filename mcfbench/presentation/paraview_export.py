@@ -82,9 +82,10 @@ def run_pieces(arrays):
 
 
 def run_provenance(arrays, source=None):
-    """What the collection says of the run: its scheme, status and message,
-    and its provenance (the ``.npz``'s, or that of the record next to a
-    matrix or gallery frames file ``source``)."""
+    """What the collection (and the animation) says of the run: its scheme,
+    status, message and failed step (:data:`RUN_KEYS`), and its provenance (the
+    ``.npz``'s, or that of the record next to a matrix or gallery frames file
+    ``source``, whose ``t_failed / tau`` is the failed step)."""
     run = {key: arrays[key].item() for key in RUN_KEYS if key in arrays}
     if "provenance" in arrays:
         run["provenance"] = json.loads(arrays["provenance"].item())
@@ -94,6 +95,9 @@ def run_provenance(arrays, source=None):
             data = load_json(record)
             run.update({key: data[key] for key in ("scheme", "status", "message", "settings",
                                                    "provenance") if key in data})
+            if data.get("t_failed") is not None and data.get("tau"):
+                # the time level of the breakdown or first defect, as a run .npz has it
+                run["failed_step"] = round(data["t_failed"] / data["tau"])
             run["record"] = record.as_posix()
     return run
 

@@ -222,10 +222,11 @@ def level_sweep(scheme, problem, levels=None, *, progress=False, **options):
 
 
 def _level_bar(levels, problem):
-    """The progress bar of a level sweep (tqdm imported on first use)."""
+    """The progress bar of a level sweep (tqdm imported on first use), wiped when
+    closed as the steps' bar is (:func:`mcfbench.running.driver.simulate`)."""
     from tqdm import tqdm
 
-    return tqdm(total=len(levels), desc=problem.name, unit="level")
+    return tqdm(total=len(levels), desc=problem.name, unit="level", leave=False)
 
 
 def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_final=None,

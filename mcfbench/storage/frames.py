@@ -15,6 +15,8 @@ A run whose mesh was refused before any frame (the gallery) has empty
 reads; both check the layout.
 """
 
+import zipfile
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -51,15 +53,29 @@ def load_frames(path):
 
     Raises
     ------
+    FileNotFoundError
+        No file ``path``.
     ValueError
-        Not readable as ``.npz``, or not the layout (:func:`check_frames`);
-        the message names the file.
+        Not an ``.npz`` archive (a zip of NumPy arrays: a mesh, a text file, a
+        single ``.npy``), unreadable, holding Python objects, or not the layout
+        (:func:`check_frames`); the message names the file.
     """
     path = Path(path)
+    if not path.is_file():
+        if not path.exists():
+            raise FileNotFoundError(f"{path}: the file does not exist")
+        raise ValueError(f"{path}: a folder, not a run's .npz")
+    if not zipfile.is_zipfile(path):      # np.load would try it as a pickle
+        raise ValueError(f"{path}: not a run's .npz (not a zip of NumPy arrays)")
     try:
         with np.load(path, allow_pickle=False) as data:
             arrays = {key: data[key] for key in data.files}
-    except (OSError, ValueError) as err:
+    except ValueError as err:
+        if "allow_pickle" in str(err):    # NumPy's advice to load it unsafely
+            raise ValueError(f"{path}: not a run's .npz (it holds Python objects, "
+                             f"which a run's file never has)") from None
         raise ValueError(f"{path}: not a run's .npz ({err})") from None
+    except (OSError, EOFError, zipfile.BadZipFile, zlib.error) as err:
+        raise ValueError(f"{path}: not a readable .npz ({err})") from None
     check_frames(arrays, path)
     return arrays

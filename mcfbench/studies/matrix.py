@@ -128,13 +128,14 @@ def plan(section=None, schemes=None, problems=None):
         chosen = list(schemes)
     elif isinstance(chosen, str):
         chosen = [chosen]
+    stepped = {}                   # NAME@INTEGRATOR -> NAME
     for integrator, names in (section.get("with_integrators") or {}).items():
         if integrator not in INTEGRATORS or integrator == "euler":
             raise ConfigError(f"config key 'matrix.with_integrators': unknown integrator "
                               f"{integrator!r}; choose one of "
                               f"{', '.join(i for i in INTEGRATORS if i != 'euler')}")
-        chosen = [*chosen, *(joined_name(name, integrator) for name in names)]
-    unknown = [s for s in chosen if find_scheme(s, schemes) is None]
+        stepped.update({joined_name(name, integrator): name for name in names})
+    unknown = [s for s in [*chosen, *stepped] if find_scheme(s, schemes) is None]
     if unknown:
         raise ConfigError(f"config key 'matrix.schemes': unknown scheme(s) {unknown}; the "
                           f"registry mcfbench.running.schemes.SCHEMES has {list(schemes)}, "
@@ -166,6 +167,8 @@ def plan(section=None, schemes=None, problems=None):
     maxiter = int(section.get("maxiter", 1000))
     if maxiter < 1:
         raise ConfigError(f"config key 'matrix.maxiter': must be >= 1, got {maxiter!r}")
+    # another integrator only for the schemes that are run (`schemes` may list fewer)
+    chosen = [*chosen, *(s for s, name in stepped.items() if name in chosen)]
     return {"schemes": list(chosen), "problems": plan_problems, "rtol": rtol,
             "maxiter": maxiter, **methods}
 

@@ -1,6 +1,9 @@
 """The bad-input sweep: every kind of bad input gets an exit status and a message
-naming the problem and the offending element or key (``python -m mcfbench run``
-and ``sphere-table``; the pipeline's config in tests/workflow/test_pipeline.py)."""
+naming the problem and the offending element or key, never a traceback (``python -m
+mcfbench``: bad meshes, settings and command lines, files that ``export`` cannot
+read; the pipeline's config in tests/workflow/test_pipeline.py)."""
+
+import re
 
 import numpy as np
 import pytest
@@ -59,7 +62,7 @@ def test_bad_meshes_are_refused_with_a_named_element(tmp_path, capsys, kind, tex
     code, out, err = _run(tmp_path, capsys, text)
     assert code == 2, (kind, out, err)
     assert err.startswith("error: ") and "Traceback" not in err
-    assert __import__("re").search(message, err), (kind, err)
+    assert re.search(message, err), (kind, err)
     assert not (tmp_path / "run.npz").exists()
 
 
@@ -97,7 +100,7 @@ def test_disconnected_components_flow_each_on_its_own(tmp_path, capsys):
 ])
 def test_bad_paths_are_named(tmp_path, capsys, name, text, message):
     code, out, err = _run(tmp_path, capsys, text, name=name)
-    assert code == 2 and __import__("re").search(message, err), err
+    assert code == 2 and re.search(message, err), err
 
 
 @pytest.mark.parametrize("options, message", [
@@ -117,7 +120,7 @@ def test_bad_settings_are_named(tmp_path, capsys, options, message):
     with pytest.raises(SystemExit) as exit_:
         main(args)
     assert exit_.value.code == 2
-    assert __import__("re").search(message, capsys.readouterr().err)
+    assert re.search(message, capsys.readouterr().err)
 
 
 def test_save_every_larger_than_steps_keeps_first_and_last(tmp_path, capsys):
@@ -163,3 +166,96 @@ def test_ddfv_option_on_another_scheme_is_named(tmp_path, capsys):
     code, out, err = _run(tmp_path, capsys, _sphere_obj(), "--scheme", "cotan",
                           "--t-init", "exact")
     assert code == 2 and "--t-init applies to the DDFV schemes only, not to cotan" in err
+
+
+# argv (MESH: a sphere's .obj, OUT: a folder) -> the message, a regular expression
+BAD_COMMAND_LINES = [
+    ([], r"the following arguments are required: command"),
+    (["frobnicate"], r"invalid choice: 'frobnicate'"),
+    (["study"], r"the following arguments are required: problem"),
+    (["study", "sphre"], r"argument problem: invalid choice: 'sphre'"),
+    (["study", "sphere", "--levels", "0"], r"--levels: must be a whole number >= 1, got 0"),
+    (["study", "sphere", "--rtol", "abc"], r"--rtol: must be a positive number, got 'abc'"),
+    (["sphere-table", "--levels", "x"], r"--levels: must be a whole number, got 'x'"),
+    (["sphere-table", "--levels", "1", "--scheme", "cotan", "--t-init", "exact"],
+     r"--t-init applies to the DDFV schemes only, not to cotan"),
+    (["sphere-table", "--csv", "OUT/blocker/table.csv"], r"blocker is a file, not a directory"),
+    (["run", "MESH"], r"the following arguments are required: --steps, --out"),
+    (["run", "MESH", "--tau", "0.1", "--tau-edge", "1", "--steps", "1", "--out", "OUT/x.npz"],
+     r"argument --tau-edge: not allowed with argument --tau"),
+    (["run", "MESH", "--tau", "0.1", "--steps", "1", "--out", "OUT/x.txt"],
+     r"name it \*\.npz or \*\.pvd"),
+    (["run", "MESH", "--tau", "0.1", "--steps", "1", "--out", "OUT/x.npz", "--movie",
+      "OUT/x.mp4"], r"--movie .*x\.mp4: the animation is a GIF"),
+    (["run", "OUT/none.obj", "--tau", "0.1", "--steps", "1", "--out", "OUT/x.npz"],
+     r"mesh file not found"),
+    (["export", "OUT/run.npz"], r"the following arguments are required: out"),
+    (["export", "OUT/none.npz", "OUT/x.vtu"], r"name it \*\.pvd or \*\.gif"),
+]
+
+
+def _cli(argv, capsys):
+    """``python -m mcfbench ARGV`` in-process: (exit status, standard error). An
+    exception other than SystemExit (argparse's) would fail the test: the user
+    would have seen its traceback."""
+    try:
+        code = main(argv)
+    except SystemExit as exit_:
+        code = exit_.code
+    return code, capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv, message", BAD_COMMAND_LINES,
+                         ids=[" ".join(a) or "(nothing)" for a, _ in BAD_COMMAND_LINES])
+def test_bad_command_lines_are_named_in_a_few_lines(tmp_path, capsys, argv, message):
+    (tmp_path / "sphere.obj").write_text(_sphere_obj())
+    (tmp_path / "blocker").write_text("a file")
+    argv = [a.replace("MESH", str(tmp_path / "sphere.obj")).replace("OUT", str(tmp_path))
+            for a in argv]
+    code, err = _cli(argv, capsys)
+    assert code == 2, err
+    assert re.search(message, err), err
+    assert "Traceback" not in err and "Errno" not in err
+    # argparse's: a one-line usage (no option list), the error, where the options are
+    assert len(err.splitlines()) <= 3, err
+    if err.startswith("usage:"):
+        assert "[options]" in err and "--help" in err.splitlines()[-1]
+
+
+def _write_npz(path, **arrays):
+    np.savez(path, **arrays)
+
+
+BAD_EXPORT_FILES = {  # name -> (how to make it, the message)
+    "missing.npz": (None, r"missing\.npz: the file does not exist"),
+    "mesh.obj": (lambda p: p.write_text(TET_V + TET_F), r"mesh\.obj: not a run's \.npz"),
+    "empty.npz": (lambda p: p.write_bytes(b""), r"empty\.npz: not a run's \.npz"),
+    "array.npy": (lambda p: np.save(p, np.zeros(3)), r"array\.npy: not a run's \.npz"),
+    "truncated.npz": (lambda p: p.write_bytes(_valid_npz_bytes(p)[:200]),
+                      r"truncated\.npz: not a"),
+    "objects.npz": (lambda p: _write_npz(p, t=np.array([{"a": 1}], dtype=object)),
+                    r"objects\.npz: not a run's \.npz \(it holds Python objects"),
+    "other.npz": (lambda p: _write_npz(p, a=np.zeros(3)), r"other\.npz: not a run's frames"),
+    "refused.npz": (lambda p: _write_npz(p, faces=np.zeros((0, 3), int), steps=np.zeros(0, int),
+                                         t=np.zeros(0)), r"refused\.npz: the run has no frames"),
+    "folder.npz": (lambda p: p.mkdir(), r"folder\.npz: a folder, not a run's \.npz"),
+}
+
+
+def _valid_npz_bytes(path):
+    V, F = icosphere(0)
+    np.savez(path, V=V[None], faces=F, steps=np.zeros(1, int), t=np.zeros(1))
+    return path.read_bytes()
+
+
+@pytest.mark.parametrize("out", ["x.pvd", "x.gif"])
+@pytest.mark.parametrize("name", sorted(BAD_EXPORT_FILES))
+def test_export_names_a_file_it_cannot_read(tmp_path, capsys, name, out):
+    make, message = BAD_EXPORT_FILES[name]
+    if make is not None:
+        make(tmp_path / name)
+    code, err = _cli(["export", str(tmp_path / name), str(tmp_path / out)], capsys)
+    assert code == 2 and err.startswith("error: ") and len(err.splitlines()) == 1, err
+    assert re.search(message, err), err
+    assert "Traceback" not in err and "Errno" not in err and "allow_pickle" not in err
+    assert not (tmp_path / out).exists()

@@ -45,6 +45,17 @@ def test_plan_levels_and_leaving_out():
     assert "torus" not in plan["problems"]
 
 
+def test_plan_adds_other_integrators_only_to_the_schemes_run():
+    section = {"with_integrators": {"bdf2": ["ddfv-chord-carried", "cotan"]}}
+    assert matrix.plan(section)["schemes"] == [*SCHEMES, "ddfv-chord-carried@bdf2",
+                                               "cotan@bdf2"]
+    assert matrix.plan({**section, "schemes": ["bgn", "cotan"]})["schemes"] == \
+        ["bgn", "cotan", "cotan@bdf2"]
+    assert matrix.plan({**section, "schemes": ["bgn"]})["schemes"] == ["bgn"]
+    with pytest.raises(ConfigError, match=r"unknown scheme\(s\) \['cotn@bdf2'\]"):
+        matrix.plan({"schemes": ["bgn"], "with_integrators": {"bdf2": ["cotn"]}})
+
+
 @pytest.mark.parametrize("section, key", [
     ({"schemes": ["ddfv", "nope"]}, "matrix.schemes"),
     ({"problems": {"spere": [1]}}, "matrix.problems"),

@@ -1,5 +1,7 @@
 """Animations of a run's frames (mcfbench.presentation.movie, ``run --movie``, ``export X.gif``)."""
 
+import json
+
 import numpy as np
 import pytest
 from PIL import Image
@@ -63,6 +65,25 @@ def test_status_turns_red_from_the_defect_on(tmp_path):
     out = write_movie(_shrinking_run("inverted", 10), tmp_path / "run.gif")
     _, frames = _frames(out)
     red = [_red(frame) for frame in frames]
+    assert red[0] == red[1] == 0 and red[2] > 50 and red[3] > red[2]   # + the message
+
+
+def test_export_of_a_matrix_frames_file_shows_the_status_of_its_record(tmp_path, capsys):
+    """A matrix or gallery frames file has no status of its own: the GIF takes the
+    record's (``.../frames/X/Y.npz`` -> ``.../runs/X/Y.json``), as the ``.pvd`` export
+    does; the failed step is ``t_failed / tau`` (10 here), red from there on."""
+    run = _shrinking_run()
+    frames = tmp_path / "frames" / "sphere" / "cotan" / "level1.npz"
+    record = tmp_path / "runs" / "sphere" / "cotan" / "level1.json"
+    frames.parent.mkdir(parents=True)
+    record.parent.mkdir(parents=True)
+    np.savez(frames, **{key: run[key] for key in ("V", "faces", "t", "steps")})
+    record.write_text(json.dumps({"scheme": "cotan", "status": "inverted", "tau": 0.01,
+                                  "message": "inverted at step 10 (t = 0.1): triangle 3",
+                                  "t_failed": 0.1}))
+    assert main(["export", str(frames), str(tmp_path / "run.gif")]) == 0
+    _, gif = _frames(tmp_path / "run.gif")
+    red = [_red(frame) for frame in gif]
     assert red[0] == red[1] == 0 and red[2] > 50 and red[3] > red[2]   # + the message
 
 

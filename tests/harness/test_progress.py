@@ -4,6 +4,7 @@ log nothing (mcfbench.cli, mcfbench.running.run.level_sweep, mcfbench.running.dr
 import fcntl
 import os
 import pty
+import re
 import struct
 import subprocess
 import sys
@@ -46,8 +47,10 @@ def test_progress_bar_of_the_levels_on_a_terminal():
     os.close(master)
     assert proc.wait(timeout=120) == 0
     screen = b"".join(chunks).decode(errors="replace")
-    assert "sphere:" in screen and "2/2" in screen and "level 2" in screen
+    assert "sphere:" in screen and "1/2" in screen and "level 2" in screen
     assert "\r" in screen                         # redrawn in place
+    # wiped when done (blanks over the bar's line), the table from the line's start
+    assert re.search(r"level 2\]\r {50,}\rcotangent on shrinking sphere", screen), screen
 
 
 def test_simulate_writes_no_bar_without_progress(capsys):

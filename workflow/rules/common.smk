@@ -2,11 +2,12 @@
 # is in the study modules (mcfbench.studies.convergence, .beyond), reached
 # through mcfbench.pipeline.Plans: each study's config section is checked
 # (its plan made) when a rule that needs it joins the job graph, so a bad
-# value stops only the targets that use it, with a message naming the key.
+# value stops only the targets that use it, with a message naming the key
+# (no traceback: mcfbench.pipeline.WorkflowPlans).
 
-from mcfbench.pipeline import Plans, mem_mb, scheme_pattern
+from mcfbench.pipeline import WorkflowPlans, mem_mb, scheme_pattern
 
-PLANS = Plans(config, f"{workflow.basedir}/workflow/schemas")
+PLANS = WorkflowPlans(config, f"{workflow.basedir}/workflow/schemas")
 # the config key `threads` (every run job), checked here
 THREADS = PLANS.threads
 # every compiled kernel in numba's cache before the run jobs (rule compile_kernels),
