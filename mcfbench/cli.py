@@ -216,6 +216,7 @@ def _sphere_table(args):
     table = sphere_table(args.levels, scheme.name, progress=_terminal(),
                          **_options(args, scheme))
     print(format_table(table))
+    _print_timing_note(table)
     if args.csv:
         _write_csv(args.csv, table, {**_settings(args, scheme), "levels": args.levels})
     _print_failures(table)
@@ -239,6 +240,7 @@ def _study(args):
                "iterations", "min_angle", "cpu_seconds"]
     print(f"{scheme.label} on {problem.label} ({problem.exact})")
     print(table[list(dict.fromkeys(columns))].to_string(index=False, float_format="%.4g"))
+    _print_timing_note(table)
     if args.csv:
         _write_csv(args.csv, table, {**_settings(args, scheme), "problem": problem.name,
                                      "levels": args.levels})
@@ -253,6 +255,18 @@ def _write_csv(path, table, config):
         table.to_csv(tmp, index=False)
     write_json(f"{path}.json", provenance(config))
     print(f"wrote {path}")
+
+
+def _print_timing_note(table):
+    """Under a table: the levels whose CPU time is the best of repeated runs."""
+    from mcfbench.running.run import SHORT_RUN
+
+    short = table[table["timing_repeats"] > 1]
+    if len(short):
+        runs = ", ".join(f"{r.level} ({r.timing_repeats} runs)" for r in short.itertuples())
+        print(f"CPU seconds of level(s) {runs}: the best of repeated runs (a run under "
+              f"{SHORT_RUN * 1000:g} ms is timed again, as timeit does); every level's "
+              f"time excludes the warm-up (compilation, first calls)")
 
 
 def _print_failures(table):

@@ -12,7 +12,7 @@ records are written atomically (:mod:`mcfbench.storage.atomic`).
 
 import hashlib
 import json
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import MISSING, asdict, dataclass, field, fields
 from pathlib import Path
 
 from mcfbench.storage.atomic import json_value, write_json
@@ -57,7 +57,9 @@ class RunResult:
         The time integrator (:data:`mcfbench.running.integrators.INTEGRATORS`).
     cpu_seconds, wall_seconds : float
         Flow construction (T-vertex initialisation included), stepping and
-        metrics.
+        metrics, the warm-up left out (compilation, first calls:
+        :func:`mcfbench.running.run.warm_up`); the best of ``timing_repeats``
+        executions.
     t_min_barycentric : float
         DDFV: the T monitor, smallest barycentric coordinate of a T-vertex
         over all time levels reached (NaN for the other schemes).
@@ -70,6 +72,12 @@ class RunResult:
     series : dict of lists
         ``t``, ``t_min_barycentric`` (every level), ``quality_t``,
         ``min_angle``, ``max_aspect``, ``flipped`` (sampled levels).
+    timing_repeats : int
+        How many executions of the run ``cpu_seconds`` and ``wall_seconds`` are
+        the best of: 1, or more for a run too short to time once (below
+        :data:`mcfbench.running.run.SHORT_RUN` CPU seconds), as :mod:`timeit`
+        does. Optional in a record (:data:`DEFAULTS`): records written before
+        it existed read as 1.
     """
 
     scheme: str
@@ -98,6 +106,7 @@ class RunResult:
     max_flipped: float
     metrics: dict = field(default_factory=dict)
     series: dict = field(default_factory=dict, repr=False)
+    timing_repeats: int = 1
 
     def to_dict(self, series=True):
         """Fields as a flat dict: the metrics as top-level keys; ``series=False``
@@ -112,6 +121,8 @@ class RunResult:
 # field -> type of the fixed part of a record; float fields may be null (NaN)
 FIELDS = {f.name: f.type for f in fields(RunResult) if f.name != "metrics"}
 FIELDS.update({"peak_rss_mb": float, "settings": dict, "provenance": dict, "checksum": str})
+DEFAULTS = {f.name: f.default for f in fields(RunResult) if f.default is not MISSING}
+"""Fields a record may lack (written before they existed) -> the value they read as."""
 RECOMPUTE = "delete it and run snakemake again to recompute it"
 
 
@@ -193,12 +204,13 @@ def read_record(path, settings=None, required=FIELDS):
         (edited by hand), or other settings; the message names the file.
     """
     record = load_json(path)
-    missing = [k for k in required if k not in record]
+    missing = [k for k in required if k not in record and k not in DEFAULTS]
     if missing:
         raise RecordError(f"{path}: missing key(s) {missing}; {RECOMPUTE}")
     if record["checksum"] != checksum(record):
         raise RecordError(f"{path}: checksum does not match the content (the record was "
                           f"edited or damaged); {RECOMPUTE}")
+    record = {**{k: v for k, v in DEFAULTS.items() if k in required}, **record}
     for key, kind in required.items():
         value = record[key]
         if kind is float:

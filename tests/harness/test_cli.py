@@ -33,6 +33,8 @@ def test_sphere_table_runs_any_scheme(capsys):
     assert main(["sphere-table", "--levels", "1", "--scheme", "bgn"]) == 0
     out = capsys.readouterr().out
     assert "3.2624e-03" in out                 # BGN's error at level 1 (NOTES.md)
+    # a level-1 run takes about 1 ms: its CPU time is the best of repeated runs
+    assert "CPU seconds of level(s) 1 (" in out and "as timeit does" in out
 
 
 def test_study_runs_a_problem_series(tmp_path, capsys):

@@ -70,3 +70,20 @@ def test_read_records_names_every_bad_record_not_only_the_first(tmp_path, result
     assert str(stale) in str(err.value) and str(damaged) in str(err.value)
     assert str(good) not in str(err.value)
     assert list(read_records({good: SETTINGS})) == [good]
+
+
+def test_a_record_written_before_timing_repeats_existed_reads_as_timed_once(tmp_path, result):
+    from mcfbench.storage.records import checksum
+
+    path = tmp_path / "level1.json"
+    record = write_record(path, result, SETTINGS)
+    assert record["timing_repeats"] == result.timing_repeats > 1    # a 1-ms run, repeated
+    del record["timing_repeats"]
+    record["checksum"] = checksum(record)
+    path.write_text(json.dumps(record))
+    assert read_record(path, SETTINGS)["timing_repeats"] == 1
+    record["timing_repeats"] = "many"
+    record["checksum"] = checksum(record)
+    path.write_text(json.dumps(record))
+    with pytest.raises(RecordError, match="'timing_repeats' should be int"):
+        read_record(path, SETTINGS)

@@ -1,10 +1,23 @@
 """Studies for any scheme on any problem (mcfbench/running/run.py)."""
 
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from mcfbench.geometry.spheres import icosphere
-from mcfbench.running.run import level_sweep, run, space_convergence, time_convergence
+from mcfbench.running.run import (
+    SHORT_RUN,
+    has_boundary,
+    level_sweep,
+    run,
+    space_convergence,
+    time_convergence,
+)
 
 
 @pytest.mark.parametrize("scheme", ["ddfv", "cotan"])
@@ -59,3 +72,42 @@ def test_breakdown_keeps_partial_results_and_names_the_time():
 def test_running_past_the_extinction_of_the_sphere_is_refused():
     with pytest.raises(ValueError, match="past the extinction time 0.25 of the sphere"):
         run("ddfv", "sphere", 1, tau=0.04, t_final=0.32)
+
+
+FIRST_AND_SECOND = """
+import json, sys
+from mcfbench.running.run import level_sweep
+out = {}
+for scheme in sys.argv[1:]:
+    first = level_sweep(scheme, "sphere", [1, 2]).set_index("level")
+    second = level_sweep(scheme, "sphere", [2, 1]).set_index("level")
+    out[scheme] = [first.cpu_seconds[1], second.cpu_seconds[1], int(first.timing_repeats[1])]
+print(json.dumps(out))
+"""
+
+
+def test_the_first_level_of_a_series_carries_no_warm_up():
+    """In a fresh process, level 1 timed first (numba's kernels not yet loaded, the
+    solver and the scheme never called) and timed second agree within 1.5 x, for a
+    vertex scheme and a DDFV scheme (before the warm-up: 0.16 s against 0.002 s)."""
+    root = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    out = subprocess.run([sys.executable, "-c", FIRST_AND_SECOND, "cotan", "ddfv-chord-carried"],
+                         cwd=root, env=env, capture_output=True, text=True, check=True)
+    for scheme, (first, second, repeats) in json.loads(out.stdout).items():
+        assert 1 / 1.5 < first / second < 1.5, (scheme, first, second)
+        assert first < SHORT_RUN and repeats > 1, (scheme, first, repeats)
+
+
+def test_a_short_run_is_timed_as_the_best_of_repeats_a_long_one_once():
+    short, _ = run("cotan", "sphere", 1)
+    assert short.cpu_seconds < SHORT_RUN and 1 < short.timing_repeats <= 25
+    long, _ = run("cotan", "sphere", 1, tau=0.04 / 4**4)             # 512 steps
+    assert long.cpu_seconds > SHORT_RUN and long.timing_repeats == 1
+    # the run's own result is its first execution's: the same numbers as once
+    assert short.steps_done == 2 and short.iterations == 4
+
+
+def test_has_boundary():
+    assert not has_boundary(icosphere(1)[1])
+    assert has_boundary(icosphere(1)[1][1:])
