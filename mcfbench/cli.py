@@ -100,6 +100,9 @@ def _common(parser, default_solver):
     parser.add_argument("--threads", type=_level, default=1,
                         help="threads of the solver and of DDFV's per-element passes "
                              "(default: 1)")
+    parser.add_argument("--force", action="store_true",
+                        help="run even when the run's estimated memory is above the "
+                             "machine's available memory (refused otherwise)")
 
 
 def build_parser():
@@ -190,7 +193,7 @@ def _options(args, scheme):
     """Run options: the solver and the DDFV-only settings that were given."""
     options = {"solver": Solver(args.solver, args.rtol, args.maxiter, threads=args.threads),
                "integrator": args.integrator, "warm_start": args.warm_start,
-               "on_defect": args.on_defect, "threads": args.threads}
+               "on_defect": args.on_defect, "threads": args.threads, "force": args.force}
     ddfv_only = {"t_init": args.t_init}
     given = {k: v for k, v in ddfv_only.items() if v is not None}
     if given and scheme.family != "ddfv":

@@ -21,6 +21,7 @@ import numpy as np
 from mcfbench.geometry import metrics
 from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.mesh import validate_mesh
+from mcfbench.running.cost import check_size
 from mcfbench.running.driver import simulate
 from mcfbench.running.problems import get_problem
 from mcfbench.running.schemes import get_scheme
@@ -82,7 +83,7 @@ class _Steady:
 
 def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrator=None,
         warm_start="extrapolate", on_defect="stop", save_every=0, samples=20, mesh=None,
-        threads=1, progress=False, observers=(), **options):
+        threads=1, progress=False, observers=(), force=False, **options):
     """Run ``scheme`` on ``problem`` at refinement ``level``.
 
     Parameters
@@ -116,6 +117,10 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
     observers : sequence of callables
         Called with the flow at every time level, after the run's own (the
         figures' :class:`mcfbench.geometry.quality.MeshQuality`).
+    force : bool
+        Run even when its estimated memory is above the machine's available
+        memory (:func:`mcfbench.running.cost.check_size`, checked before the
+        mesh is built).
     **options
         Options of the scheme's flow class (override the registry's).
 
@@ -123,10 +128,17 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
     -------
     result : RunResult
     trajectory : mcfbench.running.driver.Trajectory
+
+    Raises
+    ------
+    mcfbench.running.cost.RunTooLarge
+        A ``ValueError``: the run's estimated memory is above the available
+        memory (unless ``force``).
     """
     scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
     problem = get_problem(problem) if isinstance(problem, str) else problem
     integrator = scheme.integrator if integrator is None else integrator
+    check_size(scheme, problem, level, mesh=mesh, tau=tau, t_final=t_final, force=force)
     V, F = validate_mesh(*(problem.mesh(level) if mesh is None else mesh))
     tau = problem.tau(level, (V, F)) if tau is None else float(tau)
     steps = problem.time_steps(tau, t_final)

@@ -11,13 +11,16 @@ A no-op elsewhere than glibc; ``DDFV_MALLOC_TUNING=0`` leaves the allocator
 alone.
 
 :func:`peak_rss_mb` is the peak resident memory of the process, stored in
-every run record (:func:`mcfbench.storage.records.write_record`).
+every run record (:func:`mcfbench.storage.records.write_record`);
+:func:`resident_mb` its resident memory now, :func:`available_mb` the
+machine's available memory (the size guard, :mod:`mcfbench.running.cost`).
 """
 
 import ctypes
 import ctypes.util
 import os
 import sys
+from pathlib import Path
 
 _M_TRIM_THRESHOLD = -1
 _M_MMAP_THRESHOLD = -3
@@ -52,3 +55,29 @@ def peak_rss_mb():
         return float("nan")
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     return peak / (2**20 if sys.platform == "darwin" else 2**10)
+
+
+def resident_mb():
+    """Resident memory of this process now (``/proc/self/statm``), in MB; NaN where
+    that file does not exist."""
+    try:
+        pages = int(Path("/proc/self/statm").read_text().split()[1])
+    except OSError:
+        return float("nan")
+    return pages * os.sysconf("SC_PAGE_SIZE") / 2**20
+
+
+MEMINFO = Path("/proc/meminfo")
+
+
+def available_mb():
+    """Memory the machine has available for new allocations without swapping
+    (``MemAvailable`` of :data:`MEMINFO`), in MB; None where it is not known."""
+    try:
+        text = MEMINFO.read_text()
+    except OSError:
+        return None
+    for line in text.splitlines():
+        if line.startswith("MemAvailable:"):
+            return int(line.split()[1]) / 2**10           # kB
+    return None
