@@ -4,11 +4,12 @@ import functools
 import math
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 
-from mcfbench.geometry.axisymmetric import meridian_max_height
 from mcfbench.geometry.construction import quad_grid
+
+# scipy.integrate, scipy.optimize and the axisymmetric solver are imported on first
+# use: mcfbench.geometry.surfaces imports this module for every surface, and
+# importing them took 0.3-1.1 s of each pipeline job that builds another surface
 
 ANGENENT_RHO0_PUBLISHED = 0.437123967096460
 """Inner radius of the Angenent torus's meridian as published (NOTES.md, "More exact
@@ -35,6 +36,8 @@ def _angenent_shoot(rho0, tol=1e-13):
     def cross(s, y):
         return y[1]
 
+    from scipy.integrate import solve_ivp
+
     cross.terminal, cross.direction = True, -1
     sol = solve_ivp(_angenent_rhs, (0.0, 50.0), [rho0, 0.0, 0.0, 0.0, 0.0, 0.0],
                     method="DOP853", rtol=tol, atol=tol, events=cross, dense_output=True)
@@ -55,6 +58,8 @@ def angenent_rho0(tol=1e-13):
     -------
     float
     """
+    from scipy.optimize import brentq
+
     return brentq(lambda r0: _angenent_shoot(r0, tol)[2][2] - np.pi, 0.42, 0.45,
                   xtol=1e-15, rtol=1e-15)
 
@@ -78,6 +83,8 @@ def angenent_profile(rho0=None):
         the inner point); ``upper`` (the dense ODE solution of the upper
         half, state ``(rho, z, a, ...)``), ``half_length``.
     """
+    from mcfbench.geometry.axisymmetric import meridian_max_height
+
     rho0 = angenent_rho0() if rho0 is None else float(rho0)
     sol, S, y_end = _angenent_shoot(rho0)
     ss = np.linspace(0.0, S, 4001)

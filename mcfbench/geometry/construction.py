@@ -4,7 +4,6 @@ revolution, welding coincident vertices, orientation and the closed-manifold che
 import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
-from scipy.spatial import cKDTree
 
 from mcfbench.geometry.metrics import triangle_normals
 
@@ -112,6 +111,8 @@ def weld_vertices(V, F, tol=0.0):
     """
     n = len(V)
     if tol > 0:  # clusters of the graph of pairs closer than tol (coincident ones too)
+        from scipy.spatial import cKDTree  # on first use: scipy.spatial takes 0.1-0.4 s
+
         pairs = cKDTree(V).query_pairs(tol, output_type="ndarray")
         graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
         _, cluster = connected_components(graph, directed=False)

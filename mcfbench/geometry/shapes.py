@@ -2,7 +2,6 @@
 the hemisphere, flat patches, the torus and the dumbbell."""
 
 import numpy as np
-from scipy.spatial import Delaunay
 
 from mcfbench.geometry.construction import (
     DIAGONALS,
@@ -155,6 +154,8 @@ def flat_patch(level=1, jitter=0.3, seed=0):
     inner = inner + step[:, None] * np.column_stack([np.cos(angle), np.sin(angle)])
     phi = 2.0 * np.pi * np.arange(int(round(2.0 * np.pi / h))) / round(2.0 * np.pi / h)
     xy = np.concatenate([inner, np.column_stack([np.cos(phi), np.sin(phi)])])
+    from scipy.spatial import Delaunay  # on first use: scipy.spatial takes 0.1-0.4 s
+
     F = Delaunay(xy).simplices.astype(np.int64)
     V = np.column_stack([xy, np.zeros(len(xy))])
     return V, orient_along(V, F, np.array([0.0, 0.0, 1.0]))

@@ -3,7 +3,6 @@ the benchmark problems (bumps, a scalloped lens, perturbed, remeshed and anisotr
 spheres)."""
 
 import numpy as np
-from scipy.spatial import ConvexHull
 
 from mcfbench.geometry.construction import orient_away_from, revolution, rotation
 
@@ -322,6 +321,8 @@ def remeshed_sphere(n_points=642, seed=0):
     rng = np.random.default_rng(seed)
     V = rng.normal(size=(int(n_points), 3))
     V /= np.linalg.norm(V, axis=1, keepdims=True)
+    from scipy.spatial import ConvexHull  # on first use: scipy.spatial takes 0.1-0.4 s
+
     F = ConvexHull(V).simplices.astype(np.int64)
     if len(F) != 2 * len(V) - 4:
         raise ValueError("some points are not vertices of their convex hull; try another seed")
