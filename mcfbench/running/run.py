@@ -116,7 +116,8 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
         A progress bar of the steps (:func:`mcfbench.running.driver.simulate`).
     observers : sequence of callables
         Called with the flow at every time level, after the run's own (the
-        figures' :class:`mcfbench.geometry.quality.MeshQuality`).
+        figures' :class:`mcfbench.geometry.quality.MeshQuality`); not called
+        again when a short run is timed again (their state is the caller's).
     force : bool
         Run even when its estimated memory is above the machine's available
         memory (:func:`mcfbench.running.cost.check_size`, checked before the
@@ -127,6 +128,11 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
     Returns
     -------
     result : RunResult
+        Its times are those of the flow alone: the scheme is warmed up first
+        (:func:`warm_up`), and a run under :data:`SHORT_RUN` CPU seconds is
+        timed again, up to :data:`MAX_REPEATS` times in about
+        :data:`REPEAT_BUDGET` seconds, the best kept (``timing_repeats``); its
+        numbers are those of the first execution.
     trajectory : mcfbench.running.driver.Trajectory
 
     Raises
