@@ -144,8 +144,9 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
     scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
     problem = get_problem(problem) if isinstance(problem, str) else problem
     integrator = scheme.integrator if integrator is None else integrator
+    mesh = None if mesh is None else validate_mesh(*mesh)      # a bad one named first
     check_size(scheme, problem, level, mesh=mesh, tau=tau, t_final=t_final, force=force)
-    V, F = validate_mesh(*(problem.mesh(level) if mesh is None else mesh))
+    V, F = validate_mesh(*problem.mesh(level)) if mesh is None else mesh
     tau = problem.tau(level, (V, F)) if tau is None else float(tau)
     steps = problem.time_steps(tau, t_final)
     solver = Solver() if solver is None else solver
