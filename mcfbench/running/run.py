@@ -249,8 +249,8 @@ def warm_up(scheme, problem, faces, *, solver, integrator, warm_start, on_defect
     error metrics), the imports and first-call set-ups of the scheme, the solver, the
     integrator and the problem's metric observers at every time level (their final
     values are not timed: not warmed up).
-    Before, a level-1 sphere timed first carried 0.16 s of these against 0.002 s
-    when timed second (issue 32).
+    Before, level 1 of the sphere timed first carried 0.10-0.14 s of these against
+    0.0014-0.0036 s timed second (cotan, DDFV, BGN; issue 32).
 
     The tiny mesh is the level-1 icosphere (42 vertices) for a closed ``faces``, a
     hemisphere of 3 rings (37 vertices, the equator fixed) for one with a boundary:
