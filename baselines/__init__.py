@@ -15,6 +15,9 @@ cmcf (:class:`baselines.cmcf.CMCFFlow`)
     Conformalized mean curvature flow (Kazhdan, Solomon, Ben-Chen 2012).
 bgn (:class:`baselines.bgn.BGNFlow`)
     Barrett, Garcke, Nuernberg (2008), mass-lumped vertex normals.
+mdr (:class:`baselines.mdr.MDRFlow`)
+    The minimal deformation rate velocity of Hu and Li (2022), eliminated
+    into BGN's system with unit normals.
 
 Shared: :mod:`baselines.mesh` (edge topology, CSR pattern) and
 :mod:`baselines.kernels` (the compiled assembly).
