@@ -51,7 +51,21 @@ import numpy as np
 from .bgn import BGNFlow
 
 
-class MDRFlow(BGNFlow):
+class UnitNormalBGN(BGNFlow):
+    """BGN's system (B4) with the UNIT area-weighted vertex normals: the algebra that
+    MDR (M5) and DeTurck (:mod:`baselines.deturck`) share (not a scheme of the
+    registry: normalising BGN's normals gives another scheme, ``baselines/README.md``)."""
+
+    def _normals(self, geometry):
+        """(n, 3) the unit area-weighted vertex normals (BGN's (B3) normalised); zero at
+        a vertex whose triangles all vanished."""
+        omega = super()._normals(geometry)
+        length = np.linalg.norm(omega, axis=1)
+        return np.divide(omega, length[:, None], out=np.zeros_like(omega),
+                         where=length[:, None] > 0)
+
+
+class MDRFlow(UnitNormalBGN):
     """Mean curvature flow with the MDR tangential velocity, (M5), of one surface.
 
     Parameters
@@ -75,14 +89,6 @@ class MDRFlow(BGNFlow):
     >>> A.shape, b.shape
     ((12, 12), (3, 4))
     """
-
-    def _normals(self, geometry):
-        """(n, 3) the unit area-weighted vertex normals (BGN's (B3) normalised); zero at
-        a vertex whose triangles all vanished."""
-        omega = super()._normals(geometry)
-        length = np.linalg.norm(omega, axis=1)
-        return np.divide(omega, length[:, None], out=np.zeros_like(omega),
-                         where=length[:, None] > 0)
 
     def _system(self, at, base, dt, scaling):
         """(M5) at ``at``: BGN's system with unit normals, plus ``dt P (A B) / m``."""
