@@ -160,6 +160,16 @@ SCHEMES = {s.name: s for s in (
            {"color": "C7", "marker": "P", "linestyle": ":"},
            "Barrett, Garcke, Nuernberg (2008): mass-lumped vertex normals, tangential "
            "motion that equidistributes the mesh", matrix="scaled-spd"),
+    Scheme("mdr", "MDR", "baselines.mdr:MDRFlow", {"scaling": "mass"},
+           {"color": "tab:cyan", "marker": "d", "linestyle": "-"},
+           "minimal deformation rate (Hu, Li 2022): the velocity of least int |grad v|^2 with "
+           "normal part -H, the multiplier eliminated into BGN's system with unit normals",
+           matrix="scaled-spd"),
+    Scheme("deturck", "DeTurck", "baselines.deturck:DeTurckFlow", {"alpha": 0.1},
+           {"color": "tab:brown", "marker": "H", "linestyle": "--"},
+           "the DeTurck trick (Elliott, Fritz 2017): reparametrised by the harmonic map heat "
+           "flow onto the initial mesh with time scale 1/alpha, the advection implicit",
+           matrix="nonsymmetric"),
 )}
 """Scheme name -> :class:`Scheme`."""
 
