@@ -64,7 +64,17 @@ operators at the extrapolated state, Kovacs, Li, Lubich, Numer. Math. 143 (2019)
     to ``t = 0.04``, taus 0.01 ... 0.000625 (0.0003125): level 1 3.03, 2.99, 3.00,
     3.00; level 2 3.05, 2.88, 2.94, 2.97; level 3 2.86, 2.30, 2.60, 2.77, 2.88
     (volume 2.98-3.03 throughout): the order is reached once ``tau`` is small
-    against the mesh's stiffest mode (``h^2``), from 0.00125 on level 3.
+    against the mesh's stiffest mode (``h^2``), from 0.00125 on level 3. The
+    beyond study's time study (level 3, ``t = 0.08``, taus 0.01 ... 0.000625,
+    reference tau / 8): ``cotan`` 2.30, 2.42, 2.61, 2.78 (volume 2.97-3.00),
+    ``ddfv`` 2.79, 1.80, 2.08, 2.33 (volume 2.94-2.82),
+    ``ddfv-chord-redistribute-carried`` 1.92, 1.09, 0.78, 0.84 (volume 2.96 down
+    to 0.92); ``bgn``'s reference run (tau 7.8e-5) inverts at step 50.
+    **BGN with BDF3 inverts** once tau is small: level-3 sphere to ``t = 0.08``
+    ok at tau 0.01 and 0.0025 (smallest angle 54 -> 6.3 degrees), inverted at
+    step 46 with tau 0.000625; Table 3.1's level 4 inverted at step 39 of 128
+    (sparse LU). Its tangential motion, set anew at every step, is extrapolated
+    sevenfold (below).
 
     Stability: BDF1-2 are A-stable, BDF3-6 only A(alpha)-stable (alpha = 86.03,
     73.35, 51.84, 17.84 degrees for k = 3-6, Hairer, Wanner, Solving ODEs II,
