@@ -237,6 +237,28 @@ class CotanAssembler:
         return self.csr(data)
 
 
+def row_scaled_matrix(L, mass, dt, fixed):
+    """``I + dt diag(1/M) L`` (C3) of any sparsity, CSR, rows ``fixed`` = identity.
+
+    Parameters
+    ----------
+    L : (n, n) scipy.sparse matrix
+        A stiffness (not changed).
+    mass : (n,) float array
+        Its lumped mass, positive.
+    dt : float
+    fixed : (n,) bool array
+
+    Returns
+    -------
+    (n, n) scipy.sparse.csr_matrix
+    """
+    L = sp.csr_matrix(L, copy=True)
+    L.data *= np.repeat(dt / mass, np.diff(L.indptr))
+    A = (L + sp.identity(L.shape[0], format="csr")).tocsr()
+    return dirichlet_rows(A, fixed) if fixed.any() else A
+
+
 def dirichlet_rows(A, fixed):
     """Replace the rows ``fixed`` of a CSR matrix by rows of the identity, in place.
 
@@ -595,9 +617,7 @@ class CotanFlow(VertexFlow):
         if self.redistribution is not None:
             rhs = base + dt * self.tangential_velocity(at, dt)     # (R3)
         if self.assembly == "igl":
-            L = self.laplacian(at)
-            L.data *= np.repeat(dt / self._system_mass(at), np.diff(L.indptr))
-            A = (L + sp.identity(L.shape[0], format="csr")).tocsr()
-            return (dirichlet_rows(A, self.fixed) if self.mesh.has_boundary else A), rhs
+            return row_scaled_matrix(self.laplacian(at), self._system_mass(at), dt,
+                                     self.fixed), rhs
         g = self.geometry_at(at)
         return self.assembler.row_scaled(self._laplacian_data(g), g.mass, dt, self.fixed), rhs

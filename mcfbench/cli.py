@@ -90,7 +90,7 @@ def _common(parser, default_solver):
                         help="DDFV: T-vertex initialisation (default: paper)")
     parser.add_argument("--integrator", choices=list(INTEGRATORS),
                         help="time integrator: the paper's semi-implicit Euler (default) "
-                             "or linearly implicit BDF2")
+                             "or linearly implicit BDF2 or BDF3")
     parser.add_argument("--warm-start", choices=("extrapolate", "previous"),
                         default="extrapolate",
                         help="initial guess of the solver: 2 X^n - X^{n-1} (default) or X^n")

@@ -94,7 +94,7 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
         Override the problem's time rule.
     solver : mcfbench.running.solver.Solver, optional
         Default: BiCGStab, rtol 1e-9 (the paper's).
-    integrator : {"euler", "bdf2"}, optional
+    integrator : {"euler", "bdf2", "bdf3"}, optional
         The time integrator (:mod:`mcfbench.running.integrators`); default
         the scheme's (:attr:`mcfbench.running.schemes.Scheme.integrator`).
     warm_start : {"extrapolate", "previous"}
@@ -245,7 +245,7 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
     t_final : float, optional
         Default: the problem's.
     solver : mcfbench.running.solver.Solver, optional
-    integrator : {"euler", "bdf2"}, optional
+    integrator : {"euler", "bdf2", "bdf3"}, optional
         The time integrator of every run, the reference's included (default
         the scheme's).
     **options

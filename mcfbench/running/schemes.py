@@ -146,6 +146,12 @@ SCHEMES = {s.name: s for s in (
            {"mass": "voronoi"}, {"color": "C5", "marker": "<", "linestyle": "--"},
            "the cotangent scheme (Dziuk 1991), Voronoi (mixed) lumped mass (Meyer et al. 2003)",
            matrix="scaled-spd"),
+    Scheme("cotan-intrinsic", "cotangent, intrinsic Delaunay",
+           "baselines.cotan_intrinsic:IntrinsicCotanFlow", {},
+           {"color": "tab:brown", "marker": "d", "linestyle": "-."},
+           "the cotangent scheme (Dziuk 1991) with the stiffness and barycentric mass of the "
+           "intrinsic Delaunay triangulation (Sharp, Crane 2020; robust-laplacian), rebuilt "
+           "every step", matrix="scaled-spd"),
     Scheme("cotan-redistribute", "cotangent, area redistribution", "baselines.cotan:CotanFlow",
            {"mass": "barycentric", "redistribution": "area", "target": "triangle"},
            {"color": "tab:olive", "marker": "P", "linestyle": "--"},

@@ -3,7 +3,7 @@
 
 import numpy as np
 import pytest
-from scipy.spatial import ConvexHull
+from conftest import twin_sphere
 
 from baselines.cotan import CotanFlow
 from baselines.kernels import vertex_gradients
@@ -22,24 +22,6 @@ EXACT = Solver(method="direct", rtol=1e-12)
 def noisy_sphere():
     V, F = icosphere(2)
     return V * (1.0 + 0.1 * np.random.default_rng(7).random((len(V), 1))), F
-
-
-def twin_sphere(n=162, eps=0.1, seed=0):
-    """Sliver-rich sphere: n/2 random points each with a twin at eps x the mean
-    spacing, triangulated by their convex hull (tiny triangles and slivers)."""
-    rng = np.random.default_rng(seed)
-    P = rng.standard_normal((n // 2, 3))
-    P /= np.linalg.norm(P, axis=1, keepdims=True)
-    d = rng.standard_normal((n // 2, 3))
-    d -= (d * P).sum(1, keepdims=True) * P
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    P = np.vstack([P, P + eps * np.sqrt(4 * np.pi / n) * d])
-    P /= np.linalg.norm(P, axis=1, keepdims=True)
-    F = ConvexHull(P).simplices.copy()
-    normal = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
-    flip = (normal * P[F].mean(axis=1)).sum(axis=1) < 0
-    F[flip] = F[flip][:, ::-1]
-    return P, F
 
 
 def redistributing(V, F, tau, **options):
