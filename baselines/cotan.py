@@ -66,9 +66,9 @@ import scipy.sparse as sp
 
 from .kernels import cotan_geometry, neighbour_cosines, row_scaled_system, vertex_normals
 from .mesh import edge_mesh, laplacian_pattern
-from .redistribution import (OMEGA, REDISTRIBUTIONS, drift_laplacian, redistribution_source,
-                             solve_potential, surface_components, tangential_velocity,
-                             target_shares)
+from .redistribution import (OMEGA, PECLET, REDISTRIBUTIONS, drift_laplacian,
+                             redistribution_source, solve_potential, surface_components,
+                             tangential_velocity, target_shares)
 
 MASS_TYPES = {"barycentric": igl.MASSMATRIX_TYPE_BARYCENTRIC,
               "voronoi": igl.MASSMATRIX_TYPE_VORONOI}
@@ -494,6 +494,11 @@ class CotanFlow(VertexFlow):
         :data:`baselines.redistribution.OMEGA`): the rate used is
         ``omega 4 pi / A_0``, ``A_0`` the initial area, so that the flow is
         covariant under scaling (time scales as length squared).
+    peclet : float
+        Largest edge Peclet number ``|psi_j - psi_i|`` the drift (R4) sees
+        (R6): the tangential displacement of a step is at most about
+        ``peclet tau / h`` (default :data:`baselines.redistribution.PECLET`;
+        ``inf``: none).
     target : {"vertex", "triangle"}
         Target covolume areas of (R2): all equal (``"vertex"``, default) or
         those of equal-area triangles (``"triangle"``,
@@ -510,7 +515,7 @@ class CotanFlow(VertexFlow):
     """
 
     def __init__(self, vertices, faces, tau, *, mass="barycentric", assembly="cached",
-                 redistribution=None, omega=OMEGA, target="vertex"):
+                 redistribution=None, omega=OMEGA, peclet=PECLET, target="vertex"):
         if assembly not in ASSEMBLIES:
             raise ValueError(f"unknown assembly {assembly!r}; choose one of "
                              f"{', '.join(ASSEMBLIES)}")
@@ -519,6 +524,8 @@ class CotanFlow(VertexFlow):
                              f"'area'")
         if not (np.isfinite(omega) and omega >= 0):
             raise ValueError(f"omega must be a finite number >= 0, got {omega!r}")
+        if not peclet > 0:
+            raise ValueError(f"peclet must be a positive number (or inf), got {peclet!r}")
         if redistribution and (k := surface_components(faces, len(vertices))) > 1:
             raise ValueError(f"the redistribution (R2) needs a connected surface; this one "
                              f"has {k} components")
@@ -526,7 +533,7 @@ class CotanFlow(VertexFlow):
         self._shares = target_shares(faces, len(vertices), target)
         self.assembly = assembly
         self.redistribution = redistribution
-        self.omega = float(omega)
+        self.omega, self.peclet = float(omega), float(peclet)
         self._area_0 = None
         self.psi = None
         """The potential of the last step's tangential velocity (R2), (n,)."""
@@ -587,7 +594,7 @@ class CotanFlow(VertexFlow):
         mass = self._system_mass(at)
         rhs = base
         if self.redistribution is not None:
-            drift = drift_laplacian(L, self._potential(at, L, mass))        # (R4)
+            drift = drift_laplacian(L, self._potential(at, L, mass), self.peclet)  # (R4)
             rhs = base + dt * self._normal_drift(at, drift - L, mass)       # (R5)
             L = drift
         if self.assembly == "igl":

@@ -39,9 +39,9 @@ import numpy as np
 from .assembly import Assembler
 from .geometry import diamond_geometry, t_barycentric, vertex_normals
 from .kernels import check_threads
-from .redistribution import (OMEGA, TangentialPotential, carry_t_vertices, drift_system,
-                             neumann_stiffness, redistribution_source, surface_components,
-                             vertex_gradients)
+from .redistribution import (OMEGA, PECLET, TangentialPotential, carry_t_vertices,
+                             drift_system, neumann_stiffness, redistribution_source,
+                             surface_components, vertex_gradients)
 from .t_vertices import initial_t_vertices
 from .topology import diamond_mesh, locality_order
 
@@ -94,6 +94,9 @@ class Flow:
         of the unit sphere's area 4 pi (default :data:`ddfv.redistribution.OMEGA`):
         the rate used is ``omega 4 pi / A_0``, ``A_0`` the initial area, so that
         the flow is covariant under scaling (time scales as length squared).
+    peclet : float
+        Largest edge Peclet number ``|psi_b - psi_a|`` the drift (R7) sees (R8)
+        (default :data:`ddfv.redistribution.PECLET`; ``inf``: none).
     t_motion : {"scheme", "carried"}
         ``"carried"``: after each step every T-vertex is moved tangentially
         back to the barycentric coordinates of its initial projection in its
@@ -119,7 +122,7 @@ class Flow:
 
     def __init__(self, vertices, faces, tau, *, T0=None, t_init="paper",
                  tangential="none", dual_length="broken", threads=1,
-                 omega=OMEGA, t_motion="scheme"):
+                 omega=OMEGA, peclet=PECLET, t_motion="scheme"):
         if not (np.isfinite(tau) and tau > 0):
             raise ValueError(f"tau must be a positive number, got {tau!r}")
         if tangential not in TANGENTIAL:
@@ -130,9 +133,11 @@ class Flow:
                              f"{', '.join(T_MOTIONS)}")
         if not (np.isfinite(omega) and omega >= 0):
             raise ValueError(f"omega must be a number >= 0, got {omega!r}")
+        if not peclet > 0:
+            raise ValueError(f"peclet must be a positive number (or inf), got {peclet!r}")
         check_threads(threads)
         self.threads = threads
-        self.omega, self.t_motion = float(omega), t_motion
+        self.omega, self.peclet, self.t_motion = float(omega), float(peclet), t_motion
         self._area_0 = None
         self._faces = diamond_mesh(faces, len(vertices)).faces   # checked, as given
         if tangential == "redistribute" and (k := surface_components(self._faces,
@@ -282,9 +287,8 @@ class Flow:
 
         i.e. ``(I + dt diag(1/chi*) K*) X = B + dt g*``, ``g = 0`` (the paper),
         ``-(h - (h.N) N)`` with ``h = -diag(1/chi*) K* X*`` (the elimination
-        (3.6)); the redistribution weights the fluxes and the covolumes, (R6)-(R7):
-        ``(I + dt diag(1/(chi* e^psi*)) K_rho*) X = B + dt g*``, ``g*`` the normal
-        part of the drift at ``X*``. The paper's step is
+        (3.6)); the redistribution weights the F-rows' fluxes by the drift (R6)-(R8)
+        and adds ``g*``, the normal part of the drift at ``X*``, back. The paper's step is
         ``at = base = X^{n-1}``, ``dt = tau``; the harness's integrators choose
         them (``mcfbench.running.integrators``). Dirichlet rows: identity, right-hand
         side ``B``.
@@ -317,8 +321,7 @@ class Flow:
             rhs = base - dt * (h - (h * N).sum(axis=0) * N)           # (3.6)
         elif self.tangential == "redistribute":                       # (R6)-(R7)
             psi = self._potential_of(at, A, dt, geometry, covolumes)
-            drift = drift_system(self._assembler, self._mesh, geometry, covolumes, dt, psi,
-                                 self.threads)
+            drift = drift_system(A, geometry, self._mesh, covolumes, dt, psi, self.peclet)
             N = vertex_normals(self._mesh, geometry)
             drifted = ((drift - A) @ at.T).T                          # -dt x drift of X*
             rhs = base + (drifted * N).sum(axis=0) * N                # + dt g*: normal part back

@@ -65,36 +65,45 @@ positions, ``grad psi . grad_G X`` (``grad_G X . w = w`` for a tangent
 
     X_t = Delta_G X + grad psi . grad_G X = e^{-psi} div_G (e^psi grad_G X)   (R6)
 
-a weighted Laplace-Beltrami, discretised with the scheme's own fluxes:
-every flux of diamond ``d`` ((2.12), (2.15), i.e. ``|gamma^T|`` and
-``|gamma^F|``) is multiplied by a weight ``rho_d``, each covolume balance by
-``1 / e^{psi_i}``, ``psi`` taken at the old state (R3), ``X`` at the new level::
+a weighted Laplace-Beltrami: the flux of ``e^psi grad X`` through a dual
+curve, divided by ``e^psi`` of the balance's own vertex. Per inner diamond,
+the flux ``flux_a`` of the F-row of ``a`` ((2.12)) is multiplied by the
+Scharfetter-Gummel weight of its edge (``psi`` at the old state (R3), ``X``
+at the new level)::
 
-    chi_i e^{psi_i} (X_i^{n+1} - X_i^n) / tau + (K_rho X^{n+1})_i = chi_i e^{psi_i} g_i
-    rho_d = e^{psi_a} B(psi_a - psi_b),   B(x) = x / (e^x - 1)                 (R7)
+    flux_a -> B(psi_a - psi_b) flux_a,   flux_b -> B(psi_b - psi_a) flux_b,
+    B(x) = x / (e^x - 1)                                                      (R7)
 
-(:func:`drift_system`). ``rho_d`` is the Scharfetter-Gummel (logarithmic)
-mean of ``e^psi`` on the edge ``F_a F_b`` (symmetric in ``a, b``): in the
-F-rows ``rho_d / e^{psi_a} = B(psi_a - psi_b) = 1 + (psi_b - psi_a)/2 + ...``,
-to first order the Laplacian plus the centred advection, for large
-differences the upwind one (``max(psi_b - psi_a, 0)``), never exponentially
-large. Stability: with the chord ``|gamma|`` the scheme's ``K`` is symmetric
-positive semi-definite (the discrete Dirichlet energy of the diamonds, a
-sum over diamonds), so is ``K_rho`` (the same sum with positive weights),
-and (R7) is ``(M_psi + tau K_rho) X^{n+1} = M_psi (X^n + tau g)``,
-``M_psi = diag(chi e^psi)`` positive: one step does not increase the
-``rho``-weighted discrete Dirichlet energy ``X^T K_rho X``, for any ``tau``
-(multiply by ``X^{n+1} - X^n``), as the paper's step does not increase the
-unweighted one. The explicit shift ``X^n + tau grad psi`` it replaces has
-the stability limit of an explicit advection and let the area of real
-meshes grow 2.5-66 times (``ddfv/README.md``).
+(:func:`drift_system`): ``e^{-psi_a}`` times the logarithmic mean of
+``e^psi`` on the edge, exact for ``psi`` linear along it (the flux ``e^psi
+X'`` is constant), ``1 + (psi_b - psi_a)/2 + ...``: to first order the
+Laplacian plus the centred advection ``(psi_b - psi_a) flux_a / 2``, for
+large differences the upwind one. The T-rows keep the scheme's fluxes: the
+variant that redistributes (``chord-redistribute-carried``) carries its
+T-vertices with their triangles anyway, and a weight on the T-rows from the
+F-values (the T-values of ``psi`` carry their own constant) made the
+weights exponential in the differences (``e^{psi_d - psi_t}``): the first
+version of (R7), one weight ``e^psi`` per diamond (symmetric), blew up the
+public mesh blub (area x 1.5e6 in one step). The normal part of the drift
+at the old state is added back explicitly, ``g = N N . (A_psi - A) X^n / tau``
+(``A_psi``, ``A`` the row-scaled systems with and without (R7)), as (3.6)
+removes a tangential part: the normal motion stays the scheme's.
 
-``g``: the weighted fluxes are not exactly tangential (the drift moves
-points along chords, and its upwind part has a normal component of order
-``h |grad psi| |II|``), so the normal part of the drift at the old state is
-added back explicitly, ``g = N N . (A_rho - A) X^n / tau`` with ``A_rho``,
-``A`` the row-scaled systems with and without the weights (as (3.6) removes
-a tangential part): the normal motion stays that of the scheme.
+The edge Peclet number is limited, ``psi_b - psi_a`` clipped to
+``[-P, P]`` in (R7) (``peclet``, default :data:`PECLET` = 0.1)::
+
+    B(psi_a - psi_b) -> B(max(min(psi_a - psi_b, P), -P))                     (R8)
+
+On the public real meshes ``psi`` differs by up to 23 across an edge (the
+``h.V`` term at small features): unlimited, a step moves points by ``~0.1
+|psi_b - psi_a|`` edge lengths and folds triangles within 1-2 steps; the
+limit is inactive on a smooth refinement series once ``h |grad psi| < P``.
+Stability: the weights are positive and within ``[B(P), B(-P)] = [0.95,
+1.05]``, so the drift is a relative change of each F-row's fluxes by at most
+5 %; no step restriction comes with it (the matrix stays the implicit
+scheme's up to that change). Unlike the scheme's chord matrix, the matrix
+is not a row scaling of a symmetric one (the two rows of an edge are
+weighted differently).
 
 The vertex velocity ``v_T`` of (R4)-(R5) (:func:`vertex_gradients`) is the
 velocity (R6) carries, kept for diagnostics and tests.
@@ -106,8 +115,6 @@ from the scheme; this is a tangential velocity of the T-vertices alone,
 applied at the end of the step (see ``ddfv/README.md``).
 """
 
-from dataclasses import replace
-
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
@@ -116,6 +123,8 @@ from .assembly import flux_coefficients
 
 #: default relaxation rate ``omega`` of (R2), in 1 / time
 OMEGA = 1.0
+#: default limit of the edge Peclet number ``|psi_b - psi_a|`` of (R8)
+PECLET = 0.1
 
 
 def neumann_stiffness(assembler, geom):
@@ -379,37 +388,48 @@ def bernoulli(x):
     return np.where(x == 0.0, 1.0, b)
 
 
-def drift_system(assembler, mesh, geom, chi, dt, psi, threads=1):
-    """The matrix of (R7) in row-scaled form: ``I + dt diag(1/(chi e^psi)) K_rho``.
+def drift_system(A, geom, mesh, chi, dt, psi, peclet=np.inf):
+    """The matrix of (R7) in row-scaled form: ``A + dt diag(1/chi) D``.
 
     Parameters
     ----------
-    assembler : ddfv.assembly.Assembler
-    mesh : DiamondMesh
+    A : (n, n) scipy.sparse.csr_matrix
+        The scheme's system ``I + dt diag(1/chi) K`` at the same state.
     geom : DiamondGeometry
+    mesh : DiamondMesh
     chi : (n,) float array
         Covolume areas, F-vertices first.
     dt : float
     psi : (n,) float array
-        The potential (R3). Only its F-values enter: a T-vertex takes the mean
-        of its triangle's corners (the T-values carry their own constant, and
-        on slivers differ from their corners' by up to 25 where the F-values of
-        an edge differ by at most 4: measured on a 162-point remeshed sphere),
-        and the level is shifted (``e^psi`` enters only in ratios).
-    threads : int
+        The potential (R3); only its F-values enter.
+    peclet : float
+        Largest ``|psi_b - psi_a|`` a weight sees: the differences are clipped
+        to ``[-peclet, peclet]`` (R8).
 
     Returns
     -------
     (n, n) scipy.sparse.csr_matrix
-        Dirichlet rows are rows of the identity; with ``psi`` constant the
-        scheme's own system.
+        ``D`` multiplies the F-row part of each inner diamond's fluxes by
+        ``w - 1``, ``w_a = B(psi_a - psi_b)`` in the row of ``a`` and
+        ``w_b = B(psi_b - psi_a)`` in the row of ``b`` (:func:`bernoulli`); T-rows,
+        boundary diamonds and Dirichlet rows are those of ``A``. With ``psi``
+        constant, ``A`` itself.
     """
-    a, b = mesh.diamonds[:, 0], mesh.diamonds[:, 1]
-    pf = psi[:mesh.n_f]
-    pf = np.r_[pf, pf[mesh.faces].mean(axis=1)] - 0.5 * (pf.max() + pf.min())
-    rho = np.exp(pf[a]) * bernoulli(pf[a] - pf[b])
-    weighted = replace(geom, gamma_t=geom.gamma_t * rho, gamma_f=geom.gamma_f * rho)
-    return assembler.system(weighted, chi * np.exp(pf), dt, threads)
+    n_f, n = mesh.n_f, mesh.n_unknowns
+    inner = mesh.diamonds[:, 3] >= 0
+    a, b, t1, t2 = (mesh.diamonds[inner, k] for k in range(4))
+    alpha, beta = (np.asarray(c)[inner] for c in flux_coefficients(geom)[:2])
+    d = np.clip(psi[b] - psi[a], -peclet, peclet)
+    wa, wb = bernoulli(-d) - 1.0, bernoulli(d) - 1.0
+    free = ~np.r_[mesh.boundary_vertices, np.zeros(mesh.n_t, bool)]
+    wa, wb = wa * free[a], wb * free[b]
+    # (K f)_a = alpha (f_a - f_b) + beta (f_t2 - f_t1) = -(K f)_b: each row times w - 1
+    rows = np.concatenate([np.tile(a, 4), np.tile(b, 4)])
+    cols = np.tile(np.concatenate([a, b, n_f + t2, n_f + t1]), 2)
+    vals = np.concatenate([wa * alpha, -wa * alpha, wa * beta, -wa * beta,
+                           -wb * alpha, wb * alpha, -wb * beta, wb * beta])
+    D = sp.csr_matrix((vals * (dt / chi[rows]), (rows, cols)), shape=(n, n))
+    return (A + D).tocsr()
 
 
 def carry_t_vertices(F, T, faces, lam):
