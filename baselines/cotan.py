@@ -66,9 +66,9 @@ import scipy.sparse as sp
 
 from .kernels import cotan_geometry, neighbour_cosines, row_scaled_system, vertex_normals
 from .mesh import edge_mesh, laplacian_pattern
-from .redistribution import (OMEGA, PECLET, REDISTRIBUTIONS, drift_laplacian,
-                             redistribution_source, solve_potential, surface_components,
-                             tangential_velocity, target_shares)
+from .redistribution import (OMEGA, PECLET, REDISTRIBUTIONS, PotentialSolver, drift_laplacian,
+                             redistribution_source, surface_components, tangential_velocity,
+                             target_shares)
 
 MASS_TYPES = {"barycentric": igl.MASSMATRIX_TYPE_BARYCENTRIC,
               "voronoi": igl.MASSMATRIX_TYPE_VORONOI}
@@ -535,6 +535,7 @@ class CotanFlow(VertexFlow):
         self.redistribution = redistribution
         self.omega, self.peclet = float(omega), float(peclet)
         self._area_0 = None
+        self._potential_solver = PotentialSolver()
         self.psi = None
         """The potential of the last step's tangential velocity (R2), (n,)."""
         super().__init__(vertices, faces, tau, mass=mass)
@@ -571,7 +572,7 @@ class CotanFlow(VertexFlow):
             self._area_0 = float(mass.sum())
         rate = self.omega * 4.0 * np.pi / self._area_0           # scale-covariant omega
         f = redistribution_source(L, mass, at, self.fixed, rate, self._shares)
-        self.psi = solve_potential(L, mass, f)
+        self.psi = self._potential_solver(L, mass, f)
         self.timings["redistribution"] += time.perf_counter() - clock
         return self.psi
 

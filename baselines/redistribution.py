@@ -213,8 +213,8 @@ def redistribution_source(L, mass, X, fixed, omega, shares=None):
     return f
 
 
-def solve_potential(L, mass, f):
-    """``psi`` of (R2): ``L psi = -M f``, normalised to ``sum m_i psi_i = 0``.
+class PotentialSolver:
+    """``psi`` of (R2) along a flow: ``L psi = -M f``, normalised to ``sum m_i psi_i = 0``.
 
     ``L`` is singular (kernel: the constants). The right-hand side is
     projected onto its range (``sum = 0``), ``psi_0 = 0`` is pinned, the
@@ -223,6 +223,61 @@ def solve_potential(L, mass, f):
     constant is then projected out. Direct on purpose: on sliver-rich
     meshes Jacobi-preconditioned CG needed ~1200 iterations at 10^4
     vertices (marching-cubes blob, level 2), some 40 times the factorisation.
+    The factors are kept: the next steps' systems, whose geometry moved by
+    ``O(tau)``, are solved by iterative refinement ``x <- x + LU^{-1} (b - A
+    x)`` from the last solution until ``|b - A x| <= rtol |b|``, and factorised
+    anew when that takes more than ``max_refinements`` passes (as
+    :class:`ddfv.redistribution.TangentialPotential`, which this package may not
+    import). ``psi`` only sets a tangential velocity: ``rtol = 1e-7`` moves the
+    points by ``1e-7`` of the redistribution's own displacement.
+
+    Parameters
+    ----------
+    rtol : float
+    max_refinements : int
+    """
+
+    def __init__(self, rtol=1e-7, max_refinements=6):
+        self.rtol, self.max_refinements = rtol, max_refinements
+        self._lu = self._last = None
+        #: number of factorisations and of refinement passes so far
+        self.factorisations = self.refinements = 0
+
+    def __call__(self, L, mass, f):
+        """``psi`` (n,) for the stiffness ``L`` (n, n, symmetric positive
+        semi-definite, kernel the constants), the masses and ``f`` (n,)."""
+        b = -mass * f
+        b -= b.mean()                                  # onto the range of L (rounding)
+        n = len(b)
+        if n < 2 or not np.any(b):
+            return np.zeros(n)
+        A, b = sp.csr_matrix(L)[1:, 1:], b[1:]
+        x = self._refined(A, b)
+        if x is None:
+            self._lu = spla.splu(sp.csc_matrix(A))
+            self.factorisations += 1
+            x = self._lu.solve(b)
+        self._last = x
+        psi = np.concatenate([[0.0], x])
+        return psi - (mass * psi).sum() / mass.sum()
+
+    def _refined(self, A, b):
+        """The kept factors' iterative refinement from the last solution, or None."""
+        x = self._last
+        if self._lu is None or x is None or len(x) != len(b):
+            return None
+        norm = np.linalg.norm(b)
+        for _ in range(self.max_refinements + 1):
+            r = b - A @ x
+            if np.linalg.norm(r) <= self.rtol * norm:
+                return x
+            x = x + self._lu.solve(r)
+            self.refinements += 1
+        return None
+
+
+def solve_potential(L, mass, f):
+    """``psi`` of (R2) in one call: a fresh :class:`PotentialSolver` (a factorisation).
 
     Parameters
     ----------
@@ -234,14 +289,7 @@ def solve_potential(L, mass, f):
     -------
     (n,) float array
     """
-    b = -mass * f
-    b -= b.mean()                                  # onto the range of L (rounding)
-    n = len(b)
-    if n < 2 or not np.any(b):
-        return np.zeros(n)
-    reduced = sp.csc_matrix(sp.csr_matrix(L)[1:, 1:])
-    psi = np.concatenate([[0.0], spla.splu(reduced).solve(b[1:])])
-    return psi - (mass * psi).sum() / mass.sum()
+    return PotentialSolver()(L, mass, f)
 
 
 def tangential_velocity(vertices, faces, psi):
