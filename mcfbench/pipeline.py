@@ -39,9 +39,12 @@ from mcfbench.running.problems import get_problem
 from mcfbench.running.schemes import SCHEMES
 from mcfbench.storage.atomic import write_json
 from mcfbench.storage.provenance import code_hash
-from mcfbench.studies import beyond, convergence, gallery, matrix
+from mcfbench.studies.beyond import plan as beyond
 from mcfbench.studies.config import ConfigError, check_threads
-from mcfbench.studies.convergence import PROBLEM
+from mcfbench.studies.convergence import plan as convergence
+from mcfbench.studies.convergence.plan import PROBLEM
+from mcfbench.studies.gallery import plan as gallery
+from mcfbench.studies.matrix import plan as matrix
 
 
 def check_keys(config, schema_path):

@@ -30,7 +30,8 @@ from mcfbench.presentation.formats import (
     tex_number,
     tex_tabular,
 )
-from mcfbench.presentation.report_inputs import MARKDOWN_EXTENSIONS
+
+MARKDOWN_EXTENSIONS = ["tables", "md_in_html", "attr_list", "fenced_code", "sane_lists", "toc"]
 
 
 def as_list(value):

@@ -29,7 +29,7 @@ import yaml
 
 from mcfbench.pipeline import Plans
 from mcfbench.storage.records import checksum
-from mcfbench.studies.convergence import solver_of
+from mcfbench.studies.convergence.job import solver_of
 
 pytestmark = pytest.mark.e2e
 

@@ -1,12 +1,12 @@
 # Figures 3.1-3.8 of the paper (and two comparisons with the cotangent
 # baseline): one job per figure runs its experiment and draws it. What each
 # figure computes (shape, parameters, scheme, tau, steps, panels) is defined
-# in one place, mcfbench/studies/figure_experiments.py (EXPERIMENTS); the job
+# in one place, mcfbench/studies/figures/experiments.py (EXPERIMENTS); the job
 # is mcfbench.studies.figures.job; this file only maps the registry to files.
 #
 #   snakemake --cores 2 results/figures/fig_3_6.png   # one figure
 
-from mcfbench.studies.figure_experiments import EXPERIMENTS
+from mcfbench.studies.figures.experiments import EXPERIMENTS
 
 FIGURES = list(EXPERIMENTS)
 
@@ -28,7 +28,7 @@ wildcard_constraints:
 
 
 rule figure:
-    """Run the experiment of one figure (mcfbench/studies/figures.py) and draw it.
+    """Run the experiment of one figure (mcfbench/studies/figures/job.py) and draw it.
 
     Writes the figure, the kept frames (one file per run), per-step mesh-quality diagnostics
     (CSV and plot) and a JSON record with the status of every run. A run

@@ -14,7 +14,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
              "NUMBA_NUM_THREADS"):
     os.environ[_var] = "1"
 
-from mcfbench.studies import matrix  # noqa: E402
+from mcfbench.studies.matrix import job as matrix_job  # noqa: E402
 
-matrix.series_job(snakemake.params.settings, snakemake.output.records,  # noqa: F821
+matrix_job.series_job(snakemake.params.settings, snakemake.output.records,  # noqa: F821
                   snakemake.output.frames, snakemake.log[0])  # noqa: F821
