@@ -104,7 +104,7 @@ rule beyond_time:
 rule beyond_records:
     """Check every run record of the beyond study (a bad one stops here: the tables stay)."""
     input:
-        lambda wildcards: list(PLANS.beyond_records()),
+        lambda wildcards: list(_beyond.study_records(PLANS)),
     output:
         "results/beyond/tables/records.json",
     log:
@@ -119,7 +119,7 @@ rule beyond_records:
         mem_mb=500,
         runtime=5,
     params:
-        expected=lambda wildcards: PLANS.beyond_records(),
+        expected=lambda wildcards: _beyond.study_records(PLANS),
     script:
         "../scripts/check_records.py"
 
@@ -128,10 +128,10 @@ rule beyond_tables:
     """The tables of the beyond study and the T monitor series."""
     input:
         checked="results/beyond/tables/records.json",
-        levels=lambda wildcards: list(PLANS.beyond_runs["levels"]),
-        long_time=lambda wildcards: list(PLANS.beyond_runs["long_time"]),
-        space=lambda wildcards: list(PLANS.beyond_runs["space"]),
-        time=lambda wildcards: list(PLANS.beyond_runs["time"]),
+        levels=lambda wildcards: list(_beyond.study_runs(PLANS)["levels"]),
+        long_time=lambda wildcards: list(_beyond.study_runs(PLANS)["long_time"]),
+        space=lambda wildcards: list(_beyond.study_runs(PLANS)["space"]),
+        time=lambda wildcards: list(_beyond.study_runs(PLANS)["time"]),
     output:
         **{
             key: (
@@ -160,9 +160,9 @@ rule beyond_tables:
         mem_mb=1000,
         runtime=5,
     params:
-        expected=lambda wildcards: PLANS.beyond_records(),
-        beyond=lambda wildcards: PLANS.beyond,
-        paper_schemes=lambda wildcards: PLANS.paper_schemes(),
+        expected=lambda wildcards: _beyond.study_records(PLANS),
+        beyond=lambda wildcards: PLANS.plan("beyond"),
+        paper_schemes=lambda wildcards: _beyond.paper_schemes(PLANS.plan("beyond")),
         settings={k: config[k] for k in ("tau_level_1", "t_final", "rtol")},
     script:
         "../scripts/beyond_tables.py"
@@ -202,7 +202,7 @@ rule beyond_figures:
         mem_mb=1000,
         runtime=5,
     params:
-        beyond=lambda wildcards: PLANS.beyond,
+        beyond=lambda wildcards: PLANS.plan("beyond"),
         t_final=config["t_final"],
     script:
         "../scripts/beyond_plots.py"
@@ -235,8 +235,8 @@ rule beyond_findings:
         mem_mb=500,
         runtime=5,
     params:
-        beyond=lambda wildcards: PLANS.beyond,
-        paper_schemes=lambda wildcards: PLANS.paper_schemes(),
+        beyond=lambda wildcards: PLANS.plan("beyond"),
+        paper_schemes=lambda wildcards: _beyond.paper_schemes(PLANS.plan("beyond")),
         t_final=config["t_final"],
         tau_level_1=config["tau_level_1"],
     script:

@@ -40,7 +40,7 @@ rule run_scheme:
 rule convergence_records:
     """Check every run record of Table 3.1 (a bad one stops here: the tables stay)."""
     input:
-        lambda wildcards: list(PLANS.convergence_records()),
+        lambda wildcards: list(_convergence.table_records(PLANS)),
     output:
         "results/tables/convergence.records.json",
     log:
@@ -55,7 +55,7 @@ rule convergence_records:
         mem_mb=500,
         runtime=5,
     params:
-        expected=lambda wildcards: PLANS.convergence_records(),
+        expected=lambda wildcards: _convergence.table_records(PLANS),
     script:
         "../scripts/check_records.py"
 
@@ -64,7 +64,7 @@ rule convergence_table:
     """Table 3.1 with the paper's values and the baselines side by side."""
     input:
         checked="results/tables/convergence.records.json",
-        records=lambda wildcards: list(PLANS.convergence_records()),
+        records=lambda wildcards: list(_convergence.table_records(PLANS)),
     output:
         csv=report(
             "results/tables/convergence.csv",
@@ -87,10 +87,12 @@ rule convergence_table:
         mem_mb=500,
         runtime=5,
     params:
-        expected=lambda wildcards: PLANS.convergence_records(),
-        schemes=lambda wildcards: PLANS.convergence["schemes"],
-        levels=lambda wildcards: PLANS.convergence["levels"],
-        settings=lambda wildcards: PLANS.table_settings(),
+        expected=lambda wildcards: _convergence.table_records(PLANS),
+        schemes=lambda wildcards: PLANS.plan("convergence")["schemes"],
+        levels=lambda wildcards: PLANS.plan("convergence")["levels"],
+        settings=lambda wildcards: _convergence.table_settings(
+            PLANS.plan("convergence")
+        ),
     script:
         "../scripts/convergence_table.py"
 

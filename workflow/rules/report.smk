@@ -82,7 +82,7 @@ rule reproduction_report:
         unpack(
             lambda wildcards: {
                 **REPORT_INPUTS,
-                "records": list(PLANS.convergence_records()),
+                "records": list(_convergence.table_records(PLANS)),
                 "beyond": (
                     BEYOND_RESULTS
                     if "beyond"

@@ -198,3 +198,29 @@ def record_fields(settings):
     :func:`mcfbench.storage.records.read_records`): the time study's records
     have their own (:data:`TIME_FIELDS`), every other run record :data:`FIELDS`."""
     return TIME_FIELDS if settings.get("study") == "time" else FIELDS
+
+
+def from_config(config, plans):
+    """:func:`plan` of the config, on Table 3.1's plan (:meth:`mcfbench.pipeline.Plans.plan`)."""
+    return plan(config, plans.plan("convergence"))
+
+
+def study_runs(plans):
+    """:func:`beyond_runs` of the pipeline's plans."""
+    return beyond_runs(plans.plan("beyond"), plans.plan("convergence"), plans.code)
+
+
+def study_records(plans):
+    """``{record path: settings}`` of every run of the beyond study."""
+    return {path: s for runs in study_runs(plans).values() for path, s in runs.items()}
+
+
+def study_run_settings(plans, study, scheme, level):
+    """Settings of one run of the long-time or the space study."""
+    return study_settings(plans.plan("beyond"), plans.plan("convergence"), study, scheme, level,
+                          plans.code)
+
+
+def time_run_settings(plans, scheme):
+    """Settings of the time study of one scheme."""
+    return time_settings(plans.plan("beyond"), plans.plan("convergence"), scheme, plans.code)

@@ -108,3 +108,31 @@ def table_settings(plan):
     return {k: plan[k] for k in ("levels", "schemes", "tau_level_1", "t_final", "rtol")}
 
 
+def from_config(config, plans):
+    """:func:`plan` of the config (:meth:`mcfbench.pipeline.Plans.plan`)."""
+    return plan(config)
+
+
+def sphere_run_settings(plans, scheme, level):
+    """Settings of the record ``results/runs/{scheme}/level{level}.json``: Table
+    3.1's, or for a run of ``beyond.finest`` the beyond study's (its tolerance;
+    the only record of that folder that needs the beyond plan)."""
+    from mcfbench.studies.beyond import plan as beyond
+
+    if beyond.is_finest_run(plans.config, scheme, level):
+        return beyond.level_settings(plans.plan("beyond"), plans.plan("convergence"), scheme,
+                                     level, plans.code)
+    return record_settings(plans.plan("convergence"), scheme, level, plans.code)
+
+
+def table_records(plans):
+    """``{record path: settings}`` of Table 3.1, schemes in config order."""
+    table = plans.plan("convergence")
+    return {run_record(s, lv): sphere_run_settings(plans, s, lv)
+            for s in table["schemes"] for lv in table["levels"]}
+
+
+def level_steps(plan, level):
+    """Time steps of a run of ``level`` with Table 3.1's time step."""
+    problem = problem_of(plan)
+    return problem.time_steps(problem.tau(int(level)))

@@ -113,3 +113,6 @@ def generated_meshes():
     return {**own, **packaged}
 
 
+def from_config(config, plans):
+    """:func:`plan` of the config (:meth:`mcfbench.pipeline.Plans.plan`)."""
+    return plan(config.get("gallery"), config.get("meshes"))

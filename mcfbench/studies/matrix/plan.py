@@ -151,3 +151,8 @@ def picture_runs(plan, root=ROOT):
     the coarsest level of each problem."""
     return {(p, s): (record_path(p, s, min(levels), root), frames_path(p, s, min(levels), root))
             for p, levels in plan["problems"].items() for s in plan["schemes"]}
+
+
+def from_config(config, plans):
+    """:func:`plan` of the config (:meth:`mcfbench.pipeline.Plans.plan`)."""
+    return plan(config.get("matrix"))

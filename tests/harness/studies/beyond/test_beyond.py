@@ -21,7 +21,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from mcfbench.pipeline import Plans, mem_mb
+from mcfbench.pipeline import Plans, mem_mb, runtime_minutes
 from mcfbench.presentation.plots import beyond_figures
 from mcfbench.running.run import space_convergence
 from mcfbench.running.schemes import SCHEMES
@@ -32,7 +32,7 @@ from mcfbench.storage.records import RecordError, read_record, read_records
 from mcfbench.studies.beyond.findings import beyond_findings
 from mcfbench.studies.beyond.findings import findings as verdicts
 from mcfbench.studies.beyond.job import time_job
-from mcfbench.studies.beyond.plan import levels_of, record_fields, used_schemes
+from mcfbench.studies.beyond.plan import levels_of, record_fields, study_runs, used_schemes
 from mcfbench.studies.beyond.tables import (
     beyond_documents,
     beyond_tables,
@@ -42,7 +42,7 @@ from mcfbench.studies.beyond.tables import (
 )
 from mcfbench.studies.config import ConfigError
 from mcfbench.studies.convergence.job import job as run_job
-from mcfbench.studies.convergence.plan import problem_of
+from mcfbench.studies.convergence.plan import level_steps, problem_of, sphere_run_settings
 from mcfbench.studies.convergence.tables import convergence_documents, eoc_column, level_table
 
 REPO = Path(__file__).resolve().parents[4]
@@ -398,7 +398,7 @@ def test_default_config_passes_the_schema_and_the_checks():
 
     config = json.loads(json.dumps(CONFIG))
     validate(config, str(REPO / "workflow" / "schemas" / "config.schema.yaml"))
-    settings = Plans(config, SCHEMAS).beyond
+    settings = Plans(config, SCHEMAS).plan("beyond")
     assert settings["levels"] == [1, 2, 3, 4, 5, 6]
     assert settings["schemes"] == ["ddfv", "ddfv-chord", "ddfv-eliminate", "cotan",
                                    "ddfv@bdf2", "ddfv-chord@bdf2", "cotan@bdf2"]
@@ -411,28 +411,30 @@ def test_default_config_passes_the_schema_and_the_checks():
     assert all(s.partition("@")[0] in SCHEMES for s in used_schemes(settings))
     # the level-7 run is off by default
     assert settings["finest"] == {"level": 7, "rtol": 1e-11, "schemes": []}
-    assert not [p for p in Plans(config, SCHEMAS).beyond_runs["levels"] if "level7" in p]
+    assert not [p for p in study_runs(Plans(config, SCHEMAS))["levels"] if "level7" in p]
 
 
 def test_finest_level_adds_its_runs_only():
     config = json.loads(json.dumps(CONFIG))
     config["beyond"]["finest"]["schemes"] = ["ddfv-chord"]
     pipeline = Plans(config, SCHEMAS)
-    runs = pipeline.beyond_runs["levels"]
-    default = Plans(json.loads(json.dumps(CONFIG)), SCHEMAS).beyond_runs["levels"]
+    runs = study_runs(pipeline)["levels"]
+    default = study_runs(Plans(json.loads(json.dumps(CONFIG)), SCHEMAS))["levels"]
     assert set(runs) - set(default) == {"results/runs/ddfv-chord/level7.json"}
     assert all(runs[p] == settings for p, settings in default.items())
-    assert runs["results/runs/ddfv-chord/level7.json"] == pipeline.run_settings("ddfv-chord", 7)
+    assert runs["results/runs/ddfv-chord/level7.json"] == \
+        sphere_run_settings(pipeline, "ddfv-chord", 7)
     # the finest level's own tolerance; every other run keeps the top-level one
     assert runs["results/runs/ddfv-chord/level7.json"]["rtol"] == 1e-11
     assert {s["rtol"] for p, s in runs.items() if "level7" not in p} == {1e-9}
-    assert levels_of(pipeline.beyond, "ddfv-chord") == [1, 2, 3, 4, 5, 6, 7]
-    assert levels_of(pipeline.beyond, "ddfv") == [1, 2, 3, 4, 5, 6]
-    problem = problem_of(pipeline.convergence)
+    assert levels_of(pipeline.plan("beyond"), "ddfv-chord") == [1, 2, 3, 4, 5, 6, 7]
+    assert levels_of(pipeline.plan("beyond"), "ddfv") == [1, 2, 3, 4, 5, 6]
+    problem = problem_of(pipeline.plan("convergence"))
     assert problem.time_steps(problem.tau(7)) == 8192
     # the job's Slurm resources cover the single-core estimate of an earlier session
     # (about 630 MB and 860 s) twice over
-    assert mem_mb(7) >= 2 * 630 and pipeline.run_runtime(7) * 60 >= 2 * 860
+    runtime = runtime_minutes(7, level_steps(pipeline.plan("convergence"), 7))
+    assert mem_mb(7) >= 2 * 630 and runtime * 60 >= 2 * 860
 
 
 @pytest.mark.parametrize("path, value, message", [
@@ -452,7 +454,7 @@ def test_finest_level_adds_its_runs_only():
     (("extra",), 1, "config key 'beyond': Additional properties are not allowed ('extra'"),
 ])
 def test_beyond_schema_names_the_bad_key(path, value, message):
-    """The section ``beyond`` has its own schema, checked with its plan (Plans.beyond),
+    """The section ``beyond`` has its own schema, checked with its plan (Plans.plan("beyond")),
     not while Snakemake reads the workflow: the whole config passes the main schema."""
     from snakemake.utils import validate
 
@@ -463,7 +465,7 @@ def test_beyond_schema_names_the_bad_key(path, value, message):
     node[path[-1]] = value
     validate(json.loads(json.dumps(config)), str(SCHEMAS / "config.schema.yaml"))
     with pytest.raises(ConfigError) as err:
-        Plans(config, SCHEMAS).beyond
+        Plans(config, SCHEMAS).plan("beyond")
     assert message in str(err.value)
 
 
@@ -500,7 +502,7 @@ def test_checks_across_keys_name_the_key(path, value, message):
         config["beyond"]["finest"]["schemes"] = ["ddfv-chord"]   # checked when on
     config["beyond"][path[0]][path[1]] = value
     with pytest.raises(ConfigError) as err:
-        Plans(config, SCHEMAS).beyond
+        Plans(config, SCHEMAS).plan("beyond")
     assert message in str(err.value)
     if "unknown" in message:
         assert all(name in str(err.value) for name in SCHEMES)
@@ -509,7 +511,7 @@ def test_checks_across_keys_name_the_key(path, value, message):
 def test_time_study_takes_any_scheme():
     config = json.loads(json.dumps(CONFIG))
     config["beyond"]["time_study"]["schemes"] = ["cotan", "ddfv"]
-    assert Plans(config, SCHEMAS).beyond["time_study"]["schemes"] == ["cotan", "ddfv"]
+    assert Plans(config, SCHEMAS).plan("beyond")["time_study"]["schemes"] == ["cotan", "ddfv"]
 
 
 FINEST = "beyond={finest: {schemes: [ddfv-chord]}}"   # the command line of config/README.md
@@ -563,7 +565,8 @@ def test_dry_run_of_beyond_and_a_bad_value(tmp_path):
     assert procs["finest"].returncode == 0, out["finest"][-3000:]
     job = out["finest"].split(f"output: {level7}")[1].split("\n\n")[0]
     pipeline = Plans(json.loads(json.dumps(CONFIG)), SCHEMAS)
-    assert f"runtime={pipeline.run_runtime(7)}, mem_mb={mem_mb(7)}," in job, job
+    runtime = runtime_minutes(7, level_steps(pipeline.plan("convergence"), 7))
+    assert f"runtime={runtime}, mem_mb={mem_mb(7)}," in job, job
     assert jobs(out["finest"], "run_scheme") == jobs(out["good"], "run_scheme") + 1
     assert procs["bad_finest"].returncode != 0
     assert "config key 'beyond.finest.level': 6 is not above" in out["bad_finest"]
