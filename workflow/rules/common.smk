@@ -7,6 +7,7 @@
 from mcfbench.pipeline import Plans, mem_mb, runtime_minutes, scheme_pattern
 from mcfbench.studies.beyond import plan as _beyond
 from mcfbench.studies.convergence import plan as _convergence
+import mcfbench.studies.convergence as _convergence_paths
 
 PLANS = Plans(config, f"{workflow.basedir}/workflow/schemas")
 # the config key `threads` (every run job), checked here
@@ -52,15 +53,9 @@ def time_runtime(wildcards):
 
 
 TABLES = [
-    "results/tables/convergence.csv",
-    "results/tables/convergence.md",
-    "results/tables/convergence.tex",
-    "results/tables/convergence.csv.json",
+    f"{_convergence_paths.TABLE}.{ext}" for ext in ("csv", "md", "tex", "csv.json")
 ]
-CONVERGENCE_FIGURES = [
-    "results/figures/convergence.png",
-    "results/figures/convergence.pdf",
-]
+CONVERGENCE_FIGURES = [f"{_convergence_paths.FIGURE}.{ext}" for ext in ("png", "pdf")]
 CONVERGENCE_TARGETS = TABLES + CONVERGENCE_FIGURES
 
 

@@ -21,7 +21,7 @@
 #   index.html                                   the results page: sortable tables, figures,
 #                                                findings, in one offline file
 
-import mcfbench.studies.matrix as _paths
+import mcfbench.studies.matrix as _matrix_paths
 from mcfbench.studies.matrix import plan as _matrix
 from mcfbench.pipeline import alternatives as _alternatives
 
@@ -34,13 +34,13 @@ MATRIX_CODE = PLANS.code
 MATRIX_RUNS = _matrix.planned_runs(MATRIX, MATRIX_CODE)
 
 
-MATRIX_TABLES = _paths.table_files(MATRIX["problems"])
-MATRIX_FIGURES = _paths.figure_files()
+MATRIX_TABLES = _matrix_paths.table_files(MATRIX["problems"])
+MATRIX_FIGURES = _matrix_paths.figure_files()
 MATRIX_TARGETS = [
     *MATRIX_TABLES,
     *MATRIX_FIGURES.values(),
-    _paths.FINDINGS,
-    _paths.PAGE,
+    _matrix_paths.FINDINGS,
+    _matrix_paths.PAGE,
 ]
 
 
@@ -110,7 +110,7 @@ rule matrix_tables:
 rule matrix_plots:
     """Error against h, mesh quality over time, the picture grid."""
     input:
-        table=_paths.LONG_TABLE,
+        table=_matrix_paths.LONG_TABLE,
         records=list(MATRIX_RUNS),
         frames=[f for _, f in _matrix.picture_runs(MATRIX).values()],
     output:
@@ -137,10 +137,10 @@ rule matrix_plots:
 rule matrix_findings:
     """findings.md from the summary table (no hand-typed numbers)."""
     input:
-        summary=_paths.SUMMARY,
-        table=_paths.LONG_TABLE,
+        summary=_matrix_paths.SUMMARY,
+        table=_matrix_paths.LONG_TABLE,
     output:
-        _paths.FINDINGS,
+        _matrix_paths.FINDINGS,
     log:
         "results/logs/matrix/findings.log",
     benchmark:
@@ -162,12 +162,12 @@ rule matrix_page:
     """The results page: the tables (sortable), the figures and the findings in one
     self-contained HTML file."""
     input:
-        table=_paths.LONG_TABLE,
-        summary=_paths.SUMMARY,
-        figures=[MATRIX_FIGURES[f"{name}_png"] for name in _paths.FIGURE_NAMES],
-        findings=_paths.FINDINGS,
+        table=_matrix_paths.LONG_TABLE,
+        summary=_matrix_paths.SUMMARY,
+        figures=[MATRIX_FIGURES[f"{name}_png"] for name in _matrix_paths.FIGURE_NAMES],
+        findings=_matrix_paths.FINDINGS,
     output:
-        _paths.PAGE,
+        _matrix_paths.PAGE,
     log:
         "results/logs/matrix/page.log",
     benchmark:

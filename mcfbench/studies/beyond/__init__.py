@@ -15,3 +15,26 @@ The study's modules:
   finest common level, the ranking), worded in ``findings.md``
   (:func:`~.findings.write_findings`).
 """
+
+ROOT = "results/beyond"
+"""The folder of the study's outputs (its level runs are Table 3.1's records,
+:data:`mcfbench.studies.convergence.RUN`)."""
+
+RUN = f"{ROOT}/runs/{{study}}/{{scheme}}/level{{level}}.json"
+"""One run of the long-time (``study = long_time``) or the space study."""
+
+TIME_RUN = f"{ROOT}/runs/time/{{scheme}}.json"
+"""The time study of one scheme."""
+
+TABLES = f"{ROOT}/tables"
+"""``{name}.csv/.md/.tex`` of :data:`TABLE_NAMES`, ``t_monitor.csv``, ``beyond.json``
+(provenance), ``records.json`` (the check of the records)."""
+
+TABLE_NAMES = ("levels", "stability", "time_convergence", "space_convergence", "integrators")
+
+FIGURES = f"{ROOT}/figures"
+"""``{name}.png/.pdf`` of :data:`FIGURE_NAMES`."""
+
+FIGURE_NAMES = ("levels", "t_monitor", "time_convergence", "space_convergence")
+
+FINDINGS = f"{ROOT}/findings.md"

@@ -3,6 +3,7 @@ and the Table 3.1 keys it builds on (:func:`plan`), every record of the study wi
 its settings (:func:`beyond_runs`)."""
 
 from mcfbench.storage.records import FIELDS
+from mcfbench.studies.beyond import RUN, TIME_RUN
 from mcfbench.studies.config import (
     ConfigError,
     check_rtol,
@@ -181,14 +182,14 @@ def beyond_runs(plan, table, code):
     return {
         "levels": {convergence.run_record(s, lv): level_settings(plan, table, s, lv, code)
                    for s in plan["schemes"] for lv in levels_of(plan, s)},
-        "long_time": {f"results/beyond/runs/long_time/{s}/level{long_level}.json":
+        "long_time": {RUN.format(study="long_time", scheme=s, level=long_level):
                       study_settings(plan, table, "long_time", s, long_level, code)
                       for s in plan["long_time"]["schemes"]},
-        "space": {f"results/beyond/runs/space/{s}/level{lv}.json":
+        "space": {RUN.format(study="space", scheme=s, level=lv):
                   study_settings(plan, table, "space", s, lv, code)
                   for s in plan["space_study"]["schemes"]
                   for lv in plan["space_study"]["levels"]},
-        "time": {f"results/beyond/runs/time/{s}.json": time_settings(plan, table, s, code)
+        "time": {TIME_RUN.format(scheme=s): time_settings(plan, table, s, code)
                  for s in plan["time_study"]["schemes"]},
     }
 

@@ -13,3 +13,13 @@ The study's modules (``workflow/rules/convergence.smk`` calls them):
 :func:`~.job.sphere_table` is the same table computed in one process (the command
 line's ``sphere-table``).
 """
+
+RUN = "results/runs/{scheme}/level{level}.json"
+"""One scheme on one level: its run record (shared with the beyond study's levels)."""
+
+TABLE = "results/tables/convergence"
+"""Table 3.1: ``.csv``, ``.md``, ``.tex``, its provenance ``.csv.json`` and the check of
+its records ``.records.json``."""
+
+FIGURE = "results/figures/convergence"
+"""L2 error against h: ``.png``, ``.pdf``."""

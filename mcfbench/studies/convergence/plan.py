@@ -4,6 +4,7 @@ of one run record (:func:`record_settings`, shared with the beyond study's level
 
 from mcfbench.running.problems import get_problem
 from mcfbench.running.schemes import joined_name
+from mcfbench.studies.convergence import RUN
 from mcfbench.studies.config import (
     ConfigError,
     check_rtol,
@@ -82,7 +83,7 @@ def problem_of(plan):
 
 def run_record(scheme, level):
     """The record of (scheme, level), shared by Table 3.1 and the beyond study."""
-    return f"results/runs/{scheme}/level{level}.json"
+    return RUN.format(scheme=scheme, level=level)
 
 
 def record_settings(plan, scheme, level, code, *, study=None, tau=None, t_final=None,

@@ -250,21 +250,6 @@ def _short(text, width=34):
 
 # ---------------------------------------------------------------- the job
 
-FIGURE_OUTPUTS = ("png", "pdf", "frames", "record", "csv", "plot")
-"""The outputs of one figure's job (those of ``workflow/rules/figures.smk``)."""
-
-
-def figure_outputs(name, results="results"):
-    """Output paths of the figure ``name``: the figure (``png``, ``pdf``), the
-    folder of its runs' frames (``frames``: ``<run key>.npz`` each), its record,
-    the diagnostics (``csv``) and their plot."""
-    root = Path(results)
-    return {"png": root / "figures" / f"{name}.png", "pdf": root / "figures" / f"{name}.pdf",
-            "frames": root / "runs" / "figures" / name,
-            "record": root / "runs" / "figures" / f"{name}.json",
-            "csv": root / "diagnostics" / f"{name}.csv",
-            "plot": root / "diagnostics" / f"{name}.png"}
-
 
 def frames_file(folder, key):
     """The frames file of run ``key`` in a figure's frames folder."""

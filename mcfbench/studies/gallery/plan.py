@@ -5,6 +5,7 @@
 from pathlib import Path
 
 from mcfbench.studies.config import ConfigError
+from mcfbench.studies.gallery import MESH
 from mcfbench.studies.matrix import REAL_WORLD_SURFACES, is_real_world
 from mcfbench.studies.matrix.plan import robust_method
 
@@ -76,7 +77,7 @@ def plan(section=None, meshes=None, schemes=None):
         plan["generated"] = {}
     else:
         generated = generated_meshes()
-        plan["meshes"] = {name: f"results/gallery/meshes/{name}" for name in generated}
+        plan["meshes"] = {name: MESH.format(mesh=name) for name in generated}
         plan["generated"] = generated
     return plan
 

@@ -14,6 +14,7 @@ import pytest
 from mcfbench.geometry.surfaces import make_surface
 from mcfbench.presentation.render import cells_centre, cells_points, project
 from mcfbench.running.schemes import SCHEMES, get_scheme
+from mcfbench.studies.figures import figure_outputs
 from mcfbench.studies.figures.experiments import (
     Experiment,
     EXPERIMENTS,
@@ -28,7 +29,6 @@ from mcfbench.studies.figures.experiments import (
 from mcfbench.studies.figures.job import (
     draw_experiment,
     experiment_panels,
-    figure_outputs,
     job,
     run_experiment,
     tracked,
