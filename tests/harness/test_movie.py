@@ -109,7 +109,7 @@ def test_gallery_run_keeps_frames_for_its_movie(tmp_path):
     bad.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n")
     record, frames = tmp_path / "runs/bad.obj/cotan.json", tmp_path / "frames/bad.obj/cotan.npz"
     assert gallery_job.job(bad, "cotan", {**settings, "mesh": "bad.obj"}, record,
-                       frames).status == "unsupported"
+                           frames).status == "unsupported"
     gallery_plots.run_movie(record, frames, tmp_path / "bad.gif")
     _, shown = _frames(tmp_path / "bad.gif")
     assert len(shown) == 1                                  # the status, in red

@@ -68,13 +68,13 @@ def page(tmp_path_factory):
     root = tmp_path_factory.mktemp("matrix")
     levels = {"sphere": [1, 2], "catenoid": [1]}
     plan = matrix_plan.plan({"schemes": ["cotan", "ddfv"],
-                        "problems": {p: levels.get(p, []) for p in PROBLEMS}})
+                             "problems": {p: levels.get(p, []) for p in PROBLEMS}})
     runs = matrix_plan.planned_runs(plan, code="test", root=str(root))
     for path, s in runs.items():
         matrix_job.job(s, path, matrix_plan.frames_path(s["problem"], s["scheme"], s["level"], str(root)))
     table, _ = matrix_aggregate.aggregate(runs, plan, root / "tables")
     matrix_findings.findings(root / "tables" / "summary.csv", root / "findings.md", plan,
-                    root / "tables" / "matrix.csv")
+                             root / "tables" / "matrix.csv")
     problems, schemes, figures = list(plan["problems"]), plan["schemes"], root / "figures"
     error_figure(table, [figures / "errors.png"], problems, schemes)
     work_precision_figure(table, [figures / "work_precision.png"], problems, schemes)

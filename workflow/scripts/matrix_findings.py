@@ -10,5 +10,5 @@ from mcfbench.studies.matrix import findings as matrix_findings
 
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, force=True)  # noqa: F821
 text = matrix_findings.findings(snakemake.input.summary, snakemake.output[0],  # noqa: F821
-                       snakemake.params.plan, snakemake.input.table)  # noqa: F821
+                                snakemake.params.plan, snakemake.input.table)  # noqa: F821
 logging.info("\n%s", text)

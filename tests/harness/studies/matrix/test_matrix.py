@@ -45,7 +45,7 @@ def test_plan_defaults_to_every_scheme_and_problem():
 
 def test_plan_levels_and_leaving_out():
     plan = matrix_plan.plan({"schemes": ["cotan"], "problems": {"sphere": ["2", 1],
-                                                                   "torus": []}})
+                                                                        "torus": []}})
     assert plan["schemes"] == ["cotan"]
     assert plan["problems"]["sphere"] == [1, 2]
     assert "torus" not in plan["problems"]
@@ -77,8 +77,8 @@ def tiny(tmp_path_factory):
     """ddfv and cotan on sphere and catenoid, level 1, through run_job."""
     root = tmp_path_factory.mktemp("matrix")
     plan = matrix_plan.plan({"schemes": ["ddfv", "cotan"],
-                               "problems": {p: ([1] if p in ("sphere", "catenoid") else [])
-                                            for p in PROBLEMS}})
+                                    "problems": {p: ([1] if p in ("sphere", "catenoid") else [])
+                                                 for p in PROBLEMS}})
     runs = matrix_plan.planned_runs(plan, code="test", root=str(root))
     for path, settings in runs.items():
         frames = path.replace("/runs/", "/frames/").removesuffix(".json") + ".npz"
@@ -232,7 +232,7 @@ def test_solver_failure_is_rerun_with_the_robust_solver(tmp_path):
     """maxiter = 1 forces BiCGStab to fail on the sphere; the job re-runs the level with
     ``direct``, which finishes, and the findings call it a solver verdict."""
     plan = matrix_plan.plan({"schemes": ["cotan", "bgn"], "maxiter": 1,
-                        "problems": {p: ([1, 2] if p == "sphere" else []) for p in PROBLEMS}})
+                             "problems": {p: ([1, 2] if p == "sphere" else []) for p in PROBLEMS}})
     runs = matrix_plan.planned_runs(plan, code="test", root=str(tmp_path))
     for path, settings in runs.items():
         matrix_job.job(settings, path, path.replace(".json", ".npz"))
@@ -258,7 +258,7 @@ def test_solver_failure_is_rerun_with_the_robust_solver(tmp_path):
 
 def test_a_run_that_ended_otherwise_is_not_rerun(tmp_path):
     plan = matrix_plan.plan({"schemes": ["cotan"], "problems": {p: ([1] if p == "sphere" else [])
-                                                             for p in PROBLEMS}})
+                                                                  for p in PROBLEMS}})
     path, settings = next(iter(matrix_plan.planned_runs(plan, code="test", root=str(tmp_path)).items()))
     matrix_job.job(settings, path, path.replace(".json", ".npz"))
     record = read_record(path, settings=settings)
@@ -308,7 +308,7 @@ def test_snakemake_dry_run(tmp_path):
                                  if src.is_dir() else {}))
     meshes = tmp_path / "meshes"
     gallery_job.write_obj(meshes / "tet.obj", [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]],
-                     [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+                         [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
     out = subprocess.run([sys.executable, "-m", "snakemake", "-n", "--cores", "2",
                           "matrix", "gallery", "--config", f"meshes={meshes}"],
                          cwd=work, capture_output=True, text=True)
@@ -376,7 +376,7 @@ def test_series_job_writes_every_level_and_logs_to_one_file(tmp_path):
     """One Snakemake job per (problem, scheme): every level's record and frames,
     the same records as one job per run, one log for the series."""
     plan = matrix_plan.plan({"schemes": ["cotan"], "problems": {p: ([1, 2] if p == "sphere" else [])
-                                                           for p in PROBLEMS}})
+                                                                for p in PROBLEMS}})
     runs = matrix_plan.planned_runs(plan, code="test", root=str(tmp_path))
     records = list(runs)
     frames = [r.replace("/runs/", "/frames/").removesuffix(".json") + ".npz" for r in records]
