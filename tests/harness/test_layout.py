@@ -25,12 +25,15 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 HARNESS = ROOT / "mcfbench"
-LAYERS = ("storage", "geometry", "running", "presentation", "studies")
+LAYERS = ("storage", "geometry", "running", "problems", "presentation", "studies")
 # layer -> the mcfbench modules (prefixes) it may import
 ALLOWED = {
     "storage": ("mcfbench.storage",),
     "geometry": ("mcfbench.storage", "mcfbench.geometry"),
-    "running": ("mcfbench.storage", "mcfbench.geometry", "mcfbench.running"),
+    "running": ("mcfbench.storage", "mcfbench.geometry", "mcfbench.running", "mcfbench.problems"),
+    # a problem module: what the registry's own entries use
+    "problems": ("mcfbench.storage", "mcfbench.geometry", "mcfbench.running.problems",
+                 "mcfbench.problems"),
     "presentation": ("mcfbench.storage", "mcfbench.geometry", "mcfbench.presentation",
                      "mcfbench.running.schemes", "mcfbench.running.problems",
                      "mcfbench.running.integrators"),

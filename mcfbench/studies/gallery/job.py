@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mcfbench.running.run import framed_run
+from mcfbench.running.run import failed_result, framed_run
 from mcfbench.storage.logs import setup_logging
 from mcfbench.studies.gallery.plan import MOVIE_FRAMES
 
@@ -38,20 +38,13 @@ def write_generated_mesh(entry, path):
     write_obj(path, V, F)
 
 
-def _gallery_problem(C, steps):
-    from mcfbench.running.problems import Problem
-
-    return Problem("gallery", "a user's mesh", "", lambda level: {}, levels=(1,), tau_1=C,
-                   t_final=1.0, metrics=(), tau_rule="mesh", steps=int(steps),
-                   exact="none (mesh quality and breakdown only)")
-
-
 def job(mesh_path, scheme, settings, record, frames, log_path=None):
     """One scheme on one mesh file: ``tau = C h^2``, ``steps`` steps; record and
     frames (about :data:`MOVIE_FRAMES`, the first and last among them). A file the
     reader refuses gives status ``unsupported`` with the reader's message."""
     from mcfbench.geometry import metrics
     from mcfbench.geometry.mesh_files import read_mesh
+    from mcfbench.running.problems import Problem
     from mcfbench.running.schemes import get_scheme
     from mcfbench.running.solver import Solver
     from mcfbench.storage.frames import save_frames
@@ -60,7 +53,8 @@ def job(mesh_path, scheme, settings, record, frames, log_path=None):
     log = setup_logging(log_path)
     solver = Solver(method=settings["solver"], rtol=settings["rtol"],
                     maxiter=settings["maxiter"])
-    problem = _gallery_problem(settings["C"], settings["steps"])
+    problem = Problem.user_mesh("a user's mesh", settings["steps"], settings["C"],
+                                name="gallery")
     scheme = get_scheme(scheme)
     extra = {"mesh": Path(mesh_path).name}
     try:
@@ -78,16 +72,8 @@ def job(mesh_path, scheme, settings, record, frames, log_path=None):
                                     save_every=max(1, settings["steps"] // MOVIE_FRAMES))
         save_frames(frames, arrays)
     if result is None:
-        from mcfbench.storage.records import RunResult
-
-        nan = float("nan")
-        result = RunResult(scheme=scheme.name, problem="gallery", level=1, nV=0, nF=0, nT=0,
-                           h=nan, tau=nan, N=settings["steps"], steps_done=0,
-                           status="unsupported", message=message, t_failed=0.0, t_end=0.0,
-                           steady=False, iterations=0, solver=solver.method,
-                           integrator="euler", cpu_seconds=0.0,
-                           wall_seconds=0.0, t_min_barycentric=nan, min_angle=nan,
-                           max_aspect=nan, max_flipped=nan)
+        result = failed_result(scheme, problem, 1, "unsupported", message,
+                               steps=settings["steps"], method=solver.method)
         save_frames(frames, {"faces": np.zeros((0, 3), int), "steps": np.zeros(0, int),
                              "t": np.zeros(0)})
     write_record(record, result, settings, metric_names=[], **extra)
