@@ -84,7 +84,7 @@ def plan(config, table):
         "time_study": {"level": int(time_["level"]), "taus": taus, "reference_factor": factor,
                        "t_final": time_t,
                        "schemes": check_schemes("beyond.time_study.schemes",
-                                                time_["schemes"])},
+                                                time_.get("schemes", every_scheme()))},
         "space_study": {"levels": sorted({int(level) for level in space["levels"]}),
                         "tau": space_tau, "t_final": space_t,
                         "schemes": check_schemes("beyond.space_study.schemes",
@@ -225,3 +225,12 @@ def study_run_settings(plans, study, scheme, level):
 def time_run_settings(plans, scheme):
     """Settings of the time study of one scheme."""
     return time_settings(plans.plan("beyond"), plans.plan("convergence"), scheme, plans.code)
+
+
+def every_scheme():
+    """Every scheme of the registry with every time integrator (``NAME``, then
+    ``NAME@bdf2``, ...): the default schemes of the time study."""
+    from mcfbench.running.integrators import INTEGRATORS
+    from mcfbench.running.schemes import SCHEMES, joined_name
+
+    return [joined_name(s, i) for i in INTEGRATORS for s in SCHEMES]
