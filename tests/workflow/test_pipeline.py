@@ -28,9 +28,9 @@ import pytest
 import yaml
 
 from mcfbench.pipeline import Plans
+from mcfbench.running.solver import Solver
 from mcfbench.storage.provenance import BLAS_THREAD_VARIABLES
 from mcfbench.storage.records import checksum
-from mcfbench.studies.convergence.job import solver_of
 from mcfbench.studies.convergence.plan import sphere_run_settings
 
 pytestmark = pytest.mark.e2e
@@ -299,7 +299,7 @@ def test_threads_setting_reaches_the_rules_and_the_records(tmp_path, env):
     assert len(jobs) == 2 and all("threads: 2" in job.split("\n\n")[0] for job in jobs)
     config = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
     settings = sphere_run_settings(Plans({**config, "threads": 2}, SCHEMAS), "ddfv", 1)
-    assert settings["threads"] == 2 and solver_of(settings).threads == 2
+    assert settings["threads"] == 2 and Solver.of_settings(settings).threads == 2
     assert sphere_run_settings(Plans(config, SCHEMAS), "ddfv", 1)["threads"] == 1
 
 

@@ -24,6 +24,7 @@ def time_job(settings, output, log):
     """
     from mcfbench.running.problems import get_problem
     from mcfbench.running.run import time_convergence
+    from mcfbench.running.solver import Solver
     from mcfbench.storage.records import write_record
 
     problem = get_problem(settings["problem"]).with_settings(t_final=settings["t_final"])
@@ -35,7 +36,7 @@ def time_job(settings, output, log):
     try:
         table = time_convergence(settings["scheme"], problem, settings["level"], taus,
                                  reference_factor=factor, t_final=settings["t_final"],
-                                 solver=convergence.solver_of(settings),
+                                 solver=Solver.of_settings(settings),
                                  threads=settings.get("threads", 1))
         rows, outcome, message = table.to_dict("records"), "ok", ""
     except RuntimeError as err:

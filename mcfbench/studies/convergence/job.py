@@ -6,14 +6,6 @@ import math
 from mcfbench.running.problems import get_problem
 
 
-def solver_of(settings):
-    """The shared solver with the settings' tolerance (``maxiter``, ``threads`` if given)."""
-    from mcfbench.running.solver import Solver
-
-    return Solver(rtol=settings["rtol"], **{k: settings[k] for k in ("maxiter", "threads")
-                                            if k in settings})
-
-
 def job(settings, output, log):
     """One scheme on one level of the problem with ``settings``: its run record.
 
@@ -22,13 +14,14 @@ def job(settings, output, log):
     mcfbench.storage.records.RunResult
     """
     from mcfbench.running.run import run
+    from mcfbench.running.solver import Solver
     from mcfbench.storage.records import write_record
 
     problem = get_problem(settings["problem"]).with_settings(t_final=settings["t_final"])
     log.info("%s level %d: tau %g, t_final %g, rtol %g", settings["scheme"], settings["level"],
              settings["tau"], settings["t_final"], settings["rtol"])
     result, _ = run(settings["scheme"], problem, settings["level"], tau=settings["tau"],
-                    t_final=settings["t_final"], solver=solver_of(settings),
+                    t_final=settings["t_final"], solver=Solver.of_settings(settings),
                     threads=settings.get("threads", 1))
     record = write_record(output, result, settings)
     log.info("%s level %d: status %s, L2 error %.4e, %d iterations, %.3f s wall, "

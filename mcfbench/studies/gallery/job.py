@@ -51,8 +51,7 @@ def job(mesh_path, scheme, settings, record, frames, log_path=None):
     from mcfbench.storage.records import write_record
 
     log = setup_logging(log_path)
-    solver = Solver(method=settings["solver"], rtol=settings["rtol"],
-                    maxiter=settings["maxiter"])
+    solver = Solver.of_settings(settings)
     problem = Problem.user_mesh("a user's mesh", settings["steps"], settings["C"],
                                 name="gallery")
     scheme = get_scheme(scheme)

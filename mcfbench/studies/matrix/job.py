@@ -24,8 +24,7 @@ def job(settings, record, frames, log_path=None):
     from mcfbench.storage.records import write_record
 
     log = setup_logging(log_path) if log_path else logging.getLogger("pipeline")
-    solver = Solver(method=settings["solver"]["method"], rtol=settings["solver"]["rtol"],
-                    maxiter=settings["solver"]["maxiter"])
+    solver = Solver.of_settings(settings)
     log.info("%s on %s level %d, solver %s", settings["scheme"], settings["problem"],
              settings["level"], solver.method)
     result, arrays = framed_run(settings["scheme"], settings["problem"], settings["level"],
