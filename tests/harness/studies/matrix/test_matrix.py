@@ -53,13 +53,13 @@ def test_plan_levels_and_leaving_out():
 
 def test_plan_adds_other_integrators_only_to_the_schemes_run():
     section = {"with_integrators": {"bdf2": ["ddfv-chord-carried", "cotan"]}}
-    assert matrix.plan(section)["schemes"] == [*SCHEMES, "ddfv-chord-carried@bdf2",
+    assert matrix_plan.plan(section)["schemes"] == [*SCHEMES, "ddfv-chord-carried@bdf2",
                                                "cotan@bdf2"]
-    assert matrix.plan({**section, "schemes": ["bgn", "cotan"]})["schemes"] == \
+    assert matrix_plan.plan({**section, "schemes": ["bgn", "cotan"]})["schemes"] == \
         ["bgn", "cotan", "cotan@bdf2"]
-    assert matrix.plan({**section, "schemes": ["bgn"]})["schemes"] == ["bgn"]
+    assert matrix_plan.plan({**section, "schemes": ["bgn"]})["schemes"] == ["bgn"]
     with pytest.raises(ConfigError, match=r"unknown scheme\(s\) \['cotn@bdf2'\]"):
-        matrix.plan({"schemes": ["bgn"], "with_integrators": {"bdf2": ["cotn"]}})
+        matrix_plan.plan({"schemes": ["bgn"], "with_integrators": {"bdf2": ["cotn"]}})
 
 
 @pytest.mark.parametrize("section, key", [
