@@ -18,13 +18,12 @@ import os
 from snakemake.utils import min_version
 
 from mcfbench.pipeline import check_config, message_only
+from mcfbench.storage.provenance import BLAS_THREAD_VARIABLES
 
 # One BLAS thread per job, set once here: every job inherits it (local or
 # Slurm), before any of them imports numpy. The jobs' run records store these
 # variables (mcfbench.storage.provenance.BLAS_THREAD_VARIABLES).
-os.environ.update(
-    dict.fromkeys(("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"), "1")
-)
+os.environ.update(dict.fromkeys(BLAS_THREAD_VARIABLES, "1"))
 
 min_version("9.0")
 

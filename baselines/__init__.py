@@ -15,6 +15,12 @@ cmcf (:class:`baselines.cmcf.CMCFFlow`)
     Conformalized mean curvature flow (Kazhdan, Solomon, Ben-Chen 2012).
 bgn (:class:`baselines.bgn.BGNFlow`)
     Barrett, Garcke, Nuernberg (2008), mass-lumped vertex normals.
+mdr (:class:`baselines.mdr.MDRFlow`)
+    The minimal deformation rate velocity of Hu and Li (2022), eliminated
+    into BGN's system with unit normals.
+deturck (:class:`baselines.deturck.DeTurckFlow`)
+    The DeTurck trick of Elliott and Fritz (2017): reparametrised by the
+    harmonic map heat flow onto the initial mesh, ``alpha`` its time scale.
 
 Shared: :mod:`baselines.mesh` (edge topology, CSR pattern) and
 :mod:`baselines.kernels` (the compiled assembly).

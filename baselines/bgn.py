@@ -148,6 +148,11 @@ class BGNFlow(VertexFlow):
         vertex_normals(self.faces, geometry.area_vectors, self.mesh.n_vertices, omega)
         return omega
 
+    def _laplacian_data(self, geometry):
+        """Values of the stiffness in (B4) (``A``, in the pattern of ``L``) at the surface
+        of ``geometry``; :mod:`baselines.deturck` adds its advection."""
+        return geometry.L_data
+
     def laplacian(self):
         """The cotangent stiffness ``A`` (one coordinate) of the current surface, CSR."""
         return self.assembler.laplacian(self.geometry_at(self._X).L_data)
@@ -188,7 +193,7 @@ class BGNFlow(VertexFlow):
         g, p, n = self.geometry_at(at), self.assembler.pattern, self.mesh.n_vertices
         data = np.empty(len(self._indices))
         b = np.empty((3, n))
-        bgn_system(g.L_data, p.indptr, p.diag_slots, g.mass, self._normals(g),
+        bgn_system(self._laplacian_data(g), p.indptr, p.diag_slots, g.mass, self._normals(g),
                    np.ascontiguousarray(base), dt, self.fixed, scaling == "mass", data, b)
         A = sp.csr_matrix((data, self._indices, self._indptr), shape=(3 * n, 3 * n),
                           copy=False)

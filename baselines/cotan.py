@@ -44,10 +44,12 @@ Assembly (``assembly=``):
     ``igl.cotmatrix`` and ``igl.massmatrix`` at every step (the reference;
     the matrices agree with ``"cached"`` to rounding).
 
-Tangential redistribution (``redistribution="area"``): the right-hand
-side of (C3) becomes ``X^{n-1} + tau v_T^{n-1}``, ``v_T = grad psi`` the
-area-oriented tangential velocity of :mod:`baselines.redistribution`
-(Mikula, Remesikova, Sarkoci, Sevcovic 2014); the matrix is unchanged.
+Tangential redistribution (``redistribution="area"``): the area-oriented
+tangential velocity ``v_T = grad psi`` of :mod:`baselines.redistribution`
+(Mikula, Remesikova, Sarkoci, Sevcovic 2014), ``psi`` from the old state,
+enters the matrix as the advection ``grad psi . grad X^n``:
+``L`` of (C3) becomes the drift stiffness (R4) (Scharfetter-Gummel weights
+``c_ij B(psi_i - psi_j)``), the right-hand side stays ``X^{n-1}``.
 
 This module also holds :class:`VertexFlow`, what every vertex-based
 baseline shares: the state, the contract of ``mcfbench.running.flow.Flow``, the
@@ -62,11 +64,11 @@ import igl
 import numpy as np
 import scipy.sparse as sp
 
-from .kernels import cotan_geometry, neighbour_cosines, row_scaled_system
+from .kernels import cotan_geometry, neighbour_cosines, row_scaled_system, vertex_normals
 from .mesh import edge_mesh, laplacian_pattern
-from .redistribution import (MAX_SHIFT, OMEGA, REDISTRIBUTIONS, redistribution_source,
-                             shift_limit, solve_potential, surface_components,
-                             tangential_velocity, target_shares)
+from .redistribution import (OMEGA, PECLET, REDISTRIBUTIONS, PotentialSolver, drift_laplacian,
+                             redistribution_source, surface_components, tangential_velocity,
+                             target_shares)
 
 MASS_TYPES = {"barycentric": igl.MASSMATRIX_TYPE_BARYCENTRIC,
               "voronoi": igl.MASSMATRIX_TYPE_VORONOI}
@@ -235,6 +237,28 @@ class CotanAssembler:
         data = np.empty(p.nnz)
         row_scaled_system(L_data, p.indptr, p.diag_slots, mass, float(tau), fixed, data)
         return self.csr(data)
+
+
+def row_scaled_matrix(L, mass, dt, fixed):
+    """``I + dt diag(1/M) L`` (C3) of any sparsity, CSR, rows ``fixed`` = identity.
+
+    Parameters
+    ----------
+    L : (n, n) scipy.sparse matrix
+        A stiffness (not changed).
+    mass : (n,) float array
+        Its lumped mass, positive.
+    dt : float
+    fixed : (n,) bool array
+
+    Returns
+    -------
+    (n, n) scipy.sparse.csr_matrix
+    """
+    L = sp.csr_matrix(L, copy=True)
+    L.data *= np.repeat(dt / mass, np.diff(L.indptr))
+    A = (L + sp.identity(L.shape[0], format="csr")).tocsr()
+    return dirichlet_rows(A, fixed) if fixed.any() else A
 
 
 def dirichlet_rows(A, fixed):
@@ -484,18 +508,19 @@ class CotanFlow(VertexFlow):
     redistribution : {None, "area"}
         ``"area"``: add the area-oriented tangential velocity ``v_T = grad
         psi`` of :mod:`baselines.redistribution` (Mikula, Remesikova,
-        Sarkoci, Sevcovic 2014), explicitly: ``b = X^n + tau v_T^n`` in
-        (C3), the matrix unchanged (R3).
+        Sarkoci, Sevcovic 2014) semi-implicitly, as the advection
+        ``grad psi^n . grad X^{n+1}`` in the matrix (R3)-(R4).
     omega : float
         Relaxation rate of the area ratios in (R2), ``>= 0``, in 1 / time on a
         surface of the unit sphere's area 4 pi (default
         :data:`baselines.redistribution.OMEGA`): the rate used is
         ``omega 4 pi / A_0``, ``A_0`` the initial area, so that the flow is
         covariant under scaling (time scales as length squared).
-    max_shift : float or None
-        Largest change of an edge vector by the explicit tangential step
-        ``tau v_T``, as a fraction of the edge's length: ``v_T`` is scaled
-        by one factor for the whole mesh when needed (R4); None: no limit.
+    peclet : float
+        Largest edge Peclet number ``|psi_j - psi_i|`` the drift (R4) sees
+        (R6): the tangential displacement of a step is at most about
+        ``peclet tau / h`` (default :data:`baselines.redistribution.PECLET`;
+        ``inf``: none).
     target : {"vertex", "triangle"}
         Target covolume areas of (R2): all equal (``"vertex"``, default) or
         those of equal-area triangles (``"triangle"``,
@@ -512,8 +537,7 @@ class CotanFlow(VertexFlow):
     """
 
     def __init__(self, vertices, faces, tau, *, mass="barycentric", assembly="cached",
-                 redistribution=None, omega=OMEGA, max_shift=MAX_SHIFT,
-                 target="vertex"):
+                 redistribution=None, omega=OMEGA, peclet=PECLET, target="vertex"):
         if assembly not in ASSEMBLIES:
             raise ValueError(f"unknown assembly {assembly!r}; choose one of "
                              f"{', '.join(ASSEMBLIES)}")
@@ -522,20 +546,18 @@ class CotanFlow(VertexFlow):
                              f"'area'")
         if not (np.isfinite(omega) and omega >= 0):
             raise ValueError(f"omega must be a finite number >= 0, got {omega!r}")
-        if max_shift is not None and not (np.isfinite(max_shift) and max_shift > 0):
-            raise ValueError(f"max_shift must be None or a positive number, got {max_shift!r}")
+        if not peclet > 0:
+            raise ValueError(f"peclet must be a positive number (or inf), got {peclet!r}")
         if redistribution and (k := surface_components(faces, len(vertices))) > 1:
             raise ValueError(f"the redistribution (R2) needs a connected surface; this one "
                              f"has {k} components")
-        self.max_shift = None if max_shift is None else float(max_shift)
         self.target = target
         self._shares = target_shares(faces, len(vertices), target)
-        self.shift_factors = []
-        """Factor ``s <= 1`` of each step's tangential velocity (R4)."""
         self.assembly = assembly
         self.redistribution = redistribution
-        self.omega = float(omega)
+        self.omega, self.peclet = float(omega), float(peclet)
         self._area_0 = None
+        self._potential_solver = PotentialSolver()
         self.psi = None
         """The potential of the last step's tangential velocity (R2), (n,)."""
         super().__init__(vertices, faces, tau, mass=mass)
@@ -560,44 +582,59 @@ class CotanFlow(VertexFlow):
     def _laplacian_data(self, geometry):
         return geometry.L_data
 
-    def tangential_velocity(self, at=None, dt=None):
-        """``v_T = grad psi`` (R2) at the state ``at`` (default the current one), (3, n);
-        zero at fixed vertices.
-
-        Solves (R2) with the stiffness and mass of the system at ``at`` and
-        stores ``psi``; ``dt`` (default ``tau``) is the step the shift limit
-        (R4) applies to.
-        """
+    def potential(self, at=None):
+        """``psi`` of (R2) at the state ``at`` (default the current one), (n,), with the
+        stiffness and mass of the system at ``at``; also stored as :attr:`psi`."""
         at = self._X if at is None else at
-        dt = self.tau if dt is None else dt
+        return self._potential(at, self.laplacian(at), self._system_mass(at))
+
+    def _potential(self, at, L, mass):
         clock = time.perf_counter()
-        L, mass = self.laplacian(at), self._system_mass(at)
         if self._area_0 is None:                                 # the first step's state
             self._area_0 = float(mass.sum())
         rate = self.omega * 4.0 * np.pi / self._area_0           # scale-covariant omega
         f = redistribution_source(L, mass, at, self.fixed, rate, self._shares)
-        self.psi = solve_potential(L, mass, f)
-        alpha, _ = tangential_velocity(at.T, self.faces, self.psi)
-        alpha[:, self.fixed] = 0.0
-        factor = 1.0
-        if self.max_shift is not None:
-            factor = shift_limit(at, self.mesh.edges, alpha, dt, self.max_shift)
-            alpha *= factor
-        self.shift_factors.append(factor)
+        self.psi = self._potential_solver(L, mass, f)
         self.timings["redistribution"] += time.perf_counter() - clock
+        return self.psi
+
+    def tangential_velocity(self, at=None):
+        """``v_T = grad psi`` (R1) at the vertices of the state ``at`` (default the current
+        one), (3, n), zero at fixed vertices: the velocity the advection (R3)-(R4) of a
+        step carries (a diagnostic; the step itself takes ``psi``)."""
+        at = self._X if at is None else at
+        alpha, _ = tangential_velocity(at.T, self.faces, self.potential(at))
+        alpha[:, self.fixed] = 0.0
         return alpha
 
     def _system(self, at, base, dt):
         """``A = I + dt diag(1/M*) L*`` (C3) at ``at``, CSR, rows of boundary
-        vertices = identity; ``b = B``, or ``B + dt v_T*`` with
-        ``redistribution="area"`` (R3)."""
-        rhs = base
-        if self.redistribution is not None:
-            rhs = base + dt * self.tangential_velocity(at, dt)     # (R3)
+        vertices = identity, ``b = B``; with ``redistribution="area"`` ``L*`` is the
+        drift stiffness (R4) of the potential ``psi*`` (R2) of ``at`` and ``b = B +
+        dt g*`` (R5)."""
+        if self.redistribution is None:
+            if self.assembly == "igl":
+                return row_scaled_matrix(self.laplacian(at), self._system_mass(at), dt,
+                                         self.fixed), base
+            g = self.geometry_at(at)
+            return self.assembler.row_scaled(self._laplacian_data(g), g.mass, dt,
+                                             self.fixed), base
+        L = self.laplacian(at)
+        mass = self._system_mass(at)
+        drift = drift_laplacian(L, self._potential(at, L, mass), self.peclet)   # (R4)
+        rhs = base + dt * self._normal_drift(at, drift - L, mass)             # (R5)
         if self.assembly == "igl":
-            L = self.laplacian(at)
-            L.data *= np.repeat(dt / self._system_mass(at), np.diff(L.indptr))
-            A = (L + sp.identity(L.shape[0], format="csr")).tocsr()
-            return (dirichlet_rows(A, self.fixed) if self.mesh.has_boundary else A), rhs
-        g = self.geometry_at(at)
-        return self.assembler.row_scaled(self._laplacian_data(g), g.mass, dt, self.fixed), rhs
+            return row_scaled_matrix(drift, mass, dt, self.fixed), rhs
+        return self.assembler.row_scaled(drift.data, mass, dt, self.fixed), rhs
+
+    def _normal_drift(self, at, D, mass):
+        """``g* = N N . (D X*) / m`` (3, n) (R5): the normal part of the drift's
+        ``-(L_psi - L) X* / m`` at ``at``, to be added back; zero at fixed vertices."""
+        normals = np.empty((self.mesh.n_vertices, 3))
+        vertex_normals(self.faces, self.geometry_at(at).area_vectors, self.mesh.n_vertices,
+                       normals)
+        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
+        DX = np.asarray(D @ at.T) / np.where(mass > 0.0, mass, np.inf)[:, None]
+        g = (DX * normals).sum(axis=1)[:, None] * normals
+        g[self.fixed] = 0.0
+        return g.T

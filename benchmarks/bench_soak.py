@@ -40,10 +40,10 @@ from _harness import machine_line, one_core  # noqa: E402
 def meshes(folder=None):
     """``{name: how to get it}``: the gallery's generated meshes, or the files of ``folder``."""
     if folder is None:
-        from mcfbench.studies.gallery import generated_meshes
+        from mcfbench.studies.gallery.plan import generated_meshes
 
         return {Path(name).stem: ("generated", entry) for name, entry in generated_meshes().items()}
-    from mcfbench.studies.gallery import MESH_SUFFIXES
+    from mcfbench.studies.gallery.plan import MESH_SUFFIXES
 
     return {p.stem: ("file", str(p)) for p in sorted(Path(folder).iterdir())
             if p.suffix.lower() in MESH_SUFFIXES}

@@ -39,8 +39,9 @@ import numpy as np
 from .assembly import Assembler
 from .geometry import diamond_geometry, t_barycentric, vertex_normals
 from .kernels import check_threads
-from .redistribution import (OMEGA, TangentialPotential, carry_t_vertices, neumann_stiffness,
-                             redistribution_source, surface_components, vertex_gradients)
+from .redistribution import (OMEGA, PECLET, TangentialPotential, carry_t_vertices,
+                             drift_system, neumann_stiffness, redistribution_source,
+                             surface_components, vertex_gradients)
 from .t_vertices import initial_t_vertices
 from .topology import diamond_mesh, locality_order
 
@@ -86,13 +87,16 @@ class Flow:
         ``"eliminate"`` removes the tangential part of the discrete mean
         curvature vector from the velocity (3.6); ``"redistribute"`` adds
         the area-oriented tangential velocity ``grad psi`` of
-        :mod:`ddfv.redistribution` (R1)-(R5), explicitly:
-        ``X^{n-1} + tau v_T^{n-1}`` on the right-hand side.
+        :mod:`ddfv.redistribution` (R1)-(R5) semi-implicitly, as the
+        advection ``grad psi^{n-1} . grad X^n`` in the matrix (R6)-(R7).
     omega : float
         Relaxation rate of the redistribution (R2), in 1 / time on a surface
         of the unit sphere's area 4 pi (default :data:`ddfv.redistribution.OMEGA`):
         the rate used is ``omega 4 pi / A_0``, ``A_0`` the initial area, so that
         the flow is covariant under scaling (time scales as length squared).
+    peclet : float
+        Largest edge Peclet number ``|psi_b - psi_a|`` the drift (R7) sees (R8)
+        (default :data:`ddfv.redistribution.PECLET`; ``inf``: none).
     t_motion : {"scheme", "carried"}
         ``"carried"``: after each step every T-vertex is moved tangentially
         back to the barycentric coordinates of its initial projection in its
@@ -118,7 +122,7 @@ class Flow:
 
     def __init__(self, vertices, faces, tau, *, T0=None, t_init="paper",
                  tangential="none", dual_length="broken", threads=1,
-                 omega=OMEGA, t_motion="scheme"):
+                 omega=OMEGA, peclet=PECLET, t_motion="scheme"):
         if not (np.isfinite(tau) and tau > 0):
             raise ValueError(f"tau must be a positive number, got {tau!r}")
         if tangential not in TANGENTIAL:
@@ -129,9 +133,11 @@ class Flow:
                              f"{', '.join(T_MOTIONS)}")
         if not (np.isfinite(omega) and omega >= 0):
             raise ValueError(f"omega must be a number >= 0, got {omega!r}")
+        if not peclet > 0:
+            raise ValueError(f"peclet must be a positive number (or inf), got {peclet!r}")
         check_threads(threads)
         self.threads = threads
-        self.omega, self.t_motion = float(omega), t_motion
+        self.omega, self.peclet, self.t_motion = float(omega), float(peclet), t_motion
         self._area_0 = None
         self._faces = diamond_mesh(faces, len(vertices)).faces   # checked, as given
         if tangential == "redistribute" and (k := surface_components(self._faces,
@@ -281,7 +287,8 @@ class Flow:
 
         i.e. ``(I + dt diag(1/chi*) K*) X = B + dt g*``, ``g = 0`` (the paper),
         ``-(h - (h.N) N)`` with ``h = -diag(1/chi*) K* X*`` (the elimination
-        (3.6)) or ``v_T`` (the redistribution, (R1)-(R5)). The paper's step is
+        (3.6)); the redistribution weights the F-rows' fluxes by the drift (R6)-(R8)
+        and adds ``g*``, the normal part of the drift at ``X*``, back. The paper's step is
         ``at = base = X^{n-1}``, ``dt = tau``; the harness's integrators choose
         them (``mcfbench.running.integrators``). Dirichlet rows: identity, right-hand
         side ``B``.
@@ -312,8 +319,13 @@ class Flow:
             h = (at - (A @ at.T).T) / dt                              # h*
             N = vertex_normals(self._mesh, geometry)                  # N*
             rhs = base - dt * (h - (h * N).sum(axis=0) * N)           # (3.6)
-        elif self.tangential == "redistribute":
-            rhs = base + dt * self._tangential_velocity(at, A, dt, geometry, covolumes)
+        elif self.tangential == "redistribute":                       # (R6)-(R7)
+            psi = self._potential_of(at, A, dt, geometry, covolumes)
+            drift = drift_system(A, geometry, self._mesh, covolumes, dt, psi, self.peclet)
+            N = vertex_normals(self._mesh, geometry)
+            drifted = ((drift - A) @ at.T).T                          # -dt x drift of X*
+            rhs = base + (drifted * N).sum(axis=0) * N                # + dt g*: normal part back
+            A = drift
         self._tick("assembly", clock)
         return A, rhs
 
@@ -334,24 +346,29 @@ class Flow:
         for name in ("_state", "_barycentric"):
             self.__dict__.pop(name, None)
 
-    def _tangential_velocity(self, at, A, dt, geometry, covolumes):
-        """(3, n) ``v_T = grad psi`` (R1)-(R5) of the state ``at``, zero at
-        Dirichlet F-vertices; ``A`` the step's matrix at ``at`` with step ``dt``
-        (its discrete Laplacian gives ``h``, as in (3.6))."""
+    def _potential_of(self, at, A, dt, geometry, covolumes):
+        """(n,) ``psi`` of (R3) at the state ``at``; ``A`` the scheme's step matrix at
+        ``at`` with step ``dt`` (its discrete Laplacian gives ``h``, as in (3.6))."""
         mesh = self._mesh
         N = vertex_normals(mesh, geometry)
         h = (at - (A @ at.T).T) / dt                             # h*, zero at fixed F
         hV = (h * N).sum(axis=0) ** 2                            # h.V = H^2 (V = H N)
-        fixed = mesh.boundary_vertices
         if self._area_0 is None:                                 # the first step's state
             self._area_0 = float(covolumes[:mesh.n_f].sum())
         rate = self.omega * 4.0 * np.pi / self._area_0           # scale-covariant omega
-        source = redistribution_source(covolumes, hV, mesh.n_f, fixed, rate)  # (R3)
+        source = redistribution_source(covolumes, hV, mesh.n_f, mesh.boundary_vertices,
+                                       rate)                     # (R3)
         if self._potential is None:
             self._potential = TangentialPotential(mesh)
-        psi = self._potential(neumann_stiffness(self._assembler, geometry), source, covolumes)
-        v = vertex_gradients(mesh, geometry, psi, N)              # (R4), (R5)
-        v[:, :mesh.n_f][:, fixed] = 0.0
+        return self._potential(neumann_stiffness(self._assembler, geometry), source, covolumes)
+
+    def _tangential_velocity(self, at, A, dt, geometry, covolumes):
+        """(3, n) ``v_T = grad psi`` (R4)-(R5) of the state ``at``, zero at Dirichlet
+        F-vertices: the velocity (R6) carries (diagnostics and tests)."""
+        mesh = self._mesh
+        psi = self._potential_of(at, A, dt, geometry, covolumes)
+        v = vertex_gradients(mesh, geometry, psi, vertex_normals(mesh, geometry))
+        v[:, :mesh.n_f][:, mesh.boundary_vertices] = 0.0
         return v
 
     def _tick(self, phase, since):

@@ -58,9 +58,55 @@ normal ``N`` of :func:`ddfv.geometry.vertex_normals`::
 
     v_T(i) = (I - N N^T) sum_d J_d g_d / sum_d J_d                            (R5)
 
-It enters the step explicitly, on the right-hand side (see
-:class:`ddfv.flow.Flow`), so the matrix, its pattern and the solver are
-those of the paper.
+How it enters the step: semi-implicitly, as an advection. A tangential
+velocity ``grad psi`` of the parametrisation is, in the equation of the
+positions, ``grad psi . grad_G X`` (``grad_G X . w = w`` for a tangent
+``w``), and::
+
+    X_t = Delta_G X + grad psi . grad_G X = e^{-psi} div_G (e^psi grad_G X)   (R6)
+
+a weighted Laplace-Beltrami: the flux of ``e^psi grad X`` through a dual
+curve, divided by ``e^psi`` of the balance's own vertex. Per inner diamond,
+the flux ``flux_a`` of the F-row of ``a`` ((2.12)) is multiplied by the
+Scharfetter-Gummel weight of its edge (``psi`` at the old state (R3), ``X``
+at the new level)::
+
+    flux_a -> B(psi_a - psi_b) flux_a,   flux_b -> B(psi_b - psi_a) flux_b,
+    B(x) = x / (e^x - 1)                                                      (R7)
+
+(:func:`drift_system`): ``e^{-psi_a}`` times the logarithmic mean of
+``e^psi`` on the edge, exact for ``psi`` linear along it (the flux ``e^psi
+X'`` is constant), ``1 + (psi_b - psi_a)/2 + ...``: to first order the
+Laplacian plus the centred advection ``(psi_b - psi_a) flux_a / 2``, for
+large differences the upwind one. The T-rows keep the scheme's fluxes: the
+variant that redistributes (``chord-redistribute-carried``) carries its
+T-vertices with their triangles anyway, and a weight on the T-rows from the
+F-values (the T-values of ``psi`` carry their own constant) made the
+weights exponential in the differences (``e^{psi_d - psi_t}``): the first
+version of (R7), one weight ``e^psi`` per diamond (symmetric), blew up the
+public mesh blub (area x 1.5e6 in one step). The normal part of the drift
+at the old state is added back explicitly, ``g = N N . (A_psi - A) X^n / tau``
+(``A_psi``, ``A`` the row-scaled systems with and without (R7)), as (3.6)
+removes a tangential part: the normal motion stays the scheme's.
+
+The edge Peclet number is limited, ``psi_b - psi_a`` clipped to
+``[-P, P]`` in (R7) (``peclet``, default :data:`PECLET` = 0.1)::
+
+    B(psi_a - psi_b) -> B(max(min(psi_a - psi_b, P), -P))                     (R8)
+
+On the public real meshes ``psi`` differs by up to 23 across an edge (the
+``h.V`` term at small features): unlimited, a step moves points by ``~0.1
+|psi_b - psi_a|`` edge lengths and folds triangles within 1-2 steps; the
+limit is inactive on a smooth refinement series once ``h |grad psi| < P``.
+Stability: the weights are positive and within ``[B(P), B(-P)] = [0.95,
+1.05]``, so the drift is a relative change of each F-row's fluxes by at most
+5 %; no step restriction comes with it (the matrix stays the implicit
+scheme's up to that change). Unlike the scheme's chord matrix, the matrix
+is not a row scaling of a symmetric one (the two rows of an edge are
+weighted differently).
+
+The vertex velocity ``v_T`` of (R4)-(R5) (:func:`vertex_gradients`) is the
+velocity (R6) carries, kept for diagnostics and tests.
 
 T-vertices carried by their triangles (:func:`carry_t_vertices`): a
 T-vertex keeps the barycentric coordinates ``lambda^0`` of its initial
@@ -77,6 +123,8 @@ from .assembly import flux_coefficients
 
 #: default relaxation rate ``omega`` of (R2), in 1 / time
 OMEGA = 1.0
+#: default limit of the edge Peclet number ``|psi_b - psi_a|`` of (R8)
+PECLET = 0.1
 
 
 def neumann_stiffness(assembler, geom):
@@ -327,6 +375,61 @@ def vertex_gradients(mesh, geom, psi, normals):
     mean = np.stack([np.bincount(corners, np.concatenate([gk, gk, gk, gk[inner]]),
                                  minlength=n) for gk in g]) / total
     return mean - (mean * normals).sum(axis=0) * normals
+
+
+def bernoulli(x):
+    """``B(x) = x / (e^x - 1)``, ``B(0) = 1``, elementwise: the Scharfetter-Gummel
+    weight of (R7), positive, ``-> -x`` for ``x -> -inf``, ``-> 0`` for ``x -> +inf``
+    (no overflow). (``baselines.redistribution.bernoulli`` is the same function; the
+    two packages do not import each other.)"""
+    x = np.asarray(x, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        b = x / np.expm1(x)
+    return np.where(x == 0.0, 1.0, b)
+
+
+def drift_system(A, geom, mesh, chi, dt, psi, peclet=np.inf):
+    """The matrix of (R7) in row-scaled form: ``A + dt diag(1/chi) D``.
+
+    Parameters
+    ----------
+    A : (n, n) scipy.sparse.csr_matrix
+        The scheme's system ``I + dt diag(1/chi) K`` at the same state.
+    geom : DiamondGeometry
+    mesh : DiamondMesh
+    chi : (n,) float array
+        Covolume areas, F-vertices first.
+    dt : float
+    psi : (n,) float array
+        The potential (R3); only its F-values enter.
+    peclet : float
+        Largest ``|psi_b - psi_a|`` a weight sees: the differences are clipped
+        to ``[-peclet, peclet]`` (R8).
+
+    Returns
+    -------
+    (n, n) scipy.sparse.csr_matrix
+        ``D`` multiplies the F-row part of each inner diamond's fluxes by
+        ``w - 1``, ``w_a = B(psi_a - psi_b)`` in the row of ``a`` and
+        ``w_b = B(psi_b - psi_a)`` in the row of ``b`` (:func:`bernoulli`); T-rows,
+        boundary diamonds and Dirichlet rows are those of ``A``. With ``psi``
+        constant, ``A`` itself.
+    """
+    n_f, n = mesh.n_f, mesh.n_unknowns
+    inner = mesh.diamonds[:, 3] >= 0
+    a, b, t1, t2 = (mesh.diamonds[inner, k] for k in range(4))
+    alpha, beta = (np.asarray(c)[inner] for c in flux_coefficients(geom)[:2])
+    d = np.clip(psi[b] - psi[a], -peclet, peclet)
+    wa, wb = bernoulli(-d) - 1.0, bernoulli(d) - 1.0
+    free = ~np.r_[mesh.boundary_vertices, np.zeros(mesh.n_t, bool)]
+    wa, wb = wa * free[a], wb * free[b]
+    # (K f)_a = alpha (f_a - f_b) + beta (f_t2 - f_t1) = -(K f)_b: each row times w - 1
+    rows = np.concatenate([np.tile(a, 4), np.tile(b, 4)])
+    cols = np.tile(np.concatenate([a, b, n_f + t2, n_f + t1]), 2)
+    vals = np.concatenate([wa * alpha, -wa * alpha, wa * beta, -wa * beta,
+                           -wb * alpha, wb * alpha, -wb * beta, wb * beta])
+    D = sp.csr_matrix((vals * (dt / chi[rows]), (rows, cols)), shape=(n, n))
+    return (A + D).tocsr()
 
 
 def carry_t_vertices(F, T, faces, lam):

@@ -15,8 +15,10 @@ scheme registry (``mcfbench/running/schemes.py``) names each one ``ddfv-<variant
     Both: chord-length ``|gamma|`` and the elimination (3.6).
 ``redistribute``
     The paper's scheme with the area-oriented tangential redistribution of
-    the journal version (:mod:`ddfv.redistribution`, (R1)-(R5)): F- and
-    T-vertices move with ``grad psi``.
+    the journal version (:mod:`ddfv.redistribution`, (R1)-(R8)), semi-implicit:
+    the F-rows carry the advection ``grad psi . grad X``; the T-vertices move
+    with the scheme (before the semi-implicit form they moved with ``grad psi``
+    too).
 ``chord-redistribute``
     Chord-length ``|gamma|`` and the redistribution.
 ``chord-carried``

@@ -90,7 +90,7 @@ def _common(parser, default_solver):
                         help="DDFV: T-vertex initialisation (default: paper)")
     parser.add_argument("--integrator", choices=list(INTEGRATORS),
                         help="time integrator: the paper's semi-implicit Euler (default) "
-                             "or linearly implicit BDF2")
+                             "or linearly implicit BDF2 or BDF3")
     parser.add_argument("--warm-start", choices=("extrapolate", "previous"),
                         default="extrapolate",
                         help="initial guess of the solver: 2 X^n - X^{n-1} (default) or X^n")
@@ -211,7 +211,7 @@ def _settings(args, scheme):
 
 
 def _sphere_table(args):
-    from mcfbench.studies.convergence import sphere_table
+    from mcfbench.studies.convergence.job import sphere_table
 
     scheme = _scheme(args)
     if args.csv:
@@ -227,7 +227,7 @@ def _sphere_table(args):
 
 
 def _study(args):
-    from mcfbench.presentation.matrix_tables import is_error
+    from mcfbench.studies.matrix.tables import is_error
     from mcfbench.running.run import level_sweep
 
     scheme, problem = _scheme(args), get_problem(args.problem)
@@ -393,9 +393,9 @@ def _export(args):
 
 
 def _report(args):
-    from mcfbench.presentation.report import ReportError, Sources, build
     from mcfbench.storage.logs import setup_logging
-    from mcfbench.studies.figure_experiments import EXPERIMENTS
+    from mcfbench.studies.figures.experiments import EXPERIMENTS
+    from mcfbench.studies.report.page import ReportError, Sources, build
 
     sources = Sources(results=args.results, paper=args.paper, readme=args.readme,
                       out=args.out or args.results / "paper",

@@ -6,9 +6,10 @@ adapters that call the study modules (:mod:`mcfbench.studies`). This module is
 what the rules need beside them:
 
 Config
-    :func:`check_config` checks the top-level keys while Snakemake reads the
+    :func:`check_config` checks the whole config while Snakemake reads the
     workflow. Each study checks its own section (its schema, then its
-    ``plan``) through :class:`Plans`: those of Table 3.1 and of the beyond
+    ``plan``) through :class:`Plans` (one generic entry, :meth:`Plans.plan`):
+    those of Table 3.1 and of the beyond
     study only when a rule that needs them is in the job graph, those of the
     matrix and the gallery while Snakemake reads their rule files (their rules
     are made from them; a bad section leaves them without rules). A bad value
@@ -30,21 +31,21 @@ Kernels
 """
 
 import hashlib
+import importlib
 import json
 import math
 import re
 import time
 from contextlib import contextmanager
-from functools import cached_property, wraps
+from functools import wraps
 from pathlib import Path
 
 from mcfbench.running.problems import get_problem
 from mcfbench.running.schemes import SCHEMES
 from mcfbench.storage.atomic import write_json
 from mcfbench.storage.provenance import code_hash
-from mcfbench.studies import beyond, convergence, gallery, matrix
 from mcfbench.studies.config import ConfigError, check_threads
-from mcfbench.studies.convergence import PROBLEM
+from mcfbench.studies.convergence.plan import PROBLEM
 
 
 def check_config(config, schema_path):
@@ -158,13 +159,18 @@ class Plans:
     that needs them joins the job graph, those of the matrix and the gallery while
     Snakemake reads their rule files (:meth:`while_reading`).
 
+    A study is a folder of :mod:`mcfbench.studies` whose ``plan`` module has
+    ``from_config(config, plans)``; its section of the config (when the study has
+    one) is first checked against ``<schemas>/<study>.schema.yaml``. What a rule
+    needs of a plan (settings of a run, record paths) is a function of the study's
+    ``plan`` module, called by its ``workflow/rules/<study>.smk``.
+
     Parameters
     ----------
     config : dict
         Snakemake's config after the schema check (``config.schema.yaml``).
     schemas : str or Path
-        The folder of the schemas (``workflow/schemas``): the section ``beyond``
-        is checked against ``beyond.schema.yaml`` before its plan.
+        The folder of the schemas (``workflow/schemas``).
     """
 
     def __init__(self, config, schemas):
@@ -173,6 +179,7 @@ class Plans:
         self.code = code_hash()
         # threads of every run job and of the kernels' job: checked at once
         self.threads = check_threads(config)
+        self._plans = {}
 
     @property
     def kernels(self):
@@ -184,40 +191,29 @@ class Plans:
         digest = hashlib.sha256(json.dumps(self.code, sort_keys=True).encode()).hexdigest()
         return f"results/logs/kernels/{digest[:16]}.json"
 
-    @cached_property
-    def convergence(self):
-        """:func:`mcfbench.studies.convergence.plan` of the config."""
-        return convergence.plan(self.config)
+    def plan(self, study):
+        """The plan of ``study`` (``"convergence"``, ``"beyond"``, ``"matrix"``,
+        ``"gallery"``): its section checked against its schema, then
+        ``mcfbench.studies.<study>.plan.from_config``; made once.
 
-    @cached_property
-    def beyond(self):
-        """:func:`mcfbench.studies.beyond.plan` of the config, after its schema."""
-        check_section(self.config, "beyond", self.schemas / "beyond.schema.yaml")
-        return beyond.plan(self.config, self.convergence)
-
-    @cached_property
-    def beyond_runs(self):
-        """``{study: {record path: settings}}`` (:func:`mcfbench.studies.beyond.beyond_runs`)."""
-        return beyond.beyond_runs(self.beyond, self.convergence, self.code)
-
-    @cached_property
-    def matrix(self):
-        """:func:`mcfbench.studies.matrix.plan` of the config, after its schema."""
-        check_section(self.config, "matrix", self.schemas / "matrix.schema.yaml")
-        return matrix.plan(self.config.get("matrix"))
-
-    @cached_property
-    def gallery(self):
-        """:func:`mcfbench.studies.gallery.plan` of the config (``gallery``,
-        ``meshes``), after its schema."""
-        check_section(self.config, "gallery", self.schemas / "gallery.schema.yaml")
-        return gallery.plan(self.config.get("gallery"), self.config.get("meshes"))
+        Raises
+        ------
+        ConfigError
+            Naming the key of the first bad value.
+        """
+        if study not in self._plans:
+            module = importlib.import_module(f"mcfbench.studies.{study}.plan")
+            schema = self.schemas / f"{study}.schema.yaml"
+            if schema.is_file():
+                check_section(self.config, study, schema)
+            self._plans[study] = module.from_config(self.config, self)
+        return self._plans[study]
 
     def checked(self, study, targets):
         """``targets`` once the plan of ``study`` is made: the input of the study's
         target rule, so that a bad config value stops there with the
         :class:`~mcfbench.studies.config.ConfigError` naming it."""
-        getattr(self, study)
+        self.plan(study)
         return targets
 
     def while_reading(self, study, empty):
@@ -226,60 +222,9 @@ class Plans:
         bad: then the study has no rules and :meth:`checked` names the bad key when
         its target is asked for."""
         try:
-            return getattr(self, study)
+            return self.plan(study)
         except ConfigError:
             return empty
-
-    def beyond_run_settings(self, study, scheme, level):
-        """Settings of one run of the long-time or the space study."""
-        return beyond.study_settings(self.beyond, self.convergence, study, scheme, level,
-                                     self.code)
-
-    def time_settings(self, scheme):
-        """Settings of the time study of one scheme."""
-        return beyond.time_settings(self.beyond, self.convergence, scheme, self.code)
-
-    def paper_schemes(self):
-        """The beyond study's schemes compared with the published Table 3.1."""
-        return beyond.paper_schemes(self.beyond)
-
-    def beyond_records(self):
-        """``{record path: settings}`` of every run of the beyond study."""
-        return {path: s for runs in self.beyond_runs.values() for path, s in runs.items()}
-
-    def run_settings(self, scheme, level):
-        """Settings of the record ``results/runs/{scheme}/level{level}.json``: Table
-        3.1's, or for a run of ``beyond.finest`` the beyond study's (its tolerance;
-        the only record of that folder that needs the beyond plan)."""
-        if beyond.is_finest_run(self.config, scheme, level):
-            return beyond.level_settings(self.beyond, self.convergence, scheme, level,
-                                         self.code)
-        return convergence.record_settings(self.convergence, scheme, level, self.code)
-
-    def convergence_records(self):
-        """``{record path: settings}`` of Table 3.1, schemes in config order."""
-        plan = self.convergence
-        return {convergence.run_record(s, lv): self.run_settings(s, lv)
-                for s in plan["schemes"] for lv in plan["levels"]}
-
-    def table_settings(self):
-        """The config as far as Table 3.1 depends on it."""
-        return convergence.table_settings(self.convergence)
-
-    def run_runtime(self, level):
-        """Slurm time limit of one run of ``level`` with Table 3.1's time step."""
-        problem = convergence.problem_of(self.convergence)
-        return runtime_minutes(level, problem.time_steps(problem.tau(int(level))))
-
-    def beyond_runtime(self, study, scheme, level):
-        """Slurm time limit of one run of the long-time or the space study."""
-        settings = self.beyond_run_settings(study, scheme, level)
-        return runtime_minutes(level, round(settings["t_final"] / settings["tau"]))
-
-    def time_runtime(self):
-        """Slurm time limit of the time study of one scheme."""
-        return runtime_minutes(self.beyond["time_study"]["level"],
-                               beyond.time_steps_total(self.beyond))
 
 
 # -- resources of the jobs (minutes, MB) ----------------------------------------------

@@ -6,6 +6,7 @@ import os
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
+from scipy.spatial import ConvexHull
 
 from mcfbench.geometry import surfaces
 from mcfbench.geometry.shapes import flat_lattice
@@ -17,7 +18,7 @@ from mcfbench.geometry.spheres import random_bumpy_sphere as bumpy_sphere
 # half_height = 0.5) are those of mcfbench.geometry.shapes.cylinder.
 cylinder = functools.partial(surfaces.cylinder, diagonals="parallel")
 
-__all__ = ["approaches_the_catenoid", "bumpy_sphere", "cylinder", "flat_lattice"]
+__all__ = ["approaches_the_catenoid", "bumpy_sphere", "cylinder", "flat_lattice", "twin_sphere"]
 
 # hypothesis (tests/harness/test_properties.py): "ci", the default, draws the same few
 # examples on every run (derandomized, no example database); HYPOTHESIS_PROFILE=nightly
@@ -54,3 +55,21 @@ def approaches_the_catenoid(X, tol=0.004):
     assert np.all(np.diff(neck) < 0), neck
     assert neck[-1] == pytest.approx(a, rel=0.01)
     np.testing.assert_allclose(r[-1], a * np.cosh(z[-1] / a), atol=tol)
+
+
+def twin_sphere(n=162, eps=0.1, seed=0):
+    """Sliver-rich sphere: n/2 random points each with a twin at eps x the mean
+    spacing, triangulated by their convex hull (tiny triangles and slivers)."""
+    rng = np.random.default_rng(seed)
+    P = rng.standard_normal((n // 2, 3))
+    P /= np.linalg.norm(P, axis=1, keepdims=True)
+    d = rng.standard_normal((n // 2, 3))
+    d -= (d * P).sum(1, keepdims=True) * P
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    P = np.vstack([P, P + eps * np.sqrt(4 * np.pi / n) * d])
+    P /= np.linalg.norm(P, axis=1, keepdims=True)
+    F = ConvexHull(P).simplices.copy()
+    normal = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
+    flip = (normal * P[F].mean(axis=1)).sum(axis=1) < 0
+    F[flip] = F[flip][:, ::-1]
+    return P, F

@@ -1,5 +1,6 @@
-"""Presentation: number formats, Markdown/LaTeX tables, plots, mesh pictures and the report.
+"""Presentation: what every study shares to show its results: number formats, plots, mesh pictures, movies, documents.
 
 Rule: reads records and tables; imports ``storage``, ``geometry`` and, of ``running``, only the
-declarative registries of schemes and problems; never a solver, the driver, a flow, a study or numba.
+declarative registries (schemes, problems, integrators); never a solver, the driver, a flow, a study or numba.
+A study's own tables, findings, plots and page live in its folder (``mcfbench/studies/<study>/``).
 """

@@ -95,7 +95,7 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
         Override the problem's time rule.
     solver : mcfbench.running.solver.Solver, optional
         Default: BiCGStab, rtol 1e-9 (the paper's).
-    integrator : {"euler", "bdf2"}, optional
+    integrator : {"euler", "bdf2", "bdf3"}, optional
         The time integrator (:mod:`mcfbench.running.integrators`); default
         the scheme's (:attr:`mcfbench.running.schemes.Scheme.integrator`).
     warm_start : {"extrapolate", "previous"}
@@ -386,7 +386,7 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
     t_final : float, optional
         Default: the problem's.
     solver : mcfbench.running.solver.Solver, optional
-    integrator : {"euler", "bdf2"}, optional
+    integrator : {"euler", "bdf2", "bdf3"}, optional
         The time integrator of every run, the reference's included (default
         the scheme's).
     **options
@@ -482,15 +482,33 @@ class _Guarded:
             raise _Unsupported(str(err)) from err
 
 
-def _nan_result(scheme, problem, level, mesh, tau, steps, status, message, method, seconds,
-                integrator):
-    V, F = mesh
+def failed_result(scheme, problem, level, status, message, *, steps, method, mesh=None,
+                  tau=float("nan"), seconds=0.0):
+    """The result of a run that did not take a step: ``status`` and ``message`` (a
+    scheme that refuses the surface, a mesh file the reader refused), NaN measures.
+
+    Parameters
+    ----------
+    scheme : Scheme
+        Its ``name`` and ``integrator`` are recorded.
+    problem : Problem
+        Its ``name`` is recorded.
+    mesh : (V, F), optional
+        The mesh when there is one (its sizes and ``h``); None: 0 vertices, ``h`` NaN.
+    steps : int
+        The steps the run was to take (``N``).
+    method : str
+        The solver's method.
+    seconds : float
+        CPU (and wall) seconds spent.
+    """
     nan = float("nan")
+    nV, h = (len(mesh[0]), metrics.mean_edge_length(*mesh)) if mesh is not None else (0, nan)
     return RunResult(
-        scheme=scheme.name, problem=problem.name, level=int(level), nV=len(V), nF=len(V),
-        nT=0, h=metrics.mean_edge_length(V, F), tau=float(tau), N=int(steps), steps_done=0,
+        scheme=scheme.name, problem=problem.name, level=int(level), nV=nV, nF=nV,
+        nT=0, h=h, tau=float(tau), N=int(steps), steps_done=0,
         status=status, message=message, t_failed=0.0, t_end=0.0, steady=False, iterations=0,
-        solver=method, integrator=integrator, cpu_seconds=seconds, wall_seconds=seconds,
+        solver=method, integrator=scheme.integrator, cpu_seconds=seconds, wall_seconds=seconds,
         t_min_barycentric=nan, min_angle=nan, max_aspect=nan, max_flipped=nan, metrics={},
         series={})
 
@@ -520,9 +538,10 @@ def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_ever
         V, F = validate_mesh(*(problem.mesh(level) if mesh is None else mesh))
         tau = problem.tau(level, (V, F)) if tau is None else float(tau)
         steps = problem.time_steps(tau)
-        result = _nan_result(scheme, problem, level, (V, F), tau, steps, "unsupported",
-                             f"unsupported at step 0 (t = 0): {err}", solver.method,
-                             time.process_time() - start, scheme.integrator)
+        result = failed_result(scheme, problem, level, "unsupported",
+                               f"unsupported at step 0 (t = 0): {err}", steps=steps,
+                               method=solver.method, mesh=(V, F), tau=tau,
+                               seconds=time.process_time() - start)
         key = "F" if scheme.family == "ddfv" else "V"
         return result, {key: np.stack([V, V]), "faces": F, "steps": np.array([0, 0]),
                         "t": np.zeros(2)}

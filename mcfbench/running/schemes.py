@@ -111,14 +111,16 @@ class Scheme:
 
 def _ddfv(variant, label, color, marker, linestyle, description):
     """The chord length of the dual curves makes the DDFV matrix a row scaling of a
-    symmetric one (the paper's broken line does not: measured, 1e-2 off)."""
+    symmetric one (the paper's broken line does not: measured, 1e-2 off); the
+    redistribution's drift (R7) weights each F-row's fluxes on its own, which does not."""
     name = "ddfv" if variant == "paper" else f"ddfv-{variant}"
     from ddfv.variants import variant_options
 
     return Scheme(name, label, "ddfv.flow:Flow", variant_options(variant),
                   {"color": color, "marker": marker, "linestyle": linestyle},
                   description, family="ddfv",
-                  matrix="scaled-spd" if "chord" in variant else "nonsymmetric")
+                  matrix="scaled-spd" if "chord" in variant and "redistribute" not in variant
+                  else "nonsymmetric")
 
 
 SCHEMES = {s.name: s for s in (
@@ -131,14 +133,16 @@ SCHEMES = {s.name: s for s in (
     _ddfv("chord-eliminate", "DDFV, chord + elimination", "C4", "D", ":",
           "DDFV with chord |gamma| and the elimination (3.6)"),
     _ddfv("redistribute", "DDFV, redistribution", "C8", "X", "-",
-          "DDFV with the area-oriented tangential redistribution of the journal version"),
+          "DDFV with the area-oriented tangential redistribution of the journal version, "
+          "semi-implicit (the advection grad psi . grad X in the matrix, Peclet limit 0.1)"),
     _ddfv("chord-redistribute", "DDFV, chord + redistribution", "C9", "h", "--",
-          "DDFV with chord |gamma| and the area-oriented tangential redistribution"),
+          "DDFV with chord |gamma| and the area-oriented tangential redistribution, "
+          "semi-implicit"),
     _ddfv("chord-carried", "DDFV, chord, T carried", "darkgreen", "p", ":",
           "DDFV with chord |gamma| and every T-vertex carried by its triangle"),
     _ddfv("chord-redistribute-carried", "DDFV, chord + redistribution, T carried", "k", "*",
-          "-.", "DDFV with chord |gamma|, redistribution of the F-vertices and every "
-          "T-vertex carried by its triangle"),
+          "-.", "DDFV with chord |gamma|, semi-implicit redistribution of the F-vertices "
+          "and every T-vertex carried by its triangle"),
     Scheme("cotan", "cotangent", "baselines.cotan:CotanFlow", {"mass": "barycentric"},
            {"color": "C3", "marker": "v", "linestyle": "-"},
            "the cotangent scheme (Dziuk 1991), barycentric lumped mass", matrix="scaled-spd"),
@@ -146,12 +150,20 @@ SCHEMES = {s.name: s for s in (
            {"mass": "voronoi"}, {"color": "C5", "marker": "<", "linestyle": "--"},
            "the cotangent scheme (Dziuk 1991), Voronoi (mixed) lumped mass (Meyer et al. 2003)",
            matrix="scaled-spd"),
+    Scheme("cotan-intrinsic", "cotangent, intrinsic Delaunay",
+           "baselines.cotan_intrinsic:IntrinsicCotanFlow", {},
+           {"color": "tab:brown", "marker": "d", "linestyle": "-."},
+           "the cotangent scheme (Dziuk 1991) with the stiffness and barycentric mass of the "
+           "intrinsic Delaunay triangulation (Sharp, Crane 2020; robust-laplacian), rebuilt "
+           "every step", matrix="scaled-spd"),
     Scheme("cotan-redistribute", "cotangent, area redistribution", "baselines.cotan:CotanFlow",
            {"mass": "barycentric", "redistribution": "area", "target": "triangle"},
            {"color": "tab:olive", "marker": "P", "linestyle": "--"},
            "the cotangent scheme (Dziuk 1991) with the area-oriented tangential redistribution "
-           "of Mikula, Remesikova, Sarkoci, Sevcovic (2014), explicit, omega = 10, toward the "
-           "areas of equal-area triangles (half at a fixed boundary)", matrix="scaled-spd"),
+           "of Mikula, Remesikova, Sarkoci, Sevcovic (2014), semi-implicit (the advection "
+           "grad psi . grad X in the matrix, Scharfetter-Gummel weights, Peclet limit 0.1), "
+           "omega = 10, toward the areas of equal-area triangles (half at a fixed boundary)",
+           matrix="nonsymmetric"),
     Scheme("cmcf", "conformalized MCF", "baselines.cmcf:CMCFFlow", {"mass": "barycentric"},
            {"color": "C6", "marker": ">", "linestyle": "-."},
            "conformalized mean curvature flow (Kazhdan, Solomon, Ben-Chen 2012): initial "
@@ -160,6 +172,16 @@ SCHEMES = {s.name: s for s in (
            {"color": "C7", "marker": "P", "linestyle": ":"},
            "Barrett, Garcke, Nuernberg (2008): mass-lumped vertex normals, tangential "
            "motion that equidistributes the mesh", matrix="scaled-spd"),
+    Scheme("mdr", "MDR", "baselines.mdr:MDRFlow", {"scaling": "mass"},
+           {"color": "tab:cyan", "marker": "d", "linestyle": "-"},
+           "minimal deformation rate (Hu, Li 2022): the velocity of least int |grad v|^2 with "
+           "normal part -H, the multiplier eliminated into BGN's system with unit normals",
+           matrix="scaled-spd"),
+    Scheme("deturck", "DeTurck", "baselines.deturck:DeTurckFlow", {"alpha": 0.1},
+           {"color": "tab:brown", "marker": "H", "linestyle": "--"},
+           "the DeTurck trick (Elliott, Fritz 2017): reparametrised by the harmonic map heat "
+           "flow onto the initial mesh with time scale 1/alpha, the advection implicit",
+           matrix="nonsymmetric"),
 )}
 """Scheme name -> :class:`Scheme`."""
 

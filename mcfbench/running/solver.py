@@ -493,6 +493,20 @@ class Solver:
     #: ``solver(A, b, x0, overwrite_x0=True)`` iterates in ``x0`` (no copy), see :func:`solve`
     can_overwrite_x0 = True
 
+    @classmethod
+    def of_settings(cls, settings):
+        """The solver of a run's settings (the one function from settings to solver).
+
+        Two shapes: nested, ``settings["solver"] = {"method", "rtol", "maxiter"}`` (the
+        matrix's records); flat, ``rtol`` with optional ``maxiter`` and ``threads``, and
+        ``solver`` the method when given (Table 3.1's, the beyond study's, the gallery's).
+        """
+        spec = settings.get("solver")
+        if isinstance(spec, dict):
+            return cls(**spec)
+        flat = {k: settings[k] for k in ("rtol", "maxiter", "threads") if k in settings}
+        return cls(**flat) if spec is None else cls(method=spec, **flat)
+
     def __post_init__(self):
         from ddfv.kernels import check_threads
 

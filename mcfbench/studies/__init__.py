@@ -1,4 +1,6 @@
-"""Studies: one module per study (Table 3.1, beyond, figures, matrix, gallery), each with the same protocol.
+"""Studies: one folder per study (Table 3.1, beyond, figures, matrix, gallery, report), each with the same modules by role.
 
-Rule: the top layer of the harness: may import every other subpackage; only the command line and the Snakemake glue import it.
+Rule: the top layer of the harness: a study's ``plan`` and ``job`` may import every other subpackage;
+its other modules (``aggregate``, ``tables``, ``findings``, ``plots``, ``page``) present, under the
+presentation rule. Only the command line and the Snakemake glue import the studies.
 """

@@ -129,7 +129,7 @@ def test_collapse_to_a_point_is_detected():
 def test_t_vertex_escape_is_named_with_step_triangle_and_coordinate():
     """The cylinder of Fig. 3.6: without (3.6) a T-vertex leaves its triangle at n = 592."""
     from mcfbench.geometry.surfaces import make_surface
-    from mcfbench.studies.figure_experiments import EXPERIMENTS
+    from mcfbench.studies.figures.experiments import EXPERIMENTS
 
     run = EXPERIMENTS["fig_3_6"].runs[0]
     V, F = make_surface(run.shape, **run.params)

@@ -3,9 +3,16 @@
 Rules (``mcfbench/<layer>/__init__.py`` states each in one sentence):
 ``storage`` imports no other layer; ``geometry`` imports ``storage`` at most;
 ``running`` never ``presentation`` or ``studies``; ``presentation`` never
-``studies`` and of ``running`` only the two registries (declarative: names,
+``studies`` and of ``running`` only the registries (declarative: names,
 labels, styles, metrics); and importing any presentation module loads no solver, driver,
 flow, compiled kernel or numba.
+
+A study is one folder, ``mcfbench/studies/<study>/``, its modules named by their
+role: ``plan`` and ``job`` may run schemes (any module of the harness); every other
+module of the folder (``tables``, ``findings``, ``plots``, ``page``, ...) presents,
+under the presentation rule, and may import the presentation modules of the studies
+(Table 3.1's tables serve the beyond study's) and a study's ``__init__`` (its paths);
+``aggregate`` may read its study's plan, and loads no solver when imported either.
 """
 
 import ast
@@ -18,21 +25,47 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 HARNESS = ROOT / "mcfbench"
-LAYERS = ("storage", "geometry", "running", "presentation", "studies")
+LAYERS = ("storage", "geometry", "running", "problems", "presentation", "studies")
 # layer -> the mcfbench modules (prefixes) it may import
 ALLOWED = {
     "storage": ("mcfbench.storage",),
     "geometry": ("mcfbench.storage", "mcfbench.geometry"),
-    "running": ("mcfbench.storage", "mcfbench.geometry", "mcfbench.running"),
+    "running": ("mcfbench.storage", "mcfbench.geometry", "mcfbench.running", "mcfbench.problems"),
+    # a problem module: what the registry's own entries use
+    "problems": ("mcfbench.storage", "mcfbench.geometry", "mcfbench.running.problems",
+                 "mcfbench.problems"),
     "presentation": ("mcfbench.storage", "mcfbench.geometry", "mcfbench.presentation",
-                     "mcfbench.running.schemes", "mcfbench.running.problems"),
+                     "mcfbench.running.schemes", "mcfbench.running.problems",
+                     "mcfbench.running.integrators"),
     "studies": ("mcfbench",),
 }
+RUNNING_ROLES = ("plan", "job")
+"""The modules of a study folder that may run schemes; the others present."""
+STUDIES = sorted(p.name for p in (HARNESS / "studies").iterdir()
+                 if (p / "__init__.py").exists())
 MAX_LINES = 600
 
 
 def _modules():
     return sorted(p for p in HARNESS.rglob("*.py"))
+
+
+def _study_modules(roles):
+    """``(path, dotted name)`` of the modules of every study folder whose role is
+    in ``roles`` (``"presentation"``: every role but :data:`RUNNING_ROLES`)."""
+    found = []
+    for study in STUDIES:
+        for path in sorted((HARNESS / "studies" / study).glob("*.py")):
+            role = path.stem
+            if (role in roles) or (roles == "presentation" and role not in RUNNING_ROLES
+                                   and role != "aggregate"):
+                name = f"mcfbench.studies.{study}" + ("" if role == "__init__" else f".{role}")
+                found.append((path, name))
+    return found
+
+
+def _allowed(name, allowed):
+    return any(name == a or name.startswith(a.rstrip(".") + ".") for a in allowed)
 
 
 def _imports(path):
@@ -59,13 +92,35 @@ def test_each_layer_imports_only_the_layers_below(layer):
     assert offending == {}
 
 
+def test_the_presentation_modules_of_a_study_import_no_running_module():
+    """``tables``, ``findings``, ``plots``, ``page`` (every role but plan and job) of
+    every study folder: the presentation rule, plus the presentation modules of the
+    studies and the studies' ``__init__`` (paths, declarations)."""
+    presentation = {name for _, name in _study_modules("presentation")}
+    offending = {}
+    for path, _ in _study_modules("presentation"):
+        bad = sorted(n for n in _imports(path) if n.startswith("mcfbench.")
+                     and not _allowed(n, ALLOWED["presentation"])
+                     and n not in presentation and n.rsplit(".", 1)[0] not in presentation)
+        if bad:
+            offending[str(path.relative_to(ROOT))] = bad
+    assert offending == {}
+
+
+def test_every_study_is_one_folder_of_role_modules():
+    assert set(STUDIES) >= {"convergence", "beyond", "figures", "matrix", "gallery", "report"}
+    assert sorted(p.name for p in (HARNESS / "studies").glob("*.py")) == ["__init__.py",
+                                                                          "config.py"]
+
+
 def test_importing_presentation_loads_no_solver_driver_or_numba():
     modules = sorted(f"mcfbench.presentation.{p.stem}" for p in (HARNESS / "presentation").glob("*.py")
                      if p.stem != "__init__")
+    modules += [name for _, name in _study_modules(("aggregate",)) + _study_modules("presentation")]
     code = (f"import sys\nfor m in {modules!r}: __import__(m)\n"
             "bad = sorted(m for m in sys.modules if m == 'numba' or m.startswith(("
             "'mcfbench.running.solver', 'mcfbench.running.driver', 'mcfbench.running.run', "
-            "'mcfbench.studies', 'ddfv.kernels', 'ddfv.flow', 'baselines')))\n"
+            "'ddfv.kernels', 'ddfv.flow', 'baselines')) or m.endswith('.job'))\n"
             "print(','.join(bad))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
                          check=True).stdout.strip()
@@ -90,13 +145,13 @@ def test_no_harness_module_is_over_600_lines():
 
 
 # every study module defines these (the study protocol); no other name may repeat
-PROTOCOL = {"plan", "job", "aggregate", "findings"}
+PROTOCOL = {"plan", "job", "aggregate", "findings", "from_config"}
 
 
 def test_no_class_or_public_function_is_defined_twice():
     where = defaultdict(list)
     for path in _modules():
-        protocol = PROTOCOL if path.parent.name == "studies" else set()
+        protocol = PROTOCOL if path.parent.parent.name == "studies" else set()
         for node in ast.parse(path.read_text()).body:
             if isinstance(node, (ast.FunctionDef, ast.ClassDef)) and not node.name.startswith("_") \
                     and node.name not in protocol:

@@ -112,7 +112,8 @@ def test_gallery_run_keeps_frames_for_its_movie(tmp_path):
     one frame each; a mesh the reader refuses gives a one-frame notice."""
     import igl
 
-    from mcfbench.studies import gallery
+    from mcfbench.studies.gallery import job as gallery_job
+    from mcfbench.studies.gallery import plots as gallery_plots
 
     V, F = icosphere(1)
     mesh = tmp_path / "s.obj"
@@ -120,17 +121,17 @@ def test_gallery_run_keeps_frames_for_its_movie(tmp_path):
     settings = {"study": "gallery", "C": 0.1, "steps": 8, "solver": "direct", "rtol": 1e-9,
                 "maxiter": 1000, "mesh": "s.obj", "scheme": "cotan"}
     record, frames = tmp_path / "runs/s.obj/cotan.json", tmp_path / "frames/s.obj/cotan.npz"
-    assert gallery.job(mesh, "cotan", settings, record, frames).status == "ok"
+    assert gallery_job.job(mesh, "cotan", settings, record, frames).status == "ok"
     assert np.load(frames)["steps"].tolist() == list(range(9))
-    gallery.run_movie(record, frames, tmp_path / "cotan.gif")
+    gallery_plots.run_movie(record, frames, tmp_path / "cotan.gif")
     assert Image.open(tmp_path / "cotan.gif").n_frames == 9
 
     bad = tmp_path / "bad.obj"
     bad.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n")
     record, frames = tmp_path / "runs/bad.obj/cotan.json", tmp_path / "frames/bad.obj/cotan.npz"
-    assert gallery.job(bad, "cotan", {**settings, "mesh": "bad.obj"}, record,
-                       frames).status == "unsupported"
-    gallery.run_movie(record, frames, tmp_path / "bad.gif")
+    assert gallery_job.job(bad, "cotan", {**settings, "mesh": "bad.obj"}, record,
+                           frames).status == "unsupported"
+    gallery_plots.run_movie(record, frames, tmp_path / "bad.gif")
     _, shown = _frames(tmp_path / "bad.gif")
     assert len(shown) == 1                                  # the status, in red
     assert ((shown[0][..., 0] > 150) & (shown[0][..., 1] < 90)).sum() > 50
@@ -139,8 +140,8 @@ def test_gallery_run_keeps_frames_for_its_movie(tmp_path):
 def test_refused_ddfv_run_still_gets_its_one_frame_movie(tmp_path):
     """A DDFV scheme that refuses a surface (status unsupported) keeps the surface
     as its frames, without T-vertices: the gallery's movie job drew none and raised."""
-    from mcfbench.presentation.movie import write_movie
     from mcfbench.geometry.spheres import icosphere
+    from mcfbench.presentation.movie import write_movie
 
     V, F = icosphere(1)
     out = tmp_path / "refused.gif"

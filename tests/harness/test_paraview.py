@@ -104,13 +104,14 @@ def test_matrix_frames_file_exports_with_its_record(tmp_path):
     """A matrix run's frames file (first and last frames): the collection takes the
     provenance of the record next to it."""
     from mcfbench.storage.paraview import frame_file
-    from mcfbench.studies import matrix
+    from mcfbench.studies.matrix import job as matrix_job
+    from mcfbench.studies.matrix import plan as matrix_plan
 
-    plan = matrix.plan({"schemes": ["cotan"], "problems": {"sphere": [1]}})
-    settings = matrix.run_settings(plan, "cotan", "sphere", 1)
-    record = tmp_path / matrix.record_path("sphere", "cotan", 1, "m")
-    frames = tmp_path / matrix.frames_path("sphere", "cotan", 1, "m")
-    matrix.job(settings, record, frames)
+    plan = matrix_plan.plan({"schemes": ["cotan"], "problems": {"sphere": [1]}})
+    settings = matrix_plan.run_settings(plan, "cotan", "sphere", 1)
+    record = tmp_path / matrix_plan.record_path("sphere", "cotan", 1, "m")
+    frames = tmp_path / matrix_plan.frames_path("sphere", "cotan", 1, "m")
+    matrix_job.job(settings, record, frames)
     pvd = tmp_path / "sphere.pvd"
     assert main(["export", str(frames), str(pvd)]) == 0
     collection = read_pvd(pvd)

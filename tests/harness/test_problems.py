@@ -85,3 +85,74 @@ def test_every_scheme_runs_a_marching_cubes_mesh_or_names_why_not(scheme):
     assert result.steps_done == result.N or result.message.startswith(
         f"{result.status} at step {traj.failed_step}")
     assert result.min_angle >= 0.0 and result.iterations >= 0
+
+
+# ------------------------------------------------------------ problems as drop-in modules
+
+TINY = '''"""A unit sphere at level 1-2 with its radius as the metric (a drop-in problem)."""
+
+import numpy as np
+
+from mcfbench.running.problems import Problem
+
+
+def surface(subdivisions=1):
+    from mcfbench.geometry.spheres import icosphere
+
+    return icosphere(subdivisions)
+
+
+class Radius:
+    """Mean distance of the vertices from the origin at the end of the run."""
+
+    def __init__(self, problem):
+        self.r = np.nan
+
+    def __call__(self, flow):
+        self.r = float(np.linalg.norm(flow.vertices, axis=1).mean())
+
+    def result(self):
+        return {"mean_radius": self.r}
+
+
+METRICS = {"mean_radius": Radius}
+
+PROBLEM = Problem("tiny_sphere", "a sphere from a drop-in module", "tiny_icosphere",
+                  lambda level: {"subdivisions": int(level)}, levels=(1, 2), tau_1=0.04,
+                  t_final=0.04, metrics=("mean_radius",), exact="R(t) = sqrt(1 - 4t)",
+                  main_metric="mean_radius")
+'''
+
+
+def test_a_problem_is_one_file_found_by_the_registry(tmp_path, monkeypatch):
+    """One new module, no other file edited: the registry finds the problem, its
+    surface, its observer and its main metric; the matrix plans it and a run measures it."""
+    from mcfbench.geometry import surfaces
+    from mcfbench.running import problems
+    from mcfbench.running.run import run
+    from mcfbench.studies.matrix import plan as matrix_plan
+    from mcfbench.studies.matrix.tables import main_metric
+
+    package = tmp_path / "dropin_problems"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "tiny_sphere.py").write_text(TINY)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setattr(problems, "PROBLEMS", dict(problems.PROBLEMS))
+    monkeypatch.setattr(problems, "METRICS", dict(problems.METRICS))
+    monkeypatch.setattr(surfaces, "SURFACES", dict(surfaces.SURFACES))
+
+    assert problems.discover_problems([str(package)], "dropin_problems") == ["tiny_sphere"]
+    problem = problems.get_problem("tiny_sphere")
+    assert list(problems.PROBLEMS)[-1] == "tiny_sphere"
+    assert main_metric(problem, ["mean_radius"]) == "mean_radius"
+    V, F = problem.mesh(1)
+    assert V.shape == (42, 3) and F.shape == (80, 3)
+    plan = matrix_plan.plan({"schemes": ["cotan"], "problems": {}})
+    assert plan["problems"]["tiny_sphere"] == [1, 2]
+    result, _ = run("cotan", problem, 1)
+    # one step of tau = 0.04 from the unit sphere: R = sqrt(1 - 4 tau) = 0.916..., up to h^2
+    assert result.status == "ok" and result.steps_done == 1
+    assert abs(result.metrics["mean_radius"] - np.sqrt(1 - 4 * 0.04)) < 0.03
+    with pytest.raises(ValueError, match="already in the registry"):
+        problems.discover_problems([str(package)], "dropin_problems")

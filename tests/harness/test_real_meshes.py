@@ -10,7 +10,8 @@ from mcfbench.geometry.packaged_meshes import (
     gifti_surface,
     read_packaged_mesh,
 )
-from mcfbench.studies import gallery
+from mcfbench.studies.gallery import job as gallery_job
+from mcfbench.studies.gallery import plan as gallery_plan
 
 
 @pytest.mark.parametrize("name", sorted(PACKAGED_MESHES))
@@ -32,20 +33,20 @@ def test_packaged_meshes_mix_scans_and_cad():
 
 
 def test_default_gallery_runs_the_generated_and_the_packaged_meshes():
-    plan = gallery.plan()
+    plan = gallery_plan.plan()
     for name in PACKAGED_MESHES:
         assert plan["meshes"][f"{name}.obj"] == f"results/gallery/meshes/{name}.obj"
         assert plan["generated"][f"{name}.obj"] == ("packaged", name, 0)
     own = [k for k, (kind, _, _) in plan["generated"].items() if kind != "packaged"]
     assert own  # the suite's own meshes stay
-    assert gallery.plan({}, meshes=None)["meshes"] == plan["meshes"]
+    assert gallery_plan.plan({}, meshes=None)["meshes"] == plan["meshes"]
 
 
 def test_packaged_mesh_is_written_as_obj_the_gallery_reads(tmp_path):
     from mcfbench.geometry.mesh_files import read_mesh
 
     path = tmp_path / "nut.obj"
-    gallery.write_generated_mesh(("packaged", "nut", 0), path)
+    gallery_job.write_generated_mesh(("packaged", "nut", 0), path)
     V, F, _ = read_mesh(path)
     assert (len(V), len(F)) == (PACKAGED_MESHES["nut"].vertices, PACKAGED_MESHES["nut"].triangles)
 

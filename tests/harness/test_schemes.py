@@ -112,7 +112,8 @@ def test_unknown_matrix_kind_is_refused():
 
 
 @pytest.mark.parametrize("name, parts", [("cotan", ("cotan", "euler")),
-                                         ("cotan@bdf2", ("cotan", "bdf2"))])
+                                         ("cotan@bdf2", ("cotan", "bdf2")),
+                                         ("ddfv-chord@bdf3", ("ddfv-chord", "bdf3"))])
 def test_scheme_names_split_and_join_back(name, parts):
     from mcfbench.running.schemes import joined_name, split_name
 

@@ -382,3 +382,16 @@ def test_two_threads_give_the_same_solution_to_round_off(system):
 def test_bad_thread_counts_are_refused(threads):
     with pytest.raises(ValueError, match="threads"):
         Solver(threads=threads)
+
+
+def test_one_solver_of_either_settings_shape():
+    """Table 3.1's flat settings, the matrix's nested ones and the gallery's flat ones
+    with a method give the solvers their jobs ran with."""
+    flat = Solver.of_settings({"rtol": 1e-11, "threads": 2, "tau": 0.01})
+    assert (flat.method, flat.rtol, flat.maxiter, flat.threads) == ("bicgstab", 1e-11, 1000, 2)
+    nested = Solver.of_settings({"solver": {"method": "direct", "rtol": 1e-8, "maxiter": 7}})
+    assert (nested.method, nested.rtol, nested.maxiter) == ("direct", 1e-8, 7)
+    gallery = Solver.of_settings({"solver": "direct", "rtol": 1e-9, "maxiter": 1000, "C": 0.1})
+    assert (gallery.method, gallery.rtol, gallery.maxiter) == ("direct", 1e-9, 1000)
+    with pytest.raises(ValueError, match="unknown solver method 'lu'"):
+        Solver.of_settings({"solver": "lu", "rtol": 1e-9})

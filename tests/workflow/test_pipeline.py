@@ -28,8 +28,10 @@ import pytest
 import yaml
 
 from mcfbench.pipeline import Plans
+from mcfbench.running.solver import Solver
+from mcfbench.storage.provenance import BLAS_THREAD_VARIABLES
 from mcfbench.storage.records import checksum
-from mcfbench.studies.convergence import solver_of
+from mcfbench.studies.convergence.plan import sphere_run_settings
 
 pytestmark = pytest.mark.e2e
 
@@ -132,8 +134,7 @@ def test_provenance(workdir, table):
     assert len(sidecar["inputs"]) == 4
     record = json.loads((workdir / "results/runs/cotan/level2.json").read_text())
     # set once by the Snakefile, inherited by every job
-    assert record["provenance"]["blas_threads"] == dict.fromkeys(
-        ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"), "1")
+    assert record["provenance"]["blas_threads"] == dict.fromkeys(BLAS_THREAD_VARIABLES, "1")
     assert record["l2_error"] == table.set_index(["scheme", "level"]).loc[
         ("cotan", 2), "l2_error"]
     assert record["settings"]["code"].keys() == {"ddfv", "baselines", "mcfbench"}
@@ -304,9 +305,9 @@ def test_threads_setting_reaches_the_rules_and_the_records(tmp_path, env):
     jobs = out.stdout.split("rule run_scheme:")[1:]
     assert len(jobs) == 2 and all("threads: 2" in job.split("\n\n")[0] for job in jobs)
     config = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
-    settings = Plans({**config, "threads": 2}, SCHEMAS).run_settings("ddfv", 1)
-    assert settings["threads"] == 2 and solver_of(settings).threads == 2
-    assert Plans(config, SCHEMAS).run_settings("ddfv", 1)["threads"] == 1
+    settings = sphere_run_settings(Plans({**config, "threads": 2}, SCHEMAS), "ddfv", 1)
+    assert settings["threads"] == 2 and Solver.of_settings(settings).threads == 2
+    assert sphere_run_settings(Plans(config, SCHEMAS), "ddfv", 1)["threads"] == 1
 
 
 _ONE_STEP = ("import json; from mcfbench.running.run import run; "

@@ -1,4 +1,4 @@
-"""The results page of the matrix (mcfbench.presentation.matrix_page) in a real
+"""The results page of the matrix (mcfbench.studies.matrix.page) in a real
 headless browser: a tiny matrix (cotan and ddfv; sphere levels 1-2, catenoid
 level 1) built through the study's job function, tables, findings and plots as
 the rules build them, then the page loaded in headless Chromium with
@@ -19,13 +19,9 @@ from pathlib import Path
 import pytest
 
 from mcfbench.presentation.documents import external_references
-from mcfbench.presentation.matrix_page import (
-    PAGE_FIGURES,
-    problem_runs,
-    write_matrix_page,
-)
-from mcfbench.presentation.matrix_tables import read_long_table, read_summary
 from mcfbench.storage.frames import load_frames
+from mcfbench.studies.matrix.page import PAGE_FIGURES, problem_runs, write_matrix_page
+from mcfbench.studies.matrix.tables import read_long_table, read_summary
 
 pytestmark = pytest.mark.e2e
 
@@ -56,33 +52,36 @@ def browser():
 def page(tmp_path_factory):
     """``(matrix folder, plan)`` of a tiny matrix with its tables, findings,
     figures and ``index.html``."""
-    from mcfbench.presentation.matrix_plots import (
+    from mcfbench.running.problems import PROBLEMS
+    from mcfbench.storage.records import read_record, read_records
+    from mcfbench.studies.matrix import aggregate as matrix_aggregate
+    from mcfbench.studies.matrix import findings as matrix_findings
+    from mcfbench.studies.matrix import job as matrix_job
+    from mcfbench.studies.matrix import plan as matrix_plan
+    from mcfbench.studies.matrix.plots import (
         error_figure,
         picture_grid,
         quality_figure,
         work_precision_figure,
     )
-    from mcfbench.running.problems import PROBLEMS
-    from mcfbench.storage.records import read_record, read_records
-    from mcfbench.studies import matrix
 
     root = tmp_path_factory.mktemp("matrix")
     levels = {"sphere": [1, 2], "catenoid": [1]}
-    plan = matrix.plan({"schemes": ["cotan", "ddfv"],
-                        "problems": {p: levels.get(p, []) for p in PROBLEMS}})
-    runs = matrix.planned_runs(plan, code="test", root=str(root))
+    plan = matrix_plan.plan({"schemes": ["cotan", "ddfv"],
+                             "problems": {p: levels.get(p, []) for p in PROBLEMS}})
+    runs = matrix_plan.planned_runs(plan, code="test", root=str(root))
     for path, s in runs.items():
-        matrix.job(s, path, matrix.frames_path(s["problem"], s["scheme"], s["level"], str(root)))
-    table, _ = matrix.aggregate(runs, plan, root / "tables")
-    matrix.findings(root / "tables" / "summary.csv", root / "findings.md", plan,
-                    root / "tables" / "matrix.csv")
+        matrix_job.job(s, path, matrix_plan.frames_path(s["problem"], s["scheme"], s["level"], str(root)))
+    table, _ = matrix_aggregate.aggregate(runs, plan, root / "tables")
+    matrix_findings.findings(root / "tables" / "summary.csv", root / "findings.md", plan,
+                             root / "tables" / "matrix.csv")
     problems, schemes, figures = list(plan["problems"]), plan["schemes"], root / "figures"
     error_figure(table, [figures / "errors.png"], problems, schemes)
     work_precision_figure(table, [figures / "work_precision.png"], problems, schemes)
     quality_figure(list(read_records(runs).values()), [figures / "quality.png"], problems,
                    schemes)
     entries = {key: (read_record(r), load_frames(f))
-               for key, (r, f) in matrix.picture_runs(plan, str(root)).items()}
+               for key, (r, f) in matrix_plan.picture_runs(plan, str(root)).items()}
     picture_grid(entries, [figures / "pictures.png"], problems, schemes)
     size = write_matrix_page(root, root / "index.html", plan)
     assert size == (root / "index.html").stat().st_size

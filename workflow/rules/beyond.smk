@@ -24,30 +24,24 @@
 # Settings, record paths and resources: mcfbench.studies.beyond through
 # mcfbench.pipeline.Plans (PLANS of workflow/rules/common.smk).
 
-BEYOND_TABLE_NAMES = [
-    "levels",
-    "stability",
-    "time_convergence",
-    "space_convergence",
-    "integrators",
-]
+import mcfbench.studies.beyond as _beyond_paths
+
 BEYOND_TABLES = {
-    f"{name}_{ext}": f"results/beyond/tables/{name}.{ext}"
-    for name in BEYOND_TABLE_NAMES
+    f"{name}_{ext}": f"{_beyond_paths.TABLES}/{name}.{ext}"
+    for name in _beyond_paths.TABLE_NAMES
     for ext in ("csv", "md", "tex")
 }
-BEYOND_FIGURE_NAMES = ["levels", "t_monitor", "time_convergence", "space_convergence"]
 BEYOND_FIGURES = {
-    f"{name}_{ext}": f"results/beyond/figures/{name}.{ext}"
-    for name in BEYOND_FIGURE_NAMES
+    f"{name}_{ext}": f"{_beyond_paths.FIGURES}/{name}.{ext}"
+    for name in _beyond_paths.FIGURE_NAMES
     for ext in ("png", "pdf")
 }
 BEYOND_TARGETS = [
     *BEYOND_TABLES.values(),
-    "results/beyond/tables/t_monitor.csv",
-    "results/beyond/tables/beyond.json",
+    f"{_beyond_paths.TABLES}/t_monitor.csv",
+    f"{_beyond_paths.TABLES}/beyond.json",
     *BEYOND_FIGURES.values(),
-    "results/beyond/findings.md",
+    _beyond_paths.FINDINGS,
 ]
 
 
@@ -60,7 +54,7 @@ rule beyond_run:
     input:
         kernels=ancient(KERNELS),
     output:
-        "results/beyond/runs/{study}/{scheme}/level{level}.json",
+        _beyond_paths.RUN,
     log:
         "results/logs/beyond/{study}/{scheme}/level{level}.log",
     benchmark:
@@ -83,7 +77,7 @@ rule beyond_time:
     input:
         kernels=ancient(KERNELS),
     output:
-        "results/beyond/runs/time/{scheme}.json",
+        _beyond_paths.TIME_RUN,
     log:
         "results/logs/beyond/time/{scheme}.log",
     benchmark:
@@ -104,9 +98,9 @@ rule beyond_time:
 rule beyond_records:
     """Check every run record of the beyond study (a bad one stops here: the tables stay)."""
     input:
-        lambda wildcards: list(PLANS.beyond_records()),
+        lambda wildcards: list(_beyond.study_records(PLANS)),
     output:
-        "results/beyond/tables/records.json",
+        f"{_beyond_paths.TABLES}/records.json",
     log:
         "results/logs/beyond/records.log",
     benchmark:
@@ -119,7 +113,7 @@ rule beyond_records:
         mem_mb=500,
         runtime=5,
     params:
-        expected=lambda wildcards: PLANS.beyond_records(),
+        expected=lambda wildcards: _beyond.study_records(PLANS),
     script:
         "../scripts/check_records.py"
 
@@ -127,11 +121,11 @@ rule beyond_records:
 rule beyond_tables:
     """The tables of the beyond study and the T monitor series."""
     input:
-        checked="results/beyond/tables/records.json",
-        levels=lambda wildcards: list(PLANS.beyond_runs["levels"]),
-        long_time=lambda wildcards: list(PLANS.beyond_runs["long_time"]),
-        space=lambda wildcards: list(PLANS.beyond_runs["space"]),
-        time=lambda wildcards: list(PLANS.beyond_runs["time"]),
+        checked=f"{_beyond_paths.TABLES}/records.json",
+        levels=lambda wildcards: list(_beyond.study_runs(PLANS)["levels"]),
+        long_time=lambda wildcards: list(_beyond.study_runs(PLANS)["long_time"]),
+        space=lambda wildcards: list(_beyond.study_runs(PLANS)["space"]),
+        time=lambda wildcards: list(_beyond.study_runs(PLANS)["time"]),
     output:
         **{
             key: (
@@ -146,8 +140,8 @@ rule beyond_tables:
             )
             for key, path in BEYOND_TABLES.items()
         },
-        t_monitor="results/beyond/tables/t_monitor.csv",
-        provenance="results/beyond/tables/beyond.json",
+        t_monitor=f"{_beyond_paths.TABLES}/t_monitor.csv",
+        provenance=f"{_beyond_paths.TABLES}/beyond.json",
     log:
         "results/logs/beyond/tables.log",
     benchmark:
@@ -160,9 +154,9 @@ rule beyond_tables:
         mem_mb=1000,
         runtime=5,
     params:
-        expected=lambda wildcards: PLANS.beyond_records(),
-        beyond=lambda wildcards: PLANS.beyond,
-        paper_schemes=lambda wildcards: PLANS.paper_schemes(),
+        expected=lambda wildcards: _beyond.study_records(PLANS),
+        beyond=lambda wildcards: PLANS.plan("beyond"),
+        paper_schemes=lambda wildcards: _beyond.paper_schemes(PLANS.plan("beyond")),
         settings={k: config[k] for k in ("tau_level_1", "t_final", "rtol")},
     script:
         "../scripts/beyond_tables.py"
@@ -175,7 +169,7 @@ rule beyond_figures:
         stability=BEYOND_TABLES["stability_csv"],
         time=BEYOND_TABLES["time_convergence_csv"],
         space=BEYOND_TABLES["space_convergence_csv"],
-        t_monitor="results/beyond/tables/t_monitor.csv",
+        t_monitor=f"{_beyond_paths.TABLES}/t_monitor.csv",
     output:
         **{
             key: (
@@ -202,7 +196,7 @@ rule beyond_figures:
         mem_mb=1000,
         runtime=5,
     params:
-        beyond=lambda wildcards: PLANS.beyond,
+        beyond=lambda wildcards: PLANS.plan("beyond"),
         t_final=config["t_final"],
     script:
         "../scripts/beyond_plots.py"
@@ -218,7 +212,7 @@ rule beyond_findings:
         integrators=BEYOND_TABLES["integrators_csv"],
     output:
         report(
-            "results/beyond/findings.md",
+            _beyond_paths.FINDINGS,
             caption="../report/beyond_findings.rst",
             category="Beyond Table 3.1",
             labels={"table": "findings"},
@@ -235,8 +229,8 @@ rule beyond_findings:
         mem_mb=500,
         runtime=5,
     params:
-        beyond=lambda wildcards: PLANS.beyond,
-        paper_schemes=lambda wildcards: PLANS.paper_schemes(),
+        beyond=lambda wildcards: PLANS.plan("beyond"),
+        paper_schemes=lambda wildcards: _beyond.paper_schemes(PLANS.plan("beyond")),
         t_final=config["t_final"],
         tau_level_1=config["tau_level_1"],
     script:

@@ -1,11 +1,14 @@
 # Target lists and input functions shared by the rules. The logic behind them
-# is in the study modules (mcfbench.studies.convergence, .beyond), reached
-# through mcfbench.pipeline.Plans: each study's config section is checked
+# is in the studies' plan modules (mcfbench.studies.convergence.plan, .beyond.plan),
+# on the plans of mcfbench.pipeline.Plans: each study's config section is checked
 # (its plan made) when a rule that needs it joins the job graph, so a bad
 # value stops only the targets that use it, with a message naming the key
 # (no traceback: mcfbench.pipeline.WorkflowPlans).
 
-from mcfbench.pipeline import WorkflowPlans, mem_mb, scheme_pattern
+from mcfbench.pipeline import WorkflowPlans, mem_mb, runtime_minutes, scheme_pattern
+from mcfbench.studies.beyond import plan as _beyond
+from mcfbench.studies.convergence import plan as _convergence
+import mcfbench.studies.convergence as _convergence_paths
 
 PLANS = WorkflowPlans(config, f"{workflow.basedir}/workflow/schemas")
 # the config key `threads` (every run job), checked here
@@ -16,11 +19,12 @@ KERNELS = PLANS.kernels
 
 
 def run_settings(wildcards):
-    return PLANS.run_settings(wildcards.scheme, wildcards.level)
+    return _convergence.sphere_run_settings(PLANS, wildcards.scheme, wildcards.level)
 
 
 def run_runtime(wildcards):
-    return PLANS.run_runtime(wildcards.level)
+    steps = _convergence.level_steps(PLANS.plan("convergence"), wildcards.level)
+    return runtime_minutes(wildcards.level, steps)
 
 
 def run_mem_mb(wildcards):
@@ -28,31 +32,31 @@ def run_mem_mb(wildcards):
 
 
 def beyond_run_settings(wildcards):
-    return PLANS.beyond_run_settings(wildcards.study, wildcards.scheme, wildcards.level)
+    return _beyond.study_run_settings(
+        PLANS, wildcards.study, wildcards.scheme, wildcards.level
+    )
 
 
 def beyond_run_runtime(wildcards):
-    return PLANS.beyond_runtime(wildcards.study, wildcards.scheme, wildcards.level)
+    settings = beyond_run_settings(wildcards)
+    return runtime_minutes(
+        wildcards.level, round(settings["t_final"] / settings["tau"])
+    )
 
 
 def time_settings(wildcards):
-    return PLANS.time_settings(wildcards.scheme)
+    return _beyond.time_run_settings(PLANS, wildcards.scheme)
 
 
 def time_runtime(wildcards):
-    return PLANS.time_runtime()
+    plan = PLANS.plan("beyond")
+    return runtime_minutes(plan["time_study"]["level"], _beyond.time_steps_total(plan))
 
 
 TABLES = [
-    "results/tables/convergence.csv",
-    "results/tables/convergence.md",
-    "results/tables/convergence.tex",
-    "results/tables/convergence.csv.json",
+    f"{_convergence_paths.TABLE}.{ext}" for ext in ("csv", "md", "tex", "csv.json")
 ]
-CONVERGENCE_FIGURES = [
-    "results/figures/convergence.png",
-    "results/figures/convergence.pdf",
-]
+CONVERGENCE_FIGURES = [f"{_convergence_paths.FIGURE}.{ext}" for ext in ("png", "pdf")]
 CONVERGENCE_TARGETS = TABLES + CONVERGENCE_FIGURES
 
 

@@ -17,7 +17,7 @@ rule run_scheme:
     input:
         kernels=ancient(KERNELS),
     output:
-        "results/runs/{scheme}/level{level}.json",
+        _convergence_paths.RUN,
     log:
         "results/logs/runs/{scheme}/level{level}.log",
     benchmark:
@@ -40,9 +40,9 @@ rule run_scheme:
 rule convergence_records:
     """Check every run record of Table 3.1 (a bad one stops here: the tables stay)."""
     input:
-        lambda wildcards: list(PLANS.convergence_records()),
+        lambda wildcards: list(_convergence.table_records(PLANS)),
     output:
-        "results/tables/convergence.records.json",
+        f"{_convergence_paths.TABLE}.records.json",
     log:
         "results/logs/convergence_records.log",
     benchmark:
@@ -55,7 +55,7 @@ rule convergence_records:
         mem_mb=500,
         runtime=5,
     params:
-        expected=lambda wildcards: PLANS.convergence_records(),
+        expected=lambda wildcards: _convergence.table_records(PLANS),
     script:
         "../scripts/check_records.py"
 
@@ -63,18 +63,18 @@ rule convergence_records:
 rule convergence_table:
     """Table 3.1 with the paper's values and the baselines side by side."""
     input:
-        checked="results/tables/convergence.records.json",
-        records=lambda wildcards: list(PLANS.convergence_records()),
+        checked=f"{_convergence_paths.TABLE}.records.json",
+        records=lambda wildcards: list(_convergence.table_records(PLANS)),
     output:
         csv=report(
-            "results/tables/convergence.csv",
+            f"{_convergence_paths.TABLE}.csv",
             caption="../report/convergence_table.rst",
             category="Convergence",
             labels={"table": "Table 3.1 (CSV)"},
         ),
-        md="results/tables/convergence.md",
-        tex="results/tables/convergence.tex",
-        provenance="results/tables/convergence.csv.json",
+        md=f"{_convergence_paths.TABLE}.md",
+        tex=f"{_convergence_paths.TABLE}.tex",
+        provenance=f"{_convergence_paths.TABLE}.csv.json",
     log:
         "results/logs/convergence_table.log",
     benchmark:
@@ -87,10 +87,12 @@ rule convergence_table:
         mem_mb=500,
         runtime=5,
     params:
-        expected=lambda wildcards: PLANS.convergence_records(),
-        schemes=lambda wildcards: PLANS.convergence["schemes"],
-        levels=lambda wildcards: PLANS.convergence["levels"],
-        settings=lambda wildcards: PLANS.table_settings(),
+        expected=lambda wildcards: _convergence.table_records(PLANS),
+        schemes=lambda wildcards: PLANS.plan("convergence")["schemes"],
+        levels=lambda wildcards: PLANS.plan("convergence")["levels"],
+        settings=lambda wildcards: _convergence.table_settings(
+            PLANS.plan("convergence")
+        ),
     script:
         "../scripts/convergence_table.py"
 
@@ -98,15 +100,15 @@ rule convergence_table:
 rule convergence_figure:
     """Log-log L2 error against h for every scheme and the paper's points."""
     input:
-        csv="results/tables/convergence.csv",
+        csv=f"{_convergence_paths.TABLE}.csv",
     output:
         png=report(
-            "results/figures/convergence.png",
+            f"{_convergence_paths.FIGURE}.png",
             caption="../report/convergence_figure.rst",
             category="Convergence",
             labels={"figure": "L2 error vs h"},
         ),
-        pdf="results/figures/convergence.pdf",
+        pdf=f"{_convergence_paths.FIGURE}.pdf",
     log:
         "results/logs/convergence_figure.log",
     benchmark:

@@ -1,25 +1,20 @@
 # Figures 3.1-3.8 of the paper (and two comparisons with the cotangent
 # baseline): one job per figure runs its experiment and draws it. What each
 # figure computes (shape, parameters, scheme, tau, steps, panels) is defined
-# in one place, mcfbench/studies/figure_experiments.py (EXPERIMENTS); the job
+# in one place, mcfbench/studies/figures/experiments.py (EXPERIMENTS); the job
 # is mcfbench.studies.figures.job; this file only maps the registry to files.
 #
 #   snakemake --cores 2 results/figures/fig_3_6.png   # one figure
 
-from mcfbench.studies.figure_experiments import EXPERIMENTS
+from mcfbench.studies.figures import figure_outputs
+from mcfbench.studies.figures.experiments import EXPERIMENTS
 
 FIGURES = list(EXPERIMENTS)
 
 
-# every file the job of one figure writes
-FIGURE_FILES = [
-    "results/figures/{figure}.png",
-    "results/figures/{figure}.pdf",
-    "results/runs/figures/{figure}",
-    "results/runs/figures/{figure}.json",
-    "results/diagnostics/{figure}.csv",
-    "results/diagnostics/{figure}.png",
-]
+# every file the job of one figure writes (mcfbench.studies.figures.figure_outputs)
+FIGURE_PATHS = {key: str(path) for key, path in figure_outputs("{figure}").items()}
+FIGURE_FILES = list(FIGURE_PATHS.values())
 FIGURE_TARGETS = expand(FIGURE_FILES, figure=FIGURES)
 
 
@@ -28,7 +23,7 @@ wildcard_constraints:
 
 
 rule figure:
-    """Run the experiment of one figure (mcfbench/studies/figures.py) and draw it.
+    """Run the experiment of one figure (mcfbench/studies/figures/job.py) and draw it.
 
     Writes the figure, the kept frames (one file per run), per-step mesh-quality diagnostics
     (CSV and plot) and a JSON record with the status of every run. A run
@@ -39,17 +34,17 @@ rule figure:
         kernels=ancient(KERNELS),
     output:
         png=report(
-            "results/figures/{figure}.png",
+            FIGURE_PATHS["png"],
             caption="../report/fig_caption.rst",
             category="Figures 3.1-3.8",
             labels={"figure": "{figure}", "type": "surfaces"},
         ),
-        pdf="results/figures/{figure}.pdf",
-        frames=directory("results/runs/figures/{figure}"),
-        record="results/runs/figures/{figure}.json",
-        csv="results/diagnostics/{figure}.csv",
+        pdf=FIGURE_PATHS["pdf"],
+        frames=directory(FIGURE_PATHS["frames"]),
+        record=FIGURE_PATHS["record"],
+        csv=FIGURE_PATHS["csv"],
         plot=report(
-            "results/diagnostics/{figure}.png",
+            FIGURE_PATHS["plot"],
             caption="../report/fig_diagnostics.rst",
             category="Figures 3.1-3.8",
             labels={"figure": "{figure}", "type": "mesh quality"},

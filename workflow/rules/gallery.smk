@@ -13,9 +13,11 @@
 # and _alternatives (mcfbench.pipeline.alternatives) of workflow/rules/matrix.smk
 # (included before).
 #
-# Outputs under results/gallery/: runs/{mesh}/{scheme}.json,
-# frames/{mesh}/{scheme}.npz (about 20 frames), movies/{mesh}/{scheme}.gif,
-# table.md, table.csv, pictures.png, pictures.pdf.
+# Outputs under results/gallery/ (the paths: mcfbench/studies/gallery/__init__.py):
+# runs/{mesh}/{scheme}.json, frames/{mesh}/{scheme}.npz (about 20 frames),
+# movies/{mesh}/{scheme}.gif, table.md, table.csv, pictures.png, pictures.pdf.
+
+import mcfbench.studies.gallery as _gallery
 
 # the plan; without meshes (no runs) when the section `gallery` or `meshes` is
 # bad: then `snakemake gallery` names the bad key (rule gallery)
@@ -27,7 +29,7 @@ GALLERY_SETTINGS = {
 }
 # {record path: settings} of every run
 GALLERY_RUNS = {
-    f"results/gallery/runs/{mesh}/{scheme}.json": {
+    _gallery.RECORD.format(mesh=mesh, scheme=scheme): {
         **GALLERY_SETTINGS,
         "mesh": mesh,
         "scheme": scheme,
@@ -36,20 +38,20 @@ GALLERY_RUNS = {
     for scheme in GALLERY["schemes"]
 }
 GALLERY_FRAMES = [
-    f"results/gallery/frames/{mesh}/{scheme}.npz"
+    _gallery.FRAMES.format(mesh=mesh, scheme=scheme)
     for mesh in GALLERY["meshes"]
     for scheme in GALLERY["schemes"]
 ]
 GALLERY_MOVIES = [
-    f"results/gallery/movies/{mesh}/{scheme}.gif"
+    _gallery.MOVIE.format(mesh=mesh, scheme=scheme)
     for mesh in GALLERY["meshes"]
     for scheme in GALLERY["schemes"]
 ]
 GALLERY_TARGETS = [
-    "results/gallery/table.md",
-    "results/gallery/table.csv",
-    "results/gallery/pictures.png",
-    "results/gallery/pictures.pdf",
+    f"{_gallery.TABLE}.md",
+    f"{_gallery.TABLE}.csv",
+    f"{_gallery.PICTURES}.png",
+    f"{_gallery.PICTURES}.pdf",
     *GALLERY_MOVIES,
 ]
 
@@ -60,7 +62,7 @@ if GALLERY["generated"]:
         """One of the suite's own meshes, or a packaged real mesh, as OBJ (when no
         `meshes` folder is given)."""
         output:
-            "results/gallery/meshes/{mesh}",
+            _gallery.MESH,
         log:
             "results/logs/gallery/meshes/{mesh}.log",
         benchmark:
@@ -86,8 +88,8 @@ rule gallery_run:
         kernels=ancient(KERNELS),
         mesh=lambda wildcards: GALLERY["meshes"][wildcards.mesh],
     output:
-        record="results/gallery/runs/{mesh}/{scheme}.json",
-        frames="results/gallery/frames/{mesh}/{scheme}.npz",
+        record=_gallery.RECORD,
+        frames=_gallery.FRAMES,
     log:
         "results/logs/gallery/{mesh}/{scheme}.log",
     benchmark:
@@ -103,7 +105,7 @@ rule gallery_run:
         runtime=60,
     params:
         settings=lambda wildcards: GALLERY_RUNS[
-            f"results/gallery/runs/{wildcards.mesh}/{wildcards.scheme}.json"
+            _gallery.RECORD.format(mesh=wildcards.mesh, scheme=wildcards.scheme)
         ],
     script:
         "../scripts/gallery_run.py"
@@ -114,8 +116,8 @@ rule gallery_table:
     input:
         list(GALLERY_RUNS),
     output:
-        md="results/gallery/table.md",
-        csv="results/gallery/table.csv",
+        md=f"{_gallery.TABLE}.md",
+        csv=f"{_gallery.TABLE}.csv",
     log:
         "results/logs/gallery/table.log",
     benchmark:
@@ -140,8 +142,8 @@ rule gallery_pictures:
         records=list(GALLERY_RUNS),
         frames=GALLERY_FRAMES,
     output:
-        png="results/gallery/pictures.png",
-        pdf="results/gallery/pictures.pdf",
+        png=f"{_gallery.PICTURES}.png",
+        pdf=f"{_gallery.PICTURES}.pdf",
     log:
         "results/logs/gallery/pictures.log",
     benchmark:
@@ -163,10 +165,10 @@ rule gallery_pictures:
 rule gallery_movie:
     """One run's frames as an animated GIF (one camera, time and status per frame)."""
     input:
-        record="results/gallery/runs/{mesh}/{scheme}.json",
-        frames="results/gallery/frames/{mesh}/{scheme}.npz",
+        record=_gallery.RECORD,
+        frames=_gallery.FRAMES,
     output:
-        gif="results/gallery/movies/{mesh}/{scheme}.gif",
+        gif=_gallery.MOVIE,
     log:
         "results/logs/gallery/movies/{mesh}/{scheme}.log",
     benchmark:

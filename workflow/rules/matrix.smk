@@ -6,8 +6,9 @@
 # Settings: the config key `matrix` (config/config.yaml), checked against the
 # registries mcfbench.running.schemes.SCHEMES and mcfbench.running.problems.PROBLEMS by
 # mcfbench.studies.matrix.plan (after workflow/schemas/matrix.schema.yaml)
-# before any job runs. Everything but the rules
-# is in mcfbench/studies/matrix.py (tables, findings) and mcfbench/presentation/matrix_plots.py.
+# before any job runs. Everything but the rules is in the study's folder
+# mcfbench/studies/matrix/ (plan, job, aggregate, tables, findings, plots, page),
+# the output paths too (mcfbench/studies/matrix/__init__.py).
 #
 # Outputs under results/matrix/:
 #   runs/{problem}/{scheme}/level{level}.json    one record per run (mcfbench.storage.records)
@@ -20,7 +21,8 @@
 #   index.html                                   the results page: sortable tables, figures,
 #                                                findings, in one offline file
 
-from mcfbench.studies import matrix as _matrix
+import mcfbench.studies.matrix as _matrix_paths
+from mcfbench.studies.matrix import plan as _matrix
 from mcfbench.pipeline import alternatives as _alternatives
 
 # the plan; without problems (no rules) when the section `matrix` is bad: then
@@ -32,28 +34,13 @@ MATRIX_CODE = PLANS.code
 MATRIX_RUNS = _matrix.planned_runs(MATRIX, MATRIX_CODE)
 
 
-MATRIX_PROBLEM_TABLES = [
-    f"results/matrix/tables/{p}.{ext}"
-    for p in MATRIX["problems"]
-    for ext in ("md", "tex")
-]
-MATRIX_TABLES = [
-    "results/matrix/tables/matrix.csv",
-    *MATRIX_PROBLEM_TABLES,
-    "results/matrix/tables/summary.md",
-    "results/matrix/tables/summary.tex",
-    "results/matrix/tables/summary.csv",
-]
-MATRIX_FIGURES = {
-    f"{name}_{ext}": f"results/matrix/figures/{name}.{ext}"
-    for name in ("errors", "work_precision", "quality", "pictures")
-    for ext in ("png", "pdf")
-}
+MATRIX_TABLES = _matrix_paths.table_files(MATRIX["problems"])
+MATRIX_FIGURES = _matrix_paths.figure_files()
 MATRIX_TARGETS = [
     *MATRIX_TABLES,
     *MATRIX_FIGURES.values(),
-    "results/matrix/findings.md",
-    "results/matrix/index.html",
+    _matrix_paths.FINDINGS,
+    _matrix_paths.PAGE,
 ]
 
 
@@ -71,14 +58,8 @@ for _problem, _levels in MATRIX["problems"].items():
         input:
             kernels=ancient(KERNELS),
         output:
-            records=[
-                f"results/matrix/runs/{_problem}/{{scheme}}/level{k}.json"
-                for k in _levels
-            ],
-            frames=[
-                f"results/matrix/frames/{_problem}/{{scheme}}/level{k}.npz"
-                for k in _levels
-            ],
+            records=[_matrix.record_path(_problem, "{scheme}", k) for k in _levels],
+            frames=[_matrix.frames_path(_problem, "{scheme}", k) for k in _levels],
         log:
             f"results/logs/matrix/{_problem}/{{scheme}}.log",
         benchmark:
@@ -129,7 +110,7 @@ rule matrix_tables:
 rule matrix_plots:
     """Error against h, mesh quality over time, the picture grid."""
     input:
-        table="results/matrix/tables/matrix.csv",
+        table=_matrix_paths.LONG_TABLE,
         records=list(MATRIX_RUNS),
         frames=[f for _, f in _matrix.picture_runs(MATRIX).values()],
     output:
@@ -156,10 +137,10 @@ rule matrix_plots:
 rule matrix_findings:
     """findings.md from the summary table (no hand-typed numbers)."""
     input:
-        summary="results/matrix/tables/summary.csv",
-        table="results/matrix/tables/matrix.csv",
+        summary=_matrix_paths.SUMMARY,
+        table=_matrix_paths.LONG_TABLE,
     output:
-        "results/matrix/findings.md",
+        _matrix_paths.FINDINGS,
     log:
         "results/logs/matrix/findings.log",
     benchmark:
@@ -181,15 +162,12 @@ rule matrix_page:
     """The results page: the tables (sortable), the figures and the findings in one
     self-contained HTML file."""
     input:
-        table="results/matrix/tables/matrix.csv",
-        summary="results/matrix/tables/summary.csv",
-        figures=[
-            MATRIX_FIGURES[f"{name}_png"]
-            for name in ("errors", "work_precision", "quality", "pictures")
-        ],
-        findings="results/matrix/findings.md",
+        table=_matrix_paths.LONG_TABLE,
+        summary=_matrix_paths.SUMMARY,
+        figures=[MATRIX_FIGURES[f"{name}_png"] for name in _matrix_paths.FIGURE_NAMES],
+        findings=_matrix_paths.FINDINGS,
     output:
-        "results/matrix/index.html",
+        _matrix_paths.PAGE,
     log:
         "results/logs/matrix/page.log",
     benchmark:

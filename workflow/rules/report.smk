@@ -2,7 +2,7 @@
 # Markdown, one self-contained HTML page, a JSON of every check, and LaTeX
 # fragments. Sources: paper/ (published values, captions, checks, text,
 # templates) and the section "Deviations and interpretations" of
-# ddfv/README.md. Logic: mcfbench/presentation/report.py (`mcfbench report` by hand).
+# ddfv/README.md. Logic: mcfbench/studies/report/page.py (`mcfbench report` by hand).
 #
 #   snakemake --cores 2                       # builds it (part of rule all)
 #   snakemake --cores 2 reproduction_report   # only the report (and what it needs)
@@ -82,7 +82,7 @@ rule reproduction_report:
         unpack(
             lambda wildcards: {
                 **REPORT_INPUTS,
-                "records": list(PLANS.convergence_records()),
+                "records": list(_convergence.table_records(PLANS)),
                 "beyond": (
                     BEYOND_RESULTS
                     if "beyond"

@@ -5,7 +5,7 @@ the tables: nothing is typed by hand.
 """
 
 from mcfbench.storage.logs import setup_logging
-from mcfbench.studies.beyond import write_findings
+from mcfbench.studies.beyond.findings import write_findings
 
 sm = snakemake  # noqa: F821
 write_findings({key: sm.input[key]

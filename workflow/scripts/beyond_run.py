@@ -8,7 +8,7 @@ the job is :func:`mcfbench.studies.beyond.job`.
 
 from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.memory import tune_malloc
-from mcfbench.studies.beyond import job
+from mcfbench.studies.beyond.job import job
 
 tune_malloc()  # before any flow allocates
 

@@ -7,7 +7,7 @@ level) and ``beyond.json`` (provenance), written together.
 """
 
 from mcfbench.storage.logs import setup_logging
-from mcfbench.studies.beyond import aggregate
+from mcfbench.studies.beyond.aggregate import aggregate
 
 sm = snakemake  # noqa: F821
 inputs = {study: [str(p) for p in sm.input[study]]

@@ -10,7 +10,7 @@ the fields of :func:`mcfbench.studies.beyond.record_fields`).
 from mcfbench.storage.atomic import json_text, write_files
 from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.records import read_records
-from mcfbench.studies.beyond import record_fields
+from mcfbench.studies.beyond.plan import record_fields
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

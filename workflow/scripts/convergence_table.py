@@ -6,7 +6,7 @@ written together.
 """
 
 from mcfbench.storage.logs import setup_logging
-from mcfbench.studies.convergence import aggregate
+from mcfbench.studies.convergence.aggregate import aggregate
 
 sm = snakemake  # noqa: F821
 aggregate(dict(sm.params.expected), list(sm.params.schemes), list(sm.params.levels),

@@ -8,7 +8,8 @@ keeps its frames; the job still succeeds.
 
 from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.memory import tune_malloc
-from mcfbench.studies.figures import FIGURE_OUTPUTS, job
+from mcfbench.studies.figures import FIGURE_OUTPUTS
+from mcfbench.studies.figures.job import job
 
 tune_malloc()  # before any flow allocates
 

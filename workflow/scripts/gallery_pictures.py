@@ -3,9 +3,9 @@ last frame (rule ``gallery_pictures``, workflow/rules/gallery.smk)."""
 
 import logging
 
-from mcfbench.presentation.matrix_plots import gallery_grid
 from mcfbench.storage.frames import load_frames
 from mcfbench.storage.records import read_record
+from mcfbench.studies.gallery.plots import gallery_grid
 
 sm = snakemake  # noqa: F821
 logging.basicConfig(filename=sm.log[0], level=logging.INFO, force=True)

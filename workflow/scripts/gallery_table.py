@@ -1,11 +1,11 @@
 """The gallery table, mesh x scheme (rule ``gallery_table``,
-workflow/rules/gallery.smk; :func:`mcfbench.presentation.matrix_tables.gallery_table`)."""
+workflow/rules/gallery.smk; :func:`mcfbench.studies.matrix.tables.gallery_table`)."""
 
 import logging
 
-from mcfbench.presentation.matrix_tables import gallery_markdown, gallery_table
 from mcfbench.storage.atomic import write_text
 from mcfbench.storage.records import read_records
+from mcfbench.studies.gallery.tables import gallery_markdown, gallery_table
 
 sm = snakemake  # noqa: F821
 logging.basicConfig(filename=sm.log[0], level=logging.INFO, force=True)

@@ -1,4 +1,4 @@
-"""The results page of the benchmark matrix (mcfbench.presentation.matrix_page).
+"""The results page of the benchmark matrix (mcfbench.studies.matrix.page).
 
 Called by rule ``matrix_page`` (workflow/rules/matrix.smk): one self-contained
 HTML file, ``results/matrix/index.html``, of the tables (sortable), the
@@ -8,7 +8,7 @@ figures (as data URIs) and the findings, written atomically.
 import logging
 from pathlib import Path
 
-from mcfbench.presentation.matrix_page import write_matrix_page
+from mcfbench.studies.matrix.page import write_matrix_page
 
 sm = snakemake  # noqa: F821
 logging.basicConfig(filename=sm.log[0], level=logging.INFO, force=True)

@@ -1,4 +1,4 @@
-"""The figures of the benchmark matrix (mcfbench.presentation.matrix_plots).
+"""The figures of the benchmark matrix (mcfbench.studies.matrix.plots).
 
 Called by rule ``matrix_plots`` (workflow/rules/matrix.smk): error against h
 from the long table, mesh quality over time from the records' series, and
@@ -7,15 +7,15 @@ the picture grid of final surfaces from the saved frames.
 
 import logging
 
-from mcfbench.presentation.matrix_plots import (
-             error_figure,
-             picture_grid,
-             quality_figure,
-    work_precision_figure,
-)
-from mcfbench.presentation.matrix_tables import read_long_table
 from mcfbench.storage.frames import load_frames
 from mcfbench.storage.records import read_record, read_records
+from mcfbench.studies.matrix.plots import (
+    error_figure,
+    picture_grid,
+    quality_figure,
+    work_precision_figure,
+)
+from mcfbench.studies.matrix.tables import read_long_table
 
 sm = snakemake  # noqa: F821
 logging.basicConfig(filename=sm.log[0], level=logging.INFO, force=True)

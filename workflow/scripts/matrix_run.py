@@ -10,11 +10,11 @@ settings of each run come from ``params.settings``
 import os
 
 # Timed runs are single-threaded: BLAS reads these when numpy is first imported.
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
-             "NUMBA_NUM_THREADS"):
-    os.environ[_var] = "1"
+from mcfbench.storage.provenance import BLAS_THREAD_VARIABLES  # imports no numpy
 
-from mcfbench.studies import matrix  # noqa: E402
+os.environ.update(dict.fromkeys((*BLAS_THREAD_VARIABLES, "NUMBA_NUM_THREADS"), "1"))
 
-matrix.series_job(snakemake.params.settings, snakemake.output.records,  # noqa: F821
-                  snakemake.output.frames, snakemake.log[0])  # noqa: F821
+from mcfbench.studies.matrix import job as matrix_job  # noqa: E402
+
+matrix_job.series_job(snakemake.params.settings, snakemake.output.records,  # noqa: F821
+                      snakemake.output.frames, snakemake.log[0])  # noqa: F821

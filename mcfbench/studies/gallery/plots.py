@@ -1,0 +1,60 @@
+"""The gallery's pictures: per mesh the initial surface and every scheme's last frame
+(:func:`gallery_grid`), and one animation per run (:func:`run_movie`)."""
+
+from pathlib import Path
+
+from mcfbench.presentation.picture_grid import draw_grid, frame_surface, run_note
+from mcfbench.presentation.plots import style as scheme_style
+from mcfbench.storage.logs import setup_logging
+
+
+def run_movie(record, frames, out, log_path=None):
+    """The animation of one gallery run (:func:`mcfbench.presentation.movie.write_movie`),
+    titled with the scheme and the mesh, the status from its record (from the step of
+    the breakdown on); a run without frames (its mesh refused) gives a one-frame GIF
+    with the record's message."""
+    from mcfbench.presentation.movie import write_movie, write_notice
+    from mcfbench.running.schemes import scheme_label
+    from mcfbench.storage.frames import load_frames
+    from mcfbench.storage.records import read_record
+
+    log = setup_logging(log_path)
+    data = read_record(record)
+    scheme = scheme_label(data["scheme"])
+    title = f"{scheme} on {data.get('mesh', Path(frames).parent.name)}"
+    arrays = load_frames(frames)
+    if not len(arrays["t"]):
+        write_notice(out, title, data["status"], data["message"])
+        log.info("%s: no frames (%s) -> %s", title, data["status"], out)
+        return
+    failed = data.get("t_failed")
+    failed_step = -1 if data["status"] == "ok" or failed is None else \
+        round(failed / data["tau"])
+    write_movie({**arrays, "status": data["status"], "message": data["message"],
+                 "failed_step": failed_step}, out, title=title)
+    log.info("%s: %d frames, %s -> %s", title, len(arrays["t"]), data["status"], out)
+
+
+def gallery_grid(entries, paths, meshes, schemes):
+    """Per mesh (row) the initial surface and each scheme's last frame (columns).
+
+    ``entries``: ``(mesh, scheme) -> (record, frames)``.
+    """
+    cells = [[None] * (len(schemes) + 1) for _ in meshes]
+    for i, mesh in enumerate(meshes):
+        for j, scheme in enumerate(schemes):
+            entry = entries.get((mesh, scheme))
+            if entry is None:
+                continue
+            record, frames = entry
+            if "faces" not in frames or not len(frames["faces"]):
+                cells[i][j + 1] = (None, None, None, record["status"])
+                continue
+            F, T, faces = frame_surface(frames, -1)
+            cells[i][j + 1] = (F, T, faces, run_note(record))
+            if cells[i][0] is None:
+                F0, _, _ = frame_surface(frames, 0)
+                cells[i][0] = (F0, None, faces, f"{len(faces)} triangles")
+    labels = ["initial"] + [scheme_style(s)[0] for s in schemes]
+    draw_grid(cells, list(meshes), labels, paths, "Gallery: first and last frame per scheme",
+               share="row")

@@ -1,0 +1,44 @@
+"""The gallery's table: mesh x scheme, one row per record (CSV and Markdown)."""
+
+import numpy as np
+
+from mcfbench.studies.matrix.tables import TIMING_BASE, format_or_missing, markdown
+
+
+GALLERY_COLUMNS = ["mesh", "scheme", "status", "steps_done", "steps", "t_failed", "min_angle",
+                   "max_flipped", "t_min_barycentric", "cpu_seconds", "vertices",
+                   "triangles", "h", "tau", "solver", "message"]
+
+
+def gallery_table(records):
+    """Mesh x scheme: one row per record (:data:`GALLERY_COLUMNS`)."""
+    import pandas as pd
+
+    rows = [{"mesh": r["mesh"], "scheme": r["scheme"], "status": r["status"],
+             "steps_done": int(r["steps_done"]), "steps": int(r["N"]),
+             "t_failed": r["t_failed"], "min_angle": r["min_angle"],
+             "max_flipped": r["max_flipped"], "t_min_barycentric": r["t_min_barycentric"],
+             "cpu_seconds": r["cpu_seconds"], "vertices": int(r["nF"]),
+             "triangles": int(r["nT"]) if r["nT"] else np.nan, "h": r["h"], "tau": r["tau"],
+             "solver": r["solver"], "message": r["message"]} for r in records]
+    return pd.DataFrame(rows, columns=GALLERY_COLUMNS)
+
+
+def gallery_markdown(table, plan):
+    """The gallery table as Markdown: mesh x scheme, with the settings and timing note."""
+    import pandas as pd
+
+    view = pd.DataFrame({
+        "mesh": table["mesh"], "scheme": table["scheme"], "status": table["status"],
+        "steps": [f"{a}/{b}" for a, b in zip(table["steps_done"], table["steps"])],
+        "breakdown t": [format_or_missing(v, ".4g") for v in table["t_failed"]],
+        "min angle": [format_or_missing(v, ".3g") for v in table["min_angle"]],
+        "flipped": [format_or_missing(v, ".0f") for v in table["max_flipped"]],
+        "T monitor": [format_or_missing(v, ".3g") for v in table["t_min_barycentric"]],
+        "CPU s": [format_or_missing(v, ".3g") for v in table["cpu_seconds"]]})
+    notes = [f"Every scheme on every mesh: tau = C (mean edge length)^2 with C = {plan['C']:g}, "
+             f"{plan['steps']} steps, solver {plan['solver']} (rtol {plan['rtol']:g}). "
+             "Min angle and flipped triangles: worst over the sampled time levels; "
+             "T monitor: smallest barycentric coordinate of a T-vertex (DDFV only).",
+             TIMING_BASE]
+    return "# Gallery\n\n" + markdown(view, notes)

@@ -1,0 +1,84 @@
+"""The benchmark matrix: every scheme on every problem over its refinement series.
+
+One run is :func:`mcfbench.running.run.framed_run` of one (scheme, problem,
+level) with the problem's own time rule and the shared solver: BiCGStab (the
+paper's) on the problems with a refinement series, the robust method
+(:func:`~mcfbench.studies.matrix.plan.robust_method`) on the real-world-like
+meshes (``tau_rule = "mesh"``). The study's modules
+(``workflow/rules/matrix.smk`` calls them):
+
+* :mod:`.plan`: the config key ``matrix`` checked against the registries, the
+  settings of one run and the paths of its record and frames;
+* :mod:`.job`: one run with its record and first and last frames;
+* :mod:`.aggregate`: the records into the tables (:mod:`.tables`);
+* :mod:`.findings`: ``findings.md`` from the summary table only, in words;
+* :mod:`.plots`: the figures; :mod:`.page`: the results page (``index.html``).
+
+The presentation modules (:mod:`.tables`, :mod:`.findings`, :mod:`.plots`,
+:mod:`.page`) import no solver, driver, flow or numba; this module declares
+what they share with the plan: the output paths and which problems are
+real-world-like.
+"""
+
+ROOT = "results/matrix"
+"""The folder of the study's outputs."""
+
+RECORD = "{root}/runs/{problem}/{scheme}/level{level}.json"
+"""One run's record (:mod:`mcfbench.storage.records`)."""
+
+FRAMES = "{root}/frames/{problem}/{scheme}/level{level}.npz"
+"""One run's first and last frames (:func:`mcfbench.storage.frames.save_frames`)."""
+
+TABLES = f"{ROOT}/tables"
+"""The tables' folder (:func:`table_files`)."""
+
+LONG_TABLE = f"{TABLES}/matrix.csv"
+"""The long table: one row per run and metric."""
+
+SUMMARY = f"{TABLES}/summary.csv"
+"""Problem x scheme."""
+
+FIGURE_NAMES = ("errors", "work_precision", "quality", "pictures")
+"""The figures (:func:`figure_files`)."""
+
+FINDINGS = f"{ROOT}/findings.md"
+
+PAGE = f"{ROOT}/index.html"
+"""The results page: the tables, figures and findings in one offline file."""
+
+
+def table_files(problems):
+    """The long table, ``{problem}.md/.tex`` of every problem, ``summary.md/.tex/.csv``."""
+    return [LONG_TABLE, *(f"{TABLES}/{p}.{ext}" for p in problems for ext in ("md", "tex")),
+            f"{TABLES}/summary.md", f"{TABLES}/summary.tex", SUMMARY]
+
+
+def figure_files():
+    """``{name}_{png|pdf}`` -> path of every figure of :data:`FIGURE_NAMES`."""
+    return {f"{name}_{ext}": f"{ROOT}/figures/{name}.{ext}" for name in FIGURE_NAMES
+            for ext in ("png", "pdf")}
+
+
+def is_mesh_problem(problem):
+    """A mesh without a refinement series: ``tau ~ (mean edge)^2``, fixed steps
+    (the robust solver)."""
+    return getattr(problem, "tau_rule", "level") == "mesh"
+
+
+REAL_WORLD_SURFACES = ("blobby", "implicit_torus", "perturbed_sphere", "remeshed_sphere",
+                       "anisotropic_sphere", "flat_patch")
+"""Surfaces of :mod:`mcfbench.geometry.surfaces` that imitate meshes from the real world."""
+
+
+def is_real_world(problem):
+    """A real-world-like mesh: a mesh problem or one on a surface of
+    :data:`REAL_WORLD_SURFACES` (a bad mesh of a simple surface). The
+    recommendation asks that a scheme does not break down on these."""
+    return is_mesh_problem(problem) or getattr(problem, "surface", "") in REAL_WORLD_SURFACES
+
+
+def mesh_problems(plan):
+    """The real-world-like problems of the plan (:func:`is_real_world`)."""
+    from mcfbench.running.problems import get_problem
+
+    return [p for p in plan["problems"] if is_real_world(get_problem(p))]

@@ -1,0 +1,414 @@
+"""The findings of the benchmark matrix in words, from its summary table only: which scheme
+converges at which order on which problem, which breaks down where, and the
+recommendation.
+
+A verdict is the scheme's, not its linear solver's: a run that ended with a
+``solver_*`` status and that the robust solver (``direct``) finished when run
+again (:func:`mcfbench.studies.matrix.job`) counts as finished, with the
+robust run's value, and its text says that the failure was the solver's
+(:func:`scheme_view`)."""
+
+from pathlib import Path
+
+import numpy as np
+
+from mcfbench.studies.matrix import mesh_problems
+from mcfbench.studies.matrix.tables import (
+    is_error,
+    main_metric,
+    read_long_table,
+    read_summary,
+)
+
+ORDER_BAND = (1.7, 2.3)
+"""An EOC in this band counts as order ~2."""
+
+
+CONVERGING_EOC = 0.5
+"""Below this EOC (between the two finest levels) an error is not decreasing."""
+
+
+WRONG_LIMIT = 10.0
+"""A non-decreasing error this many times the smallest of any scheme: a wrong limit."""
+
+
+TIE = 0.05
+"""Candidates whose scores differ by less than this (relative) are called tied."""
+
+
+ROUNDOFF = 1e-10
+"""An error at most this large on every finished level is exact up to round-off."""
+
+
+def _pct_or(value, metric):
+    """Relative metrics (``*relative*`` or the catenoid's neck) in percent."""
+    if "relative" in metric or metric.startswith("neck"):
+        return f"{100 * value:+.3g} %"
+    return f"{value:.3e}"
+
+
+def _classify(row):
+    """``order2``, ``converging``, ``not_converging``, ``exact`` (round-off),
+    ``broke_down`` or ``no_error``. A row whose runs broke down but whose error was
+    measured on every level before (the volume before a pinch) is judged by it."""
+    values = [abs(float(v)) for v in str(row["values"]).split(";") if v]
+    measured = row["error"] and sum(np.isfinite(v) for v in values) == row["runs"]
+    if row["runs_ok"] < row["runs"] and not measured:
+        return "broke_down"
+    if not row["error"]:
+        return "no_error"
+    if values and all(np.isfinite(v) and v <= ROUNDOFF for v in values):
+        return "exact"
+    if not np.isfinite(row["eoc"]):
+        return "one_level" if sum(np.isfinite(v) for v in values) < 2 else "not_converging"
+    if ORDER_BAND[0] <= row["eoc"] <= ORDER_BAND[1]:
+        return "order2"
+    return "converging" if row["eoc"] >= CONVERGING_EOC else "not_converging"
+
+
+def cheapest_to_reach(table):
+    """Work-precision verdicts: per problem with an error metric, the target error
+    ``E`` = the largest of the schemes' smallest errors (so every scheme with a
+    finite error reaches it), and for each scheme the fewest CPU seconds of a run
+    whose ``|error| <= E``.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The long table (:func:`mcfbench.studies.matrix.tables.long_table`).
+
+    Returns
+    -------
+    list of dict
+        ``problem, metric, target, costs`` (scheme -> CPU seconds, cheapest first).
+    """
+    rows = []
+    for problem in dict.fromkeys(table["problem"]):
+        part = table[table["problem"] == problem]
+        metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
+        runs = part[(part["metric"] == metric) & np.isfinite(part["value"])]
+        if not is_error(metric) or runs.empty:
+            continue
+        runs = runs.assign(error=np.abs(runs["value"]))
+        best = runs.groupby("scheme", sort=False)["error"].min()
+        target = float(best.max())
+        reach = runs[runs["error"] <= target].groupby("scheme", sort=False)["cpu_seconds"].min()
+        rows.append({"problem": problem, "metric": metric, "target": target,
+                     "costs": dict(sorted(reach.items(), key=lambda kv: kv[1]))})
+    return rows
+
+
+def work_precision_section(rows, labels=None):
+    """The work-precision verdicts of :func:`cheapest_to_reach` in words."""
+    labels = labels or {}
+    lines = ["## Accuracy per CPU second", "",
+             "To reach the error every scheme with a finite error reaches on a problem "
+             "(the largest of their smallest errors), the cheapest run of each scheme, in CPU "
+             "seconds on one core with the problem's solver rule for every scheme (the same "
+             "footing within a problem; `figures/work_precision.png`):", ""]
+    for r in rows:
+        costs = list(r["costs"].items())
+        if not costs:
+            continue
+        first, seconds = costs[0]
+        rest = ", ".join(f"{labels.get(s, s)} {c:.3g} s" for s, c in costs[1:])
+        lines.append(f"- {r['problem']} ({r['metric']} <= {r['target']:.3g}): "
+                     f"**{labels.get(first, first)}** is the cheapest, {seconds:.3g} s"
+                     + (f" (then {rest})." if rest else "."))
+    return lines + [""]
+
+
+def _where(failed):
+    """``"level 3: solver_failed at t = 0.03; ..."`` from ``"3:solver_failed:0.03;..."``."""
+    return "; ".join(f"level {lv}: {st}" + (f" at t = {float(t):.4g}" if t else "")
+                     for lv, st, t in (f.split(":") for f in str(failed).split(";") if f))
+
+
+def scheme_view(summary):
+    """The summary with the robust solver's re-runs in place of the runs whose failure
+    they remove, and a ``solver_note`` column saying so.
+
+    A row whose every failure is such a solver failure becomes a finished row
+    (``runs_ok``, ``eoc``, ``values``, ``finest_*`` from the ``robust_*``
+    columns of :func:`mcfbench.studies.matrix.tables.summary_table`,
+    ``status`` ``ok``); a row with other failures keeps them and only gets the
+    note. Summaries written before the re-runs existed are returned unchanged
+    (empty notes).
+    """
+    summary = summary.copy()
+    notes = []
+    for i, r in summary.iterrows():
+        fixed = str(r.get("solver_only", "") or "")
+        if not fixed:
+            notes.append("")
+            continue
+        notes.append(f"A solver verdict, not a scheme verdict: the matrix's solver failed "
+                     f"({_where(fixed)}) and the robust solver (direct) finished "
+                     f"{'that run' if ';' not in fixed else 'those runs'} when run again.")
+        if r["runs_robust_ok"] == r["runs"]:
+            for column in ("eoc", "eoc_levels", "finest_level", "finest_value", "values"):
+                summary.at[i, column] = r[f"robust_{column}"]
+            summary.at[i, "runs_ok"] = r["runs"]
+            summary.at[i, "status"] = "ok"
+    summary["solver_note"] = notes
+    for i, r in summary.iterrows():
+        failed = str(r.get("robust_failed", "") or "")
+        if failed:
+            summary.at[i, "solver_note"] = (
+                r["solver_note"] + " " if r["solver_note"] else "") + (
+                f"The robust solver (direct) failed too ({_where(failed)}): a scheme verdict.")
+    return summary
+
+
+def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summary.csv",
+                    work_precision=()):
+    """The findings, Markdown, written from the summary table only.
+
+    Parameters
+    ----------
+    summary : pandas.DataFrame
+        :func:`summary_table` (or ``summary.csv`` read back).
+    labels : dict, optional
+        Scheme name -> label.
+    mesh_problems : sequence of str
+        The real-world-like problems (no refinement series).
+    work_precision : list of dict
+        :func:`cheapest_to_reach` of the long table (a section when given).
+    """
+    labels = labels or {}
+    summary = scheme_view(summary)
+    problems = list(dict.fromkeys(summary["problem"]))
+    schemes = list(dict.fromkeys(summary["scheme"]))
+    lines = ["# Findings of the benchmark matrix", "",
+             f"Written by `mcfbench.studies.matrix.findings` from `{source}`: every number below "
+             "is read from the tables, none typed by hand. Order ~2 means an EOC between "
+             f"the two finest finished levels in [{ORDER_BAND[0]}, {ORDER_BAND[1]}]; an "
+             f"error with EOC below {CONVERGING_EOC} is not decreasing.", ""]
+    verdict = {}
+    lines += ["## Per problem", ""]
+    for problem in problems:
+        part = summary[summary["problem"] == problem].copy()
+        part["class"] = [_classify(r) for _, r in part.iterrows()]
+        metric = part["metric"].iloc[0]
+        kind = "real-world-like mesh" if problem in mesh_problems else \
+            "refinement series" if part["error"].iloc[0] else "refinement series, no exact value"
+        done = part[(part["runs_ok"] == part["runs"]) & np.isfinite(part["finest_value"])]
+        smallest = np.abs(done["finest_value"]).min() if len(done) else np.nan
+        lines += [f"### {problem}", "",
+                  f"Main metric `{metric}`; levels {part['levels'].iloc[0]} ({kind}).", ""]
+        for _, r in part.iterrows():
+            verdict[(problem, r["scheme"])] = r
+            name = f"**{r['scheme']}**"
+            values = [float(v) if v else float("nan") for v in str(r["values"]).split(";")]
+            shown = ", ".join(_pct_or(v, metric) if np.isfinite(v) else "–" for v in values)
+            eocs = str(r["eocs"]) if isinstance(r["eocs"], str) else ""
+            if r["class"] == "order2":
+                text = (f"{name} converges at order ~2: EOC {r['eoc']:.2f} (levels "
+                        f"{r['eoc_levels']}), finest error {_pct_or(r['finest_value'], metric)}"
+                        f" (level {int(r['finest_level'])}); errors {shown}.")
+            elif r["class"] == "converging":
+                text = (f"{name} converges at order {r['eoc']:.2f} (levels {r['eoc_levels']}),"
+                        f" not ~2; errors {shown}.")
+            elif r["class"] == "not_converging":
+                text = (f"{name} does not converge: the error is not decreasing (EOCs "
+                        f"{eocs.replace(';', ', ') or '–'}; errors {shown})")
+                ratio = abs(r["finest_value"]) / smallest if smallest > 0 else np.inf
+                if ratio >= WRONG_LIMIT:
+                    text += (f": it converges to another surface (finest error {ratio:.3g} x "
+                             "the smallest of any scheme).")
+                else:
+                    text += "."
+            elif r["class"] == "one_level":
+                text = (f"{name}: one finished level only ({metric} {shown}), no EOC.")
+            elif r["class"] == "exact":
+                text = (f"{name} is exact up to round-off: {metric} at most "
+                        f"{max(abs(v) for v in values):.2e} on every level.")
+            elif r["class"] == "no_error":
+                text = (f"{name} finished every level; {metric} at the finest level "
+                        f"{r['finest_value']:.4g}.")
+            else:
+                fails = [f.split(":") for f in str(r["failed"]).split(";") if f]
+                where = "; ".join(f"level {lv}: {st}" + (f" at t = {float(t):.4g}" if t else "")
+                                  for lv, st, t in fails)
+                text = (f"{name} broke down in {r['runs'] - r['runs_ok']} of {r['runs']} runs "
+                        f"({where}).")
+                if np.isfinite(r["finest_value"]):
+                    text += (f" Finished levels: {metric} {shown}"
+                             + (f", EOC {r['eoc']:.2f}" if np.isfinite(r["eoc"]) else "") + ".")
+            if np.isfinite(r["t_min_barycentric"]):
+                text += f" Smallest T monitor {r['t_min_barycentric']:.3g}."
+            if r["solver_note"]:
+                text += " " + r["solver_note"]
+            lines.append("- " + text)
+        lines += _common_floor(part, metric)
+        lines.append("")
+    if work_precision:
+        lines += work_precision_section(work_precision, labels)
+    lines += recommendation(summary, verdict, problems, schemes, mesh_problems)
+    solver = summary[summary["solver_only"] != ""] if "solver_only" in summary \
+        else summary.iloc[:0]
+    if len(solver):
+        lines += ["## Solver verdicts", "",
+                  "Runs whose failure the robust solver removes: the failure belongs to "
+                  "the linear solver on that system, not to the scheme, and the verdicts "
+                  "above count those runs as finished with the robust solver's values: "
+                  + "; ".join(f"{r['scheme']} on {r['problem']} ({_where(r['solver_only'])})"
+                              for _, r in solver.iterrows() if r["solver_only"]) + ".", ""]
+    return "\n".join(lines).rstrip() + "\n"
+
+
+def _common_floor(part, metric):
+    """A remark when no scheme's error decreases and all finish with about the
+    same error: the floor belongs to the problem, not to a scheme."""
+    finished = part[part["class"].isin(["not_converging", "converging"])]
+    if len(finished) < 2 or (part["class"] == "order2").any() \
+            or not (finished["class"] == "not_converging").all():
+        return []
+    values = np.abs(finished["finest_value"].to_numpy(dtype=float))
+    spread = values.max() / values.min() if values.min() > 0 else np.inf
+    if not spread < 2.0:
+        return []
+    return ["", f"No scheme's error decreases at order ~2 here, and the {len(finished)} schemes "
+                f"that finished end within a factor {spread:.2f} of each other "
+                f"({values.min():.3e} to {values.max():.3e}): an error floor common to all "
+                "schemes (the problem's stopping rule or time error), not a property of one "
+                "scheme."]
+
+
+def recommendation(summary, verdict, problems, schemes, mesh_problems):
+    """The section "Across problems".
+
+    A candidate converges on every problem with an exact error (at order ~2
+    wherever at least one scheme reaches order ~2 there; otherwise it only
+    has to finish every level) and breaks down on none of the
+    real-world-like meshes. Candidates are ranked by the geometric mean over
+    those problems of their finest-level error relative to the smallest
+    one. The problems without an exact value (singular flows such as a
+    pinching torus) only inform: which scheme reaches the latest time.
+    """
+    mesh_problems = [p for p in problems if p in set(mesh_problems)]
+    exact = [p for p in problems if p not in mesh_problems
+             and bool(summary[summary["problem"] == p]["error"].any())]
+    singular = [p for p in problems if p not in exact and p not in mesh_problems]
+    lines = ["## Across problems", ""]
+    if not exact:
+        return lines + ["No problem with an exact error was run: no recommendation.", ""]
+    lines.append(f"Problems with an exact error: {', '.join(exact)}. Real-world-like meshes "
+                 f"(a breakdown disqualifies): {', '.join(mesh_problems) or 'none run'}. "
+                 f"Without an exact value (breakdown times only): "
+                 f"{', '.join(singular) or 'none'}.")
+    lines.append("")
+
+    def cls(p, s):
+        return _classify(verdict[(p, s)]) if (p, s) in verdict else "missing"
+
+    needs_order2 = {p: any(cls(p, s) == "order2" for s in schemes) for p in exact}
+    relaxed = [p for p in exact if not needs_order2[p]]
+    if relaxed:
+        lines.append(f"No scheme reaches order ~2 on {', '.join(relaxed)}: there a scheme "
+                     "only has to finish every level.")
+        lines.append("")
+    winners = {}
+    for p in exact:
+        good = [s for s in schemes if cls(p, s) in ("order2", "exact")] if needs_order2[p] \
+            else [s for s in schemes
+                  if cls(p, s) in ("converging", "not_converging", "exact", "one_level")]
+        if good:
+            winners[p] = min(good, key=lambda s: abs(verdict[(p, s)]["finest_value"]))
+    candidates, why_not = [], {}
+    for s in schemes:
+        reasons = []
+        for p in exact:
+            c = cls(p, s)
+            if c == "missing":
+                reasons.append(f"not run on {p}")
+            elif c == "broke_down":
+                reasons.append(f"broke down on {p}")
+            elif needs_order2[p] and c not in ("order2", "exact"):
+                eoc = verdict[(p, s)]["eoc"]
+                reasons.append(f"EOC {eoc:.2f} on {p}" if np.isfinite(eoc) else
+                               f"no EOC on {p}")
+        for p in mesh_problems:
+            if (p, s) in verdict and cls(p, s) == "broke_down":
+                reasons.append(f"broke down on {p}")
+        if reasons:
+            why_not[s] = reasons
+        else:
+            candidates.append(s)
+    ratios = {}
+    for p in exact:
+        part = summary[(summary["problem"] == p) & np.isfinite(summary["finest_value"])
+                       & (summary["runs_ok"] == summary["runs"])]
+        best = np.abs(part["finest_value"]).min() if len(part) else np.nan
+        if not best > ROUNDOFF:  # exact to round-off somewhere: no ranking by this problem
+            continue
+        for _, r in part.iterrows():
+            ratios[(p, r["scheme"])] = abs(r["finest_value"]) / best
+
+    def geometric_mean(s):
+        logs = [np.log(ratios[(p, s)]) for p in exact if (p, s) in ratios]
+        return float(np.exp(np.mean(logs))) if logs else float("nan")
+
+    if candidates:
+        score = {s: geometric_mean(s) for s in candidates}
+        ranked = sorted(candidates, key=lambda s: (not np.isfinite(score[s]), score[s]))
+        best = ranked[0]
+        lines.append("Converge as required on every problem with an exact error and do not "
+                     "break down on the real-world-like meshes: " + ", ".join(
+                         f"{s} (finest-level errors {score[s]:.3g} x the smallest, geometric "
+                         "mean)" for s in ranked) + ".")
+        lines.append("")
+        tied = [s for s in ranked[1:] if score[s] <= (1 + TIE) * score[best]]
+        if tied:
+            lines.append(f"{best} and {', '.join(tied)} are practically tied (scores within "
+                         f"{100 * TIE:.0f} %): either is a sound choice.")
+            lines.append("")
+        beaten = [f"{p}: {winners[p]}" for p in exact if winners.get(p) not in (None, best)]
+        lines.append(f"**Recommendation: {best}**" + (
+            ", with the smallest finest-level error on every problem with an exact error."
+            if not beaten else
+            ", the smallest finest-level errors on average among them, though not on every "
+            "problem (smallest elsewhere: " + "; ".join(beaten) + ")."))
+    else:
+        lines.append("**No scheme wins everywhere**: none converges as required on every "
+                     "problem with an exact error without breaking down on a real-world-like "
+                     "mesh.")
+    lines.append("")
+    lines.append("Smallest finest-level error per problem (among the schemes that converge as "
+                 "required there): " + "; ".join(f"{p}: {winners.get(p, 'none')}"
+                                                 for p in exact) + ".")
+    if why_not:
+        lines.append("")
+        lines.append("Left out: " + "; ".join(f"{s} ({', '.join(r)})"
+                                              for s, r in why_not.items()) + ".")
+    if singular:
+        lines.append("")
+        for p in singular:
+            done = [s for s in schemes if (p, s) in verdict and cls(p, s) != "broke_down"]
+            times = {s: verdict[(p, s)]["t_failed"] for s in schemes if (p, s) in verdict
+                     and cls(p, s) == "broke_down" and np.isfinite(verdict[(p, s)]["t_failed"])}
+            text = f"On {p} "
+            text += (f"{', '.join(done)} finished every level" if done else
+                     "every scheme broke down")
+            if times:
+                latest = max(times, key=times.get)
+                text += ("; " if done else ", ") + f"the latest breakdown: {latest} at t = " \
+                    f"{times[latest]:.4g} (earliest: {min(times, key=times.get)} at t = " \
+                    f"{min(times.values()):.4g}; coarsest failing level)"
+            lines.append(text + ".")
+    return lines + [""]
+
+
+def findings(summary_csv, out, plan, long_csv=None):
+    """``findings.md`` from ``summary.csv`` and, for the cost of accuracy, the long
+    table ``matrix.csv`` (numbers from the tables only)."""
+    from mcfbench.running.schemes import scheme_label
+    from mcfbench.storage.atomic import write_text
+
+    summary = read_summary(summary_csv)
+    labels = {s: scheme_label(s) for s in plan["schemes"]}
+    costs = cheapest_to_reach(read_long_table(long_csv)) if long_csv else ()
+    text = matrix_findings(summary, labels, mesh_problems(plan),
+                           source=Path(summary_csv).as_posix(), work_precision=costs)
+    write_text(out, text)
+    return text

@@ -1,0 +1,205 @@
+"""The results page of the benchmark matrix: one self-contained HTML file
+(``results/matrix/index.html``) of the summary, one sortable table of runs per
+problem, the figures as data URIs and the findings.
+
+Every table on the page sorts by any column: a click on a header sorts
+ascending, a second click descending (stable: rows that tie keep their order;
+empty cells last either way). A numeric column sorts by the exact value
+(``data-sort``, the shortest round-trip form of the float), not by the shown
+text. The URL fragment ``#sort=COLUMN`` (``#sort=-COLUMN``: descending)
+clicks that column of every table that has it once the page has loaded, so a
+sorted view can be linked, and a headless browser can be checked
+(``tests/workflow/test_results_page.py``). Nothing is fetched at view time:
+no CDN, no font, no script but the page's own.
+"""
+
+import html as _html
+import math
+import re
+from pathlib import Path
+
+import markdown as _markdown
+
+from mcfbench.presentation.documents import (
+    MARKDOWN_EXTENSIONS,
+    data_uri,
+    embed_images,
+    environment,
+    external_references,
+    unlink_files,
+)
+from mcfbench.presentation.formats import MISSING, sci, sig
+from mcfbench.studies.matrix.tables import (
+    is_error,
+    main_metric,
+    read_long_table,
+    read_summary,
+    TIMING_NOTE,
+)
+
+TEMPLATES = Path(__file__).with_name("templates")
+
+# (name, caption) of the figures of rule matrix_plots, in page order
+PAGE_FIGURES = (
+    ("errors", ("Error of each problem's main metric against the mesh size h, every "
+                "scheme; slope-2 guides.")),
+    ("work_precision", ("Work-precision: the main error of every run against its CPU "
+                        "seconds (one core, the problem's solver rule).")),
+    ("quality", "Smallest angle (and the DDFV T monitor) against time, per problem."),
+    ("pictures", "The final surfaces, scheme x problem (coarsest level)."),
+)
+
+# columns of a problem's table of runs: (column of matrix.csv, header, format)
+RUN_COLUMNS = (
+    ("scheme", "scheme", None), ("level", "level", None), ("h", "h", sig),
+    ("tau", "tau", sig), ("steps_done", "steps done", None), ("steps", "steps", None),
+    ("value", "value", sci), ("eoc", "EOC", lambda x: sig(x, 3)),
+    ("status", "status", None), ("t_failed", "t failed", lambda x: sig(x, 4)),
+    ("min_angle", "min angle", sig), ("max_flipped", "flipped", lambda x: sig(x, 3)),
+    ("t_min_barycentric", "T monitor", sig), ("iterations", "iterations", None),
+    ("cpu_seconds", "CPU s", sig),
+)
+
+# columns of the summary (summary.csv)
+SUMMARY_COLUMNS = (
+    ("problem", "problem", None), ("scheme", "scheme", None), ("metric", "metric", None),
+    ("levels", "levels", None), ("runs_ok", "runs ok", None), ("runs", "runs", None),
+    ("eoc", "EOC", lambda x: sig(x, 3)), ("eoc_levels", "EOC levels", None),
+    ("finest_level", "finest level", lambda x: sig(x, 3)),
+    ("finest_value", "finest value", sci), ("status", "status", None),
+    ("t_failed", "t failed", lambda x: sig(x, 4)), ("min_angle", "min angle", sig),
+    ("t_min_barycentric", "T monitor", sig), ("cpu_seconds", "CPU s (finest)", sig),
+)
+
+
+def problem_runs(table, problem):
+    """The runs of ``problem`` on its main metric: the rows of the long table
+    (``matrix.csv``) in its order, index reset, and the metric's name."""
+    part = table[table["problem"] == problem]
+    metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
+    return part[part["metric"] == metric].reset_index(drop=True), metric
+
+
+def sort_key(value):
+    """The ``data-sort`` of a cell: a number in its shortest round-trip form
+    (``Infinity`` for inf, JavaScript's spelling), ``""`` for NaN or None, text as is."""
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return str(value)
+    if isinstance(value, (int, float)) or hasattr(value, "dtype"):
+        value = float(value)
+        if math.isnan(value):
+            return ""
+        if math.isinf(value):
+            return "Infinity" if value > 0 else "-Infinity"
+        return str(int(value)) if value.is_integer() and abs(value) < 2 ** 53 else repr(value)
+    return str(value)
+
+
+def html_table(frame, columns, table_id, caption=""):
+    """A sortable table for the template: ``{"id", "caption", "header", "rows"}``;
+    header cells ``{"column", "text", "numeric"}``, row cells ``{"text", "key"}``."""
+    import pandas as pd
+
+    present = [c for c in columns if c[0] in frame.columns]
+    header = [{"column": name, "text": text,
+               "numeric": bool(pd.api.types.is_numeric_dtype(frame[name]))
+               and not pd.api.types.is_bool_dtype(frame[name])}
+              for name, text, _ in present]
+    rows = []
+    for record in frame.to_dict("records"):
+        cells = []
+        for name, _, fmt in present:
+            value = record[name]
+            key = sort_key(value)
+            text = fmt(value) if fmt else (MISSING if key == "" else str(value))
+            cells.append({"text": text, "key": key})
+        rows.append(cells)
+    return {"id": table_id, "caption": caption, "header": header, "rows": rows}
+
+
+def findings_html(text, base, shift=2):
+    """``findings.md`` as HTML (the report's Markdown extensions), headings
+    ``shift`` levels down (its title under the page's section heading), images
+    embedded from ``base``, links to files as text."""
+    body = _markdown.Markdown(extensions=MARKDOWN_EXTENSIONS).convert(text)
+    body = re.sub(r"<(/?)h([1-6])\b",
+                  lambda m: f"<{m[1]}h{min(6, int(m[2]) + shift)}", body)
+    return unlink_files(embed_images(body, base))
+
+
+def _problem_section(table, problem):
+    from mcfbench.running.problems import PROBLEMS
+
+    runs, metric = problem_runs(table, problem)
+    p = PROBLEMS.get(problem)
+    notes = [f"Main metric: <code>{_html.escape(metric)}</code>"
+             + (" (an error: EOC (3.1) between consecutive levels)." if is_error(metric)
+                else " (no exact value: no EOC).")]
+    if p is not None:
+        notes.append(_html.escape(f"{p.label}. {p.description}".strip()))
+        if getattr(p, "exact", None):
+            notes.append(_html.escape(f"Exact answer: {p.exact}."))
+    section = html_table(runs, RUN_COLUMNS, f"runs-{problem}",
+                         f"{problem}: every run, value of {metric}")
+    section.update(problem=problem, metric=metric, notes=notes)
+    return section
+
+
+def matrix_page(matrix_dir, plan=None, title="Benchmark matrix: results"):
+    """The HTML of the results page of the matrix in ``matrix_dir`` (its
+    ``tables/matrix.csv``, ``tables/summary.csv``, ``figures/*.png`` and
+    ``findings.md``; a missing figure or findings file is named on the page).
+
+    Parameters
+    ----------
+    matrix_dir : path
+        ``results/matrix`` of a pipeline run.
+    plan : dict, optional
+        :func:`mcfbench.studies.matrix.plan` of the run: problem and scheme
+        order (default: that of ``matrix.csv``).
+    """
+    from mcfbench.running.schemes import scheme_label
+
+    root = Path(matrix_dir)
+    table = read_long_table(root / "tables" / "matrix.csv")
+    problems = [p for p in (plan["problems"] if plan else dict.fromkeys(table["problem"]))
+                if p in set(table["problem"])]
+    schemes = list(plan["schemes"]) if plan else list(dict.fromkeys(table["scheme"]))
+    labels = {s: scheme_label(s) for s in schemes}
+    summary = read_summary(root / "tables" / "summary.csv")
+    figures = []
+    for name, caption in PAGE_FIGURES:
+        path = root / "figures" / f"{name}.png"
+        figures.append({"name": name, "caption": caption,
+                        "src": data_uri(path) if path.is_file() else None,
+                        "path": f"figures/{name}.png"})
+    findings = root / "findings.md"
+    context = {
+        "title": title,
+        "schemes": [{"name": s, "label": labels[s]} for s in schemes],
+        "problems": problems,
+        "runs": len(table.drop_duplicates(["scheme", "problem", "level"])),
+        "summary": html_table(summary, SUMMARY_COLUMNS, "summary",
+                              "problem x scheme: the main metric"),
+        "sections": [_problem_section(table, p) for p in problems],
+        "figures": figures,
+        "findings": findings_html(findings.read_text(), root) if findings.is_file() else None,
+        "timing_note": TIMING_NOTE,
+    }
+    html = environment(TEMPLATES).get_template("page.html.j2").render(**context)
+    outside = external_references(html)
+    if outside:
+        raise ValueError(f"the results page would load {outside[:3]} at view time; "
+                         "it must be self-contained")
+    return html
+
+
+def write_matrix_page(matrix_dir, out, plan=None):
+    """Write :func:`matrix_page` to ``out`` atomically; returns its size in bytes."""
+    from mcfbench.storage.atomic import write_text
+
+    html = matrix_page(matrix_dir, plan)
+    write_text(out, html)
+    return len(html.encode("utf-8"))

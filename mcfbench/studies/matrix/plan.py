@@ -1,0 +1,161 @@
+"""The plan of the benchmark matrix: the config key ``matrix`` checked against the
+registries (:func:`plan`), the settings of one run (:func:`run_settings`) and the
+paths of its record and frames (:data:`mcfbench.studies.matrix.RECORD`)."""
+
+from mcfbench.studies.config import ConfigError
+from mcfbench.studies.matrix import FRAMES, RECORD, ROOT, is_mesh_problem
+
+EXACT_SOLVER = "bicgstab"
+"""Solver of the problems with a refinement series: the paper's comparison."""
+
+
+def robust_method():
+    """The shared solver's method for meshes of unknown quality (:data:`mcfbench.running.solver.ROBUST`)."""
+    from mcfbench.running.solver import ROBUST
+
+    return ROBUST
+
+
+def _levels(value, key):
+    if value is None:
+        return None
+    if not isinstance(value, (list, tuple)):
+        value = [value]
+    try:
+        levels = sorted({int(v) for v in value})
+    except (TypeError, ValueError):
+        raise ConfigError(f"config key {key!r}: levels must be whole numbers, got "
+                          f"{value!r}") from None
+    if any(level < 1 for level in levels):
+        raise ConfigError(f"config key {key!r}: levels start at 1, got {value!r}")
+    return levels
+
+
+def plan(section=None, schemes=None, problems=None):
+    """The config key ``matrix`` checked against the registries and normalised.
+
+    Parameters
+    ----------
+    section : dict, optional
+        ``schemes`` ("all" or a list of :data:`mcfbench.running.schemes.SCHEMES`
+        names), ``with_integrators`` (integrator -> schemes also run with it,
+        as ``NAME@INTEGRATOR``), ``problems`` (problem -> levels; a problem of the registry
+        not named runs at its registry levels, ``[]`` leaves it out),
+        ``rtol``, ``maxiter``, ``solver`` (method of the refinement series),
+        ``mesh_solver`` (method of the real-world-like meshes, ``"robust"``
+        = :func:`robust_method`).
+    schemes, problems : dict, optional
+        The registries (default :data:`~mcfbench.running.schemes.SCHEMES`,
+        :data:`~mcfbench.running.problems.PROBLEMS`).
+
+    Returns
+    -------
+    dict
+        ``schemes`` (list; those of ``with_integrators`` last), ``problems``
+        (name -> sorted levels, registry order), ``rtol``, ``maxiter``, ``solver``, ``mesh_solver``.
+
+    Raises
+    ------
+    ConfigError
+        An unknown scheme, problem or solver, or bad levels, naming the key.
+    """
+    from mcfbench.running import solver as _solver
+    from mcfbench.running.integrators import INTEGRATORS
+    from mcfbench.running.schemes import find_scheme, joined_name
+
+    if schemes is None:
+        from mcfbench.running.schemes import SCHEMES as schemes
+    if problems is None:
+        from mcfbench.running.problems import PROBLEMS as problems
+    section = dict(section or {})
+    chosen = section.get("schemes", "all")
+    if chosen in ("all", None):
+        chosen = list(schemes)
+    elif isinstance(chosen, str):
+        chosen = [chosen]
+    stepped = {}                   # NAME@INTEGRATOR -> NAME
+    for integrator, names in (section.get("with_integrators") or {}).items():
+        if integrator not in INTEGRATORS or integrator == "euler":
+            raise ConfigError(f"config key 'matrix.with_integrators': unknown integrator "
+                              f"{integrator!r}; choose one of "
+                              f"{', '.join(i for i in INTEGRATORS if i != 'euler')}")
+        stepped.update({joined_name(name, integrator): name for name in names})
+    unknown = [s for s in [*chosen, *stepped] if find_scheme(s, schemes) is None]
+    if unknown:
+        raise ConfigError(f"config key 'matrix.schemes': unknown scheme(s) {unknown}; the "
+                          f"registry mcfbench.running.schemes.SCHEMES has {list(schemes)}, "
+                          f"each also as NAME@INTEGRATOR ({', '.join(INTEGRATORS)})")
+    overrides = section.get("problems") or {}
+    unknown = [p for p in overrides if p not in problems]
+    if unknown:
+        raise ConfigError(f"config key 'matrix.problems': unknown problem(s) {unknown}; the "
+                          f"registry mcfbench.running.problems.PROBLEMS has {list(problems)}")
+    plan_problems = {}
+    for name, problem in problems.items():
+        levels = _levels(overrides[name], f"matrix.problems.{name}") if name in overrides \
+            else sorted(int(v) for v in problem.levels)
+        if levels:
+            plan_problems[name] = levels
+    if not plan_problems:
+        raise ConfigError("config key 'matrix.problems': every problem is left out")
+    methods = {}
+    for key, default in (("solver", EXACT_SOLVER), ("mesh_solver", "robust")):
+        method = section.get(key, default)
+        method = robust_method() if method == "robust" else method
+        if method not in _solver.METHODS:
+            raise ConfigError(f"config key 'matrix.{key}': unknown solver {method!r}; choose "
+                              f"one of {', '.join(_solver.METHODS)} or robust")
+        methods[key] = method
+    rtol = float(section.get("rtol", 1e-9))
+    if not 0 < rtol < 1:
+        raise ConfigError(f"config key 'matrix.rtol': must lie in (0, 1), got {rtol!r}")
+    maxiter = int(section.get("maxiter", 1000))
+    if maxiter < 1:
+        raise ConfigError(f"config key 'matrix.maxiter': must be >= 1, got {maxiter!r}")
+    # another integrator only for the schemes that are run (`schemes` may list fewer)
+    chosen = [*chosen, *(s for s, name in stepped.items() if name in chosen)]
+    return {"schemes": list(chosen), "problems": plan_problems, "rtol": rtol,
+            "maxiter": maxiter, **methods}
+
+
+def solver_method(plan, problem):
+    """The method of ``problem``'s runs: robust on real-world-like meshes."""
+    from mcfbench.running.problems import get_problem
+
+    problem = get_problem(problem) if isinstance(problem, str) else problem
+    return plan["mesh_solver"] if is_mesh_problem(problem) else plan["solver"]
+
+
+def record_path(problem, scheme, level, root=ROOT):
+    return RECORD.format(root=root, problem=problem, scheme=scheme, level=level)
+
+
+def frames_path(problem, scheme, level, root=ROOT):
+    return FRAMES.format(root=root, problem=problem, scheme=scheme, level=level)
+
+
+def run_settings(plan, scheme, problem, level, code=""):
+    """Everything that determines the record of one run of the matrix."""
+    return {"study": "matrix", "scheme": scheme, "problem": problem, "level": int(level),
+            "solver": {"method": solver_method(plan, problem), "rtol": plan["rtol"],
+                       "maxiter": plan["maxiter"]},
+            "code": code}
+
+
+def planned_runs(plan, code="", root=ROOT):
+    """``{record path: settings}`` of every run, problems then schemes then levels."""
+    return {record_path(p, s, level, root): run_settings(plan, s, p, level, code)
+            for p, levels in plan["problems"].items() for s in plan["schemes"]
+            for level in levels}
+
+
+def picture_runs(plan, root=ROOT):
+    """``{(problem, scheme): (record path, frames path)}`` of the picture grid:
+    the coarsest level of each problem."""
+    return {(p, s): (record_path(p, s, min(levels), root), frames_path(p, s, min(levels), root))
+            for p, levels in plan["problems"].items() for s in plan["schemes"]}
+
+
+def from_config(config, plans):
+    """:func:`plan` of the config (:meth:`mcfbench.pipeline.Plans.plan`)."""
+    return plan(config.get("matrix"))

@@ -1,0 +1,427 @@
+"""The tables of the benchmark matrix: the long table (one row per run and metric, EOC (3.1) of every error), the table of one problem, the summary (problem x scheme), their Markdown and LaTeX, and the gallery's table.
+
+Errors and EOC
+--------------
+A metric is an *error* when its exact value is zero (:func:`is_error`:
+``l2_error``, the catenoid's neck and profile errors, the height of the
+hemisphere above the flat disk, the displacement of the flat patch). Its
+EOC between levels ``k - 1`` and ``k`` is ``log2(|e_{k-1}| / |e_k|)``
+(levels one apart, both runs finished). Other metrics (volume, area) have
+no exact value: no EOC. The *main metric* of a problem
+(:func:`main_metric`) is the one of the summary, the plots and the
+findings.
+"""
+
+
+import numpy as np
+
+from mcfbench.geometry.exact import eoc
+
+TIMING_BASE = (
+    "Timings compare schemes fairly only on the same footing: the same solver and "
+    "tolerance rule, the same machine, one core each. A DDFV system has about 3 times "
+    "the unknowns of a vertex-based scheme (F- and T-vertices)."
+)
+
+
+TIMING_NOTE = TIMING_BASE[:-1] + (
+    "; the matrix uses BiCGStab on the refinement series but the robust solver on the "
+    "real-world-like meshes, so compare timings within one problem only."
+)
+
+
+# metric observer (Problem.metrics) -> preferred main metrics, best first
+MAIN_METRICS = {
+    "sphere_l2": ("l2_error",),
+    "catenoid": ("neck_error", "max_radial_error"),
+    "height": ("max_height", "l2_height"),
+    "shape": ("volume", "area"),
+    "still": ("max_displacement", "max_height"),
+    "decay": ("decay_rate_error",),
+    "angenent": ("distance_error", "area_error"),
+    "enneper": ("height_error", "area_error"),
+    "reference_volume": ("volume_error", "pinch_time_error"),
+}
+
+
+# metrics whose exact value is zero besides the ones named "*error*"
+ZERO_METRICS = ("max_height", "l2_height", "max_displacement")
+
+
+# modules that do not change what a run computes (left out of the code digest)
+LONG_COLUMNS = ["scheme", "problem", "level", "h", "tau", "steps", "steps_done", "metric",
+                "value", "eoc", "status", "t_failed", "min_angle", "max_flipped",
+                "t_min_barycentric", "iterations", "cpu_seconds", "robust_status",
+                "robust_value", "robust_t_failed"]
+"""Columns of the long table. ``robust_*``: the re-run of a run that ended with a
+``solver_*`` status with the robust solver (:func:`mcfbench.studies.matrix.job`;
+``robust_status`` empty without a re-run)."""
+
+
+def is_error(metric):
+    """The metric's exact value is zero (it is an error): EOC applies."""
+    return "error" in metric or metric in ZERO_METRICS
+
+
+def main_metric(problem, available=()):
+    """The metric of ``problem`` shown in the summary, the plots and the findings.
+
+    ``problem.main_metric`` if the problem names one, else the first of
+    :data:`MAIN_METRICS` of its observers found in ``available``, else the
+    first error among ``available``, else the first of ``available``.
+    """
+    from mcfbench.running.problems import get_problem
+
+    problem = get_problem(problem) if isinstance(problem, str) else problem
+    available = list(available)
+    named = getattr(problem, "main_metric", None)
+    if named and (not available or named in available):
+        return named
+    for observer in problem.metrics:
+        for name in MAIN_METRICS.get(observer, ()):
+            if name in available:
+                return name
+    errors = [m for m in available if is_error(m)]
+    return (errors or available or [""])[0]
+
+
+def _metric_names(record):
+    names = record.get("metric_names")
+    if names is None:
+        from mcfbench.storage.records import FIELDS
+
+        names = [k for k in record if k not in FIELDS and k != "metric_names"]
+    return list(names)
+
+
+def long_table(records, schemes=None, problems=None):
+    """One row per run and metric (:data:`LONG_COLUMNS`), with the EOC of the errors.
+
+    Parameters
+    ----------
+    records : iterable of dict
+        Run records (:func:`mcfbench.storage.records.read_record`).
+    schemes, problems : list of str, optional
+        Row order (default: order of first appearance).
+
+    A run without a value of a metric another run of its problem has (a
+    scheme that refused the surface) gets a row with NaN.
+    """
+    import pandas as pd
+
+    by_problem = {}
+    for r in records:
+        names = by_problem.setdefault(r["problem"], [])
+        names.extend(m for m in _metric_names(r) if m not in names)
+    rows = []
+    for r in records:
+        for metric in by_problem[r["problem"]] or [""]:
+            value = r.get(metric, float("nan")) if metric else float("nan")
+            rows.append({
+                "scheme": r["scheme"], "problem": r["problem"], "level": int(r["level"]),
+                "h": r["h"], "tau": r["tau"], "steps": int(r["N"]),
+                "steps_done": int(r["steps_done"]), "metric": metric,
+                "value": float("nan") if value is None else float(value), "eoc": float("nan"),
+                "status": r["status"], "t_failed": r["t_failed"], "min_angle": r["min_angle"],
+                "max_flipped": r["max_flipped"], "t_min_barycentric": r["t_min_barycentric"],
+                "iterations": int(r["iterations"]), "cpu_seconds": r["cpu_seconds"],
+                **_robust(r, metric)})
+    table = pd.DataFrame(rows, columns=LONG_COLUMNS)
+    for column in ("h", "tau", "value", "eoc", "t_failed", "min_angle", "max_flipped",
+                   "t_min_barycentric", "cpu_seconds", "robust_value", "robust_t_failed"):
+        table[column] = table[column].astype(float)
+    schemes = schemes or list(dict.fromkeys(table["scheme"]))
+    problems = problems or list(dict.fromkeys(table["problem"]))
+    table = _ordered(table, schemes, problems)
+    return add_eoc(table)
+
+
+def _robust(record, metric):
+    """The robust re-run's columns of one row of the long table."""
+    value = (record.get("robust_metrics") or {}).get(metric) if metric else None
+    t_failed = record.get("robust_t_failed")
+    return {"robust_status": record.get("robust_status") or "",
+            "robust_value": float("nan") if value is None else float(value),
+            "robust_t_failed": float("nan") if t_failed is None else float(t_failed)}
+
+
+def solver_only(row):
+    """A run (a row of the long table) that ended with a ``solver_*`` status whose
+    re-run with the robust solver finished: the failure is the solver's, not the
+    scheme's."""
+    from mcfbench.storage.statuses import SOLVER_STATUSES
+
+    return row["status"] in SOLVER_STATUSES and row.get("robust_status", "") == "ok"
+
+
+def _ordered(table, schemes, problems):
+    rank_s = {s: i for i, s in enumerate(schemes)}
+    rank_p = {p: i for i, p in enumerate(problems)}
+    key = table["problem"].map(rank_p).fillna(len(rank_p)).astype(int) * 10_000 + \
+        table["scheme"].map(rank_s).fillna(len(rank_s)).astype(int) * 100
+    order = np.lexsort([table.index.to_numpy(), table["level"].to_numpy(), key.to_numpy()])
+    return table.iloc[order].reset_index(drop=True)
+
+
+def add_eoc(table):
+    """Fill ``eoc``: ``log2(|e_{k-1}| / |e_k|)`` for error metrics, levels one apart,
+    both values finite and non-zero; NaN elsewhere."""
+    table = table.copy()
+    table["eoc"] = np.nan
+    for (_, _, metric), group in table.groupby(["scheme", "problem", "metric"], sort=False):
+        if not is_error(metric):
+            continue
+        group = group.sort_values("level")
+        table.loc[group.index, "eoc"] = eoc(group["value"], levels=group["level"])
+    return table
+
+
+def format_or_missing(x, spec=".3e", none="–"):
+    if x is None or (isinstance(x, float) and not np.isfinite(x)):
+        return none
+    return format(x, spec)
+
+
+def _levels_text(levels):
+    levels = sorted(int(v) for v in levels)
+    if len(levels) > 2 and levels == list(range(levels[0], levels[-1] + 1)):
+        return f"{levels[0]}-{levels[-1]}"
+    return ", ".join(str(v) for v in levels)
+
+
+def breakdown_text(status, t_failed, level=None):
+    """``"t_escaped at t = 0.052 (level 3)"``."""
+    text = str(status)
+    if t_failed is not None and np.isfinite(t_failed):
+        text += f" at t = {t_failed:.4g}"
+    if level is not None:
+        text += f" (level {int(level)})"
+    return text
+
+
+def summary_table(table, problems=None, schemes=None):
+    """Problem x scheme: EOC between the two finest finished levels and the
+    finest-level value of the problem's main metric, or the breakdown.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``problem, scheme, metric, error, levels, runs, runs_ok,
+        eoc, eoc_levels, finest_level, finest_value, eocs, values, status,
+        failed_level, t_failed, min_angle, t_min_barycentric,
+        cpu_seconds`` (CPU of the finest finished level). ``status`` is
+        ``ok`` or that of the coarsest run that did not finish; ``eocs``
+        and ``values`` list every EOC and value by level (``;``-separated).
+        The scheme's own verdict, with the robust solver's re-run in place of
+        a run whose failure it removes (:func:`solver_only`): ``solver_only``
+        (those runs, ``level:status:t_failed``), ``robust_failed`` (the re-runs
+        that failed too, ``level:robust_status:robust_t_failed``), ``runs_robust_ok``,
+        ``robust_values``, ``robust_eoc``, ``robust_eoc_levels``,
+        ``robust_finest_level``, ``robust_finest_value``.
+    """
+    import pandas as pd
+
+    problems = problems or list(dict.fromkeys(table["problem"]))
+    schemes = schemes or list(dict.fromkeys(table["scheme"]))
+    rows = []
+    for problem in problems:
+        part = table[table["problem"] == problem]
+        if not len(part):
+            continue
+        metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
+        for scheme in schemes:
+            runs = part[(part["scheme"] == scheme) & (part["metric"] == metric)] \
+                .sort_values("level")
+            if not len(runs):
+                continue
+            ok = runs[runs["status"] == "ok"]
+            failed = runs[runs["status"] != "ok"]
+            # a value is measured when finite: a finished run's, or one taken before
+            # a later breakdown (the volume before a pinch)
+            finished = runs[np.isfinite(runs["value"])]
+            finest = finished.iloc[-1] if len(finished) else None
+            eoc_rows = finished[np.isfinite(finished["eoc"])]
+            last_eoc = eoc_rows.iloc[-1] if len(eoc_rows) else None
+            first_fail = failed.iloc[0] if len(failed) else None
+            rows.append({
+                "problem": problem, "scheme": scheme, "metric": metric,
+                "error": is_error(metric), "levels": _levels_text(runs["level"]),
+                "runs": len(runs), "runs_ok": len(ok),
+                "eoc": np.nan if last_eoc is None else last_eoc["eoc"],
+                "eoc_levels": "" if last_eoc is None else
+                f"{int(last_eoc['level']) - 1}-{int(last_eoc['level'])}",
+                "finest_level": np.nan if finest is None else int(finest["level"]),
+                "finest_value": np.nan if finest is None else finest["value"],
+                "eocs": ";".join(format_or_missing(v, ".2f", "") for v in runs["eoc"].iloc[1:]),
+                "values": ";".join(format_or_missing(v, ".4e", "") for v in runs["value"]),
+                "status": "ok" if first_fail is None else first_fail["status"],
+                "failed_level": np.nan if first_fail is None else int(first_fail["level"]),
+                "t_failed": np.nan if first_fail is None else first_fail["t_failed"],
+                "failed": ";".join(f"{int(r.level)}:{r.status}:{format_or_missing(r.t_failed, '.6g', '')}"
+                                   for r in failed.itertuples()),
+                "min_angle": runs["min_angle"].min(),
+                "t_min_barycentric": runs["t_min_barycentric"].min(),
+                "cpu_seconds": np.nan if finest is None else finest["cpu_seconds"],
+                **_robust_summary(runs, metric),
+            })
+    return pd.DataFrame(rows)
+
+
+def _robust_summary(runs, metric):
+    """The summary's ``robust_*`` columns of one scheme on one problem (its runs of the
+    main metric, by level): each run whose failure the robust solver removes replaced
+    by its re-run."""
+    fixed = runs[[solver_only(r) for _, r in runs.iterrows()]] if len(runs) else runs
+    values = np.where([solver_only(r) for _, r in runs.iterrows()], runs["robust_value"],
+                      np.where(runs["status"] == "ok", runs["value"], np.nan)) \
+        if len(runs) else np.array([])
+    levels = runs["level"].to_numpy()
+    eocs = eoc(values, levels=levels) if is_error(metric) and len(values) \
+        else np.full(len(values), np.nan)
+    finite = np.flatnonzero(np.isfinite(values))
+    with_eoc = np.flatnonzero(np.isfinite(eocs))
+    rerun = runs[[r["robust_status"] not in ("", "ok") for _, r in runs.iterrows()]] \
+        if len(runs) else runs
+    return {
+        "robust_failed": ";".join(f"{int(r.level)}:{r.robust_status}:"
+                                  f"{format_or_missing(r.robust_t_failed, '.6g', '')}"
+                                  for r in rerun.itertuples()),
+        "solver_only": ";".join(f"{int(r.level)}:{r.status}:{format_or_missing(r.t_failed, '.6g', '')}"
+                                for r in fixed.itertuples()),
+        "runs_robust_ok": int((runs["status"] == "ok").sum()) + len(fixed),
+        "robust_values": ";".join(format_or_missing(v, ".4e", "") for v in values),
+        "robust_eoc": eocs[with_eoc[-1]] if len(with_eoc) else np.nan,
+        "robust_eoc_levels": f"{int(levels[with_eoc[-1]]) - 1}-{int(levels[with_eoc[-1]])}"
+        if len(with_eoc) else "",
+        "robust_finest_level": int(levels[finite[-1]]) if len(finite) else np.nan,
+        "robust_finest_value": values[finite[-1]] if len(finite) else np.nan,
+    }
+
+
+def summary_cell(row):
+    """One cell of the summary: ``"2.01 · 1.23e-03 (L4)"`` or the breakdown."""
+    parts = []
+    if row["error"] and np.isfinite(row["eoc"]):
+        parts.append(f"EOC {row['eoc']:.2f}")
+    if np.isfinite(row["finest_value"]):
+        parts.append(f"{row['finest_value']:.3e} (L{int(row['finest_level'])})")
+    if row["status"] != "ok":
+        parts.append(breakdown_text(row["status"], row["t_failed"], row["failed_level"]))
+        if row.get("solver_only", ""):
+            parts.append("the robust solver finishes " + (
+                "every level" if row["runs_robust_ok"] == row["runs"] else
+                "level(s) " + ", ".join(f.split(":")[0]
+                                        for f in str(row["solver_only"]).split(";"))))
+    return "; ".join(parts) or "–"
+
+
+def summary_views(summary, problems=None, schemes=None, labels=None):
+    """The summary as a wide frame (problem rows, scheme columns) of cells."""
+    import pandas as pd
+
+    problems = problems or list(dict.fromkeys(summary["problem"]))
+    schemes = schemes or list(dict.fromkeys(summary["scheme"]))
+    labels = labels or {}
+    wide = []
+    for problem in problems:
+        part = summary[summary["problem"] == problem]
+        if not len(part):
+            continue
+        row = {"problem": f"{problem} ({part['metric'].iloc[0]})"}
+        for scheme in schemes:
+            hit = part[part["scheme"] == scheme]
+            row[labels.get(scheme, scheme)] = summary_cell(hit.iloc[0]) if len(hit) else "–"
+        wide.append(row)
+    return pd.DataFrame(wide)
+
+
+def problem_table(table, problem, schemes=None, labels=None):
+    """One problem, schemes as rows: the main metric per level, its EOCs, the
+    status, the mesh quality over all levels and the finest level's cost."""
+    import pandas as pd
+
+    part = table[table["problem"] == problem]
+    metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
+    schemes = schemes or list(dict.fromkeys(part["scheme"]))
+    labels = labels or {}
+    levels = sorted(part["level"].unique())
+    rows = []
+    for scheme in schemes:
+        runs = part[(part["scheme"] == scheme) & (part["metric"] == metric)] \
+            .sort_values("level").set_index("level")
+        if not len(runs):
+            continue
+        row = {"scheme": labels.get(scheme, scheme)}
+        for level in levels:
+            if level not in runs.index:
+                row[f"L{level}"] = "–"
+                continue
+            r = runs.loc[level]
+            row[f"L{level}"] = format_or_missing(r["value"]) if r["status"] == "ok" else r["status"]
+        row["EOC"] = ", ".join(format_or_missing(v, ".2f") for v in runs["eoc"].iloc[1:]) \
+            if is_error(metric) and len(runs) > 1 else "–"
+        failed = runs[runs["status"] != "ok"]
+        row["status"] = "ok" if not len(failed) else "; ".join(
+            breakdown_text(r.status, r.t_failed, lv) for lv, r in failed.iterrows())
+        finest = runs.iloc[-1]
+        row["steps (finest)"] = f"{int(finest['steps_done'])}/{int(finest['steps'])}"
+        row["min angle"] = format_or_missing(runs["min_angle"].min(), ".3g")
+        row["flipped"] = format_or_missing(runs["max_flipped"].max(), ".0f")
+        row["T monitor"] = format_or_missing(runs["t_min_barycentric"].min(), ".3g")
+        row["iterations (finest)"] = str(int(finest["iterations"]))
+        row["CPU s (finest)"] = format_or_missing(finest["cpu_seconds"], ".3g")
+        rows.append(row)
+    return pd.DataFrame(rows), metric
+
+
+def markdown(frame, notes=()):
+    """A pipe table (:func:`mcfbench.presentation.formats.md_table`), then ``notes`` as paragraphs."""
+    from mcfbench.presentation.formats import md_table
+
+    lines = [md_table(list(frame.columns), frame.itertuples(index=False))]
+    lines += [f"\n{note}" for note in notes]
+    return "\n".join(lines) + "\n"
+
+
+def latex(frame, caption="", notes=()):
+    """A ``table`` with a booktabs ``tabular`` (:func:`mcfbench.presentation.formats.tex_tabular`),
+    the notes below it."""
+    from mcfbench.presentation.formats import tex_escape, tex_tabular
+
+    lines = [r"\begin{table}[ht]",
+             tex_tabular([tex_escape(c) for c in frame.columns],
+                         [[tex_escape(v) for v in row] for row in frame.itertuples(index=False)],
+                         "l" + "r" * (len(frame.columns) - 1))]
+    if caption:
+        lines.append(r"\caption{" + tex_escape(caption) + "}")
+    lines += [r"\par\smallskip{\footnotesize " + tex_escape(note) + "}" for note in notes]
+    lines.append(r"\end{table}")
+    return "\n".join(lines) + "\n"
+
+
+SUMMARY_TEXT = ("levels", "eoc_levels", "eocs", "values", "failed", "metric", "status",
+                "solver_only", "robust_failed", "robust_values", "robust_eoc_levels")
+
+
+def read_summary(path):
+    """``summary.csv`` back as written (text columns as text, empty as "")."""
+    import pandas as pd
+
+    summary = pd.read_csv(path, dtype={c: str for c in SUMMARY_TEXT})
+    for column in SUMMARY_TEXT:
+        if column in summary:
+            summary[column] = summary[column].fillna("")
+    summary["error"] = summary["error"].astype(bool)
+    return summary
+
+
+def read_long_table(path):
+    """``matrix.csv`` back (metric names as text)."""
+    import pandas as pd
+
+    table = pd.read_csv(path, dtype={"metric": str, "status": str, "scheme": str,
+                                     "problem": str})
+    table["metric"] = table["metric"].fillna("")
+    return table
+
+

@@ -1,0 +1,114 @@
+"""The cotangent scheme on the intrinsic Delaunay triangulation (baselines/cotan_intrinsic.py)."""
+
+import numpy as np
+import pytest
+from conftest import cylinder, twin_sphere
+
+from baselines.cotan import CotanFlow, cotangent_laplacian, lumped_mass
+from baselines.cotan_intrinsic import IntrinsicCotanFlow, intrinsic_operators
+from mcfbench.geometry.exact import SphereL2Error, eoc
+from mcfbench.geometry.spheres import icosphere
+from mcfbench.running.driver import simulate
+from mcfbench.running.solver import Solver
+
+EXACT = Solver(method="direct", rtol=1e-12)
+
+
+def flipped_icosphere(level=2):
+    """An icosphere with one edge flipped: the two new triangles fold across the old
+    edge, whose opposite angles (each about 60 degrees) become the new edge's
+    neighbours, so the new edge's opposite angles sum to about 240 degrees (not
+    Delaunay: a negative cotangent weight)."""
+    V, F = icosphere(level)
+    F = F.copy()
+    a, b, c = F[0]                                  # triangle (a, b, c), edge (a, b)
+    k = next(i for i in range(1, len(F)) if {a, b} <= set(F[i]))
+    d = next(v for v in F[k] if v not in (a, b))    # triangle (b, a, d)
+    F[0], F[k] = (c, d, b), (d, c, a)               # edge (c, d), orientation kept
+    return V, F
+
+
+def test_on_a_delaunay_mesh_the_operators_are_the_cotangent_ones():
+    """Icosphere: ``L`` = the mesh's cotangent stiffness, the mass = its barycentric
+    lumped mass (not the Voronoi one: they differ by 2e-3 at level 3)."""
+    V, F = icosphere(3)
+    L, mass = intrinsic_operators(V, F)
+    np.testing.assert_allclose(L.toarray(), cotangent_laplacian(V, F).toarray(), rtol=0,
+                               atol=1e-14)
+    np.testing.assert_allclose(mass, lumped_mass(V, F), rtol=1e-14)
+    assert np.abs(mass - lumped_mass(V, F, "voronoi")).max() > 1e-3
+
+
+def test_on_a_delaunay_mesh_the_flow_is_cotan_with_barycentric_mass():
+    V, F = icosphere(2)
+    runs = [simulate(cls(V, F, 0.01), 8, solver=EXACT, save_every=0).frames["V"][-1]
+            for cls in (IntrinsicCotanFlow, CotanFlow)]
+    np.testing.assert_allclose(runs[0], runs[1], rtol=0, atol=1e-13)
+    voronoi = simulate(CotanFlow(V, F, 0.01, mass="voronoi"), 8, solver=EXACT,
+                       save_every=0).frames["V"][-1]
+    assert np.abs(runs[0] - voronoi).max() > 1e-4
+
+
+def test_on_a_non_delaunay_mesh_every_edge_weight_is_nonnegative():
+    V, F = flipped_icosphere()
+    L_mesh = cotangent_laplacian(V, F)
+    assert L_mesh.tocoo().data.max() > 0.1             # a negative weight -L_ij < 0
+    L, mass = intrinsic_operators(V, F)
+    off = L.tocoo()
+    assert off.data[off.row != off.col].max() <= 0.0
+    assert abs(L - L.T).max() < 1e-15 and np.abs(np.asarray(L.sum(axis=1))).max() < 1e-13
+    area = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]),
+                                axis=1).sum()
+    assert mass.min() > 0 and mass.sum() == pytest.approx(area, rel=1e-13)
+    traj = simulate(IntrinsicCotanFlow(V, F, 0.001), 10, solver=EXACT, save_every=0)
+    assert traj.status == "ok", traj.message
+
+
+def test_order_2_on_the_sphere():
+    """Table 3.1 setting, levels 1-3: L2 1.4464e-2, 3.3985e-3, 8.2796e-4 (EOC 2.09,
+    2.04), cotan's values."""
+    errors = []
+    for level in (1, 2, 3):
+        V, F = icosphere(level)
+        tau = 0.04 / 4 ** (level - 1)
+        error = SphereL2Error(1.0)
+        traj = simulate(IntrinsicCotanFlow(V, F, tau), round(0.08 / tau), solver=EXACT,
+                        save_every=0, observers=[error])
+        assert traj.status == "ok", traj.message
+        errors.append(error.value)
+    np.testing.assert_allclose(errors, [1.4464e-2, 3.3985e-3, 8.2796e-4], rtol=1e-4)
+    orders = eoc(np.array(errors))[1:]
+    assert np.all((orders > 2.0) & (orders < 2.15)), orders
+
+
+def test_open_cylinder_keeps_its_boundary_and_follows_cotan_to_the_catenoid():
+    """The 24 x 8 cylinder is Delaunay (its tufted Laplacian is the mesh's cotangent
+    one to 4e-15), so the flow is cotan's, whose approach to the catenoid
+    tests/baselines/test_cotan.py checks; the boundary stays exactly fixed."""
+    V, F = cylinder(24, 8)
+    flow = IntrinsicCotanFlow(V, F, 0.005)
+    traj = simulate(flow, 200, solver=EXACT, save_every=50)
+    cotan = simulate(CotanFlow(V, F, 0.005), 200, solver=EXACT, save_every=50)
+    assert traj.status == "ok", traj.message
+    for frame in traj.frames["V"]:
+        np.testing.assert_array_equal(frame[flow.fixed], V[flow.fixed])
+    np.testing.assert_allclose(traj.frames["V"], cotan.frames["V"], rtol=0, atol=1e-12)
+
+
+def test_twin_point_sphere_completes_where_cotan_inverts():
+    """The sliver-rich twin-point sphere, n = 162, tau = 0.01 towards t = 0.24
+    (extinction 0.25), sparse LU at rtol 1e-9: cotan inverts at step 22, the intrinsic Laplacian
+    completes the 24 steps (mean radius 0.296; the exact sphere's 0.2)."""
+    V, F = twin_sphere()
+    runs = [simulate(cls(V, F, 0.01), 24, solver=Solver("direct"), save_every=0)
+            for cls in (CotanFlow, IntrinsicCotanFlow)]
+    assert (runs[0].status, runs[0].steps_done) == ("inverted", 22)
+    assert (runs[1].status, runs[1].steps_done) == ("ok", 24)
+    assert np.linalg.norm(runs[1].frames["V"][-1], axis=1).mean() == pytest.approx(0.296,
+                                                                                  abs=1e-3)
+
+
+@pytest.mark.parametrize("mollify", [-1.0, np.nan, np.inf])
+def test_bad_mollify_is_named(mollify):
+    with pytest.raises(ValueError, match="mollify must be a finite number >= 0"):
+        IntrinsicCotanFlow(*icosphere(1), 0.01, mollify=mollify)

@@ -1,0 +1,427 @@
+"""The benchmark matrix (mcfbench.studies.matrix, workflow/rules/matrix.smk): the config
+check against the registries, one tiny matrix run for real (2 schemes x 2
+problems at level 1) through the job function, records, tables, findings and
+plots, the EOC and summary logic on records with known numbers, and the
+Snakemake DAG of the targets `matrix` and `gallery`."""
+
+import math
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from mcfbench.running.problems import PROBLEMS
+from mcfbench.running.schemes import SCHEMES
+from mcfbench.storage.frames import load_frames
+from mcfbench.storage.records import FIELDS, read_record, read_records, write_record
+from mcfbench.storage.statuses import STATUSES
+from mcfbench.studies.config import ConfigError
+from mcfbench.studies.gallery import job as gallery_job
+from mcfbench.studies.gallery import plan as gallery_plan
+from mcfbench.studies.gallery import tables as gallery_tables
+from mcfbench.studies.matrix import aggregate as matrix_aggregate
+from mcfbench.studies.matrix import findings as matrix_findings
+from mcfbench.studies.matrix import job as matrix_job
+from mcfbench.studies.matrix import plan as matrix_plan
+from mcfbench.studies.matrix import tables as matrix_tables
+
+REPO = Path(__file__).resolve().parents[4]
+
+
+# ------------------------------------------------------------ config
+
+
+def test_plan_defaults_to_every_scheme_and_problem():
+    plan = matrix_plan.plan({})
+    assert plan["schemes"] == list(SCHEMES)
+    assert list(plan["problems"]) == list(PROBLEMS)
+    assert plan["problems"]["sphere"] == sorted(PROBLEMS["sphere"].levels)
+    assert plan["solver"] == "bicgstab"
+
+
+def test_plan_levels_and_leaving_out():
+    plan = matrix_plan.plan({"schemes": ["cotan"], "problems": {"sphere": ["2", 1],
+                                                                        "torus": []}})
+    assert plan["schemes"] == ["cotan"]
+    assert plan["problems"]["sphere"] == [1, 2]
+    assert "torus" not in plan["problems"]
+
+
+def test_plan_adds_other_integrators_only_to_the_schemes_run():
+    section = {"with_integrators": {"bdf2": ["ddfv-chord-carried", "cotan"]}}
+    assert matrix_plan.plan(section)["schemes"] == [*SCHEMES, "ddfv-chord-carried@bdf2",
+                                               "cotan@bdf2"]
+    assert matrix_plan.plan({**section, "schemes": ["bgn", "cotan"]})["schemes"] == \
+        ["bgn", "cotan", "cotan@bdf2"]
+    assert matrix_plan.plan({**section, "schemes": ["bgn"]})["schemes"] == ["bgn"]
+    with pytest.raises(ConfigError, match=r"unknown scheme\(s\) \['cotn@bdf2'\]"):
+        matrix_plan.plan({"schemes": ["bgn"], "with_integrators": {"bdf2": ["cotn"]}})
+
+
+@pytest.mark.parametrize("section, key", [
+    ({"schemes": ["ddfv", "nope"]}, "matrix.schemes"),
+    ({"problems": {"spere": [1]}}, "matrix.problems"),
+    ({"problems": {"sphere": [0]}}, "matrix.problems.sphere"),
+    ({"solver": "gmres"}, "matrix.solver"),
+])
+def test_plan_names_the_bad_key(section, key):
+    with pytest.raises(ConfigError, match=key.replace(".", r"\.")):
+        matrix_plan.plan(section)
+
+
+def test_mesh_problems_get_the_robust_solver():
+    plan = matrix_plan.plan({})
+    for name, problem in PROBLEMS.items():
+        expected = plan["mesh_solver"] if problem.tau_rule == "mesh" else "bicgstab"
+        assert matrix_plan.solver_method(plan, name) == expected
+
+
+# ------------------------------------------------------------ a tiny matrix for real
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    """ddfv and cotan on sphere and catenoid, level 1, through run_job."""
+    root = tmp_path_factory.mktemp("matrix")
+    plan = matrix_plan.plan({"schemes": ["ddfv", "cotan"],
+                                    "problems": {p: ([1] if p in ("sphere", "catenoid") else [])
+                                                 for p in PROBLEMS}})
+    runs = matrix_plan.planned_runs(plan, code="test", root=str(root))
+    for path, settings in runs.items():
+        frames = path.replace("/runs/", "/frames/").removesuffix(".json") + ".npz"
+        matrix_job.job(settings, path, frames)
+    table, summary = matrix_aggregate.aggregate(runs, plan, root / "tables")
+    return root, plan, runs, table, summary
+
+
+def test_tiny_records_and_frames(tiny):
+    root, plan, runs, table, _ = tiny
+    for path, settings in runs.items():
+        record = read_record(path, settings=settings)
+        assert record["status"] in STATUSES
+        if record["problem"] == "sphere":
+            assert record["status"] == "ok", record["message"]
+        if record["status"] != "ok":  # e.g. the paper's DDFV on the catenoid
+            assert record["message"].startswith(record["status"])
+            assert record["t_failed"] == pytest.approx(record["steps_done"] * record["tau"],
+                                                       abs=2 * record["tau"])
+        assert record["metric_names"]
+        frames = load_frames(path.replace("/runs/", "/frames/")
+                                    .removesuffix(".json") + ".npz")
+        assert len(frames["steps"]) == 2 and frames["steps"][0] == 0
+        assert frames["steps"][-1] == record["steps_done"]
+    assert not list(root.rglob("*.tmp"))
+    sphere = table[(table["problem"] == "sphere") & (table["metric"] == "l2_error")]
+    assert set(sphere["scheme"]) == {"ddfv", "cotan"}
+    # the paper's level-1 value (Table 3.1: 1.34e-2) within 10 %
+    ddfv = sphere[sphere["scheme"] == "ddfv"]["value"].iloc[0]
+    assert ddfv == pytest.approx(1.34e-2, rel=0.1)
+    assert list(table.columns) == matrix_tables.LONG_COLUMNS
+
+
+def test_tiny_tables_and_findings(tiny):
+    root, plan, runs, table, summary = tiny
+    out = root / "tables"
+    for name in ("matrix.csv", "sphere.md", "sphere.tex", "catenoid.md", "catenoid.tex",
+                 "summary.md", "summary.tex", "summary.csv"):
+        assert (out / name).is_file(), name
+    for name in ("sphere.md", "catenoid.md", "summary.md"):
+        assert "same footing" in (out / name).read_text()
+    text = matrix_findings.findings(out / "summary.csv", root / "findings.md", plan)
+    for problem in plan["problems"]:
+        assert f"### {problem}" in text
+    for r in summary.itertuples():  # every status is shown, in the tables and the text
+        if r.status != "ok":
+            assert f"{r.status} at t = {r.t_failed:.4g}" in (out / "summary.md").read_text()
+            assert f"{r.status} at t = {r.t_failed:.4g}" in text
+    assert "## Across problems" in text
+    back = matrix_tables.read_long_table(out / "matrix.csv")
+    assert len(back) == len(table)
+    assert np.allclose(back["value"], table["value"], equal_nan=True, rtol=1e-9)
+
+
+def test_tiny_plots(tiny):
+    from mcfbench.studies.matrix.plots import (
+        error_figure,
+        picture_grid,
+        quality_figure,
+        work_precision_figure,
+    )
+
+    root, plan, runs, table, _ = tiny
+    problems, schemes = list(plan["problems"]), plan["schemes"]
+    figs = root / "figures"
+    error_figure(table, [figs / "errors.png"], problems, schemes)
+    quality_figure(list(read_records(runs).values()), [figs / "quality.png"], problems, schemes)
+    entries = {key: (read_record(r), load_frames(f))
+               for key, (r, f) in matrix_plan.picture_runs(plan, str(root)).items()}
+    picture_grid(entries, [figs / "pictures.png"], problems, schemes)
+    drawn = work_precision_figure(table, [figs / "work_precision.png"], problems, schemes)
+    for problem, lines in drawn.items():          # every point is a run's (CPU s, |error|)
+        for scheme, (cpu, err) in lines.items():
+            metric = matrix_tables.main_metric(problem, table["metric"].unique())
+            rows = table[(table["problem"] == problem) & (table["scheme"] == scheme)
+                         & (table["metric"] == metric)].sort_values("level")
+            np.testing.assert_array_equal(cpu, rows["cpu_seconds"])
+            np.testing.assert_array_equal(err, np.abs(rows["value"]))
+    assert set(drawn) == {"sphere", "catenoid"} and set(drawn["sphere"]) == set(schemes)
+    assert set(drawn["catenoid"]) == {"cotan"}        # ddfv's T-vertex escapes: no error
+    for name in ("errors.png", "work_precision.png", "quality.png", "pictures.png"):
+        assert (figs / name).stat().st_size > 1000
+
+
+# ------------------------------------------------------------ EOC and summary on known numbers
+
+
+def _record(scheme, problem, level, value, status="ok", t_failed=float("nan"),
+            metric="l2_error"):
+    row = {k: (float("nan") if kind is float else 0 if kind is int else "" if kind is str
+               else {} if kind is dict else False) for k, kind in FIELDS.items()
+           if k not in ("settings", "provenance", "checksum")}
+    row.update(scheme=scheme, problem=problem, level=level, h=0.5 / 2 ** level,
+               tau=0.04 / 4 ** level, N=2 * 4 ** level, steps_done=2 * 4 ** level,
+               status=status, t_failed=t_failed, min_angle=30.0, max_flipped=0.0,
+               iterations=10 * level, cpu_seconds=0.1 * level, solver="bicgstab",
+               series={"t": [], "t_min_barycentric": []}, metric_names=[metric])
+    row[metric] = value
+    return row
+
+
+def test_eoc_is_log2_of_the_error_ratio(tmp_path):
+    errors = {"a": [1.0e-2, 2.5e-3, 6.0e-4], "b": [2.0e-2, 1.8e-2, 2.1e-2]}
+    records = [_record(s, "sphere", k + 1, e) for s, es in errors.items()
+               for k, e in enumerate(es)]
+    records += [_record("a", "catenoid", 1, -0.01, metric="neck_error"),
+                _record("a", "catenoid", 2, float("nan"), "t_escaped", 0.25,
+                        metric="neck_error")]
+    # through a real record file: NaN as null and back
+    path = tmp_path / "r.json"
+    write_record(path, records[0], {"x": 1})
+    assert read_record(path, settings={"x": 1})["l2_error"] == 1.0e-2
+    table = matrix_tables.long_table(records)
+    for scheme, es in errors.items():
+        eoc = table[(table["scheme"] == scheme) & (table["problem"] == "sphere")]["eoc"]
+        assert math.isnan(eoc.iloc[0])
+        assert eoc.iloc[1:].tolist() == pytest.approx(
+            [math.log2(es[0] / es[1]), math.log2(es[1] / es[2])])
+    cat = table[table["problem"] == "catenoid"]
+    assert cat["status"].tolist() == ["ok", "t_escaped"]
+    assert cat["eoc"].isna().all()
+    summary = matrix_tables.summary_table(table)
+    a = summary[(summary["problem"] == "sphere") & (summary["scheme"] == "a")].iloc[0]
+    assert a["eoc"] == pytest.approx(math.log2(2.5e-3 / 6.0e-4))
+    assert a["finest_value"] == 6.0e-4 and a["status"] == "ok"
+    c = summary[summary["problem"] == "catenoid"].iloc[0]
+    assert c["status"] == "t_escaped" and c["t_failed"] == 0.25 and c["failed_level"] == 2
+    assert "t_escaped at t = 0.25 (level 2)" in matrix_tables.summary_cell(c)
+    text = matrix_findings.matrix_findings(summary)
+    assert "**a** converges at order ~2" in text
+    assert "**b** does not converge" in text
+    assert "broke down in 1 of 2 runs (level 2: t_escaped at t = 0.25)" in text
+    assert "No scheme wins everywhere" in text  # a broke down on the catenoid
+
+
+def test_recommendation_when_one_scheme_wins():
+    records = []
+    for scheme, c in (("good", 1.0), ("fine", 3.0)):
+        for problem in ("sphere", "hemisphere"):
+            records += [_record(scheme, problem, k, c * 4.0 ** -k,
+                                metric="l2_error" if problem == "sphere" else "max_height")
+                        for k in (1, 2, 3)]
+    text = matrix_findings.matrix_findings(matrix_tables.summary_table(matrix_tables.long_table(records)))
+    assert "**Recommendation: good**" in text
+
+
+# ------------------------------------------------------------ solver verdicts (issue #24)
+
+
+def test_solver_failure_is_rerun_with_the_robust_solver(tmp_path):
+    """maxiter = 1 forces BiCGStab to fail on the sphere; the job re-runs the level with
+    ``direct``, which finishes, and the findings call it a solver verdict."""
+    plan = matrix_plan.plan({"schemes": ["cotan", "bgn"], "maxiter": 1,
+                             "problems": {p: ([1, 2] if p == "sphere" else []) for p in PROBLEMS}})
+    runs = matrix_plan.planned_runs(plan, code="test", root=str(tmp_path))
+    for path, settings in runs.items():
+        matrix_job.job(settings, path, path.replace(".json", ".npz"))
+    for path, settings in runs.items():
+        record = read_record(path, settings=settings)
+        assert record["status"] == "solver_failed" and "iteration limit 1" in record["message"]
+        assert record["robust_status"] == "ok" and record["robust_solver"] == "direct"
+        assert record["robust_message"] == "" and record["robust_steps_done"] == record["N"]
+        assert record["robust_metrics"]["l2_error"] < 2e-2
+    table, summary = matrix_aggregate.aggregate(runs, plan, tmp_path / "tables")
+    assert (table["robust_status"] == "ok").all() and np.isfinite(table["robust_value"]).all()
+    cotan = summary[summary["scheme"] == "cotan"].iloc[0]
+    assert cotan["runs_ok"] == 0 and cotan["runs_robust_ok"] == 2
+    assert cotan["solver_only"] == "1:solver_failed:0.04;2:solver_failed:0.01"
+    assert 1.7 < cotan["robust_eoc"] < 2.3 and cotan["robust_eoc_levels"] == "1-2"
+    assert "the robust solver finishes every level" in (tmp_path / "tables" / "summary.md").read_text()
+    text = matrix_findings.findings(tmp_path / "tables" / "summary.csv", tmp_path / "findings.md", plan)
+    assert "**cotan** converges at order ~2" in text
+    assert "A solver verdict, not a scheme verdict: the matrix's solver failed (level 1: " \
+           "solver_failed at t = 0.04; level 2: solver_failed at t = 0.01)" in text
+    assert "## Solver verdicts" in text and "broke down" not in text
+
+
+def test_a_run_that_ended_otherwise_is_not_rerun(tmp_path):
+    plan = matrix_plan.plan({"schemes": ["cotan"], "problems": {p: ([1] if p == "sphere" else [])
+                                                                  for p in PROBLEMS}})
+    path, settings = next(iter(matrix_plan.planned_runs(plan, code="test", root=str(tmp_path)).items()))
+    matrix_job.job(settings, path, path.replace(".json", ".npz"))
+    record = read_record(path, settings=settings)
+    assert record["status"] == "ok" and record["robust_status"] == ""
+    assert "robust_metrics" not in record
+
+
+def test_findings_tell_solver_verdicts_from_scheme_verdicts():
+    """``a`` fails at level 3 with the solver only (the robust re-run finishes it with an
+    order-2 error); ``b`` fails at level 3 with the solver and the robust solver fails
+    too: only ``b`` broke down."""
+    records = []
+    for scheme, c in (("a", 1.0), ("b", 2.0)):
+        for k in (1, 2, 3):
+            records.append(_record(scheme, "sphere", k, c * 4.0 ** -k))
+        records[-1].update(status="solver_failed", t_failed=0.03, l2_error=float("nan"),
+                           robust_status="ok" if scheme == "a" else "solver_breakdown",
+                           robust_metrics={"l2_error": c * 4.0 ** -3 if scheme == "a" else None})
+    summary = matrix_tables.summary_table(matrix_tables.long_table(records))
+    a = summary[summary["scheme"] == "a"].iloc[0]
+    assert a["status"] == "solver_failed" and a["runs_robust_ok"] == 3
+    assert a["robust_eoc"] == pytest.approx(2.0) and a["robust_finest_value"] == 4.0 ** -3
+    b = summary[summary["scheme"] == "b"].iloc[0]
+    assert b["runs_robust_ok"] == 2 and b["solver_only"] == ""
+    text = matrix_findings.matrix_findings(summary)
+    assert "**a** converges at order ~2: EOC 2.00 (levels 2-3)" in text
+    assert "A solver verdict, not a scheme verdict" in text
+    assert "**b** broke down in 1 of 3 runs (level 3: solver_failed at t = 0.03)" in text
+    assert "The robust solver (direct) failed too (level 3: solver_breakdown): a scheme " \
+           "verdict." in text
+    assert "a on sphere (level 3: solver_failed at t = 0.03)" in text
+    assert "**Recommendation: a**" in text
+
+
+# ------------------------------------------------------------ the Snakemake DAG
+
+
+@pytest.mark.e2e
+def test_snakemake_dry_run(tmp_path):
+    """Both targets resolve to the planned jobs, in a copy of the repository."""
+    work = tmp_path / "work"
+    work.mkdir()
+    for name in ("Snakefile", "workflow", "config", "ddfv", "baselines", "mcfbench"):
+        src = REPO / name
+        (shutil.copytree if src.is_dir() else shutil.copy)(
+            src, work / name, **({"ignore": shutil.ignore_patterns("__pycache__")}
+                                 if src.is_dir() else {}))
+    meshes = tmp_path / "meshes"
+    gallery_job.write_obj(meshes / "tet.obj", [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]],
+                         [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    out = subprocess.run([sys.executable, "-m", "snakemake", "-n", "--cores", "2",
+                          "matrix", "gallery", "--config", f"meshes={meshes}"],
+                         cwd=work, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr[-3000:]
+    plan = matrix_plan.plan(
+        __import__("yaml").safe_load((REPO / "config" / "config.yaml").read_text())["matrix"])
+    counts = dict(line.split()[:2] for line in out.stdout.splitlines()
+                  if len(line.split()) == 2 and line.split()[1].isdigit())
+    for problem, levels in plan["problems"].items():   # one job per series
+        assert int(counts.get(f"matrix_run_{problem}", 0)) == (len(plan["schemes"]) if levels else 0)
+    assert int(counts["matrix_page"]) == 1  # results/matrix/index.html
+    assert int(counts["gallery_run"]) == len(SCHEMES)  # one mesh file, every scheme
+    assert "gallery_mesh" not in counts  # a folder given: no generated meshes
+
+
+# ------------------------------------------------------------ the gallery
+
+
+def test_gallery_runs_every_scheme_on_every_file(tmp_path):
+    from mcfbench.geometry.surfaces import make_surface
+
+    meshes = tmp_path / "meshes"
+    gallery_job.write_obj(meshes / "ball.obj", *make_surface("sphere", level=2))
+    (meshes / "broken.off").write_text("OFF\n3 1 0\n0 0 0\n1 0 0\n")
+    (meshes / "notes.txt").write_text("not a mesh")
+    plan = gallery_plan.plan({"schemes": ["ddfv", "cotan"], "steps": 3}, str(meshes))
+    assert list(plan["meshes"]) == ["ball.obj", "broken.off"]
+    assert plan["C"] == 0.1 and plan["solver"] == matrix_plan.robust_method()
+    records = []
+    for mesh, path in plan["meshes"].items():
+        for scheme in plan["schemes"]:
+            settings = {"study": "gallery", "mesh": mesh, "scheme": scheme,
+                        **{k: plan[k] for k in ("C", "steps", "solver", "rtol", "maxiter")}}
+            out = tmp_path / "runs" / mesh / f"{scheme}.json"
+            gallery_job.job(path, scheme, settings, out, out.with_suffix(".npz"))
+            records.append(read_record(out, settings=settings))
+    table = gallery_tables.gallery_table(records)
+    ball = table[table["mesh"] == "ball.obj"]
+    assert ball["status"].tolist() == ["ok", "ok"] and ball["steps_done"].tolist() == [3, 3]
+    h = ball["h"].iloc[0]
+    assert ball["tau"].iloc[0] == pytest.approx(0.1 * h * h)
+    assert (table[table["mesh"] == "broken.off"]["status"] == "unsupported").all()
+    text = gallery_tables.gallery_markdown(table, plan)
+    assert "same footing" in text and "| ball.obj | ddfv | ok | 3/3 |" in text
+    with pytest.raises(ConfigError, match="'meshes'"):
+        gallery_plan.plan({}, str(tmp_path / "missing"))
+
+
+def test_cheapest_to_reach_reads_the_long_table():
+    """The work-precision verdict on known numbers: target = the largest of the
+    schemes' smallest errors; per scheme the cheapest run at or below it."""
+    from mcfbench.studies.matrix.findings import cheapest_to_reach, work_precision_section
+
+    rows = [("a", 1, 1e-2, 1.0), ("a", 2, 2.5e-3, 4.0), ("b", 1, 4e-3, 3.0), ("b", 2, 1e-3, 9.0)]
+    table = pd.DataFrame([{"problem": "sphere", "scheme": s, "level": lv, "metric": "l2_error",
+                           "value": e, "cpu_seconds": c} for s, lv, e, c in rows])
+    (verdict,) = cheapest_to_reach(table)
+    assert verdict["target"] == 2.5e-3                    # a's smallest error; b reaches it too
+    assert verdict["costs"] == {"a": 4.0, "b": 9.0}
+    text = "\n".join(work_precision_section([verdict], {"a": "A"}))
+    assert "**A** is the cheapest, 4 s (then b 9 s)" in text
+
+
+def test_series_job_writes_every_level_and_logs_to_one_file(tmp_path):
+    """One Snakemake job per (problem, scheme): every level's record and frames,
+    the same records as one job per run, one log for the series."""
+    plan = matrix_plan.plan({"schemes": ["cotan"], "problems": {p: ([1, 2] if p == "sphere" else [])
+                                                                for p in PROBLEMS}})
+    runs = matrix_plan.planned_runs(plan, code="test", root=str(tmp_path))
+    records = list(runs)
+    frames = [r.replace("/runs/", "/frames/").removesuffix(".json") + ".npz" for r in records]
+    log = tmp_path / "series.log"
+    results = matrix_job.series_job(list(runs.values()), records, frames, log)
+    assert [r.level for r in results] == [1, 2] and all(r.status == "ok" for r in results)
+    one = tmp_path / "one.json"
+    matrix_job.job(runs[records[1]], one, tmp_path / "one.npz")
+    assert read_record(records[1])["l2_error"] == read_record(one)["l2_error"]
+    text = log.read_text()
+    assert "sphere level 1" in text and "sphere level 2" in text
+
+
+def test_summary_keeps_a_value_measured_before_a_later_breakdown():
+    """The torus's volume at t = 0.1 is measured before the run stops at the pinch:
+    the summary shows it and its EOC, and still names the breakdown."""
+    rows = [("cotan", 1, 0.0156, "solver_stagnated"), ("cotan", 2, 0.0039, "inverted")]
+    table = pd.DataFrame([{"scheme": s, "problem": "torus", "level": lv, "h": 0.1 / lv,
+                           "tau": 0.004, "steps": 50, "steps_done": 30, "metric": "volume_error",
+                           "value": v, "eoc": np.nan, "status": st, "t_failed": 0.13,
+                           "min_angle": 20.0, "max_flipped": 0, "t_min_barycentric": np.nan,
+                           "iterations": 10, "cpu_seconds": 1.0, "robust_status": "",
+                           "robust_value": np.nan, "robust_t_failed": np.nan}
+                          for s, lv, v, st in rows])
+    summary = matrix_tables.summary_table(matrix_tables.add_eoc(table))
+    (row,) = summary.to_dict("records")
+    assert row["finest_value"] == 0.0039 and row["eoc"] == pytest.approx(2.0, abs=1e-9)
+    assert row["runs_ok"] == 0 and row["status"] == "solver_stagnated"
+
+
+def test_a_pinch_after_the_measurement_is_judged_by_the_measured_error():
+    from mcfbench.studies.matrix.findings import _classify as classify_row  # noqa: PLC2701
+
+    row = {"runs": 3, "runs_ok": 0, "error": True, "values": "0.164;0.0463;0.0129",
+           "eoc": 1.84}
+    assert classify_row(row) == "order2"
+    assert classify_row({**row, "values": "0.164;0.0463"}) == "broke_down"
