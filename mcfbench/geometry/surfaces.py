@@ -33,6 +33,7 @@ name                     n_F    n_T    boundary  what
 ``implicit_torus``       4476   8952   none      marching cubes of a tilted torus, 48^3
 ``angenent_torus``       1152   2304   none      Angenent's self-shrinking torus, 48 x 24
 ``enneper_patch``        376    687    1 loop    Enneper patch R = 0.8, interior lifted 0.2 (defaults)
+``real_mesh``            523    1046   none      a committed real mesh (``nut``), Loop limit, level 0
 ======================== ====== ====== ========= ======================================
 
 Refinement: the icosphere family (``sphere``, ``bumpy_sphere``,
@@ -40,10 +41,13 @@ Refinement: the icosphere family (``sphere``, ``bumpy_sphere``,
 ``anisotropic_sphere``, ``dumbbell`` and ``flat_patch`` (``level``),
 ``cylinder`` and ``torus`` (double both counts), ``hemisphere`` (double
 ``rings``), ``remeshed_sphere`` (4x ``n_points``) and the marching-cubes
-surfaces (double ``resolution``).
+surfaces (double ``resolution``); ``real_mesh`` (``mesh``, ``level``) is
+level ``level`` of the Loop-limit series of a mesh of
+:mod:`mcfbench.geometry.committed_meshes` (:mod:`mcfbench.geometry.subdivision`).
 """
 
 from mcfbench.geometry.angenent import angenent_torus
+from mcfbench.geometry.committed_meshes import real_mesh
 from mcfbench.geometry.implicit import blobby, implicit_torus
 from mcfbench.geometry.minimal import enneper_patch
 from mcfbench.geometry.shapes import (
@@ -82,6 +86,7 @@ SURFACES = {
     "implicit_torus": implicit_torus,
     "angenent_torus": angenent_torus,
     "enneper_patch": enneper_patch,
+    "real_mesh": real_mesh,
 }
 """Name -> generator of the initial surfaces; ``SURFACES[name](**params)``."""
 

@@ -459,3 +459,14 @@ def _discover():
 
 
 _discover()
+
+
+# the real meshes (mcfbench/data/meshes): one problem per mesh with a reference
+# file, generated from its manifest entry and references (one module: the kind)
+from mcfbench.running.real_mesh_problems import (  # noqa: E402
+    RealMeshShape,
+    real_mesh_problems,
+)
+
+METRICS["real_mesh"] = RealMeshShape
+PROBLEMS.update(real_mesh_problems())

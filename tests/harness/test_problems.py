@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from mcfbench.geometry.committed_meshes import mesh_manifest
 from mcfbench.geometry.mesh import summarize
 from mcfbench.geometry.metrics import catenoid_parameter
 from mcfbench.running.problems import PROBLEMS, Problem, get_problem, time_steps
@@ -11,7 +12,8 @@ from mcfbench.running.schemes import SCHEMES
 from mcfbench.storage.statuses import STATUSES
 
 CLOSED = {"sphere": 0, "torus": 1, "dumbbell": 0, "perturbed_sphere": 0, "remeshed_sphere": 0,
-          "anisotropic_sphere": 0, "blobby": 0, "marching_torus": 1, "angenent": 1}
+          "anisotropic_sphere": 0, "blobby": 0, "marching_torus": 1, "angenent": 1,
+          **{f"real_{name}": entry["genus"] for name, entry in mesh_manifest().items()}}
 OPEN = {"catenoid": 2, "hemisphere": 1, "flat_patch": 1, "enneper": 1}
 
 

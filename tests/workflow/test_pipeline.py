@@ -216,8 +216,8 @@ BAD_CONFIGS = {  # --config value -> expected part of the message (the key named
     "threads=0": "config key 'threads': 0 is less than the minimum of 1",
     "foo=1": "unknown config key(s) ['foo']; known keys: beyond, gallery,",
     "integrators=[bdf2]": "config key 'integrators': must include euler",
-    "integrators=[euler,bdf3]": "config key 'integrators': unknown integrator(s) ['bdf3']",
-    "schemes=[ddfv@bdf3]": "config key 'schemes': unknown scheme(s) ['ddfv@bdf3']",
+    "integrators=[euler,bdf4]": "config key 'integrators': unknown integrator(s) ['bdf4']",
+    "schemes=[ddfv@bdf4]": "config key 'schemes': unknown scheme(s) ['ddfv@bdf4']",
 }
 
 

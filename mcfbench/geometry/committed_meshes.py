@@ -1,0 +1,69 @@
+"""Real triangle meshes committed as data under ``mcfbench/data/meshes/``.
+
+Public closed surfaces with a permissive licence (CAD parts, modelled
+characters), each a
+file of that folder described by one entry of its ``manifest.json``: the
+source repository, path and commit, the author, the licence, the kind, the
+counts, Euler characteristic and genus after the intake, the processing done
+and the file's SHA-256. The folder's ``README.md`` is the table of the same
+entries for readers. Every file reads through the one intake
+(:func:`mcfbench.geometry.mesh_files.read_mesh`), after its SHA-256 is checked,
+so a corrupted or replaced file is refused by name. :func:`real_mesh` is
+the surface generator ``real_mesh`` of :mod:`mcfbench.geometry.surfaces`: a
+level of the mesh's Loop-limit series.
+"""
+
+import functools
+import hashlib
+import json
+from pathlib import Path
+
+from mcfbench.geometry.mesh_files import read_mesh
+from mcfbench.geometry.subdivision import loop_limit_level
+
+MESH_DIR = Path(__file__).resolve().parents[1] / "data" / "meshes"
+"""The folder of the committed meshes, their manifest and README."""
+
+
+@functools.cache
+def mesh_manifest():
+    """The entries of ``manifest.json``: name -> dict (``file``, ``sha256``,
+    ``repository``, ``path``, ``commit``, ``author``, ``licence``, ``kind``,
+    ``vertices``, ``faces``, ``euler_characteristic``, ``genus``,
+    ``thin_features``, ``processing``)."""
+    return json.loads((MESH_DIR / "manifest.json").read_text())
+
+
+def committed_mesh_file(name):
+    """The file of the committed mesh ``name``, its SHA-256 checked.
+
+    Raises
+    ------
+    ValueError
+        Unknown name (listing the known ones), or the file's SHA-256 differs
+        from the manifest's (a corrupted or replaced file).
+    """
+    manifest = mesh_manifest()
+    if name not in manifest:
+        raise ValueError(f"unknown committed mesh {name!r}; choose one of {', '.join(manifest)}")
+    entry = manifest[name]
+    path = MESH_DIR / entry["file"]
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()
+    if digest != entry["sha256"]:
+        raise ValueError(f"committed mesh {name!r}: {path} has SHA-256 {digest}, not the "
+                         f"manifest's {entry['sha256']} (corrupted or replaced file)")
+    return path
+
+
+def read_committed_mesh(name):
+    """``(V, F)`` of the committed mesh ``name`` through :func:`read_mesh`
+    (a ``(n, 3)`` float64 and an ``(m, 3)`` int64 array, a valid surface)."""
+    V, F, _ = read_mesh(committed_mesh_file(name))
+    return V, F
+
+
+def real_mesh(mesh="nut", level=0):
+    """Level ``level`` of the Loop-limit refinement series of the committed mesh
+    named ``mesh`` (default the smallest, ``nut``;
+    :func:`mcfbench.geometry.subdivision.loop_limit_level`): ``(V, F)``."""
+    return loop_limit_level(*read_committed_mesh(mesh), level)

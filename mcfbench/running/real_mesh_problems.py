@@ -1,0 +1,136 @@
+"""Real meshes as problems: one problem ``real_<name>`` per committed mesh.
+
+Every mesh of :mod:`mcfbench.geometry.committed_meshes` is one problem of
+:data:`mcfbench.running.problems.PROBLEMS`, generated here from two files and
+nothing else: the mesh's manifest entry and its reference answers
+``mcfbench/data/meshes/references/<name>.json`` (made by
+``benchmarks/real_mesh_references.py``, which names the command that remakes
+them; the matrix does not recompute them). A mesh without a reference file
+is not a problem.
+
+The problem
+-----------
+* surface: level ``k`` of the mesh's Loop-limit series (``real_mesh``,
+  :mod:`mcfbench.geometry.subdivision`): ``k`` Loop steps, every vertex at
+  its limit position, so all levels sample one smooth surface;
+* time step ``tau_k = 0.1 h_0^2 / 4^k`` (``h_0`` the mean edge of level 0,
+  the run command's ``--tau-edge 0.1`` on level 0);
+* final time ``t_final = N tau_0`` (``N <= 10``), before the flow's first
+  singularity found by the reference runs;
+* metric ``real_mesh`` (:class:`RealMeshShape`): the relative errors of the
+  area and the enclosed volume against the reference at the checkpoints
+  ``t = j tau_0``, sampled as they are reached, so they stay valid when the
+  run breaks down later.
+"""
+
+import json
+import math
+
+from mcfbench.geometry import metrics
+from mcfbench.geometry.committed_meshes import MESH_DIR, mesh_manifest
+
+REFERENCE_DIR = MESH_DIR / "references"
+"""One ``<name>.json`` of reference answers per real mesh."""
+
+TAU_EDGE = 0.1
+"""``tau_0 = TAU_EDGE h_0^2``."""
+
+
+def reference_path(name):
+    """The reference file of the committed mesh ``name``."""
+    return REFERENCE_DIR / f"{name}.json"
+
+
+def real_mesh_problem(name, reference):
+    """The problem ``real_<name>`` with the reference (or provisional) settings.
+
+    Parameters
+    ----------
+    name : str
+        A committed mesh.
+    reference : dict
+        At least ``h0`` (mean edge of level 0), ``steps`` (``N``),
+        ``checkpoints`` (the ``j`` of ``t = j tau_0``) and ``levels``; the
+        reference file adds ``area`` and ``volume`` at the checkpoints (the
+        metric needs them), their accuracy, the EOCs and the singularity.
+
+    Returns
+    -------
+    mcfbench.running.problems.Problem
+    """
+    from mcfbench.running.problems import Problem  # the registry imports this module
+
+    entry = mesh_manifest()[name]
+    tau_0 = TAU_EDGE * reference["h0"] ** 2
+    singular = reference.get("singularity", {}).get("time")
+    when = f"first singularity at t = {singular:.4g}" if singular is not None else \
+        "no singularity before the searched time"
+    return Problem(
+        f"real_{name}", f"{name} ({entry['kind']}, real mesh)", "real_mesh",
+        lambda level: {"mesh": name, "level": int(level)},
+        levels=tuple(reference["levels"]), tau_1=tau_0 / 4.0,
+        t_final=reference["steps"] * tau_0, metrics=("real_mesh",),
+        exact=f"reference: finest levels of cotan and bgn ({when})",
+        reference=dict(reference),
+        description=f"The {entry['kind']} mesh {entry['file']} ({entry['vertices']} vertices, "
+                    f"genus {entry['genus']}; {entry['author']}), refined by Loop subdivision "
+                    f"to its limit surface; tau_k = {TAU_EDGE} h_0^2 / 4^k to "
+                    f"{reference['steps']} tau_0; area and volume at the checkpoints against "
+                    "the reference.")
+
+
+def real_mesh_problems():
+    """Every committed mesh that has a reference file, as its problem:
+    ``{"real_<name>": Problem}``."""
+    problems = {}
+    for name in mesh_manifest():
+        path = reference_path(name)
+        if path.is_file():
+            problem = real_mesh_problem(name, json.loads(path.read_text()))
+            problems[problem.name] = problem
+    return problems
+
+
+class RealMeshShape:
+    """Observer of a real-mesh problem: area and enclosed volume at the
+    checkpoints ``t = j tau_0``, and their largest relative error against the
+    reference (``area_error``, ``volume_error``: signed, the checkpoint of the
+    largest magnitude; NaN if a checkpoint was not reached). Values are kept
+    when the run breaks down after the checkpoints (``keeps_before_breakdown``).
+    """
+
+    keeps_before_breakdown = True
+
+    def __init__(self, problem):
+        ref = problem.reference
+        tau_0 = TAU_EDGE * ref["h0"] ** 2
+        self.times = [j * tau_0 for j in ref["checkpoints"]]
+        self.reference = {q: None if ref.get(q) is None else
+                          [math.nan if r is None else r for r in ref[q]]
+                          for q in ("area", "volume")}
+        self.samples = {}
+
+    def __call__(self, flow):
+        t = flow.n * flow.tau
+        for i, tc in enumerate(self.times):
+            if math.isclose(t, tc, rel_tol=1e-9, abs_tol=1e-15):
+                self.samples[i] = (metrics.area(flow.vertices, flow.faces),
+                                   metrics.volume(flow.vertices, flow.faces))
+
+    def values(self):
+        """``{"area": [...], "volume": [...]}`` at the checkpoints (NaN where
+        not reached)."""
+        nan = (math.nan, math.nan)
+        sampled = [self.samples.get(i, nan) for i in range(len(self.times))]
+        return {"area": [a for a, _ in sampled], "volume": [v for _, v in sampled]}
+
+    def result(self):
+        out = {}
+        for key, values in self.values().items():
+            reference = self.reference[key]
+            if reference is None:
+                continue
+            errors = [v / r - 1.0 for v, r in zip(values, reference)]
+            worst = max(errors, key=lambda e: -1.0 if math.isnan(e) else abs(e))
+            out[f"{key}_error"] = math.nan if any(map(math.isnan, errors)) else worst
+        return out

@@ -1,0 +1,71 @@
+"""The real-mesh problems (mcfbench.running.real_mesh_problems): one per committed
+mesh, generated from its manifest entry and reference file; the time rule
+tau_k = 0.1 h_0^2 / 4^k; the stored answers are what the reference machinery
+makes of the stored runs; the metric measures a run against them."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from mcfbench.geometry.committed_meshes import mesh_manifest
+from mcfbench.geometry.metrics import mean_edge_length
+from mcfbench.running.problems import PROBLEMS
+from mcfbench.running.real_mesh_problems import reference_path
+from mcfbench.running.run import run
+from mcfbench.running.solver import Solver
+from mcfbench.running.two_scheme_references import QUANTITIES, reference_answers
+from mcfbench.storage.atomic import json_value
+
+NAMES = sorted(mesh_manifest())
+
+
+def _stored(name):
+    return json.loads(reference_path(name).read_text())
+
+
+def _runs(ref):
+    return [{**r, **{q: [math.nan if x is None else x for x in r[q]] for q in QUANTITIES}}
+            for r in ref["runs"]]
+
+
+def test_every_committed_mesh_is_a_problem():
+    assert {f"real_{n}" for n in NAMES} <= set(PROBLEMS)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_problem_time_rule_and_levels_follow_the_reference_file(name):
+    ref, problem = _stored(name), PROBLEMS[f"real_{name}"]
+    V, F = problem.mesh(0)
+    h0 = mean_edge_length(V, F)
+    assert ref["h0"] == pytest.approx(h0, rel=1e-12)
+    assert len(V) == ref["vertices"]["0"] == mesh_manifest()[name]["vertices"]
+    for level in problem.levels:
+        assert problem.tau(level) == pytest.approx(0.1 * h0 ** 2 / 4 ** level, rel=1e-12)
+        assert problem.time_steps(problem.tau(level)) == ref["steps"] * 4 ** level
+    assert 1 <= ref["steps"] <= 10 and ref["checkpoints"] == list(range(1, ref["steps"] + 1))
+    assert ref["command"].endswith(f"--mesh {name}")
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_stored_answers_are_what_the_machinery_makes_of_the_stored_runs(name):
+    ref = _stored(name)
+    again = json_value(reference_answers(_runs(ref), ref["tau0"], 10))
+    for key in ("steps", "checkpoints", "singularity", *QUANTITIES,
+                *(f"{q}_accuracy" for q in QUANTITIES)):
+        assert again[key] == ref[key], key
+    for q in QUANTITIES:
+        assert np.all(np.asarray(ref[f"{q}_accuracy"]) >= 0)
+        assert np.all(np.asarray(ref[f"{q}_accuracy"]) < 0.05 * np.abs(ref[q]))
+
+
+def test_metric_measures_a_run_against_the_reference():
+    """cotan on level 0 of the nut: the metric's errors are the stored run's
+    values at the checkpoints against the reference (worst in magnitude)."""
+    ref = _stored("nut")
+    result, _ = run("cotan", "real_nut", 0, solver=Solver(method="direct"))
+    stored = next(r for r in ref["runs"] if (r["scheme"], r["level"]) == ("cotan", 0))
+    for q in QUANTITIES:
+        errors = [stored[q][j] / ref[q][j - 1] - 1 for j in ref["checkpoints"]]
+        assert result.metrics[f"{q}_error"] == pytest.approx(max(errors, key=abs), rel=1e-9)

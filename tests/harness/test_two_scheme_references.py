@@ -1,0 +1,71 @@
+"""The reference machinery (mcfbench.running.two_scheme_references) on a case with a
+known answer, the shrinking sphere r(t)^2 = 1 - 4t: its reference area and
+volume agree with the exact ones within the stated accuracy; and the
+singularity rule on synthetic runs."""
+
+import math
+
+import numpy as np
+import pytest
+
+from mcfbench.geometry.metrics import mean_edge_length
+from mcfbench.running.problems import PROBLEMS
+from mcfbench.running.two_scheme_references import (
+    first_singularity,
+    reference_answers,
+    reference_runs,
+)
+
+
+@pytest.fixture(scope="module")
+def sphere_answers():
+    problem = PROBLEMS["sphere"]
+    h = mean_edge_length(*problem.mesh(2))
+    tau_0 = 0.1 * h ** 2
+    runs = reference_runs(problem, {"cotan": (2, 3, 4), "bgn": (2, 3)}, tau_0, 4)
+    return tau_0, reference_answers(runs, tau_0, 4)
+
+
+def test_sphere_reference_is_within_its_stated_accuracy(sphere_answers):
+    tau_0, ref = sphere_answers
+    assert ref["steps"] == 4 and ref["singularity"]["time"] is None
+    t = tau_0 * np.asarray(ref["checkpoints"])
+    exact = {"area": 4 * np.pi * (1 - 4 * t), "volume": 4 / 3 * np.pi * (1 - 4 * t) ** 1.5}
+    for q in ("area", "volume"):
+        error = np.abs(np.asarray(ref[q]) - exact[q])
+        accuracy = np.asarray(ref[f"{q}_accuracy"])
+        assert np.all(error <= accuracy), (q, error, accuracy)
+        assert np.all(accuracy < 0.005 * exact[q])       # and the accuracy is informative
+        assert ref[f"{q}_disagree"] == []
+    cotan = ref["orders"]["cotan"]["volume"]["observed"]
+    assert len(cotan) == 1 and 1.5 < cotan[0] < 2.5        # O(h^2 + tau), tau ~ h^2
+
+
+def _run(scheme, level, status, t_end, tau_0=0.1, steps=10):
+    reached = min(steps, math.floor(t_end / tau_0 + 1e-9))
+    values = [1.0 + 0.5 ** level - 0.01 * j if j <= reached else math.nan
+              for j in range(steps + 1)]
+    return {"scheme": scheme, "level": level, "status": status, "t_end": t_end,
+            "area": values, "volume": values}
+
+
+def test_runs_that_stop_together_are_the_singularity_and_t_final_is_before_it():
+    runs = [_run("cotan", 0, "ok", 1.0), _run("cotan", 1, "inverted", 0.74),
+            _run("cotan", 2, "inverted", 0.71), _run("bgn", 0, "degenerated", 0.66),
+            _run("bgn", 1, "inverted", 0.69)]
+    sing = first_singularity(runs, 0.1, 10)
+    assert sing["time"] == pytest.approx((0.71 + 0.69) / 2) and sing["breakdowns"] == []
+    ref = reference_answers(runs, 0.1, 10)
+    assert ref["steps"] == 6 and ref["checkpoints"] == [1, 2, 3, 4, 5, 6]
+
+
+def test_runs_that_stop_apart_are_breakdowns_not_the_singularity():
+    runs = [_run("cotan", 0, "inverted", 0.2), _run("cotan", 1, "inverted", 0.15),
+            _run("bgn", 0, "ok", 1.0), _run("bgn", 1, "ok", 1.0)]
+    sing = first_singularity(runs, 0.1, 10)
+    assert sing["time"] is None and sing["searched_to"] == pytest.approx(1.0)
+    assert [(b["scheme"], b["level"]) for b in sing["breakdowns"]] == [("cotan", 0), ("cotan", 1)]
+    ref = reference_answers(runs, 0.1, 10)     # the final time is the flow's, not cotan's
+    assert ref["steps"] == 10
+    assert ref["area_schemes"] == [["bgn", "cotan"]] + [["bgn"]] * 9
+    assert ref["orders"]["cotan"]["area"]["checkpoint"] == 1
