@@ -53,13 +53,45 @@ def test_plan_levels_and_leaving_out():
 
 def test_plan_adds_other_integrators_only_to_the_schemes_run():
     section = {"with_integrators": {"bdf2": ["ddfv-chord-carried", "cotan"]}}
-    assert matrix.plan(section)["schemes"] == [*SCHEMES, "ddfv-chord-carried@bdf2",
+    assert matrix_plan.plan(section)["schemes"] == [*SCHEMES, "ddfv-chord-carried@bdf2",
                                                "cotan@bdf2"]
-    assert matrix.plan({**section, "schemes": ["bgn", "cotan"]})["schemes"] == \
+    assert matrix_plan.plan({**section, "schemes": ["bgn", "cotan"]})["schemes"] == \
         ["bgn", "cotan", "cotan@bdf2"]
-    assert matrix.plan({**section, "schemes": ["bgn"]})["schemes"] == ["bgn"]
+    assert matrix_plan.plan({**section, "schemes": ["bgn"]})["schemes"] == ["bgn"]
     with pytest.raises(ConfigError, match=r"unknown scheme\(s\) \['cotn@bdf2'\]"):
-        matrix.plan({"schemes": ["bgn"], "with_integrators": {"bdf2": ["cotn"]}})
+        matrix_plan.plan({"schemes": ["bgn"], "with_integrators": {"bdf2": ["cotn"]}})
+
+
+def test_select_runs_exactly_the_named_schemes_problems_and_levels():
+    """`matrix.select` cuts the matrix down to what it names, whatever the rest of
+    the section (Snakemake merges --config into config.yaml's section)."""
+    full = {"schemes": "all", "with_integrators": {"bdf2": ["cotan"]},
+            "problems": {"sphere": [1, 2, 3, 4, 5], "torus": [1, 2]}}
+    plan = matrix_plan.plan({**full, "select": {"schemes": ["cotan", "bgn@bdf2"],
+                                                "problems": {"torus": [2], "sphere": ["1", 2]}}})
+    assert plan["schemes"] == ["cotan", "bgn@bdf2"]          # no cotan@bdf2 added
+    assert plan["problems"] == {"sphere": [1, 2], "torus": [2]}   # registry order
+    assert plan["selected"] and not matrix_plan.plan(full)["selected"]
+    runs = matrix_plan.planned_runs(plan)
+    assert len(runs) == 2 * 3
+    # either key alone keeps the full matrix's other one
+    only_sphere = matrix_plan.plan({**full, "select": {"problems": {"sphere": [1]}}})
+    assert only_sphere["schemes"] == [*SCHEMES, "cotan@bdf2"]
+    assert only_sphere["problems"] == {"sphere": [1]}
+    assert matrix_plan.plan({**full, "select": {"schemes": ["bgn"]}})["problems"] == \
+        matrix_plan.plan(full)["problems"]
+
+
+def test_run_settings_do_not_depend_on_the_other_levels():
+    """A Snakemake job's params are its series' settings without the level, so that
+    trimming levels reruns none already computed."""
+    wide = matrix_plan.plan({"select": {"problems": {"sphere": [1, 2, 3]}}})
+    narrow = matrix_plan.plan({"select": {"problems": {"sphere": [1]}}})
+    path = matrix_plan.record_path("sphere", "cotan", 1)
+    assert matrix_plan.planned_runs(wide)[path] == matrix_plan.planned_runs(narrow)[path]
+    assert matrix_plan.level_of(path) == 1
+    assert matrix_plan.run_settings(wide, "cotan", "sphere", 3) == \
+        {**matrix_plan.series_settings(narrow, "cotan", "sphere"), "level": 3}
 
 
 @pytest.mark.parametrize("section, key", [
@@ -67,6 +99,11 @@ def test_plan_adds_other_integrators_only_to_the_schemes_run():
     ({"problems": {"spere": [1]}}, "matrix.problems"),
     ({"problems": {"sphere": [0]}}, "matrix.problems.sphere"),
     ({"solver": "gmres"}, "matrix.solver"),
+    ({"select": {"schemes": ["fem"]}}, "matrix.select.schemes"),
+    ({"select": {"problems": {"spere": [1]}}}, "matrix.select.problems"),
+    ({"select": {"problems": {"sphere": []}}}, "matrix.select.problems.sphere"),
+    ({"select": {"problems": ["sphere"]}}, "matrix.select.problems"),
+    ({"select": {"levels": [1]}}, "matrix.select"),
 ])
 def test_plan_names_the_bad_key(section, key):
     with pytest.raises(ConfigError, match=key.replace(".", r"\.")):
@@ -392,7 +429,9 @@ def test_series_job_writes_every_level_and_logs_to_one_file(tmp_path):
     records = list(runs)
     frames = [r.replace("/runs/", "/frames/").removesuffix(".json") + ".npz" for r in records]
     log = tmp_path / "series.log"
-    results = matrix_job.series_job(list(runs.values()), records, frames, log)
+    series = matrix_plan.series_settings(plan, "cotan", "sphere", code="test")
+    results = matrix_job.series_job(series, records, frames, log)
+    assert [read_record(r)["settings"] for r in records] == list(runs.values())
     assert [r.level for r in results] == [1, 2] and all(r.status == "ok" for r in results)
     one = tmp_path / "one.json"
     matrix_job.job(runs[records[1]], one, tmp_path / "one.npz")
