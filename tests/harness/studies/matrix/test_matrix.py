@@ -416,8 +416,94 @@ def test_cheapest_to_reach_reads_the_long_table():
     (verdict,) = cheapest_to_reach(table)
     assert verdict["target"] == 2.5e-3                    # a's smallest error; b reaches it too
     assert verdict["costs"] == {"a": 4.0, "b": 9.0}
-    text = "\n".join(work_precision_section([verdict], {"a": "A"}))
-    assert "**A** is the cheapest, 4 s (then b 9 s)" in text
+    text = "\n".join(work_precision_section([verdict]))
+    assert "sphere (l2_error <= 2.500e-03): **a** is the cheapest, 4 s (then b 9 s)." in text
+
+
+# ------------------------------------------------------------ findings that read straight (#33)
+
+
+def _summary(rows, problem="sphere", metric="l2_error"):
+    """The summary of synthetic runs: ``{scheme: [error per level 1, 2, ...]}``."""
+    return matrix_tables.summary_table(matrix_tables.long_table(
+        [_record(s, problem, k + 1, e, metric=metric) for s, es in rows.items()
+         for k, e in enumerate(es)]))
+
+
+def test_findings_state_their_scope():
+    registry_schemes, registry_problems = ["cotan", "bgn", "ddfv"], ["sphere", "torus"]
+    cut = {"schemes": ["cotan", "bgn"], "problems": {"sphere": [1, 2]}, "selected": True}
+    text = " ".join(matrix_findings.scope_lines(cut, registry_schemes, registry_problems,
+                                                {"cotan": "cotangent", "bgn": "bgn"}))
+    assert text.startswith("Scope: a cut-down matrix (`matrix.select`): 2 scheme(s) (cotan, "
+                           "bgn; the registry has 3) on 1 of the 2 problems, at the levels "
+                           "sphere 1, 2.")
+    assert "cotan (cotangent)." in text and "bgn (bgn)" not in text  # a label only where it adds
+    full = {"schemes": ["cotan", "bgn", "ddfv", "cotan@bdf2"],
+            "problems": {"sphere": [1, 2, 3], "torus": [1]}}
+    text = " ".join(matrix_findings.scope_lines(full, registry_schemes, registry_problems))
+    assert text.startswith("Scope: the full matrix, every scheme of the registry (4 with the "
+                           "other integrators) on every problem (2), at the levels sphere 1-3; "
+                           "torus 1.")
+    summary = _summary({"cotan": [1e-2, 2.5e-3]})
+    assert "Scope: the full" in matrix_findings.matrix_findings(
+        summary, scope=matrix_findings.scope_lines(full, registry_schemes, registry_problems))
+
+
+def test_every_problem_with_an_exact_error_is_listed_even_a_real_world_like_one():
+    summary = pd.concat([_summary({"a": [1e-2, 2.5e-3, 6e-4]}),
+                         _summary({"a": [2e-2, 5e-3, 1.2e-3]}, problem="perturbed_sphere")])
+    text = matrix_findings.matrix_findings(summary, mesh_problems=["perturbed_sphere"])
+    assert "Problems with an exact error: sphere, perturbed_sphere." in text
+    assert "Real-world-like meshes (a breakdown disqualifies): perturbed_sphere." in text
+
+
+def test_a_recommendation_never_hides_an_order_the_verdicts_call_off():
+    """On the torus no scheme reaches order ~2, so b (EOC 1.58 there) may still win, but
+    the recommendation says what the torus verdict says."""
+    summary = pd.concat([_summary({"b": [1e-2, 2.5e-3, 6.25e-4], "c": [3e-2, 7.5e-3, 1.9e-3]}),
+                         _summary({"b": [1e-2, 5e-3, 1.67e-3], "c": [1e-2, 6e-3, 3e-3]},
+                                  problem="torus", metric="volume_error")])
+    text = matrix_findings.matrix_findings(summary)
+    assert "**b** converges at order 1.58 (levels 2-3), not ~2" in text
+    assert "**Recommendation: b**" in text
+    assert ("It does not show order ~2 everywhere: EOC 1.58 on torus, not ~2 (no scheme "
+            "reaches order ~2 there).") in text
+
+
+def test_an_eoc_from_two_levels_does_not_disqualify():
+    """a: EOC 2.0 on the sphere; b: EOC 2.6 on the sphere from two levels only."""
+    summary = _summary({"a": [1e-2, 2.5e-3], "b": [6e-3, 1e-3]})
+    text = matrix_findings.matrix_findings(summary)
+    assert "**b** converges, EOC 2.58 (levels 1-2): from two levels only, the order is " \
+           "not settled" in text
+    assert "Left out" not in text
+    assert "**a** converges at order ~2 from two levels only: EOC 2.00" in text
+    assert "**Recommendation: b**" in text
+    assert "EOC 2.58 on sphere from two levels only (the order is not settled)" in text
+    three = _summary({"a": [4e-2, 1e-2, 2.5e-3], "b": [3.6e-2, 6e-3, 1e-3]})
+    text = matrix_findings.matrix_findings(three)           # three levels: it counts
+    assert "Left out: b (EOC 2.58 on sphere)." in text and "**Recommendation: a**" in text
+
+
+def test_findings_show_values_as_the_tables_do():
+    """A relative error is a number, as in the summary table, never a percentage."""
+    summary = _summary({"a": [-3.2e-2, -8.424e-4]}, problem="catenoid", metric="neck_error")
+    text = matrix_findings.matrix_findings(summary)
+    assert "-8.424e-04" in text and matrix_tables.summary_cell(summary.iloc[0]).count("-8.424e-04")
+    assert "%" not in text.split("## Across problems")[0].split("## Per problem")[1]
+
+
+def test_noise_level_timings_are_marked_and_not_ranked():
+    fast = {"problem": "sphere", "metric": "l2_error", "target": 1e-3,
+            "costs": {"cotan": 0.0045, "bgn": 0.0061, "ddfv": 0.5}}
+    text = "\n".join(matrix_findings.work_precision_section([fast]))
+    assert "no ranking, the cheapest runs are at the noise level: cotan 0.0045 s (noise " \
+           "level), bgn 0.0061 s (noise level), ddfv 0.5 s." in text
+    assert "**" not in text.split("ranked:")[1]
+    one_fast = {**fast, "costs": {"cotan": 0.0045, "ddfv": 0.5}}
+    assert "**cotan** is the cheapest, 0.0045 s (noise level) (then ddfv 0.5 s)." in \
+        "\n".join(matrix_findings.work_precision_section([one_fast]))
 
 
 def test_series_job_writes_every_level_and_logs_to_one_file(tmp_path):
