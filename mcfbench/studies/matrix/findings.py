@@ -46,8 +46,8 @@ NOISE_SECONDS = 0.01
 
 
 def _number(value):
-    """A metric's value as the tables show it (:func:`~mcfbench.studies.matrix.tables.summary_cell`):
-    one unit per quantity, no percentages."""
+    """A metric's value as the tables show it (``tables.summary_cell``): one unit
+    per quantity, no percentages."""
     return f"{value:.3e}"
 
 

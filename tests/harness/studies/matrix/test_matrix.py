@@ -550,3 +550,47 @@ def test_a_pinch_after_the_measurement_is_judged_by_the_measured_error():
            "eoc": 1.84}
     assert classify_row(row) == "order2"
     assert classify_row({**row, "values": "0.164;0.0463"}) == "broke_down"
+
+
+def test_figures_fit_a_laptop_column_with_text_of_8_pt_at_least(monkeypatch, tmp_path):
+    """Every problem of the registry, two schemes (one of them breaking down, so the
+    notes are drawn): the error, work-precision and quality figures are at most
+    12.4 in wide (a 1280 px page's column at print size, as the page shows them) and
+    no visible text is below SMALLEST_TEXT points."""
+    from matplotlib.text import Text
+
+    from mcfbench.presentation.plots import SMALLEST_TEXT
+    from mcfbench.studies.matrix import plots
+
+    figures = []
+    monkeypatch.setattr(plots, "save_figure", lambda fig, *paths: figures.append(fig))
+    records = []
+    for problem, entry in PROBLEMS.items():
+        metric = matrix_tables.main_metric(problem, [
+            m for o in entry.metrics for m in matrix_tables.MAIN_METRICS.get(o, ())] or ["area"])
+        for scheme, c in (("cotan", 1.0), ("ddfv", 2.0)):
+            for k in (1, 2):
+                broke = scheme == "ddfv" and k == 2
+                r = _record(scheme, problem, k, float("nan") if broke else c * 4.0 ** -k,
+                            status="inverted" if broke else "ok",
+                            t_failed=0.01 if broke else float("nan"), metric=metric)
+                r["series"] = {"t": [0.0, 0.01], "t_min_barycentric": [0.3, -0.9],
+                               "quality_t": [0.0, 0.01], "min_angle": [30.0, 20.0]}
+                records.append(r)
+    table = matrix_tables.long_table(records)
+    problems, schemes = list(PROBLEMS), ["cotan", "ddfv"]
+    plots.error_figure(table, [tmp_path / "e.png"], problems, schemes)
+    plots.work_precision_figure(table, [tmp_path / "w.png"], problems, schemes)
+    plots.quality_figure(records, [tmp_path / "q.png"], problems, schemes)
+    assert len(figures) == 3
+    for fig in figures:
+        assert fig.get_size_inches()[0] <= 1190 / 96, fig.get_suptitle()
+        fig.canvas.draw()
+        sizes = [t.get_fontsize() for t in fig.findobj(Text)
+                 if t.get_visible() and t.get_text().strip()]
+        assert sizes and min(sizes) >= SMALLEST_TEXT, (fig.get_suptitle(), min(sizes))
+        texts = " ".join(t.get_text() for t in fig.findobj(Text))
+        if "main metric" in fig.get_suptitle():
+            assert "slope 2" in texts and "broke down: " in texts
+        if "quality" in fig.get_suptitle():
+            assert "clipped at -0.5" in texts
