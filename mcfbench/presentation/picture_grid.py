@@ -7,6 +7,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from mcfbench.presentation.plots import SMALLEST_TEXT  # noqa: E402
 from mcfbench.storage.atomic import save_figure  # noqa: E402
 
 DIAMONDS_UP_TO = 1500
@@ -60,13 +61,13 @@ def draw_grid(cells, row_labels, col_labels, paths, title, views=None, share="co
             for spine in ax.spines.values():
                 spine.set_visible(False)
             if i == 0:
-                ax.set_title(col_labels[j], fontsize=8)
+                ax.set_title(col_labels[j], fontsize=SMALLEST_TEXT)
             if j == 0:
-                ax.set_ylabel(row_labels[i], fontsize=7)
+                ax.set_ylabel(row_labels[i], fontsize=SMALLEST_TEXT)
             if not finite(cell):
                 text = "no frame" if cell is None else cell[3] if cell[0] is None \
                     else "non-finite state"
-                ax.text(0.5, 0.5, text, ha="center", va="center", fontsize=6,
+                ax.text(0.5, 0.5, text, ha="center", va="center", fontsize=SMALLEST_TEXT,
                         transform=ax.transAxes)
                 continue
             F, T, faces, note = cell
@@ -78,7 +79,7 @@ def draw_grid(cells, row_labels, col_labels, paths, title, views=None, share="co
             ax.set_ylim(centre[1] - half, centre[1] + half)
             ax.set_aspect("equal")
             if note:
-                ax.text(0.5, 0.01, note, ha="center", va="bottom", fontsize=5.5,
+                ax.text(0.5, 0.01, note, ha="center", va="bottom", fontsize=SMALLEST_TEXT,
                         transform=ax.transAxes)
     fig.suptitle(title, fontsize=9)
     fig.tight_layout()

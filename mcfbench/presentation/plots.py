@@ -25,6 +25,10 @@ from matplotlib.ticker import FixedFormatter, FixedLocator, NullFormatter  # noq
 
 from mcfbench.running.schemes import find_scheme  # noqa: E402
 
+SMALLEST_TEXT = 8
+"""The smallest text of a figure on a results page, in points: the matrix's page shows
+its figures at print size (``mcfbench.studies.matrix.page.print_width``), so this is
+what a reader sees."""
 EDGE = 1.0 / 3.0   # 1/3 - monitor at which a T-vertex reaches an edge of its triangle
 UNREGISTERED = {"color": "k", "marker": "x", "linestyle": "-"}
 

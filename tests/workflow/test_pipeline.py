@@ -295,6 +295,48 @@ def test_a_bad_matrix_or_gallery_value_stops_only_its_target(tmp_path, env):
     assert not (work / "results").exists()
 
 
+SELECT = "matrix={select: {schemes: [cotan, bgn], problems: {sphere: [1, 2]}}}"
+
+
+def planned_jobs(out):
+    """Snakemake's job stats of a dry run: rule -> count."""
+    stats = out.split("Job stats:")[1].split("total")[0]
+    return {line.split()[0]: int(line.split()[1]) for line in stats.splitlines()
+            if len(line.split()) == 2 and line.split()[1].isdigit()}
+
+
+def test_a_one_line_selection_plans_only_the_named_runs(tmp_path, env):
+    """`matrix.select` on the command line: the named schemes on the named problems
+    at the named levels, nothing of config.yaml's full matrix (dry run)."""
+    work = copy_workflow(tmp_path / "work")
+    code, out = snakemake(work, env, "-n", "--cores", "2", "matrix", "--config", SELECT)
+    assert code == 0, out[-3000:]
+    jobs = planned_jobs(out)
+    assert {r: n for r, n in jobs.items() if r.startswith("matrix_run")} == \
+        {"matrix_run_sphere": 2}                 # one series job per scheme
+    records = set(re.findall(r"results/matrix/runs/\S+?\.json", out))
+    assert records == {f"results/matrix/runs/sphere/{s}/level{k}.json"
+                       for s in ("cotan", "bgn") for k in (1, 2)}
+    assert not (work / "results").exists()
+
+
+def test_trimming_the_levels_reruns_no_run(tmp_path, env):
+    """A series' job params do not depend on its set of levels: after sphere 1-2,
+    asking for level 1 alone (or 1-2 again) plans no run, only the tables, and
+    names why in a few short lines."""
+    work = copy_workflow(tmp_path / "work")
+    one = "matrix={select: {schemes: [cotan], problems: {sphere: [1, 2]}}}"
+    code, out = snakemake(work, env, "--cores", "2", "matrix", "--config", one)
+    assert code == 0, out[-3000:]
+    for levels in ("[1]", "[1, 2]"):
+        code, out = snakemake(work, env, "-n", "--cores", "2", "matrix", "--config",
+                              one.replace("[1, 2]", levels))
+        assert code == 0, out[-3000:]
+        assert "matrix_run" not in out, out[-3000:]
+        assert max(map(len, out.splitlines())) < 1000
+    assert "Nothing to be done" in out
+
+
 def test_threads_setting_reaches_the_rules_and_the_records(tmp_path, env):
     work = copy_workflow(tmp_path / "work")
     out = subprocess.run(

@@ -189,3 +189,71 @@ def test_rows_in_the_browser_follow_pandas_sort(browser, page, tmp_path):
             moved += order != sorted(order)
     assert checked >= 2 * len(FRAGMENTS)
     assert moved >= 3  # not only tables that were already in order
+
+
+MEASURE = """<script>window.addEventListener("load", function () {
+  var d = document.documentElement, s = document.getElementById("summary").parentElement;
+  var out = {page: [d.scrollWidth, d.clientWidth], summary: [s.scrollWidth, s.clientWidth],
+    figures: Array.prototype.map.call(document.querySelectorAll("figure img"), function (i) {
+      return [i.alt, i.clientWidth]; })};
+  var p = document.createElement("pre"); p.id = "measured"; p.textContent = JSON.stringify(out);
+  document.body.appendChild(p); });</script></body>"""
+
+
+def _measure(browser, page_path, profile, width=1280):
+    """Widths in CSS px of the page at a ``width`` px window: ``page`` and ``summary``
+    (scroll width, client width: equal when nothing scrolls sideways), ``figures``
+    (name, shown width). Measured in a copy of the page with a probe script."""
+    import json
+    import re
+
+    probe = Path(page_path).with_name("probe.html")
+    probe.write_text(Path(page_path).read_text().replace("</body>", MEASURE))
+    proc = subprocess.run(
+        [browser, "--headless", "--disable-gpu", "--no-sandbox", "--no-first-run",
+         f"--user-data-dir={profile}", f"--window-size={width},900", "--dump-dom",
+         probe.as_uri()], capture_output=True, text=True, timeout=120, check=False)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    found = re.search(r'<pre id="measured">(.*?)</pre>', proc.stdout)
+    assert found, proc.stdout[-2000:]
+    return json.loads(found.group(1).replace("&quot;", '"'))
+
+
+def _longest_names(root, dest):
+    """A copy of the matrix folder whose tables carry the registry's longest scheme and
+    problem names and a long status (the widest summary the matrix can show)."""
+    import pandas as pd
+
+    from mcfbench.running.problems import PROBLEMS
+    from mcfbench.running.schemes import SCHEMES
+
+    shutil.copytree(root, dest)
+    scheme = max(SCHEMES, key=len) + "@bdf3"
+    problem = max(PROBLEMS, key=len)
+    for name in ("summary.csv", "matrix.csv"):
+        frame = pd.read_csv(dest / "tables" / name)
+        frame["scheme"] = frame["scheme"].replace({"ddfv": scheme})
+        frame["problem"] = frame["problem"].replace({"catenoid": problem})
+        frame.loc[frame.index[-1], "status"] = "solver_stagnated"
+        frame.to_csv(dest / "tables" / name, index=False)
+    write_matrix_page(dest, dest / "index.html")
+    return dest
+
+
+def test_summary_fits_a_laptop_and_figures_show_at_print_size(browser, page, tmp_path):
+    """At a 1280 px window: neither the page nor the summary table scrolls sideways
+    (also with the registry's longest names), and every figure is shown at print size
+    (96 px to the inch), so its text has the size it was drawn with, 8 pt at least
+    (tests/harness/studies/matrix/test_matrix.py checks the figures' fonts)."""
+    from mcfbench.studies.matrix.page import print_width
+
+    root, _ = page
+    for folder in (root, _longest_names(root, tmp_path / "longest")):
+        measured = _measure(browser, folder / "index.html", tmp_path / "profile")
+        assert measured["page"][0] <= measured["page"][1], measured
+        assert measured["summary"][0] <= measured["summary"][1], measured
+        assert 1100 <= measured["summary"][1] <= 1280, measured
+        shown = dict(measured["figures"])
+        assert set(shown) == {name for name, _ in PAGE_FIGURES}
+        for name, width in shown.items():
+            assert abs(width - print_width(folder / "figures" / f"{name}.png")) <= 1, (name, width)

@@ -74,11 +74,12 @@ for _problem, _levels in MATRIX["problems"].items():
         resources:
             mem_mb=1500,
             runtime=120,
+        # independent of the levels (each run's level is its record's): trimming
+        # or adding levels reruns no level already computed
         params:
-            settings=lambda wildcards, problem=_problem, levels=_levels: [
-                MATRIX_RUNS[_matrix.record_path(problem, wildcards.scheme, k)]
-                for k in levels
-            ],
+            series=lambda wildcards, problem=_problem: _matrix.series_settings(
+                MATRIX, wildcards.scheme, problem, MATRIX_CODE
+            ),
         script:
             "../scripts/matrix_run.py"
 
@@ -100,9 +101,11 @@ rule matrix_tables:
     resources:
         mem_mb=1500,
         runtime=10,
+    # the plan and the code digest, not the settings of every run (which the script
+    # makes from them): a changed matrix is named in a few lines, not hundreds
     params:
-        expected=MATRIX_RUNS,
         plan=MATRIX,
+        code=MATRIX_CODE,
     script:
         "../scripts/matrix_tables.py"
 
@@ -127,9 +130,8 @@ rule matrix_plots:
         mem_mb=2000,
         runtime=10,
     params:
-        expected=MATRIX_RUNS,
         plan=MATRIX,
-        pictures=_matrix.picture_runs(MATRIX),
+        code=MATRIX_CODE,
     script:
         "../scripts/matrix_plots.py"
 

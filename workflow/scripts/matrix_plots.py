@@ -9,6 +9,7 @@ import logging
 
 from mcfbench.storage.frames import load_frames
 from mcfbench.storage.records import read_record, read_records
+from mcfbench.studies.matrix.plan import picture_runs, planned_runs
 from mcfbench.studies.matrix.plots import (
     error_figure,
     picture_grid,
@@ -24,9 +25,9 @@ problems, schemes = list(plan["problems"]), plan["schemes"]
 table = read_long_table(sm.input.table)
 error_figure(table, [out.errors_png, out.errors_pdf], problems, schemes)
 work_precision_figure(table, [out.work_precision_png, out.work_precision_pdf], problems, schemes)
-quality_figure(list(read_records(sm.params.expected).values()), [out.quality_png, out.quality_pdf],
-               problems, schemes)
+records = read_records(planned_runs(plan, sm.params.code))
+quality_figure(list(records.values()), [out.quality_png, out.quality_pdf], problems, schemes)
 entries = {key: (read_record(record), load_frames(frames))
-           for key, (record, frames) in sm.params.pictures.items()}
+           for key, (record, frames) in picture_runs(plan).items()}
 picture_grid(entries, [out.pictures_png, out.pictures_pdf], problems, schemes)
 logging.info("wrote %s", ", ".join(out))

@@ -2,8 +2,9 @@
 record and first/last frame per level.
 
 Called by the rules ``matrix_run_{problem}`` (workflow/rules/matrix.smk); the
-settings of each run come from ``params.settings``
-(:func:`mcfbench.studies.matrix.run_settings`). The work is
+settings of the series come from ``params.series``
+(:func:`mcfbench.studies.matrix.plan.series_settings`), each run's level from
+its record path. The work is
 :func:`mcfbench.studies.matrix.series_job`.
 """
 
@@ -16,5 +17,5 @@ os.environ.update(dict.fromkeys((*BLAS_THREAD_VARIABLES, "NUMBA_NUM_THREADS"), "
 
 from mcfbench.studies.matrix import job as matrix_job  # noqa: E402
 
-matrix_job.series_job(snakemake.params.settings, snakemake.output.records,  # noqa: F821
+matrix_job.series_job(snakemake.params.series, snakemake.output.records,  # noqa: F821
                       snakemake.output.frames, snakemake.log[0])  # noqa: F821

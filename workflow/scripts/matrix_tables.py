@@ -10,9 +10,10 @@ import logging
 from pathlib import Path
 
 from mcfbench.studies.matrix.aggregate import aggregate
+from mcfbench.studies.matrix.plan import planned_runs
 
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, force=True)  # noqa: F821
-table, summary = aggregate(snakemake.params.expected, snakemake.params.plan,  # noqa: F821
+expected = planned_runs(snakemake.params.plan, snakemake.params.code)  # noqa: F821
+table, summary = aggregate(expected, snakemake.params.plan,  # noqa: F821
                            Path(snakemake.output[0]).parent)  # noqa: F821
-logging.info("%d runs, %d rows; summary:\n%s", len(snakemake.params.expected),  # noqa: F821
-             len(table), summary.to_string())
+logging.info("%d runs, %d rows; summary:\n%s", len(expected), len(table), summary.to_string())

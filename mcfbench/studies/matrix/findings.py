@@ -14,6 +14,7 @@ import numpy as np
 
 from mcfbench.studies.matrix import mesh_problems
 from mcfbench.studies.matrix.tables import (
+    levels_text,
     is_error,
     main_metric,
     read_long_table,
@@ -40,16 +41,25 @@ ROUNDOFF = 1e-10
 """An error at most this large on every finished level is exact up to round-off."""
 
 
-def _pct_or(value, metric):
-    """Relative metrics (``*relative*`` or the catenoid's neck) in percent."""
-    if "relative" in metric or metric.startswith("neck"):
-        return f"{100 * value:+.3g} %"
+NOISE_SECONDS = 0.01
+"""CPU times below this are at the noise level of the clock and the start-up: not ranked."""
+
+
+def _number(value):
+    """A metric's value as the tables show it (``tables.summary_cell``): one unit
+    per quantity, no percentages."""
     return f"{value:.3e}"
 
 
+def _seconds(value):
+    return f"{value:.3g} s" + (" (noise level)" if value < NOISE_SECONDS else "")
+
+
 def _classify(row):
-    """``order2``, ``converging``, ``not_converging``, ``exact`` (round-off),
-    ``broke_down`` or ``no_error``. A row whose runs broke down but whose error was
+    """``order2``, ``converging``, ``unsettled`` (a decreasing error outside the
+    order-2 band measured on two levels only: no order can be read from it),
+    ``not_converging``, ``one_level``, ``exact`` (round-off), ``broke_down`` or
+    ``no_error``. A row whose runs broke down but whose error was
     measured on every level before (the volume before a pinch) is judged by it."""
     values = [abs(float(v)) for v in str(row["values"]).split(";") if v]
     measured = row["error"] and sum(np.isfinite(v) for v in values) == row["runs"]
@@ -59,11 +69,14 @@ def _classify(row):
         return "no_error"
     if values and all(np.isfinite(v) and v <= ROUNDOFF for v in values):
         return "exact"
+    finished = sum(np.isfinite(v) for v in values)
     if not np.isfinite(row["eoc"]):
-        return "one_level" if sum(np.isfinite(v) for v in values) < 2 else "not_converging"
+        return "one_level" if finished < 2 else "not_converging"
     if ORDER_BAND[0] <= row["eoc"] <= ORDER_BAND[1]:
         return "order2"
-    return "converging" if row["eoc"] >= CONVERGING_EOC else "not_converging"
+    if row["eoc"] < CONVERGING_EOC:
+        return "not_converging"
+    return "unsettled" if finished == 2 else "converging"
 
 
 def cheapest_to_reach(table):
@@ -98,22 +111,28 @@ def cheapest_to_reach(table):
     return rows
 
 
-def work_precision_section(rows, labels=None):
-    """The work-precision verdicts of :func:`cheapest_to_reach` in words."""
-    labels = labels or {}
+def work_precision_section(rows):
+    """The work-precision verdicts of :func:`cheapest_to_reach` in words; CPU times
+    below :data:`NOISE_SECONDS` are marked, and a problem whose two cheapest runs are
+    both below it is not ranked."""
     lines = ["## Accuracy per CPU second", "",
              "To reach the error every scheme with a finite error reaches on a problem "
              "(the largest of their smallest errors), the cheapest run of each scheme, in CPU "
              "seconds on one core with the problem's solver rule for every scheme (the same "
-             "footing within a problem; `figures/work_precision.png`):", ""]
+             "footing within a problem; `figures/work_precision.png`). A time below "
+             f"{1000 * NOISE_SECONDS:.0f} ms is at the noise level of the clock and is not "
+             "ranked:", ""]
     for r in rows:
         costs = list(r["costs"].items())
         if not costs:
             continue
-        first, seconds = costs[0]
-        rest = ", ".join(f"{labels.get(s, s)} {c:.3g} s" for s, c in costs[1:])
-        lines.append(f"- {r['problem']} ({r['metric']} <= {r['target']:.3g}): "
-                     f"**{labels.get(first, first)}** is the cheapest, {seconds:.3g} s"
+        head = f"- {r['problem']} ({r['metric']} <= {_number(r['target'])}): "
+        if costs[min(1, len(costs) - 1)][1] < NOISE_SECONDS:
+            lines.append(head + "no ranking, the cheapest runs are at the noise level: "
+                         + ", ".join(f"{s} {_seconds(c)}" for s, c in costs) + ".")
+            continue
+        (first, seconds), rest = costs[0], ", ".join(f"{s} {_seconds(c)}" for s, c in costs[1:])
+        lines.append(head + f"**{first}** is the cheapest, {_seconds(seconds)}"
                      + (f" (then {rest})." if rest else "."))
     return lines + [""]
 
@@ -160,8 +179,46 @@ def scheme_view(summary):
     return summary
 
 
+def scope_lines(plan, all_schemes, all_problems, labels=None):
+    """What the matrix ran: full (every scheme and problem of the registries) or cut
+    down, at which levels, and the schemes' labels beside their registry names.
+
+    Parameters
+    ----------
+    plan : dict
+        :func:`mcfbench.studies.matrix.plan.plan` (``schemes``, ``problems``: name ->
+        levels, ``selected``).
+    all_schemes, all_problems : sequence of str
+        The registries' names.
+    labels : dict, optional
+        Scheme name -> label.
+    """
+    from mcfbench.running.schemes import split_name
+
+    labels = labels or {}
+    schemes, problems = list(plan["schemes"]), dict(plan["problems"])
+    base = {split_name(s)[0] for s in schemes}
+    full = (not plan.get("selected") and set(all_schemes) <= base
+            and set(all_problems) <= set(problems))
+    levels = "; ".join(f"{p} {levels_text(k)}" for p, k in problems.items())
+    if full:
+        text = (f"Scope: the full matrix, every scheme of the registry ({len(schemes)} with "
+                f"the other integrators) on every problem ({len(problems)}), at the levels "
+                f"{levels}.")
+    else:
+        text = (f"Scope: a cut-down matrix{' (`matrix.select`)' if plan.get('selected') else ''}"
+                f": {len(schemes)} scheme(s) ({', '.join(schemes)}; the registry has "
+                f"{len(all_schemes)}) on {len(problems)} of the {len(all_problems)} problems, "
+                f"at the levels {levels}. The verdicts and the recommendation below hold for "
+                "this selection only.")
+    named = [f"{s} ({labels[s]})" for s in schemes if labels.get(s) not in (None, s)]
+    return [text, ""] + (["Schemes are named as in the registry "
+                          "(`mcfbench.running.schemes.SCHEMES`), with their labels: "
+                          + ", ".join(named) + ".", ""] if named else [])
+
+
 def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summary.csv",
-                    work_precision=()):
+                    work_precision=(), scope=()):
     """The findings, Markdown, written from the summary table only.
 
     Parameters
@@ -174,8 +231,9 @@ def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summa
         The real-world-like problems (no refinement series).
     work_precision : list of dict
         :func:`cheapest_to_reach` of the long table (a section when given).
+    scope : list of str
+        :func:`scope_lines` (after the introduction).
     """
-    labels = labels or {}
     summary = scheme_view(summary)
     problems = list(dict.fromkeys(summary["problem"]))
     schemes = list(dict.fromkeys(summary["scheme"]))
@@ -183,7 +241,10 @@ def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summa
              f"Written by `mcfbench.studies.matrix.findings` from `{source}`: every number below "
              "is read from the tables, none typed by hand. Order ~2 means an EOC between "
              f"the two finest finished levels in [{ORDER_BAND[0]}, {ORDER_BAND[1]}]; an "
-             f"error with EOC below {CONVERGING_EOC} is not decreasing.", ""]
+             f"error with EOC below {CONVERGING_EOC} is not decreasing; an EOC from two "
+             "levels only settles no order and disqualifies no scheme. Values are "
+             "numbers as in the tables (a relative error too, not a percentage).", "",
+             *scope]
     verdict = {}
     lines += ["## Per problem", ""]
     for problem in problems:
@@ -200,19 +261,24 @@ def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summa
             verdict[(problem, r["scheme"])] = r
             name = f"**{r['scheme']}**"
             values = [float(v) if v else float("nan") for v in str(r["values"]).split(";")]
-            shown = ", ".join(_pct_or(v, metric) if np.isfinite(v) else "–" for v in values)
+            shown = ", ".join(_number(v) if np.isfinite(v) else "–" for v in values)
             eocs = str(r["eocs"]) if isinstance(r["eocs"], str) else ""
             if r["class"] == "order2":
-                text = (f"{name} converges at order ~2: EOC {r['eoc']:.2f} (levels "
-                        f"{r['eoc_levels']}), finest error {_pct_or(r['finest_value'], metric)}"
+                two = " from two levels only" if sum(np.isfinite(values)) == 2 else ""
+                text = (f"{name} converges at order ~2{two}: EOC {r['eoc']:.2f} (levels "
+                        f"{r['eoc_levels']}), finest error {_number(r['finest_value'])}"
                         f" (level {int(r['finest_level'])}); errors {shown}.")
             elif r["class"] == "converging":
                 text = (f"{name} converges at order {r['eoc']:.2f} (levels {r['eoc_levels']}),"
                         f" not ~2; errors {shown}.")
+            elif r["class"] == "unsettled":
+                text = (f"{name} converges, EOC {r['eoc']:.2f} (levels {r['eoc_levels']}): "
+                        f"from two levels only, the order is not settled; errors {shown}.")
             elif r["class"] == "not_converging":
                 text = (f"{name} does not converge: the error is not decreasing (EOCs "
                         f"{eocs.replace(';', ', ') or '–'}; errors {shown})")
-                ratio = abs(r["finest_value"]) / smallest if smallest > 0 else np.inf
+                ratio = abs(r["finest_value"]) / smallest if smallest > 0 else \
+                    np.inf if smallest == 0 else np.nan   # nan: no scheme finished
                 if ratio >= WRONG_LIMIT:
                     text += (f": it converges to another surface (finest error {ratio:.3g} x "
                              "the smallest of any scheme).")
@@ -243,7 +309,7 @@ def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summa
         lines += _common_floor(part, metric)
         lines.append("")
     if work_precision:
-        lines += work_precision_section(work_precision, labels)
+        lines += work_precision_section(work_precision)
     lines += recommendation(summary, verdict, problems, schemes, mesh_problems)
     solver = summary[summary["solver_only"] != ""] if "solver_only" in summary \
         else summary.iloc[:0]
@@ -287,8 +353,7 @@ def recommendation(summary, verdict, problems, schemes, mesh_problems):
     pinching torus) only inform: which scheme reaches the latest time.
     """
     mesh_problems = [p for p in problems if p in set(mesh_problems)]
-    exact = [p for p in problems if p not in mesh_problems
-             and bool(summary[summary["problem"] == p]["error"].any())]
+    exact = [p for p in problems if bool(summary[summary["problem"] == p]["error"].any())]
     singular = [p for p in problems if p not in exact and p not in mesh_problems]
     lines = ["## Across problems", ""]
     if not exact:
@@ -310,9 +375,9 @@ def recommendation(summary, verdict, problems, schemes, mesh_problems):
         lines.append("")
     winners = {}
     for p in exact:
-        good = [s for s in schemes if cls(p, s) in ("order2", "exact")] if needs_order2[p] \
-            else [s for s in schemes
-                  if cls(p, s) in ("converging", "not_converging", "exact", "one_level")]
+        good = [s for s in schemes if cls(p, s) in ORDER2_ENOUGH] if needs_order2[p] \
+            else [s for s in schemes if cls(p, s) in ("converging", "not_converging", "exact",
+                                                      "one_level", "unsettled")]
         if good:
             winners[p] = min(good, key=lambda s: abs(verdict[(p, s)]["finest_value"]))
     candidates, why_not = [], {}
@@ -324,12 +389,12 @@ def recommendation(summary, verdict, problems, schemes, mesh_problems):
                 reasons.append(f"not run on {p}")
             elif c == "broke_down":
                 reasons.append(f"broke down on {p}")
-            elif needs_order2[p] and c not in ("order2", "exact"):
+            elif needs_order2[p] and c not in ORDER2_ENOUGH:
                 eoc = verdict[(p, s)]["eoc"]
                 reasons.append(f"EOC {eoc:.2f} on {p}" if np.isfinite(eoc) else
                                f"no EOC on {p}")
         for p in mesh_problems:
-            if (p, s) in verdict and cls(p, s) == "broke_down":
+            if p not in exact and (p, s) in verdict and cls(p, s) == "broke_down":
                 reasons.append(f"broke down on {p}")
         if reasons:
             why_not[s] = reasons
@@ -368,7 +433,8 @@ def recommendation(summary, verdict, problems, schemes, mesh_problems):
             ", with the smallest finest-level error on every problem with an exact error."
             if not beaten else
             ", the smallest finest-level errors on average among them, though not on every "
-            "problem (smallest elsewhere: " + "; ".join(beaten) + ")."))
+            "problem (smallest elsewhere: " + "; ".join(beaten) + ").")
+            + _order_caveat(best, exact, cls, verdict, needs_order2))
     else:
         lines.append("**No scheme wins everywhere**: none converges as required on every "
                      "problem with an exact error without breaking down on a real-world-like "
@@ -399,16 +465,37 @@ def recommendation(summary, verdict, problems, schemes, mesh_problems):
     return lines + [""]
 
 
+ORDER2_ENOUGH = ("order2", "exact", "unsettled")
+"""Classes that meet the order-2 requirement of a problem where some scheme reaches it."""
+
+
+def _order_caveat(scheme, exact, cls, verdict, needs_order2):
+    """What the recommendation of ``scheme`` does not claim: its orders that are not ~2,
+    in the words of the per-problem verdicts."""
+    notes = []
+    for p in exact:
+        c, eoc = cls(p, scheme), verdict[(p, scheme)]["eoc"]
+        if c == "unsettled":
+            notes.append(f"EOC {eoc:.2f} on {p} from two levels only (the order is not settled)")
+        elif c in ("converging", "not_converging", "one_level"):
+            notes.append((f"EOC {eoc:.2f} on {p}, not ~2" if np.isfinite(eoc) else
+                          f"no EOC on {p}")
+                         + ("" if needs_order2[p] else " (no scheme reaches order ~2 there)"))
+    return (" It does not show order ~2 everywhere: " + "; ".join(notes) + ".") if notes else ""
+
+
 def findings(summary_csv, out, plan, long_csv=None):
     """``findings.md`` from ``summary.csv`` and, for the cost of accuracy, the long
     table ``matrix.csv`` (numbers from the tables only)."""
-    from mcfbench.running.schemes import scheme_label
+    from mcfbench.running.problems import PROBLEMS
+    from mcfbench.running.schemes import SCHEMES, scheme_label
     from mcfbench.storage.atomic import write_text
 
     summary = read_summary(summary_csv)
     labels = {s: scheme_label(s) for s in plan["schemes"]}
     costs = cheapest_to_reach(read_long_table(long_csv)) if long_csv else ()
     text = matrix_findings(summary, labels, mesh_problems(plan),
-                           source=Path(summary_csv).as_posix(), work_precision=costs)
+                           source=Path(summary_csv).as_posix(), work_precision=costs,
+                           scope=scope_lines(plan, list(SCHEMES), list(PROBLEMS), labels))
     write_text(out, text)
     return text

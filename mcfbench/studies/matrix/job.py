@@ -6,6 +6,7 @@ import logging
 
 from mcfbench.running.run import framed_run
 from mcfbench.storage.logs import setup_logging
+from mcfbench.studies.matrix.plan import level_of
 
 
 def job(settings, record, frames, log_path=None):
@@ -44,15 +45,20 @@ def job(settings, record, frames, log_path=None):
     return result
 
 
-def series_job(settings, records, frames, log_path=None):
+def series_job(series, records, frames, log_path=None):
     """The runs of one scheme on one problem's refinement series, coarsest first,
     each :func:`job` (its record and frames written as soon as it is done): the
     matrix's Snakemake job. One process per series instead of per run saves the
     start-up of every run but one (importing the harness and loading the compiled
     kernels, about 1 s each); a killed job redoes the whole series.
+
+    ``series`` is :func:`~mcfbench.studies.matrix.plan.series_settings`; the level of
+    each run is that of its record path, so that the job's params do not depend
+    on the set of levels.
     """
     setup_logging(log_path)
-    return [job(s, r, f) for s, r, f in zip(settings, records, frames, strict=True)]
+    return [job({**series, "level": level_of(r)}, r, f)
+            for r, f in zip(records, frames, strict=True)]
 
 
 def robust_rerun(settings, result, solver):

@@ -72,6 +72,18 @@ SUMMARY_COLUMNS = (
 )
 
 
+def print_width(png):
+    """The width of a PNG at print size in CSS pixels (96 to the inch), from the
+    resolution matplotlib wrote into it: the page shows a figure at this width, so
+    its text has the size in points it was drawn with
+    (:data:`mcfbench.presentation.plots.SMALLEST_TEXT` at least)."""
+    from PIL import Image
+
+    with Image.open(png) as image:
+        dpi = float(image.info.get("dpi", (96.0, 96.0))[0]) or 96.0
+        return round(image.width * 96.0 / dpi)
+
+
 def problem_runs(table, problem):
     """The runs of ``problem`` on its main metric: the rows of the long table
     (``matrix.csv``) in its order, index reset, and the metric's name."""
@@ -174,6 +186,7 @@ def matrix_page(matrix_dir, plan=None, title="Benchmark matrix: results"):
         path = root / "figures" / f"{name}.png"
         figures.append({"name": name, "caption": caption,
                         "src": data_uri(path) if path.is_file() else None,
+                        "width": print_width(path) if path.is_file() else None,
                         "path": f"figures/{name}.png"})
     findings = root / "findings.md"
     context = {

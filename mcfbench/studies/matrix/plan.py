@@ -2,6 +2,8 @@
 registries (:func:`plan`), the settings of one run (:func:`run_settings`) and the
 paths of its record and frames (:data:`mcfbench.studies.matrix.RECORD`)."""
 
+import re
+
 from mcfbench.studies.config import ConfigError
 from mcfbench.studies.matrix import FRAMES, RECORD, ROOT, is_mesh_problem
 
@@ -43,7 +45,10 @@ def plan(section=None, schemes=None, problems=None):
         not named runs at its registry levels, ``[]`` leaves it out),
         ``rtol``, ``maxiter``, ``solver`` (method of the refinement series),
         ``mesh_solver`` (method of the real-world-like meshes, ``"robust"``
-        = :func:`robust_method`).
+        = :func:`robust_method`), ``select`` (a cut-down matrix: ``schemes``,
+        exactly these, ``NAME@INTEGRATOR`` included, ``with_integrators`` then
+        adds none; ``problems``, problem -> levels, exactly these; either
+        omitted keeps the full matrix's).
     schemes, problems : dict, optional
         The registries (default :data:`~mcfbench.running.schemes.SCHEMES`,
         :data:`~mcfbench.running.problems.PROBLEMS`).
@@ -52,7 +57,8 @@ def plan(section=None, schemes=None, problems=None):
     -------
     dict
         ``schemes`` (list; those of ``with_integrators`` last), ``problems``
-        (name -> sorted levels, registry order), ``rtol``, ``maxiter``, ``solver``, ``mesh_solver``.
+        (name -> sorted levels, registry order), ``rtol``, ``maxiter``, ``solver``,
+        ``mesh_solver``, ``selected`` (whether ``select`` cut the matrix down).
 
     Raises
     ------
@@ -61,7 +67,7 @@ def plan(section=None, schemes=None, problems=None):
     """
     from mcfbench.running import solver as _solver
     from mcfbench.running.integrators import INTEGRATORS
-    from mcfbench.running.schemes import find_scheme, joined_name
+    from mcfbench.running.schemes import joined_name
 
     if schemes is None:
         from mcfbench.running.schemes import SCHEMES as schemes
@@ -80,22 +86,18 @@ def plan(section=None, schemes=None, problems=None):
                               f"{integrator!r}; choose one of "
                               f"{', '.join(i for i in INTEGRATORS if i != 'euler')}")
         stepped.update({joined_name(name, integrator): name for name in names})
-    unknown = [s for s in [*chosen, *stepped] if find_scheme(s, schemes) is None]
-    if unknown:
-        raise ConfigError(f"config key 'matrix.schemes': unknown scheme(s) {unknown}; the "
-                          f"registry mcfbench.running.schemes.SCHEMES has {list(schemes)}, "
-                          f"each also as NAME@INTEGRATOR ({', '.join(INTEGRATORS)})")
-    overrides = section.get("problems") or {}
-    unknown = [p for p in overrides if p not in problems]
-    if unknown:
-        raise ConfigError(f"config key 'matrix.problems': unknown problem(s) {unknown}; the "
-                          f"registry mcfbench.running.problems.PROBLEMS has {list(problems)}")
-    plan_problems = {}
-    for name, problem in problems.items():
-        levels = _levels(overrides[name], f"matrix.problems.{name}") if name in overrides \
-            else sorted(int(v) for v in problem.levels)
-        if levels:
-            plan_problems[name] = levels
+    select = section.get("select") or {}
+    if not isinstance(select, dict) or set(select) - {"schemes", "problems"}:
+        raise ConfigError(f"config key 'matrix.select': a mapping with the keys schemes "
+                          f"and problems, got {select!r}")
+    _check_schemes([*chosen, *stepped], "matrix.schemes", schemes)
+    if "schemes" in select:
+        chosen, stepped = _names(select["schemes"], "matrix.select.schemes"), {}
+        _check_schemes(chosen, "matrix.select.schemes", schemes)
+    plan_problems = _plan_problems(section.get("problems") or {}, "matrix.problems", problems)
+    if "problems" in select:
+        plan_problems = _plan_problems(select["problems"], "matrix.select.problems",
+                                       problems, only=True)
     if not plan_problems:
         raise ConfigError("config key 'matrix.problems': every problem is left out")
     methods = {}
@@ -115,7 +117,50 @@ def plan(section=None, schemes=None, problems=None):
     # another integrator only for the schemes that are run (`schemes` may list fewer)
     chosen = [*chosen, *(s for s, name in stepped.items() if name in chosen)]
     return {"schemes": list(chosen), "problems": plan_problems, "rtol": rtol,
-            "maxiter": maxiter, **methods}
+            "maxiter": maxiter, **methods, "selected": bool(select)}
+
+
+def _names(value, key):
+    if isinstance(value, str):
+        value = [value]
+    if not isinstance(value, (list, tuple)) or not value:
+        raise ConfigError(f"config key {key!r}: a non-empty list of scheme names, got {value!r}")
+    return list(dict.fromkeys(value))
+
+
+def _check_schemes(names, key, schemes):
+    from mcfbench.running.integrators import INTEGRATORS
+    from mcfbench.running.schemes import find_scheme
+
+    unknown = [s for s in names if find_scheme(s, schemes) is None]
+    if unknown:
+        raise ConfigError(f"config key {key!r}: unknown scheme(s) {unknown}; the "
+                          f"registry mcfbench.running.schemes.SCHEMES has {list(schemes)}, "
+                          f"each also as NAME@INTEGRATOR ({', '.join(INTEGRATORS)})")
+
+
+def _plan_problems(levels, key, problems, only=False):
+    """Problem -> sorted levels in registry order: those of ``levels``, and with
+    ``only=False`` every other problem at its registry levels (``[]`` leaves one out)."""
+    if not isinstance(levels, dict):
+        raise ConfigError(f"config key {key!r}: a mapping problem -> levels, got {levels!r}")
+    unknown = [p for p in levels if p not in problems]
+    if unknown:
+        raise ConfigError(f"config key {key!r}: unknown problem(s) {unknown}; the "
+                          f"registry mcfbench.running.problems.PROBLEMS has {list(problems)}")
+    planned = {}
+    for name, problem in problems.items():
+        if name in levels:
+            chosen = _levels(levels[name], f"{key}.{name}")
+            if only and not chosen:
+                raise ConfigError(f"config key '{key}.{name}': no levels; name at least one")
+        elif only:
+            continue
+        else:
+            chosen = sorted(int(v) for v in problem.levels)
+        if chosen:
+            planned[name] = chosen
+    return planned
 
 
 def solver_method(plan, problem):
@@ -134,12 +179,27 @@ def frames_path(problem, scheme, level, root=ROOT):
     return FRAMES.format(root=root, problem=problem, scheme=scheme, level=level)
 
 
-def run_settings(plan, scheme, problem, level, code=""):
-    """Everything that determines the record of one run of the matrix."""
-    return {"study": "matrix", "scheme": scheme, "problem": problem, "level": int(level),
+def series_settings(plan, scheme, problem, code=""):
+    """What determines every record of one scheme's series on ``problem`` but the
+    level: the params of its Snakemake job, so that adding or removing levels does
+    not rerun the levels already computed."""
+    return {"study": "matrix", "scheme": scheme, "problem": problem,
             "solver": {"method": solver_method(plan, problem), "rtol": plan["rtol"],
                        "maxiter": plan["maxiter"]},
             "code": code}
+
+
+def run_settings(plan, scheme, problem, level, code=""):
+    """Everything that determines the record of one run of the matrix."""
+    return {**series_settings(plan, scheme, problem, code), "level": int(level)}
+
+
+def level_of(record):
+    """The level of a run from its record path (:func:`record_path`)."""
+    match = re.search(r"/level(\d+)\.json$", str(record))
+    if match is None:
+        raise ValueError(f"{record}: not a matrix record path (.../level<k>.json)")
+    return int(match.group(1))
 
 
 def planned_runs(plan, code="", root=ROOT):

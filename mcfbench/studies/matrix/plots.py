@@ -19,14 +19,16 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from mcfbench.presentation.picture_grid import draw_grid, frame_surface, run_note  # noqa: E402
+from mcfbench.presentation.plots import SMALLEST_TEXT  # noqa: E402
 from mcfbench.presentation.plots import style as scheme_style  # noqa: E402
 from mcfbench.storage.atomic import save_figure  # noqa: E402
 from mcfbench.studies.matrix.tables import is_error, main_metric  # noqa: E402
 
 T_FLOOR = -0.5
 """Lower limit of the T monitor axes (values below are clipped and noted)."""
-PER_ROW = 4
-"""Panels per row of the error and quality figures."""
+PER_ROW = 3
+"""Panels per row of the error and quality figures: 3 x 3.4 in, within a laptop's
+column (about 12.4 in at 1280 px) at print size."""
 VIEWS = {"catenoid": (15.0, -60.0), "hemisphere": (25.0, -60.0)}
 """View (elev, azim) of the pictures per problem (default ``(20, -60)``)."""
 
@@ -47,8 +49,8 @@ def _legend(fig, schemes):
     for scheme in schemes:
         label, style = scheme_style(scheme)
         handles.append(Line2D([], [], label=label, **style))
-    fig.legend(handles=handles, loc="lower center", ncol=min(4, len(handles)), fontsize=8,
-               frameon=False)
+    fig.legend(handles=handles, loc="lower center", ncol=min(4, len(handles)),
+               fontsize=SMALLEST_TEXT, frameon=False)
 
 
 def _log_axis(axis):
@@ -105,7 +107,7 @@ def error_figure(table, paths, problems=None, schemes=None):
                 for anchor in (ys[xs == xs.min()].min(), ys[xs == xs.min()].max()):
                     ax.plot(h, anchor * (h / h[0]) ** 2, color="0.6", lw=0.8, ls=":")
                 ax.text(h[1], ys[xs == xs.min()].max() * (h[1] / h[0]) ** 2, "slope 2",
-                        fontsize=7, color="0.4", ha="right", va="bottom")
+                        fontsize=SMALLEST_TEXT, color="0.4", ha="right", va="bottom")
         if error and points:
             ax.set_yscale("log")
             _log_axis(ax.yaxis)
@@ -118,7 +120,7 @@ def error_figure(table, paths, problems=None, schemes=None):
             notes.append("error 0 (exact): " + ", ".join(exact))
         if notes:
             ax.text(0.02, 0.98, "\n".join(_wrap(n) for n in notes), transform=ax.transAxes,
-                    ha="left", va="top", fontsize=5.5, color="0.2",
+                    ha="left", va="top", fontsize=SMALLEST_TEXT, color="0.2",
                     bbox={"fc": "white", "ec": "0.8", "alpha": 0.85, "pad": 1.5})
         ax.set_xlabel("h (mean edge length)")
         ax.set_ylabel(f"|{metric}|" if error else "time reached (breakdown)")
@@ -182,7 +184,7 @@ def work_precision_figure(table, paths, problems=None, schemes=None):
     return drawn
 
 
-def _wrap(text, width=48):
+def _wrap(text, width=40):
     import textwrap
 
     return "\n".join(textwrap.wrap(text, width))
@@ -236,7 +238,8 @@ def quality_figure(records, paths, problems=None, schemes=None):
         if lows and min(lows) < T_FLOOR:  # a T-vertex far outside: keep 0 readable
             bottom.set_ylim(T_FLOOR, 0.36)
             bottom.text(0.98, 0.02, f"clipped at {T_FLOOR} (lowest {min(lows):.3g})",
-                        transform=bottom.transAxes, ha="right", va="bottom", fontsize=6)
+                        transform=bottom.transAxes, ha="right", va="bottom",
+                        fontsize=SMALLEST_TEXT)
         bottom.set_xlabel("t")
         for ax in (top, bottom):
             ax.grid(True, lw=0.3, alpha=0.5)

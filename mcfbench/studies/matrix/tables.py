@@ -182,7 +182,8 @@ def format_or_missing(x, spec=".3e", none="–"):
     return format(x, spec)
 
 
-def _levels_text(levels):
+def levels_text(levels):
+    """``"1-5"`` for consecutive levels, else ``"1, 3"``."""
     levels = sorted(int(v) for v in levels)
     if len(levels) > 2 and levels == list(range(levels[0], levels[-1] + 1)):
         return f"{levels[0]}-{levels[-1]}"
@@ -245,7 +246,7 @@ def summary_table(table, problems=None, schemes=None):
             first_fail = failed.iloc[0] if len(failed) else None
             rows.append({
                 "problem": problem, "scheme": scheme, "metric": metric,
-                "error": is_error(metric), "levels": _levels_text(runs["level"]),
+                "error": is_error(metric), "levels": levels_text(runs["level"]),
                 "runs": len(runs), "runs_ok": len(ok),
                 "eoc": np.nan if last_eoc is None else last_eoc["eoc"],
                 "eoc_levels": "" if last_eoc is None else

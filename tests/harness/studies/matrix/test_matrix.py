@@ -62,11 +62,48 @@ def test_plan_adds_other_integrators_only_to_the_schemes_run():
         matrix_plan.plan({"schemes": ["bgn"], "with_integrators": {"bdf2": ["cotn"]}})
 
 
+def test_select_runs_exactly_the_named_schemes_problems_and_levels():
+    """`matrix.select` cuts the matrix down to what it names, whatever the rest of
+    the section (Snakemake merges --config into config.yaml's section)."""
+    full = {"schemes": "all", "with_integrators": {"bdf2": ["cotan"]},
+            "problems": {"sphere": [1, 2, 3, 4, 5], "torus": [1, 2]}}
+    plan = matrix_plan.plan({**full, "select": {"schemes": ["cotan", "bgn@bdf2"],
+                                                "problems": {"torus": [2], "sphere": ["1", 2]}}})
+    assert plan["schemes"] == ["cotan", "bgn@bdf2"]          # no cotan@bdf2 added
+    assert plan["problems"] == {"sphere": [1, 2], "torus": [2]}   # registry order
+    assert plan["selected"] and not matrix_plan.plan(full)["selected"]
+    runs = matrix_plan.planned_runs(plan)
+    assert len(runs) == 2 * 3
+    # either key alone keeps the full matrix's other one
+    only_sphere = matrix_plan.plan({**full, "select": {"problems": {"sphere": [1]}}})
+    assert only_sphere["schemes"] == [*SCHEMES, "cotan@bdf2"]
+    assert only_sphere["problems"] == {"sphere": [1]}
+    assert matrix_plan.plan({**full, "select": {"schemes": ["bgn"]}})["problems"] == \
+        matrix_plan.plan(full)["problems"]
+
+
+def test_run_settings_do_not_depend_on_the_other_levels():
+    """A Snakemake job's params are its series' settings without the level, so that
+    trimming levels reruns none already computed."""
+    wide = matrix_plan.plan({"select": {"problems": {"sphere": [1, 2, 3]}}})
+    narrow = matrix_plan.plan({"select": {"problems": {"sphere": [1]}}})
+    path = matrix_plan.record_path("sphere", "cotan", 1)
+    assert matrix_plan.planned_runs(wide)[path] == matrix_plan.planned_runs(narrow)[path]
+    assert matrix_plan.level_of(path) == 1
+    assert matrix_plan.run_settings(wide, "cotan", "sphere", 3) == \
+        {**matrix_plan.series_settings(narrow, "cotan", "sphere"), "level": 3}
+
+
 @pytest.mark.parametrize("section, key", [
     ({"schemes": ["ddfv", "nope"]}, "matrix.schemes"),
     ({"problems": {"spere": [1]}}, "matrix.problems"),
     ({"problems": {"sphere": [0]}}, "matrix.problems.sphere"),
     ({"solver": "gmres"}, "matrix.solver"),
+    ({"select": {"schemes": ["fem"]}}, "matrix.select.schemes"),
+    ({"select": {"problems": {"spere": [1]}}}, "matrix.select.problems"),
+    ({"select": {"problems": {"sphere": []}}}, "matrix.select.problems.sphere"),
+    ({"select": {"problems": ["sphere"]}}, "matrix.select.problems"),
+    ({"select": {"levels": [1]}}, "matrix.select"),
 ])
 def test_plan_names_the_bad_key(section, key):
     with pytest.raises(ConfigError, match=key.replace(".", r"\.")):
@@ -379,8 +416,94 @@ def test_cheapest_to_reach_reads_the_long_table():
     (verdict,) = cheapest_to_reach(table)
     assert verdict["target"] == 2.5e-3                    # a's smallest error; b reaches it too
     assert verdict["costs"] == {"a": 4.0, "b": 9.0}
-    text = "\n".join(work_precision_section([verdict], {"a": "A"}))
-    assert "**A** is the cheapest, 4 s (then b 9 s)" in text
+    text = "\n".join(work_precision_section([verdict]))
+    assert "sphere (l2_error <= 2.500e-03): **a** is the cheapest, 4 s (then b 9 s)." in text
+
+
+# ------------------------------------------------------------ findings that read straight (#33)
+
+
+def _summary(rows, problem="sphere", metric="l2_error"):
+    """The summary of synthetic runs: ``{scheme: [error per level 1, 2, ...]}``."""
+    return matrix_tables.summary_table(matrix_tables.long_table(
+        [_record(s, problem, k + 1, e, metric=metric) for s, es in rows.items()
+         for k, e in enumerate(es)]))
+
+
+def test_findings_state_their_scope():
+    registry_schemes, registry_problems = ["cotan", "bgn", "ddfv"], ["sphere", "torus"]
+    cut = {"schemes": ["cotan", "bgn"], "problems": {"sphere": [1, 2]}, "selected": True}
+    text = " ".join(matrix_findings.scope_lines(cut, registry_schemes, registry_problems,
+                                                {"cotan": "cotangent", "bgn": "bgn"}))
+    assert text.startswith("Scope: a cut-down matrix (`matrix.select`): 2 scheme(s) (cotan, "
+                           "bgn; the registry has 3) on 1 of the 2 problems, at the levels "
+                           "sphere 1, 2.")
+    assert "cotan (cotangent)." in text and "bgn (bgn)" not in text  # a label only where it adds
+    full = {"schemes": ["cotan", "bgn", "ddfv", "cotan@bdf2"],
+            "problems": {"sphere": [1, 2, 3], "torus": [1]}}
+    text = " ".join(matrix_findings.scope_lines(full, registry_schemes, registry_problems))
+    assert text.startswith("Scope: the full matrix, every scheme of the registry (4 with the "
+                           "other integrators) on every problem (2), at the levels sphere 1-3; "
+                           "torus 1.")
+    summary = _summary({"cotan": [1e-2, 2.5e-3]})
+    assert "Scope: the full" in matrix_findings.matrix_findings(
+        summary, scope=matrix_findings.scope_lines(full, registry_schemes, registry_problems))
+
+
+def test_every_problem_with_an_exact_error_is_listed_even_a_real_world_like_one():
+    summary = pd.concat([_summary({"a": [1e-2, 2.5e-3, 6e-4]}),
+                         _summary({"a": [2e-2, 5e-3, 1.2e-3]}, problem="perturbed_sphere")])
+    text = matrix_findings.matrix_findings(summary, mesh_problems=["perturbed_sphere"])
+    assert "Problems with an exact error: sphere, perturbed_sphere." in text
+    assert "Real-world-like meshes (a breakdown disqualifies): perturbed_sphere." in text
+
+
+def test_a_recommendation_never_hides_an_order_the_verdicts_call_off():
+    """On the torus no scheme reaches order ~2, so b (EOC 1.58 there) may still win, but
+    the recommendation says what the torus verdict says."""
+    summary = pd.concat([_summary({"b": [1e-2, 2.5e-3, 6.25e-4], "c": [3e-2, 7.5e-3, 1.9e-3]}),
+                         _summary({"b": [1e-2, 5e-3, 1.67e-3], "c": [1e-2, 6e-3, 3e-3]},
+                                  problem="torus", metric="volume_error")])
+    text = matrix_findings.matrix_findings(summary)
+    assert "**b** converges at order 1.58 (levels 2-3), not ~2" in text
+    assert "**Recommendation: b**" in text
+    assert ("It does not show order ~2 everywhere: EOC 1.58 on torus, not ~2 (no scheme "
+            "reaches order ~2 there).") in text
+
+
+def test_an_eoc_from_two_levels_does_not_disqualify():
+    """a: EOC 2.0 on the sphere; b: EOC 2.6 on the sphere from two levels only."""
+    summary = _summary({"a": [1e-2, 2.5e-3], "b": [6e-3, 1e-3]})
+    text = matrix_findings.matrix_findings(summary)
+    assert "**b** converges, EOC 2.58 (levels 1-2): from two levels only, the order is " \
+           "not settled" in text
+    assert "Left out" not in text
+    assert "**a** converges at order ~2 from two levels only: EOC 2.00" in text
+    assert "**Recommendation: b**" in text
+    assert "EOC 2.58 on sphere from two levels only (the order is not settled)" in text
+    three = _summary({"a": [4e-2, 1e-2, 2.5e-3], "b": [3.6e-2, 6e-3, 1e-3]})
+    text = matrix_findings.matrix_findings(three)           # three levels: it counts
+    assert "Left out: b (EOC 2.58 on sphere)." in text and "**Recommendation: a**" in text
+
+
+def test_findings_show_values_as_the_tables_do():
+    """A relative error is a number, as in the summary table, never a percentage."""
+    summary = _summary({"a": [-3.2e-2, -8.424e-4]}, problem="catenoid", metric="neck_error")
+    text = matrix_findings.matrix_findings(summary)
+    assert "-8.424e-04" in text and matrix_tables.summary_cell(summary.iloc[0]).count("-8.424e-04")
+    assert "%" not in text.split("## Across problems")[0].split("## Per problem")[1]
+
+
+def test_noise_level_timings_are_marked_and_not_ranked():
+    fast = {"problem": "sphere", "metric": "l2_error", "target": 1e-3,
+            "costs": {"cotan": 0.0045, "bgn": 0.0061, "ddfv": 0.5}}
+    text = "\n".join(matrix_findings.work_precision_section([fast]))
+    assert "no ranking, the cheapest runs are at the noise level: cotan 0.0045 s (noise " \
+           "level), bgn 0.0061 s (noise level), ddfv 0.5 s." in text
+    assert "**" not in text.split("ranked:")[1]
+    one_fast = {**fast, "costs": {"cotan": 0.0045, "ddfv": 0.5}}
+    assert "**cotan** is the cheapest, 0.0045 s (noise level) (then ddfv 0.5 s)." in \
+        "\n".join(matrix_findings.work_precision_section([one_fast]))
 
 
 def test_series_job_writes_every_level_and_logs_to_one_file(tmp_path):
@@ -392,7 +515,9 @@ def test_series_job_writes_every_level_and_logs_to_one_file(tmp_path):
     records = list(runs)
     frames = [r.replace("/runs/", "/frames/").removesuffix(".json") + ".npz" for r in records]
     log = tmp_path / "series.log"
-    results = matrix_job.series_job(list(runs.values()), records, frames, log)
+    series = matrix_plan.series_settings(plan, "cotan", "sphere", code="test")
+    results = matrix_job.series_job(series, records, frames, log)
+    assert [read_record(r)["settings"] for r in records] == list(runs.values())
     assert [r.level for r in results] == [1, 2] and all(r.status == "ok" for r in results)
     one = tmp_path / "one.json"
     matrix_job.job(runs[records[1]], one, tmp_path / "one.npz")
@@ -425,3 +550,47 @@ def test_a_pinch_after_the_measurement_is_judged_by_the_measured_error():
            "eoc": 1.84}
     assert classify_row(row) == "order2"
     assert classify_row({**row, "values": "0.164;0.0463"}) == "broke_down"
+
+
+def test_figures_fit_a_laptop_column_with_text_of_8_pt_at_least(monkeypatch, tmp_path):
+    """Every problem of the registry, two schemes (one of them breaking down, so the
+    notes are drawn): the error, work-precision and quality figures are at most
+    12.4 in wide (a 1280 px page's column at print size, as the page shows them) and
+    no visible text is below SMALLEST_TEXT points."""
+    from matplotlib.text import Text
+
+    from mcfbench.presentation.plots import SMALLEST_TEXT
+    from mcfbench.studies.matrix import plots
+
+    figures = []
+    monkeypatch.setattr(plots, "save_figure", lambda fig, *paths: figures.append(fig))
+    records = []
+    for problem, entry in PROBLEMS.items():
+        metric = matrix_tables.main_metric(problem, [
+            m for o in entry.metrics for m in matrix_tables.MAIN_METRICS.get(o, ())] or ["area"])
+        for scheme, c in (("cotan", 1.0), ("ddfv", 2.0)):
+            for k in (1, 2):
+                broke = scheme == "ddfv" and k == 2
+                r = _record(scheme, problem, k, float("nan") if broke else c * 4.0 ** -k,
+                            status="inverted" if broke else "ok",
+                            t_failed=0.01 if broke else float("nan"), metric=metric)
+                r["series"] = {"t": [0.0, 0.01], "t_min_barycentric": [0.3, -0.9],
+                               "quality_t": [0.0, 0.01], "min_angle": [30.0, 20.0]}
+                records.append(r)
+    table = matrix_tables.long_table(records)
+    problems, schemes = list(PROBLEMS), ["cotan", "ddfv"]
+    plots.error_figure(table, [tmp_path / "e.png"], problems, schemes)
+    plots.work_precision_figure(table, [tmp_path / "w.png"], problems, schemes)
+    plots.quality_figure(records, [tmp_path / "q.png"], problems, schemes)
+    assert len(figures) == 3
+    for fig in figures:
+        assert fig.get_size_inches()[0] <= 1190 / 96, fig.get_suptitle()
+        fig.canvas.draw()
+        sizes = [t.get_fontsize() for t in fig.findobj(Text)
+                 if t.get_visible() and t.get_text().strip()]
+        assert sizes and min(sizes) >= SMALLEST_TEXT, (fig.get_suptitle(), min(sizes))
+        texts = " ".join(t.get_text() for t in fig.findobj(Text))
+        if "main metric" in fig.get_suptitle():
+            assert "slope 2" in texts and "broke down: " in texts
+        if "quality" in fig.get_suptitle():
+            assert "clipped at -0.5" in texts
