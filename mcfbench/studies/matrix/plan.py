@@ -18,7 +18,9 @@ def robust_method():
     return ROBUST
 
 
-def _levels(value, key):
+def _levels(value, key, first=1):
+    """Sorted whole levels, none below ``first`` (the problem's first level: 0 for
+    the real meshes, whose level 0 is the mesh itself, 1 for the others)."""
     if value is None:
         return None
     if not isinstance(value, (list, tuple)):
@@ -28,8 +30,8 @@ def _levels(value, key):
     except (TypeError, ValueError):
         raise ConfigError(f"config key {key!r}: levels must be whole numbers, got "
                           f"{value!r}") from None
-    if any(level < 1 for level in levels):
-        raise ConfigError(f"config key {key!r}: levels start at 1, got {value!r}")
+    if any(level < first for level in levels):
+        raise ConfigError(f"config key {key!r}: levels start at {first}, got {value!r}")
     return levels
 
 
@@ -151,7 +153,7 @@ def _plan_problems(levels, key, problems, only=False):
     planned = {}
     for name, problem in problems.items():
         if name in levels:
-            chosen = _levels(levels[name], f"{key}.{name}")
+            chosen = _levels(levels[name], f"{key}.{name}", min(problem.levels))
             if only and not chosen:
                 raise ConfigError(f"config key '{key}.{name}': no levels; name at least one")
         elif only:
