@@ -66,8 +66,14 @@ def is_mesh_problem(problem):
 
 
 REAL_WORLD_SURFACES = ("blobby", "implicit_torus", "perturbed_sphere", "remeshed_sphere",
-                       "anisotropic_sphere", "flat_patch")
-"""Surfaces of :mod:`mcfbench.geometry.surfaces` that imitate meshes from the real world."""
+                       "anisotropic_sphere", "flat_patch", "real_mesh")
+"""Surfaces of :mod:`mcfbench.geometry.surfaces` that imitate meshes from the real world,
+and ``real_mesh``: the committed real meshes (:mod:`mcfbench.running.real_mesh_problems`)."""
+
+
+def is_real_mesh(problem):
+    """One of the committed real meshes with its reference answers."""
+    return getattr(problem, "surface", "") == "real_mesh"
 
 
 def is_real_world(problem):

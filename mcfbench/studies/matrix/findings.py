@@ -310,6 +310,7 @@ def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summa
         lines.append("")
     if work_precision:
         lines += work_precision_section(work_precision)
+    lines += real_mesh_section(summary, verdict, problems, schemes)
     lines += recommendation(summary, verdict, problems, schemes, mesh_problems)
     solver = summary[summary["solver_only"] != ""] if "solver_only" in summary \
         else summary.iloc[:0]
@@ -339,6 +340,38 @@ def _common_floor(part, metric):
                 f"({values.min():.3e} to {values.max():.3e}): an error floor common to all "
                 "schemes (the problem's stopping rule or time error), not a property of one "
                 "scheme."]
+
+
+def real_mesh_section(summary, verdict, problems, schemes):
+    """The section "On the real meshes": per scheme, on how many of the committed real
+    meshes it reached the final time on every level, and the median magnitude of its
+    finest-level error against the references there (the real meshes also count as
+    real-world-like meshes in the recommendation: a breakdown there disqualifies)."""
+    from mcfbench.running.problems import get_problem
+    from mcfbench.studies.matrix import is_real_mesh
+
+    real = [p for p in problems if is_real_mesh(get_problem(p))]
+    if not real:
+        return []
+    lines = ["## On the real meshes", "",
+             f"The committed real meshes run ({', '.join(real)}; references from the "
+             "finest levels of two schemes, `mcfbench/data/meshes/README.md`): per scheme, "
+             "the meshes on which it reached the final time on every level, and the median "
+             "magnitude of its finest-level error there.", ""]
+    for s in schemes:
+        rows = [verdict[(p, s)] for p in real if (p, s) in verdict]
+        if not rows:
+            continue
+        done = [r for r in rows if r["runs_ok"] == r["runs"]]
+        errors = [abs(r["finest_value"]) for r in done if np.isfinite(r["finest_value"])]
+        broke = [f"{r['problem']}" for r in rows if r["runs_ok"] < r["runs"]]
+        text = f"- **{s}**: {len(done)} of {len(rows)}"
+        if errors:
+            text += f", median error {_number(float(np.median(errors)))}"
+        if broke:
+            text += f"; broke down on {', '.join(broke)}"
+        lines.append(text + ".")
+    return lines + [""]
 
 
 def recommendation(summary, verdict, problems, schemes, mesh_problems):

@@ -594,3 +594,21 @@ def test_figures_fit_a_laptop_column_with_text_of_8_pt_at_least(monkeypatch, tmp
             assert "slope 2" in texts and "broke down: " in texts
         if "quality" in fig.get_suptitle():
             assert "clipped at -0.5" in texts
+
+
+def test_the_real_meshes_get_a_survival_count_and_a_breakdown_there_disqualifies():
+    """#28: per scheme, on how many real meshes it reached the final time, its median
+    error there; a breakdown on a real mesh leaves the scheme out of the recommendation."""
+    records = [_record("a", p, k + 1, e, metric="area_error")
+               for p in ("real_nut", "real_spot") for k, e in enumerate([8e-2, 2e-2])]
+    records += [_record("b", "real_nut", 1, 6e-2, metric="area_error"),
+                _record("b", "real_nut", 2, 1.5e-2, metric="area_error"),
+                _record("b", "real_spot", 1, 7e-3, metric="area_error"),
+                _record("b", "real_spot", 2, float("nan"), "inverted", 0.001,
+                        metric="area_error")]
+    summary = matrix_tables.summary_table(matrix_tables.long_table(records))
+    text = matrix_findings.matrix_findings(summary, mesh_problems=["real_nut", "real_spot"])
+    section = text.split("## On the real meshes")[1].split("## ")[0]
+    assert "- **a**: 2 of 2, median error 2.000e-02." in section
+    assert "- **b**: 1 of 2, median error 1.500e-02; broke down on real_spot." in section
+    assert "**Recommendation: a**" in text and "b (broke down on real_spot)" in text
