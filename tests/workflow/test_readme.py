@@ -32,7 +32,7 @@ def commands():
 def test_the_readme_has_the_two_quick_start_commands_and_ci_runs_the_second():
     found = commands()
     assert found[:2] == [f'{INSTALL}. && snakemake --cores 2',
-                         f'{INSTALL}".[test]" && python -m pytest']
+                         f'{INSTALL}".[test]" && python -m pytest -n 2']
     assert found[1] in (ROOT / ".ci" / "run").read_text().splitlines()
 
 
