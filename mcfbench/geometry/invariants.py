@@ -138,8 +138,9 @@ class FlowInvariants:
         were not at step 0, of the state ``vertices`` (n, 3): one compiled pass over
         the triangles and one over the pairs of edge-neighbours."""
         V = np.ascontiguousarray(vertices, dtype=np.float64)
-        area, tangent, folded = _kernel()(V, self.faces, *self.neighbours, self._skip,
-                                          self._work)
+        N, R, S = self._work
+        area, tangent = _kernel()(V, self.faces, N)
+        folded = folds_kernel()(N, *self.neighbours, self._skip, R, S)
         return float(area), float(np.degrees(np.arctan(tangent))), int(folded)
 
     def _folded(self, V):
@@ -169,26 +170,22 @@ _KERNEL = None
 
 
 def _kernel():
-    """The compiled passes of :meth:`FlowInvariants.measure` (numba imported and the
-    kernel loaded from its cache on first use)."""
+    """The compiled pass of :meth:`FlowInvariants.measure` over the triangles (numba
+    imported and the kernel loaded from its cache on first use); the fold count is
+    :func:`folds_kernel`, shared with the quality monitor."""
     global _KERNEL
     if _KERNEL is not None:
         return _KERNEL
     import numba
 
     @numba.njit(cache=True, nogil=True, error_model="numpy")
-    def invariants_kernel(V, F, t1, t2, skip, work):
-        """Total area; the smallest tangent of the smallest angles of the triangles
-        (the smallest angle of a triangle, opposite its shortest side, is at most 60
-        degrees, so its tangent ``|u x v| / (u . v)`` is increasing in it); the
-        number of triangles ``t`` with ``skip[t] == 0`` whose normal ``n_t = (b - a) x
-        (c - a)`` has ``n_t . sum_s n_s < 0`` over its edge-neighbours ``s``
-        (``work[0]``: the normals, ``work[1]``, ``work[2]``: the sums). NaN
+    def invariants_kernel(V, F, N):
+        """Total area and the smallest tangent of the smallest angles of the
+        triangles (the smallest angle of a triangle, opposite its shortest side, is
+        at most 60 degrees, so its tangent ``|u x v| / (u . v)`` is increasing in
+        it); ``N[t]``: the normal ``(b - a) x (c - a)`` of triangle ``t``. NaN
         propagates to the area and the tangent."""
         m = F.shape[0]
-        N = work[0]
-        R = work[1]
-        S = work[2]
         area = 0.0
         tangent = np.inf
         for t in range(m):
@@ -218,6 +215,30 @@ def _kernel():
             tan = twice / dot if dot > 0 else (0.0 if twice == twice else twice)
             if tangent == tangent and (tan < tangent or tan != tan):
                 tangent = tan
+        return area, tangent
+
+    _KERNEL = invariants_kernel
+    return _KERNEL
+
+
+_FOLDS = None
+
+
+def folds_kernel():
+    """The compiled fold count of :class:`FlowInvariants` and of the quality monitor
+    :func:`mcfbench.geometry.metrics.quality` (numba imported and the kernel loaded from
+    its cache on first use)."""
+    global _FOLDS
+    if _FOLDS is not None:
+        return _FOLDS
+    import numba
+
+    @numba.njit(cache=True, nogil=True, error_model="numpy")
+    def count_folds(N, t1, t2, skip, R, S):
+        """Number of triangles ``t`` with ``skip[t] == 0`` whose normal ``N[t]`` has
+        ``N_t . sum_s N_s < 0`` over its edge-neighbours ``s`` (the pairs ``t1, t2``);
+        the sums accumulated like ``np.bincount(t1, N[t2]) + np.bincount(t2, N[t1])``
+        into the scratch ``R``, ``S`` (m, 3)."""
         R[:, :] = 0.0
         S[:, :] = 0.0
         for k in range(t1.shape[0]):
@@ -229,12 +250,12 @@ def _kernel():
             S[q, 1] += N[p, 1]
             S[q, 2] += N[p, 2]
         folded = 0
-        for t in range(m):
-            d = N[t, 0] * (R[t, 0] + S[t, 0]) + N[t, 1] * (R[t, 1] + S[t, 1]) \
-                + N[t, 2] * (R[t, 2] + S[t, 2])
+        for t in range(N.shape[0]):
+            d = (N[t, 0] * (R[t, 0] + S[t, 0]) + N[t, 2] * (R[t, 2] + S[t, 2])) \
+                + N[t, 1] * (R[t, 1] + S[t, 1])
             if d < 0 and skip[t] == 0:
                 folded += 1
-        return area, tangent, folded
+        return folded
 
-    _KERNEL = invariants_kernel
-    return _KERNEL
+    _FOLDS = count_folds
+    return _FOLDS

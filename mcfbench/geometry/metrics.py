@@ -434,8 +434,10 @@ def quality(vertices, faces, neighbours=None):
     # against plain numpy evaluations of the same formulas in tests/harness/test_metrics.py);
     # the arctan2 of the smallest angles is numpy's
     work = np.empty((4, len(F), 3))
-    aspect, a_min, a_max, flipped = _quality_kernel()(
-        V, F.astype(np.int64, copy=False), t1, t2, work)
+    aspect, a_min, a_max = _quality_kernel()(V, F.astype(np.int64, copy=False), work)
+    from mcfbench.geometry.invariants import folds_kernel   # (invariants imports metrics)
+
+    flipped = folds_kernel()(work[1], t1, t2, np.zeros(len(F), np.uint8), work[2], work[3])
     angle = np.arctan2(work[0, :, 0], work[0, :, 1]).min()
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = float(np.float64(a_max) / np.float64(a_min))
@@ -455,16 +457,14 @@ def _quality_kernel():
     import numba
 
     @numba.njit(cache=True, nogil=True, error_model="numpy")
-    def quality_kernel(V, F, t1, t2, work):
-        """Largest aspect ratio, smallest and largest area, flipped triangles;
+    def quality_kernel(V, F, work):
+        """Largest aspect ratio, smallest and largest area;
         ``work[0, t, :2]``: ``|u x v|`` and ``u . v`` of the smallest angle of
-        triangle ``t`` (``work[1]``, ``work[2]``: scratch). NaN propagates as in
-        numpy's min/max."""
+        triangle ``t``, ``work[1, t]`` its normal ``(b - a) x (c - a)``. NaN
+        propagates as in numpy's min/max."""
         m = F.shape[0]
         out = work[0]
         N = work[1]
-        R = work[2]
-        S = work[3]
         asp = -np.inf
         a_min = np.inf
         a_max = -np.inf
@@ -509,28 +509,11 @@ def _quality_kernel():
                 a_min = area
             if a_max == a_max and (area > a_max or area != area):
                 a_max = area
-        # flipped: n_t . (sum of the neighbours' normals) < 0, the sums accumulated
-        # like np.bincount(t1, N[t2]) + np.bincount(t2, N[t1])
-        R[:, :] = 0.0
-        S[:, :] = 0.0
-        for k in range(t1.shape[0]):
-            p, q = t1[k], t2[k]
-            R[p, 0] += N[q, 0]
-            R[p, 1] += N[q, 1]
-            R[p, 2] += N[q, 2]
-            S[q, 0] += N[p, 0]
-            S[q, 1] += N[p, 1]
-            S[q, 2] += N[p, 2]
-        flipped = 0
-        for t in range(m):
-            d = (N[t, 0] * (R[t, 0] + S[t, 0]) + N[t, 2] * (R[t, 2] + S[t, 2])) \
-                + N[t, 1] * (R[t, 1] + S[t, 1])
-            if d < 0:
-                flipped += 1
-        return asp, a_min, a_max, flipped
+        return asp, a_min, a_max
 
     _QUALITY = quality_kernel
     return _QUALITY
+
 
 
 # -------------------------------------------------------- steady state
