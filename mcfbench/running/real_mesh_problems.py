@@ -5,7 +5,8 @@ Every mesh of :mod:`mcfbench.geometry.committed_meshes` is one problem of
 nothing else: the mesh's manifest entry and its reference answers
 ``mcfbench/data/meshes/references/<name>.json`` (made by
 ``benchmarks/real_mesh_references.py``, which names the command that remakes
-them; the matrix does not recompute them). A mesh without a reference file
+them; the matrix does not recompute them). A mesh without a reference file,
+or whose reference runs all broke down before ``t = tau_0`` (no checkpoint),
 is not a problem.
 
 The problem
@@ -80,13 +81,14 @@ def real_mesh_problem(name, reference):
 
 
 def real_mesh_problems():
-    """Every committed mesh that has a reference file, as its problem:
-    ``{"real_<name>": Problem}``."""
+    """Every committed mesh whose reference file has a checkpoint (``N >= 1``),
+    as its problem: ``{"real_<name>": Problem}``."""
     problems = {}
     for name in mesh_manifest():
         path = reference_path(name)
-        if path.is_file():
-            problem = real_mesh_problem(name, json.loads(path.read_text()))
+        reference = json.loads(path.read_text()) if path.is_file() else {}
+        if reference.get("steps"):
+            problem = real_mesh_problem(name, reference)
             problems[problem.name] = problem
     return problems
 

@@ -20,8 +20,10 @@ answer is known (``tests/harness/test_two_scheme_references.py``).
      other; its time is the mean of the finest runs' end times. Otherwise
      "none before the horizon", and the runs that stopped are breakdowns.
    * **final time** ``t_final = N tau_0``: the largest ``N`` (at most the
-     horizon) before the singularity at which the two finest runs of at
-     least one scheme have values (the samples of a run's last state are
+     horizon) before the singularity, and before the first checkpoint whose
+     reference area or volume has a relative accuracy worse than
+     :data:`ACCURACY`, at which the two finest runs of at least one scheme
+     have values (the samples of a run's last state are
      dropped when that state is invalid). A scheme that broke down before
      (e.g. the cotangent scheme, folding on a real mesh while BGN goes on)
      is left out of the checkpoints after its breakdown: the final time is
@@ -57,6 +59,12 @@ from mcfbench.storage.statuses import STATE_STATUSES
 AGREEMENT = 1.25
 """Largest ratio of the end times of the finest runs that still counts as one
 singularity of the flow."""
+
+ACCURACY = 0.02
+"""Largest relative accuracy of a reference value: the final time stops
+before the first checkpoint whose area or volume is known less well (on a
+coarse real mesh the flow can shrink the surface so fast that the levels part
+before the horizon)."""
 
 QUANTITIES = ("area", "volume")
 
@@ -214,7 +222,18 @@ def reference_answers(runs, tau_0, steps):
 
     N = max((j for j in range(1, limit + 1)
              if any(len(rs) >= 2 and usable(rs, j) for rs in schemes.values())), default=0)
-    out = {"singularity": singularity, "steps": N, "checkpoints": list(range(1, N + 1)),
+    while True:
+        out = _answers_to(N, schemes, usable)
+        coarse = [j for j in out["checkpoints"] if any(
+            out[f"{q}_accuracy"][j - 1] > ACCURACY * abs(out[q][j - 1]) for q in QUANTITIES)]
+        if not coarse:
+            return {"singularity": singularity, **out}
+        N = coarse[0] - 1
+
+
+def _answers_to(N, schemes, usable):
+    """The answers of :func:`reference_answers` at the checkpoints ``1..N``."""
+    out = {"steps": N, "checkpoints": list(range(1, N + 1)),
            "orders": {s: {} for s in schemes}}
     for q in QUANTITIES:
         fields = {k: [] for k in ("", "_level_difference", "_scheme_difference", "_accuracy",

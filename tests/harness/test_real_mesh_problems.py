@@ -69,3 +69,16 @@ def test_metric_measures_a_run_against_the_reference():
     for q in QUANTITIES:
         errors = [stored[q][j] / ref[q][j - 1] - 1 for j in ref["checkpoints"]]
         assert result.metrics[f"{q}_error"] == pytest.approx(max(errors, key=abs), rel=1e-9)
+
+
+def test_mesh_whose_reference_runs_all_broke_down_before_tau0_is_no_problem(tmp_path, monkeypatch):
+    from mcfbench.running import real_mesh_problems as rmp
+
+    name = "nut"
+    ref = _stored(name)
+    monkeypatch.setattr(rmp, "REFERENCE_DIR", tmp_path)
+    (tmp_path / f"{name}.json").write_text(json.dumps(ref))
+    assert f"real_{name}" in rmp.real_mesh_problems()
+    (tmp_path / f"{name}.json").write_text(json.dumps({**ref, "steps": 0, "checkpoints": []}))
+    assert f"real_{name}" not in rmp.real_mesh_problems()
+    assert rmp.real_mesh_problems().keys() == set()    # no other reference in the folder

@@ -11,6 +11,7 @@ import pytest
 from mcfbench.geometry.metrics import mean_edge_length
 from mcfbench.running.problems import PROBLEMS
 from mcfbench.running.two_scheme_references import (
+    ACCURACY,
     first_singularity,
     reference_answers,
     reference_runs,
@@ -41,9 +42,11 @@ def test_sphere_reference_is_within_its_stated_accuracy(sphere_answers):
     assert len(cotan) == 1 and 1.5 < cotan[0] < 2.5        # O(h^2 + tau), tau ~ h^2
 
 
-def _run(scheme, level, status, t_end, tau_0=0.1, steps=10):
+def _run(scheme, level, status, t_end, tau_0=0.1, steps=10, spread=lambda j: 1e-3):
+    """Values ``1 - 0.01 j + spread(j) 0.5^level``: first order in h, the levels
+    ``spread(j)`` apart at checkpoint ``j``."""
     reached = min(steps, math.floor(t_end / tau_0 + 1e-9))
-    values = [1.0 + 0.5 ** level - 0.01 * j if j <= reached else math.nan
+    values = [1.0 + spread(j) * 0.5 ** level - 0.01 * j if j <= reached else math.nan
               for j in range(steps + 1)]
     return {"scheme": scheme, "level": level, "status": status, "t_end": t_end,
             "area": values, "volume": values}
@@ -69,3 +72,19 @@ def test_runs_that_stop_apart_are_breakdowns_not_the_singularity():
     assert ref["steps"] == 10
     assert ref["area_schemes"] == [["bgn", "cotan"]] + [["bgn"]] * 9
     assert ref["orders"]["cotan"]["area"]["checkpoint"] == 1
+
+
+def test_final_time_stops_before_the_first_checkpoint_known_worse_than_the_accuracy():
+    def spread(j):          # the levels part from checkpoint 7 on (a coarse mesh shrinking fast)
+        return 1e-3 if j < 7 else 0.2
+    runs = [_run(s, lv, "ok", 1.0, spread=spread) for s, lv in
+            (("cotan", 0), ("cotan", 1), ("cotan", 2), ("bgn", 0), ("bgn", 1))]
+    ref = reference_answers(runs, 0.1, 10)
+    assert ref["steps"] == 6 and ref["singularity"]["time"] is None
+    accuracy = np.asarray(ref["area_accuracy"]) / np.abs(ref["area"])
+    assert np.all(accuracy <= ACCURACY) and accuracy.max() > 0
+    # Richardson on cotan's three levels (order 1): the exact limit 1 - 0.01 j
+    assert ref["area"] == pytest.approx([1 - 0.01 * j for j in range(1, 7)], rel=1e-12)
+    assert reference_answers([_run(s, lv, "ok", 1.0) for s, lv in
+                              (("cotan", 0), ("cotan", 1), ("bgn", 0), ("bgn", 1))],
+                             0.1, 10)["steps"] == 10
