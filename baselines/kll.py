@@ -28,7 +28,8 @@ scaled step. Lumped mass ``m_i`` (barycentric), cotangent stiffness ``L``, both
 of ``X*``, row-scaled as the cotangent scheme's (C3)::
 
     (I + dt diag(1/m) L) u = B_u + dt (w / m) u*                            (K3)
-    w_i = sum_{t ni i} |t| |A|_t^2 / 3,   |A|_t^2 = |E_t|_F^2 / |N_t|^2,   E_t = sum_k nu*_k (x) e_k   (K4)
+    w_i = sum_{t ni i} |t| |A|_t^2 / 3,   |A|_t^2 = |E_t|_F^2 / |N_t|^2          (K4)
+    E_t = sum_k nu*_k (x) e_k
 
 ``N_t`` the area vector of triangle ``t`` of ``X*`` (``|N_t| = 2 |t|``), ``e_k``
 its edge opposite corner ``k``: on a flat triangle ``grad phi_k = N_t x e_k /
