@@ -68,21 +68,21 @@ import numpy as np
 import scipy.sparse as sp
 
 from .cotan import VertexFlow
+from .kernels import gradient_norm_weights
 from .mdr import unit_vertex_normals
 
 ROWS = 7
 """The state ``(X, nu, H)``: 3 + 3 + 1 rows."""
 
 
-def curvature_weights(vertices, faces, area_vectors, nu):
-    """``w`` of (K4): the lumped ``int |grad_G nu|^2 phi_i``, one value per triangle.
+def curvature_weights(vertices, faces, nu):
+    """``w`` of (K4): the lumped ``int |grad_G nu|^2 phi_i``, one value per triangle
+    (kernel :func:`baselines.kernels.gradient_norm_weights`).
 
     Parameters
     ----------
     vertices : (n, 3) float array
     faces : (m, 3) int array
-    area_vectors : (m, 3) float array
-        ``N_t`` of the triangles of ``vertices``.
     nu : (n, 3) float array
         Nodal values of a P1 vector field.
 
@@ -96,20 +96,15 @@ def curvature_weights(vertices, faces, area_vectors, nu):
     Examples
     --------
     >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0]])
-    >>> F = np.array([[0, 1, 2]])
-    >>> N = np.cross(V[1] - V[0], V[2] - V[0])[None]
-    >>> w, sq = curvature_weights(V, F, N, V * [2.0, 3.0, 0.0])     # grad (2x, 3y): 4 + 9
-    >>> sq.round(12).tolist(), w.round(4).tolist()
+    >>> w, sq = curvature_weights(V, np.array([[0, 1, 2]]), V * [2.0, 3.0, 0.0])
+    >>> sq.round(12).tolist(), w.round(4).tolist()          # grad (2x, 3y): 4 + 9
     ([13.0], [2.1667, 2.1667, 2.1667])
     """
-    P = vertices[faces]                                          # (m, 3 corners, 3)
-    edges = P[:, [2, 0, 1]] - P[:, [1, 2, 0]]                    # e_k opposite corner k
-    E = np.einsum("tkc,tkd->tcd", nu[faces], edges)              # sum_k nu_k (x) e_k
-    double = np.einsum("tc,tc->t", area_vectors, area_vectors)   # |N_t|^2
-    squared = np.divide(np.einsum("tcd,tcd->t", E, E), double, out=np.zeros(len(faces)),
-                        where=double > 0)
-    share = squared * np.sqrt(double) / 6.0                      # |t| |A|_t^2 / 3
-    return np.bincount(faces.ravel(), np.repeat(share, 3), minlength=len(vertices)), squared
+    w, squared = np.empty(len(vertices)), np.empty(len(faces))
+    gradient_norm_weights(np.ascontiguousarray(vertices, dtype=np.float64),
+                          np.ascontiguousarray(faces, dtype=np.int64),
+                          np.ascontiguousarray(nu, dtype=np.float64), w, squared)
+    return w, squared
 
 
 class KLLFlow(VertexFlow):
@@ -203,7 +198,7 @@ class KLLFlow(VertexFlow):
         g, n = self.geometry_at(X), self.mesh.n_vertices
         self._assembles_here = at is self._U
         S = self.assembler.row_scaled(g.L_data, g.mass, dt, self.fixed)
-        w = curvature_weights(np.ascontiguousarray(X.T), self.faces, g.area_vectors, nu.T)[0]
+        w = curvature_weights(X.T, self.faces, nu.T)[0]
         source = dt * np.divide(w, g.mass, out=np.zeros(n), where=g.mass > 0)
         top = np.stack([np.ones((3, n)), np.broadcast_to(dt * H, (3, n)), dt * nu], axis=2)
         data = np.concatenate([top.ravel(), np.tile(S.data, 4)])
