@@ -200,8 +200,10 @@ class KLLFlow(VertexFlow):
         S = self.assembler.row_scaled(g.L_data, g.mass, dt, self.fixed)
         w = curvature_weights(X.T, self.faces, nu.T)[0]
         source = dt * np.divide(w, g.mass, out=np.zeros(n), where=g.mass > 0)
-        top = np.stack([np.ones((3, n)), np.broadcast_to(dt * H, (3, n)), dt * nu], axis=2)
-        data = np.concatenate([top.ravel(), np.tile(S.data, 4)])
+        data = np.empty(len(self._indices))
+        top = data[:9 * n].reshape(3, n, 3)          # the X rows: (X_c, nu_c, H) entries
+        top[..., 0], top[..., 1], top[..., 2] = 1.0, dt * H, dt * nu
+        data[9 * n:].reshape(4, -1)[:] = S.data
         A = sp.csr_matrix((data, self._indices, self._indptr), shape=(ROWS * n, ROWS * n),
                           copy=False)
         b = np.array(base, dtype=np.float64)
