@@ -10,19 +10,20 @@ surface with the velocity ``v = -H nu`` built from them::
     d nu = Delta_G nu + |A|^2 nu,    d H = Delta_G H + |A|^2 H,    |A|^2 = |grad_G nu|^2   (K2)
 
 (``d`` the material derivative, ``Delta_G`` the Laplace-Beltrami operator of the
-surface ``G``; the paper's (2.1)-(2.5) and the system of its Section 3). Sign:
+surface ``G``: Huisken's evolution equations, as the paper's abstract names them;
+its full text was not available to us, ``baselines/README.md``). Sign:
 ``H = div_G nu``, a sphere of radius ``R`` with its outer normal has ``H = 2 / R``
 and shrinks as ``r(t) = sqrt(R^2 - 4 t)``; the product ``H nu`` (the mean
 curvature vector, ``-Delta_G X``) does not depend on which side ``nu`` points to.
 
-Discretisation (paper, Sections 3-4; our labels (K3)-(K6), ``baselines/README.md``)
-------------------------------------------------------------------------------
+Discretisation (derived here; our labels (K1)-(K6), ``baselines/README.md``)
+-------------------------------------------------------------------------
 Evolving P1 elements on the surface of the nodes ``X`` (degree 1: the paper's
 proof needs degree >= 2, ``baselines/README.md``), ``u = (nu, H)`` nodal P1 values.
 The weak form of (K2) is ``M(X) du/dt + L(X) u = f(X, u)`` with ``M`` the mass,
 ``L`` the stiffness and ``f_i = int |grad_G nu|^2 u phi_i`` (the paper's
 matrix-vector form). The harness's integrators (``mcfbench.running.integrators``,
-(I1)) give the linearly implicit BDF of the paper's Section 4: operators and the
+(I1)) give the paper's linearly implicit BDF (its (4.2) as cited there): operators and the
 nonlinearity at the extrapolated state ``X*, u*``, ``B`` the base, ``dt`` the
 scaled step. Lumped mass ``m_i`` (barycentric), cotangent stiffness ``L``, both
 of ``X*``, row-scaled as the cotangent scheme's (C3)::
@@ -37,9 +38,10 @@ its edge opposite corner ``k``: on a flat triangle ``grad phi_k = N_t x e_k /
 |E_t|^2 / |N_t|^2`` (``E_t`` lies in the triangle's plane). ``w`` is the
 lumped quadrature of ``f``: one value of ``|A|^2`` per triangle.
 
-The velocity law (K1) with the BDF derivative of ``X`` (the paper's
-``dX/dt = v^n``, ``v^n = -H^n nu^n`` nodal, both at the new level) is bilinear in
-the new ``(nu, H)``; it is linearised at the extrapolation::
+The velocity law (K1) with the BDF derivative of ``X``, ``dX/dt = v^n`` with
+``v^n = -H^n nu^n`` (our reading of the abstract's velocity law "projected to the
+finite element space": the nodal interpolation, both factors at the new level), is
+bilinear in the new ``(nu, H)``; it is linearised at the extrapolation::
 
     X + dt (H* nu + H nu*) = B_X + dt H* nu*                                 (K5)
 
@@ -196,7 +198,7 @@ class KLLFlow(VertexFlow):
     def _system(self, at, base, dt):
         X, nu, H = (self._X, at[3:6], at[6]) if at is self._U else (at[:3], at[3:6], at[6])
         g, n = self.geometry_at(X), self.mesh.n_vertices
-        self._assembles_here = at is self._U
+        self._assembles_here = at is self._U     # (VertexFlow.system saw at = U, never None)
         S = self.assembler.row_scaled(g.L_data, g.mass, dt, self.fixed)
         w = curvature_weights(X.T, self.faces, nu.T)[0]
         source = dt * np.divide(w, g.mass, out=np.zeros(n), where=g.mass > 0)
@@ -215,10 +217,6 @@ class KLLFlow(VertexFlow):
         """Accept ``U`` (7, n) as the state ``n + 1``."""
         self._adopt(U)
         super().advance(self._X)
-
-    def frame(self):
-        """``{"V": (n, 3)}`` copy of the current vertices."""
-        return {"V": self._X.T.copy()}
 
     def defects(self):
         """:meth:`baselines.cotan.VertexFlow.defects`, and ``"degenerated"`` for
