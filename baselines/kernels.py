@@ -426,7 +426,7 @@ def gradient_norm_weights(V, faces, u, w, squared):
     of component ``c`` is ``N x E_c / |N|^2`` with ``E = sum_k u_k (x) e_k`` (3 x 3, its
     rows in the triangle's plane) and ``|grad_t u|^2 = |E|_F^2 / |N|^2``. Then
     ``w_i = sum_{t ni i} |t| |grad_t u|^2 / 3`` (barycentric quadrature). KLL's
-    ``|A|^2`` term (:mod:`baselines.kll`, (K4)).
+    ``|A|^2`` term (:mod:`baselines.kll`, (KL4)).
 
     Parameters
     ----------

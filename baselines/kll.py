@@ -6,8 +6,8 @@ mean curvature flow of closed surfaces", Numer. Math. 143 (2019) 797-853 (arXiv
 and the mean curvature ``H`` by Huisken's evolution equations, and moves the
 surface with the velocity ``v = -H nu`` built from them::
 
-    d/dt X = v = -H nu                                                     (K1)
-    d nu = Delta_G nu + |A|^2 nu,    d H = Delta_G H + |A|^2 H,    |A|^2 = |grad_G nu|^2   (K2)
+    d/dt X = v = -H nu                                                     (KL1)
+    d nu = Delta_G nu + |A|^2 nu,    d H = Delta_G H + |A|^2 H,    |A|^2 = |grad_G nu|^2   (KL2)
 
 (``d`` the material derivative, ``Delta_G`` the Laplace-Beltrami operator of the
 surface ``G``: Huisken's evolution equations, as the paper's abstract names them;
@@ -16,11 +16,11 @@ its full text was not available to us, ``baselines/README.md``). Sign:
 and shrinks as ``r(t) = sqrt(R^2 - 4 t)``; the product ``H nu`` (the mean
 curvature vector, ``-Delta_G X``) does not depend on which side ``nu`` points to.
 
-Discretisation (derived here; our labels (K1)-(K6), ``baselines/README.md``)
+Discretisation (derived here; our labels (KL1)-(KL6), ``baselines/README.md``)
 -------------------------------------------------------------------------
 Evolving P1 elements on the surface of the nodes ``X`` (degree 1: the paper's
 proof needs degree >= 2, ``baselines/README.md``), ``u = (nu, H)`` nodal P1 values.
-The weak form of (K2) is ``M(X) du/dt + L(X) u = f(X, u)`` with ``M`` the mass,
+The weak form of (KL2) is ``M(X) du/dt + L(X) u = f(X, u)`` with ``M`` the mass,
 ``L`` the stiffness and ``f_i = int |grad_G nu|^2 u phi_i`` (the paper's
 matrix-vector form). The harness's integrators (``mcfbench.running.integrators``,
 (I1)) give the paper's linearly implicit BDF (its (4.2) as cited there): operators and the
@@ -28,8 +28,8 @@ nonlinearity at the extrapolated state ``X*, u*``, ``B`` the base, ``dt`` the
 scaled step. Lumped mass ``m_i`` (barycentric), cotangent stiffness ``L``, both
 of ``X*``, row-scaled as the cotangent scheme's (C3)::
 
-    (I + dt diag(1/m) L) u = B_u + dt (w / m) u*                            (K3)
-    w_i = sum_{t ni i} |t| |A|_t^2 / 3,   |A|_t^2 = |E_t|_F^2 / |N_t|^2          (K4)
+    (I + dt diag(1/m) L) u = B_u + dt (w / m) u*                            (KL3)
+    w_i = sum_{t ni i} |t| |A|_t^2 / 3,   |A|_t^2 = |E_t|_F^2 / |N_t|^2          (KL4)
     E_t = sum_k nu*_k (x) e_k
 
 ``N_t`` the area vector of triangle ``t`` of ``X*`` (``|N_t| = 2 |t|``), ``e_k``
@@ -38,21 +38,21 @@ its edge opposite corner ``k``: on a flat triangle ``grad phi_k = N_t x e_k /
 |E_t|^2 / |N_t|^2`` (``E_t`` lies in the triangle's plane). ``w`` is the
 lumped quadrature of ``f``: one value of ``|A|^2`` per triangle.
 
-The velocity law (K1) with the BDF derivative of ``X``, ``dX/dt = v^n`` with
+The velocity law (KL1) with the BDF derivative of ``X``, ``dX/dt = v^n`` with
 ``v^n = -H^n nu^n`` (our reading of the abstract's velocity law "projected to the
 finite element space": the nodal interpolation, both factors at the new level), is
 bilinear in the new ``(nu, H)``; it is linearised at the extrapolation::
 
-    X + dt (H* nu + H nu*) = B_X + dt H* nu*                                 (K5)
+    X + dt (H* nu + H nu*) = B_X + dt H* nu*                                 (KL5)
 
 which differs from ``X = B_X - dt H nu`` by ``dt (H - H*) (nu - nu*)``,
 ``O(tau^(2k+1))`` per step for BDF-k (``O(tau^3)`` for Euler): below the local
 error of every integrator, and the step stays ONE linear system that the
 harness solves and extrapolates like any other (the BDF3 start-up combines whole
-solutions). (K3) and (K5) together, the state ``U = (X, nu, H)`` (7, n)::
+solutions). (KL3) and (KL5) together, the state ``U = (X, nu, H)`` (7, n)::
 
     [ I   dt H*  dt nu* ] [X ]   [B_X + dt H* nu*     ]
-    [ 0   S      0      ] [nu] = [B_nu + dt w/m nu*   ]                     (K6)
+    [ 0   S      0      ] [nu] = [B_nu + dt w/m nu*   ]                     (KL6)
     [ 0   0      S      ] [H ]   [B_H + dt w/m H*     ]
 
 ``S = I + dt diag(1/m) L`` (C3), ``dt H*`` and ``dt nu*`` diagonal: a (7n, 7n)
@@ -78,7 +78,7 @@ ROWS = 7
 
 
 def curvature_weights(vertices, faces, nu):
-    """``w`` of (K4): the lumped ``int |grad_G nu|^2 phi_i``, one value per triangle
+    """``w`` of (KL4): the lumped ``int |grad_G nu|^2 phi_i``, one value per triangle
     (kernel :func:`baselines.kernels.gradient_norm_weights`).
 
     Parameters
@@ -110,7 +110,7 @@ def curvature_weights(vertices, faces, nu):
 
 
 class KLLFlow(VertexFlow):
-    """Mean curvature flow by the algorithm of Kovacs, Li and Lubich, (K6), of one
+    """Mean curvature flow by the algorithm of Kovacs, Li and Lubich, (KL6), of one
     closed surface; state ``(X, nu, H)``.
 
     Parameters
@@ -145,7 +145,7 @@ class KLLFlow(VertexFlow):
         nu = unit_vertex_normals(self.faces, g.area_vectors, n)
         H = np.einsum("ic,ic->i", nu, self.assembler.laplacian(g.L_data) @ self.vertices) / g.mass
         self._adopt(np.vstack([self._X, nu.T, H[None]]))
-        # (K6)'s CSR pattern: the X rows (X_c, nu_c, H), then four blocks of S
+        # (KL6)'s CSR pattern: the X rows (X_c, nu_c, H), then four blocks of S
         p = self.assembler.pattern
         i = np.arange(n)
         top = np.stack([[c * n + i, (3 + c) * n + i, 6 * n + i] for c in range(3)])
@@ -179,7 +179,7 @@ class KLLFlow(VertexFlow):
         return self.state[6]
 
     def system(self, at=None, base=None, dt=None):
-        """``(A, b)`` of (K6) with the operators at the state ``at`` (7, n).
+        """``(A, b)`` of (KL6) with the operators at the state ``at`` (7, n).
 
         Parameters
         ----------

@@ -15,7 +15,7 @@ from mcfbench.running.integrators import get_integrator
 from mcfbench.running.solver import Solver
 
 EXACT = Solver(method="direct", rtol=1e-12)
-KRYLOV = Solver(rtol=1e-10)          # BiCGStab: the LU of (K6) costs 40 x more at level 3
+KRYLOV = Solver(rtol=1e-10)          # BiCGStab: the LU of (KL6) costs 40 x more at level 3
 
 
 def final_errors(level, integrator, t_final=0.08):
@@ -52,8 +52,8 @@ def test_sphere_position_normal_and_curvature_converge_at_order_2(integrator, ex
     assert np.all((orders > 1.9) & (orders < 2.8)), orders
 
 
-def test_system_is_k6_against_an_independent_assembly(noisy_sphere):
-    """(K6) at a state ``U*`` with a base ``B``: ``S = I + dt diag(1/m) L`` and ``|A|^2``
+def test_system_is_kl6_against_an_independent_assembly(noisy_sphere):
+    """(KL6) at a state ``U*`` with a base ``B``: ``S = I + dt diag(1/m) L`` and ``|A|^2``
     from libigl (cotangent matrix, barycentric mass, the per-triangle gradient)."""
     V, F = noisy_sphere
     n, dt = len(V), 0.003
