@@ -21,6 +21,9 @@ mdr (:class:`baselines.mdr.MDRFlow`)
 deturck (:class:`baselines.deturck.DeTurckFlow`)
     The DeTurck trick of Elliott and Fritz (2017): reparametrised by the
     harmonic map heat flow onto the initial mesh, ``alpha`` its time scale.
+kll (:class:`baselines.kll.KLLFlow`)
+    Kovacs, Li and Lubich (2019): the normal and the mean curvature evolved by
+    Huisken's equations with the position, velocity ``-H nu``; P1, closed surfaces.
 
 Shared: :mod:`baselines.mesh` (edge topology, CSR pattern) and
 :mod:`baselines.kernels` (the compiled assembly).

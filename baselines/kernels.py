@@ -415,3 +415,55 @@ def vertex_gradients(V, faces, psi, alpha):
         d = gx * ux + gy * uy + gz * uz
         alpha[i, 0], alpha[i, 1], alpha[i, 2] = gx - d * ux, gy - d * uy, gz - d * uz
     return degenerate, first
+
+
+@njit(cache=True)
+def gradient_norm_weights(V, faces, u, w, squared):
+    """The lumped ``int |grad u|^2 phi_i`` of a P1 vector field ``u``, one value per triangle.
+
+    On triangle ``t`` with area vector ``N`` and edges ``e_k`` opposite corner ``k``
+    (counter-clockwise about ``N``), ``grad phi_k = N x e_k / |N|^2``, so the gradient
+    of component ``c`` is ``N x E_c / |N|^2`` with ``E = sum_k u_k (x) e_k`` (3 x 3, its
+    rows in the triangle's plane) and ``|grad_t u|^2 = |E|_F^2 / |N|^2``. Then
+    ``w_i = sum_{t ni i} |t| |grad_t u|^2 / 3`` (barycentric quadrature). KLL's
+    ``|A|^2`` term (:mod:`baselines.kll`, (KL4)).
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    faces : (m, 3) int64 array
+    u : (n, 3) float64 array
+    w : (n,) float64 array, output
+    squared : (m,) float64 array, output
+        ``|grad_t u|^2``; 0 on a triangle of zero (or non-finite) area.
+
+    Returns
+    -------
+    degenerate : int
+        Triangles of zero (or non-finite) area, skipped (never a division by zero).
+    """
+    w[:] = 0.0
+    degenerate = 0
+    for t in range(faces.shape[0]):
+        i0, i1, i2 = faces[t, 0], faces[t, 1], faces[t, 2]
+        ax, ay, az = V[i1, 0] - V[i0, 0], V[i1, 1] - V[i0, 1], V[i1, 2] - V[i0, 2]
+        bx, by, bz = V[i2, 0] - V[i0, 0], V[i2, 1] - V[i0, 1], V[i2, 2] - V[i0, 2]
+        nx, ny, nz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+        dbl2 = nx * nx + ny * ny + nz * nz
+        squared[t] = 0.0
+        if not (dbl2 > 0.0 and np.isfinite(dbl2)):
+            degenerate += 1
+            continue
+        total = 0.0
+        for d in range(3):
+            # e_0 = x2 - x1, e_1 = x0 - x2, e_2 = x1 - x0, component d
+            e0, e1, e2 = V[i2, d] - V[i1, d], V[i0, d] - V[i2, d], V[i1, d] - V[i0, d]
+            for c in range(3):
+                E = u[i0, c] * e0 + u[i1, c] * e1 + u[i2, c] * e2
+                total += E * E
+        squared[t] = total / dbl2
+        share = squared[t] * np.sqrt(dbl2) / 6.0
+        w[i0] += share
+        w[i1] += share
+        w[i2] += share
+    return degenerate

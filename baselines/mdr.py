@@ -49,6 +49,30 @@ Boundary vertices (open surfaces) are held fixed: identity rows, as in BGN.
 import numpy as np
 
 from .bgn import BGNFlow
+from .kernels import vertex_normals
+
+
+def unit_vertex_normals(faces, area_vectors, n):
+    """The unit area-weighted vertex normals (BGN's (B3) normalised).
+
+    Parameters
+    ----------
+    faces : (m, 3) int array
+    area_vectors : (m, 3) float array
+        Twice the area times the unit normal of each triangle.
+    n : int
+        Number of vertices.
+
+    Returns
+    -------
+    (n, 3) float array
+        Zero at a vertex whose triangles all vanished.
+    """
+    omega = np.empty((n, 3))
+    vertex_normals(faces, area_vectors, n, omega)
+    length = np.linalg.norm(omega, axis=1)
+    return np.divide(omega, length[:, None], out=np.zeros_like(omega),
+                     where=length[:, None] > 0)
 
 
 class UnitNormalBGN(BGNFlow):
@@ -59,10 +83,7 @@ class UnitNormalBGN(BGNFlow):
     def _normals(self, geometry):
         """(n, 3) the unit area-weighted vertex normals (BGN's (B3) normalised); zero at
         a vertex whose triangles all vanished."""
-        omega = super()._normals(geometry)
-        length = np.linalg.norm(omega, axis=1)
-        return np.divide(omega, length[:, None], out=np.zeros_like(omega),
-                         where=length[:, None] > 0)
+        return unit_vertex_normals(self.faces, geometry.area_vectors, self.mesh.n_vertices)
 
 
 class MDRFlow(UnitNormalBGN):

@@ -36,6 +36,49 @@ def sphere_radius(t, radius=1.0):
     return np.sqrt(radius**2 - 4.0 * np.asarray(t))
 
 
+def sphere_state_errors(vertices, weights, t, *, normals=None, curvature=None, radius=1.0):
+    """Errors at time ``t`` of a state of the flow of the sphere of radius ``R`` about the
+    origin: position, normal and mean curvature, lumped L2.
+
+    ``sqrt(sum_i w_i e_i^2)`` with ``e_i`` the distance ``| |x_i| - r(t) |`` to the exact
+    sphere (:func:`sphere_radius`), ``|nu_i - x_i / |x_i||`` (the outer unit normal at the
+    point's direction) and ``|H_i - 2 / r(t)|`` (``H = div nu``: positive on a sphere
+    with its outer normal).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    weights : (n,) float array
+        Quadrature weights (a lumped mass).
+    t : float
+    normals : (n, 3) float array, optional
+    curvature : (n,) float array, optional
+    radius : float
+
+    Returns
+    -------
+    dict
+        ``"position"``, and ``"normal"``, ``"curvature"`` when given.
+
+    Examples
+    --------
+    >>> X = np.array([[0.5, 0, 0], [0, 0, -0.5]])
+    >>> e = sphere_state_errors(X, [1.0, 1.0], 0.1875, normals=-X, curvature=[4.0, 3.0])
+    >>> {k: round(float(v), 6) for k, v in e.items()}
+    {'position': 0.0, 'normal': 2.12132, 'curvature': 1.0}
+    """
+    X, w = np.asarray(vertices, dtype=float), np.asarray(weights, dtype=float)
+    r = float(sphere_radius(t, radius))
+    distance = np.linalg.norm(X, axis=1)
+    errors = {"position": np.sqrt(w @ (distance - r) ** 2)}
+    if normals is not None:
+        exact = X / distance[:, None]
+        errors["normal"] = np.sqrt(w @ ((np.asarray(normals) - exact) ** 2).sum(axis=1))
+    if curvature is not None:
+        errors["curvature"] = np.sqrt(w @ (np.asarray(curvature) - 2.0 / r) ** 2)
+    return {key: float(value) for key, value in errors.items()}
+
+
 class SphereL2Error:
     """Space-time L2 error (3.2) of a flow started from a sphere.
 

@@ -11,7 +11,9 @@ scheme (:data:`COSTS`: vertex, DDFV, BGN, the redistributing ones apart, whose
 potential is a sparse LU at every step: level 5, 29.9 MB and 78 ms a step for
 ``cotan-redistribute`` against 14.1 MB and 3 ms for ``cotan``; 85.7 MB and
 38 ms for ``ddfv-chord-redistribute-carried`` against 27.1 MB and 6 ms for
-``ddfv``; ``bgn`` 16.4 MB and 4 ms):
+``ddfv``; ``bgn`` 16.4 MB and 4 ms; ``kll``, its 7n x 7n system, measured
+2026-11-26 beside ``cotan`` and ``bgn`` at load average 7: 25.4 MB and 6.7 ms
+against 14.0 MB and 2.1 ms for ``cotan``, 16.2 MB and 4.2 ms for ``bgn``):
 
 * the peak resident memory that grows with the mesh (mesh, flow, solver), above
   a process that made a level-1 run first, ``a n^p`` (slopes 1.06-1.12), plus
@@ -49,24 +51,26 @@ COSTS = {
     "ddfv": ((4.547e-4, 1.064), (1.143e-6, 0.825)),
     "ddfv, redistributing": ((7.923e-4, 1.122), (2.134e-6, 0.947)),
     "bgn": ((9.613e-4, 1.055), (9.14e-6, 0.661)),
+    "kll": ((1.322e-3, 1.068), (3.061e-6, 0.833)),
 }
 """Kind of scheme (:func:`cost_class`) -> ``((a, p), (b, q))``: memory ``a n^p`` MB above
 a warmed-up process and ``b n^q`` CPU seconds per step (module docstring;
 ``benchmarks/bench_cost.py``: ``cotan``, ``cotan-redistribute``, ``ddfv``,
-``ddfv-chord-redistribute-carried``, ``bgn``)."""
+``ddfv-chord-redistribute-carried``, ``bgn``, ``kll``)."""
 FIXED_MB = 135.0
 """The memory a process takes on for its first run, whatever its size: numba, the
 compiled kernels, scipy's solvers (the level-1 run after the imports)."""
 
 def cost_class(scheme):
     """The kind of a scheme (a name or a registry entry) in :data:`COSTS`: ``"bgn"``
-    (a coupled 3n x 3n system), ``"ddfv"`` or ``"vertex"`` (the other vertex
+    (a coupled 3n x 3n system), ``"kll"`` (a coupled 7n x 7n one), ``"ddfv"`` or
+    ``"vertex"`` (the other vertex
     schemes), with ``", redistributing"`` for a scheme with a tangential
     redistribution (a potential solved at every step)."""
     entry = get_scheme(scheme) if isinstance(scheme, str) else scheme
     entry = find_scheme(entry.name) or entry      # a study's wrapper -> the registry's entry
-    if split_name(entry.name)[0] == "bgn":
-        return "bgn"
+    if split_name(entry.name)[0] in ("bgn", "kll"):
+        return split_name(entry.name)[0]
     options = getattr(entry, "options", {})
     redistributing = options.get("redistribution") is not None or \
         options.get("tangential") == "redistribute"

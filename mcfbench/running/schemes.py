@@ -182,6 +182,11 @@ SCHEMES = {s.name: s for s in (
            "the DeTurck trick (Elliott, Fritz 2017): reparametrised by the harmonic map heat "
            "flow onto the initial mesh with time scale 1/alpha, the advection implicit",
            matrix="nonsymmetric"),
+    Scheme("kll", "KLL", "baselines.kll:KLLFlow", {},
+           {"color": "tab:purple", "marker": "*", "linestyle": "-"},
+           "Kovacs, Li, Lubich (2019): normal and mean curvature evolved by Huisken's "
+           "equations, velocity -H nu, P1 elements (the proof needs degree >= 2), the "
+           "velocity law linearised at the extrapolated state", matrix="nonsymmetric"),
 )}
 """Scheme name -> :class:`Scheme`."""
 

@@ -96,3 +96,17 @@ def test_defects_of_a_state_with_a_zero_area_triangle(flow_class):
     [(status, detail)] = flow.defects()
     assert status == "degenerated" and "triangle 1" in detail
     flow.system()                                   # assembles without raising
+
+
+def test_gradient_norm_weights_skip_a_zero_area_triangle():
+    """KLL's ``|A|^2`` weights: the flat triangle 1 adds nothing and is counted; the
+    others give ``|grad u|^2 = 2`` for ``u = (x, y, 0)`` on the plane z = 0 (area 1)."""
+    V, F = flattened_tetrahedron()
+    u = V * [1.0, 1.0, 0.0]
+    w, squared = np.empty(4), np.empty(4)
+    assert kernels.gradient_norm_weights(V, F, u, w, squared) == 1
+    assert squared[1] == 0.0 and np.allclose(squared[[0, 2, 3]], 2.0, rtol=1e-14)
+    assert w.sum() == pytest.approx(2.0, rel=1e-14)
+    V[2] = np.nan
+    assert kernels.gradient_norm_weights(V, F, u, w, squared) == 4
+    assert np.all(w == 0.0)

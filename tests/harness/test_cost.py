@@ -89,6 +89,6 @@ def test_the_command_line_refuses_level_12_in_one_line(monkeypatch, capsys):
 @pytest.mark.parametrize("scheme, kind", [
     ("cotan", "vertex"), ("cmcf", "vertex"), ("cotan-redistribute", "vertex, redistributing"),
     ("ddfv-chord-carried@bdf2", "ddfv"), ("ddfv-redistribute", "ddfv, redistributing"),
-    ("bgn@bdf2", "bgn")])
+    ("bgn@bdf2", "bgn"), ("kll@bdf3", "kll")])
 def test_cost_class(scheme, kind):
     assert cost.cost_class(scheme) == kind

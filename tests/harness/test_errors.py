@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from ddfv import Flow
-from mcfbench.geometry.exact import SphereL2Error, eoc, sphere_radius
+from mcfbench.geometry.exact import SphereL2Error, eoc, sphere_radius, sphere_state_errors
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate
 
@@ -77,3 +77,17 @@ def test_eoc_only_between_finished_runs_one_level_apart_and_for_any_step_ratio()
                                [np.nan, 2.0, np.nan, np.nan, 2.0])
     assert np.isnan(eoc([1e-2, 0.0])).all()                      # an exact zero: no order
     np.testing.assert_allclose(eoc([1e-2, 1e-3], sizes=[0.3, 0.03]), [np.nan, 1.0])
+
+
+def test_sphere_state_errors_vanish_on_the_exact_state_and_measure_offsets():
+    """The exact sphere at ``t`` with its outer normals and ``H = 2 / r``: zero; a radial
+    offset ``d``, a normal and a curvature off by constants: ``sqrt(area) x`` those."""
+    V, F = icosphere(3)
+    t, r = 0.05, float(sphere_radius(0.05))
+    w = np.full(len(V), 4.0 / len(V))                       # weights summing to 4
+    exact = sphere_state_errors(r * V, w, t, normals=V, curvature=np.full(len(V), 2 / r))
+    assert max(exact.values()) < 1e-14
+    shifted = sphere_state_errors((r + 1e-3) * V, w, t, normals=-V,
+                                  curvature=np.full(len(V), 2 / r + 0.1))
+    assert shifted == pytest.approx({"position": 2e-3, "normal": 4.0, "curvature": 0.2})
+    assert set(sphere_state_errors(V, w, 0.0)) == {"position"}

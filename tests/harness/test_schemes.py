@@ -79,6 +79,8 @@ def _symmetrizing_residual(A):
     keep = v != 0
     r, c, v = r[keep], c[keep], v[keep]
     vt = np.asarray(A[c, r]).ravel()
+    if not (vt != 0).all():        # not structurally symmetric (KLL's block triangle)
+        return np.inf, A
     assert (np.sign(vt) == np.sign(v)).all()          # structurally symmetric, signs alike
     q = np.log(vt / v)
     rows = np.arange(len(q))

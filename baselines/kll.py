@@ -1,0 +1,228 @@
+"""The evolving finite element algorithm of Kovacs, Li and Lubich (KLL) for mean curvature flow.
+
+B. Kovacs, B. Li, Ch. Lubich, "A convergent evolving finite element algorithm for
+mean curvature flow of closed surfaces", Numer. Math. 143 (2019) 797-853 (arXiv
+1805.06667). Besides the position ``X`` it evolves the outer unit normal ``nu``
+and the mean curvature ``H`` by Huisken's evolution equations, and moves the
+surface with the velocity ``v = -H nu`` built from them::
+
+    d/dt X = v = -H nu                                                     (KL1)
+    d nu = Delta_G nu + |A|^2 nu,    d H = Delta_G H + |A|^2 H,    |A|^2 = |grad_G nu|^2   (KL2)
+
+(``d`` the material derivative, ``Delta_G`` the Laplace-Beltrami operator of the
+surface ``G``: Huisken's evolution equations, as the paper's abstract names them;
+its full text was not available to us, ``baselines/README.md``). Sign:
+``H = div_G nu``, a sphere of radius ``R`` with its outer normal has ``H = 2 / R``
+and shrinks as ``r(t) = sqrt(R^2 - 4 t)``; the product ``H nu`` (the mean
+curvature vector, ``-Delta_G X``) does not depend on which side ``nu`` points to.
+
+Discretisation (derived here; our labels (KL1)-(KL6), ``baselines/README.md``)
+-------------------------------------------------------------------------
+Evolving P1 elements on the surface of the nodes ``X`` (degree 1: the paper's
+proof needs degree >= 2, ``baselines/README.md``), ``u = (nu, H)`` nodal P1 values.
+The weak form of (KL2) is ``M(X) du/dt + L(X) u = f(X, u)`` with ``M`` the mass,
+``L`` the stiffness and ``f_i = int |grad_G nu|^2 u phi_i`` (the paper's
+matrix-vector form). The harness's integrators (``mcfbench.running.integrators``,
+(I1)) give the paper's linearly implicit BDF (its (4.2) as cited there): operators and the
+nonlinearity at the extrapolated state ``X*, u*``, ``B`` the base, ``dt`` the
+scaled step. Lumped mass ``m_i`` (barycentric), cotangent stiffness ``L``, both
+of ``X*``, row-scaled as the cotangent scheme's (C3)::
+
+    (I + dt diag(1/m) L) u = B_u + dt (w / m) u*                            (KL3)
+    w_i = sum_{t ni i} |t| |A|_t^2 / 3,   |A|_t^2 = |E_t|_F^2 / |N_t|^2          (KL4)
+    E_t = sum_k nu*_k (x) e_k
+
+``N_t`` the area vector of triangle ``t`` of ``X*`` (``|N_t| = 2 |t|``), ``e_k``
+its edge opposite corner ``k``: on a flat triangle ``grad phi_k = N_t x e_k /
+|N_t|^2``, so ``grad_t nu*_c = N_t x E_c / |N_t|^2`` and ``|grad_t nu*|^2 =
+|E_t|^2 / |N_t|^2`` (``E_t`` lies in the triangle's plane). ``w`` is the
+lumped quadrature of ``f``: one value of ``|A|^2`` per triangle.
+
+The velocity law (KL1) with the BDF derivative of ``X``, ``dX/dt = v^n`` with
+``v^n = -H^n nu^n`` (our reading of the abstract's velocity law "projected to the
+finite element space": the nodal interpolation, both factors at the new level), is
+bilinear in the new ``(nu, H)``; it is linearised at the extrapolation::
+
+    X + dt (H* nu + H nu*) = B_X + dt H* nu*                                 (KL5)
+
+which differs from ``X = B_X - dt H nu`` by ``dt (H - H*) (nu - nu*)``,
+``O(tau^(2k+1))`` per step for BDF-k (``O(tau^3)`` for Euler): below the local
+error of every integrator, and the step stays ONE linear system that the
+harness solves and extrapolates like any other (the BDF3 start-up combines whole
+solutions). (KL3) and (KL5) together, the state ``U = (X, nu, H)`` (7, n)::
+
+    [ I   dt H*  dt nu* ] [X ]   [B_X + dt H* nu*     ]
+    [ 0   S      0      ] [nu] = [B_nu + dt w/m nu*   ]                     (KL6)
+    [ 0   0      S      ] [H ]   [B_H + dt w/m H*     ]
+
+``S = I + dt diag(1/m) L`` (C3), ``dt H*`` and ``dt nu*`` diagonal: a (7n, 7n)
+block upper triangular matrix, not symmetric (BiCGStab or a sparse LU); its
+eigenvalues are 1 and those of ``S``.
+
+Initial values (any mesh): ``nu^0`` the unit area-weighted vertex normals
+(:func:`baselines.mdr.unit_vertex_normals`), ``H^0_i = nu^0_i . (L X^0)_i / m_i`` the
+normal part of the cotangent mean curvature vector (``-Delta X = H nu``), as
+MDR's ``H``. Closed surfaces only (the paper's setting): a mesh with a boundary
+is refused (``ValueError``; the harness records ``unsupported``).
+"""
+
+import numpy as np
+import scipy.sparse as sp
+
+from .cotan import VertexFlow
+from .kernels import gradient_norm_weights
+from .mdr import unit_vertex_normals
+
+ROWS = 7
+"""The state ``(X, nu, H)``: 3 + 3 + 1 rows."""
+
+
+def curvature_weights(vertices, faces, nu):
+    """``w`` of (KL4): the lumped ``int |grad_G nu|^2 phi_i``, one value per triangle
+    (kernel :func:`baselines.kernels.gradient_norm_weights`).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+    nu : (n, 3) float array
+        Nodal values of a P1 vector field.
+
+    Returns
+    -------
+    w : (n,) float array
+        ``sum_{t ni i} |t| |grad_t nu|^2 / 3``; triangles of zero area add nothing.
+    squared : (m,) float array
+        ``|grad_t nu|^2`` (0 on a triangle of zero area).
+
+    Examples
+    --------
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0]])
+    >>> w, sq = curvature_weights(V, np.array([[0, 1, 2]]), V * [2.0, 3.0, 0.0])
+    >>> sq.round(12).tolist(), w.round(4).tolist()          # grad (2x, 3y): 4 + 9
+    ([13.0], [2.1667, 2.1667, 2.1667])
+    """
+    w, squared = np.empty(len(vertices)), np.empty(len(faces))
+    gradient_norm_weights(np.ascontiguousarray(vertices, dtype=np.float64),
+                          np.ascontiguousarray(faces, dtype=np.int64),
+                          np.ascontiguousarray(nu, dtype=np.float64), w, squared)
+    return w, squared
+
+
+class KLLFlow(VertexFlow):
+    """Mean curvature flow by the algorithm of Kovacs, Li and Lubich, (KL6), of one
+    closed surface; state ``(X, nu, H)``.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+        Initial surface ``X^0``.
+    faces : (m, 3) int array
+        Consistently oriented triangles of a closed manifold surface.
+    tau : float
+
+    Raises
+    ------
+    ValueError
+        The mesh has a boundary.
+
+    Examples
+    --------
+    >>> V = np.array([[1., 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]])   # tetrahedron
+    >>> F = np.array([[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])
+    >>> flow = KLLFlow(V, F, 0.01)
+    >>> A, b = flow.system()
+    >>> A.shape, b.shape, flow.state.shape
+    ((28, 28), (7, 4), (7, 4))
+    """
+
+    def __init__(self, vertices, faces, tau):
+        super().__init__(vertices, faces, tau, mass="barycentric")
+        if self.fixed.any():
+            raise ValueError(f"kll evolves closed surfaces (Kovacs, Li, Lubich 2019); this "
+                             f"mesh has {int(self.fixed.sum())} boundary vertices")
+        g, n = self.geometry, self.mesh.n_vertices
+        nu = unit_vertex_normals(self.faces, g.area_vectors, n)
+        H = np.einsum("ic,ic->i", nu, self.assembler.laplacian(g.L_data) @ self.vertices) / g.mass
+        self._adopt(np.vstack([self._X, nu.T, H[None]]))
+        # (KL6)'s CSR pattern: the X rows (X_c, nu_c, H), then four blocks of S
+        p = self.assembler.pattern
+        i = np.arange(n)
+        top = np.stack([[c * n + i, (3 + c) * n + i, 6 * n + i] for c in range(3)])
+        self._indices = np.concatenate([top.transpose(0, 2, 1).ravel()]
+                                       + [r * n + p.indices for r in range(3, ROWS)])
+        self._indptr = np.concatenate([3 * np.arange(3 * n)]
+                                      + [9 * n + k * p.nnz + p.indptr[:-1] for k in range(4)]
+                                      + [[9 * n + 4 * p.nnz]])
+
+    def _adopt(self, U):
+        """Make ``U`` (7, n) the state; ``X`` is a view of its first rows."""
+        self._U = np.require(U, np.float64, ["C", "W"])
+        self._X = self._U[:3]
+
+    @property
+    def state(self):
+        """(7, n) read-only view of ``(X^n, nu^n, H^n)``, what :meth:`system` and
+        :meth:`advance` work with."""
+        view = self._U.view()
+        view.flags.writeable = False
+        return view
+
+    @property
+    def nu(self):
+        """(n, 3) read-only view of the evolved normals ``nu^n`` (not normalised)."""
+        return self.state[3:6].T
+
+    @property
+    def H(self):
+        """(n,) read-only view of the evolved mean curvature ``H^n``."""
+        return self.state[6]
+
+    def system(self, at=None, base=None, dt=None):
+        """``(A, b)`` of (KL6) with the operators at the state ``at`` (7, n).
+
+        Parameters
+        ----------
+        at, base : (7, n) float arrays, optional
+            ``(X*, nu*, H*)`` and ``B``; default the current state.
+        dt : float, optional
+            Default ``tau``.
+
+        Returns
+        -------
+        A : (7n, 7n) scipy.sparse.csr_matrix
+        b : (7, n) float array
+        """
+        return super().system(self._U if at is None else at, base, dt)
+
+    def _system(self, at, base, dt):
+        X, nu, H = (self._X, at[3:6], at[6]) if at is self._U else (at[:3], at[3:6], at[6])
+        g, n = self.geometry_at(X), self.mesh.n_vertices
+        self._assembles_here = at is self._U     # (VertexFlow.system saw at = U, never None)
+        S = self.assembler.row_scaled(g.L_data, g.mass, dt, self.fixed)
+        w = curvature_weights(X.T, self.faces, nu.T)[0]
+        source = dt * np.divide(w, g.mass, out=np.zeros(n), where=g.mass > 0)
+        data = np.empty(len(self._indices))
+        top = data[:9 * n].reshape(3, n, 3)          # the X rows: (X_c, nu_c, H) entries
+        top[..., 0], top[..., 1], top[..., 2] = 1.0, dt * H, dt * nu
+        data[9 * n:].reshape(4, -1)[:] = S.data
+        A = sp.csr_matrix((data, self._indices, self._indptr), shape=(ROWS * n, ROWS * n),
+                          copy=False)
+        b = np.array(base, dtype=np.float64)
+        b[:3] += dt * H * nu
+        b[3:] += source * at[3:]
+        return A, b
+
+    def advance(self, U):
+        """Accept ``U`` (7, n) as the state ``n + 1``."""
+        self._adopt(U)
+        super().advance(self._X)
+
+    def defects(self):
+        """:meth:`baselines.cotan.VertexFlow.defects`, and ``"degenerated"`` for
+        non-finite normals or curvatures."""
+        bad = ~np.isfinite(self._U[3:]).all(axis=0)
+        if bad.any():
+            return [("degenerated", f"non-finite normal or mean curvature at {int(bad.sum())} "
+                     f"vertex(es), e.g. vertex {int(np.flatnonzero(bad)[0])}")]
+        return super().defects()

@@ -1,0 +1,129 @@
+"""The algorithm of Kovacs, Li and Lubich (baselines/kll.py)."""
+
+import igl
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from conftest import cylinder
+from test_mdr import agrees_under_rigid_motion_and_relabelling
+
+from baselines.cotan import cotangent_laplacian
+from baselines.kll import KLLFlow, curvature_weights
+from mcfbench.geometry.exact import sphere_state_errors
+from mcfbench.geometry.spheres import icosphere
+from mcfbench.running.integrators import get_integrator
+from mcfbench.running.solver import Solver
+
+EXACT = Solver(method="direct", rtol=1e-12)
+KRYLOV = Solver(rtol=1e-10)          # BiCGStab: the LU of (KL6) costs 40 x more at level 3
+
+
+def final_errors(level, integrator, t_final=0.08):
+    """Errors of the position, ``nu`` and ``H`` at ``t_final`` on the level-``level``
+    icosphere, ``tau = 0.04 / 4^(level-1)`` (the Table 3.1 setting; lumped L2,
+    :func:`mcfbench.geometry.exact.sphere_state_errors`)."""
+    V, F = icosphere(level)
+    tau = 0.04 / 4 ** (level - 1)
+    flow, stepper = KLLFlow(V, F, tau), get_integrator(integrator)
+    for _ in range(round(t_final / tau)):
+        stepper.step(flow, KRYLOV)
+    errors = sphere_state_errors(flow.vertices, flow.l2_weights, t_final, normals=flow.nu,
+                                 curvature=flow.H)
+    return [errors["position"], errors["normal"], errors["curvature"]]
+
+
+def eoc(errors):
+    return np.log2(errors[:-1] / errors[1:])
+
+
+@pytest.mark.parametrize("integrator, expected", [
+    ("euler", [[1.8973e-2, 1.2863e-2, 1.9718e-1], [5.4812e-3, 3.9939e-3, 4.3922e-2],
+               [1.3638e-3, 9.1978e-4, 1.1347e-2]]),
+    ("bdf2", [[1.5040e-2, 1.4534e-2, 1.2572e-1], [3.0801e-3, 4.2286e-3, 5.4936e-3],
+              [6.7797e-4, 9.2971e-4, 8.3865e-4]])])
+def test_sphere_position_normal_and_curvature_converge_at_order_2(integrator, expected):
+    """Levels 1-3 (42-642 vertices, 2-32 steps), ``tau ~ h^2``: errors (position, nu, H)
+    as measured, and EOC 2.0-2.7 from level 2 to 3 (H with BDF2: 2.71, Euler's time
+    error O(tau) = O(h^2) dominates its H). Level 4 (``baselines/README.md``): EOC
+    2.02 / 2.06 / 1.97 (Euler), 2.06 / 2.07 / 2.08 (BDF2)."""
+    errors = np.array([final_errors(level, integrator) for level in (1, 2, 3)])
+    np.testing.assert_allclose(errors, expected, rtol=2e-3)
+    orders = eoc(errors)[-1]
+    assert np.all((orders > 1.9) & (orders < 2.8)), orders
+
+
+def test_system_is_kl6_against_an_independent_assembly(noisy_sphere):
+    """(KL6) at a state ``U*`` with a base ``B``: ``S = I + dt diag(1/m) L`` and ``|A|^2``
+    from libigl (cotangent matrix, barycentric mass, the per-triangle gradient)."""
+    V, F = noisy_sphere
+    n, dt = len(V), 0.003
+    rng = np.random.default_rng(2)
+    flow = KLLFlow(V, F, 0.01)
+    at = np.array(flow.state) + 0.01 * rng.standard_normal((7, n))
+    base = np.array(flow.state) + 0.01 * rng.standard_normal((7, n))
+    A, b = flow.system(at, base, dt)
+    X, nu, H = at[:3].T, at[3:6].T, at[6]
+    m = igl.massmatrix(X, F, igl.MASSMATRIX_TYPE_BARYCENTRIC).diagonal()
+    S = sp.identity(n) + sp.diags(dt / m) @ cotangent_laplacian(X, F)
+    G = igl.grad(X, F)                                        # (3 m, n): d/dx, d/dy, d/dz
+    squared = ((G @ nu) ** 2).reshape(3, len(F), 3).sum(axis=(0, 2))
+    w = np.bincount(F.ravel(), np.repeat(igl.doublearea(X, F) / 6 * squared, 3))
+    Z = sp.csr_matrix((n, n))
+    rows = [[sp.identity(n) if d == c else Z for d in range(3)]
+            + [sp.diags(dt * H) if d == c else Z for d in range(3)] + [sp.diags(dt * nu[:, c])]
+            for c in range(3)]
+    rows += [[Z] * (3 + r) + [S] + [Z] * (3 - r) for r in range(4)]
+    np.testing.assert_allclose(A.toarray(), sp.bmat(rows).toarray(), rtol=0, atol=1e-12)
+    expected = base.copy()
+    expected[:3] += dt * H * nu.T
+    expected[3:] += dt * w / m * at[3:]
+    np.testing.assert_allclose(b, expected, rtol=0, atol=1e-12)
+    assert np.ptp(w / m) > 0.5                                # a real |A|^2, not constant
+
+
+def test_curvature_weights_of_the_sphere_normal():
+    """``nu = x`` on the level-3 icosphere: ``|grad_G nu|^2 = |A|^2 = 2`` on the unit
+    sphere (measured 1.9984 to 2.0000 on the flat triangles)."""
+    V, F = icosphere(3)
+    w, squared = curvature_weights(V, F, V)
+    assert np.all(np.abs(squared - 2) < 2e-3)
+    m = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC).diagonal()
+    np.testing.assert_allclose(w / m, 2, atol=2e-3)
+
+
+def test_initial_values_and_orientation():
+    """``nu^0``, ``H^0`` from the mesh, level-3 icosphere: ``nu^0`` within 0.012 of ``x``
+    (O(h)); ``H^0`` (the suite's sign, ``H = 2 / R``) within 0.009 of 2 but at the 12
+    valence-5 vertices, where the cotangent mean curvature is 0.286 off at every level
+    (0.269, 0.286, 0.290, 0.291 at levels 2-5). The reversed orientation flips both and
+    moves the vertices the same way (``H nu`` does not depend on the side)."""
+    V, F = icosphere(3)
+    flow, flipped = KLLFlow(V, F, 0.0025), KLLFlow(V, F[:, ::-1], 0.0025)
+    assert np.linalg.norm(flow.nu - V, axis=1).max() < 0.012
+    assert np.abs(flow.H[12:] - 2).max() < 0.009                       # valence 6
+    np.testing.assert_allclose(flow.H[:12], 2.286, atol=1e-3)          # valence 5
+    np.testing.assert_allclose(flipped.nu, -flow.nu, atol=1e-15)
+    np.testing.assert_allclose(flipped.H, -flow.H, atol=1e-12)
+    steppers = [get_integrator("bdf2") for _ in range(2)]
+    for _ in range(3):
+        for f, s in zip((flow, flipped), steppers):
+            s.step(f, EXACT)
+    np.testing.assert_allclose(flipped.vertices, flow.vertices, rtol=0, atol=1e-13)
+
+
+def test_invariant_under_rigid_motion_and_relabelling(noisy_sphere):
+    agrees_under_rigid_motion_and_relabelling(KLLFlow, *noisy_sphere)
+
+
+def test_open_surface_is_refused():
+    with pytest.raises(ValueError, match="kll evolves closed surfaces .* 48 boundary vertices"):
+        KLLFlow(*cylinder(24, 8), 0.01)
+
+
+def test_non_finite_curvature_is_a_defect():
+    flow = KLLFlow(*icosphere(1), 0.01)
+    U = np.array(flow.state)
+    U[6, 5] = np.nan
+    flow.advance(U)
+    assert flow.defects() == [("degenerated", "non-finite normal or mean curvature at 1 "
+                                              "vertex(es), e.g. vertex 5")]
