@@ -1,0 +1,170 @@
+"""Tangential motion of the F-vertices of least Dirichlet energy: BGN's and MDR's.
+
+The paper's step (2.1), (2.10)-(2.15) gives every F-vertex a velocity whose
+normal part is the scheme's discrete ``h . N`` and whose tangential part is
+whatever the DDFV Laplacian of the new state has (on real meshes it lets the
+F-mesh degenerate, ``ddfv/README.md``). Here the normal displacement of each
+F-vertex is kept, and its tangential displacement is chosen as Barrett, Garcke
+& Nuernberg (J. Comput. Phys. 222 (2007) 441-467; 227 (2008) 4281-4307, the
+surface scheme (B1)-(B2) of :mod:`baselines.bgn`'s docstring) or Hu & Li
+(Numer. Math. 152 (2022) 127-181, the minimal deformation rate) choose it for
+the P1 vertex scheme. Equation labels (TM1)-(TM5) are ours; the derivation
+(ours: the papers' texts beyond their abstracts were not available) is in
+``ddfv/README.md``, section "Tangential motion of the F-vertices".
+
+The two as constrained minimisations. On the F-mesh ``Gamma^{n-1}`` (the
+triangles of the F-vertices of the old state), with ``A`` its P1 (cotangent)
+stiffness, ``N_k`` the unit normal at F-vertex ``k`` and ``d_k`` a prescribed
+normal displacement, BGN's (B2) for the new positions ``X`` with the test
+functions ``eta = phi_k t`` (``t . N_k = 0``) says ``P_k (A X)_k = 0``,
+``P_k = I - N_k N_k^T``: the stationarity of the Dirichlet energy of the new
+surface among the positions of the given normal displacement (``kappa`` of
+(B1)-(B2) is the multiplier of that constraint). MDR's (M1) is the same with
+the displacement ``X - X^{n-1}`` in place of ``X``. Both are::
+
+    X = argmin { 1/2 sum_c (Y + X - X^*)_c^T A (Y + X - X^*)_c :
+                 N_k . (X_k - X^*_k) = 0 for every k, X_k = X^*_k if k fixed }   (TM1)
+
+    Y = X^*              (BGN: the energy of the new surface)
+    Y = X^* - X^{n-1}    (MDR: the energy of the displacement)
+
+where ``X^*`` are the F-vertices of the scheme's step (the constraint keeps
+its normal displacement ``d_k = N_k . (X^*_k - X^{n-1}_k)``), ``c`` runs over
+the three coordinates. With ``E_k = [t1_k, t2_k]`` (3, 2) an orthonormal
+basis of the tangent plane of ``N_k``, ``X_k = X^*_k + E_k s_k`` and (TM1) is
+the symmetric positive definite ``2 n x 2 n`` system::
+
+    S s = -r,   S_(k a),(j b) = A_kj t_a,k . t_b,j,   r_(k a) = t_a,k . (A Y)_k   (TM2)
+
+(``S`` is positive definite on a closed surface: ``E s`` constant would be a
+vector tangent at every vertex, i.e. zero; at fixed vertices ``s = 0``). Its
+solution does not depend on the choice of the bases (a rotation of ``E_k`` is
+a change of the unknowns ``s_k``) and moves every F-vertex in the tangent
+plane of its normal::
+
+    N_k . (X_k - X^*_k) = 0                                                 (TM3)
+
+T-vertices keep their barycentric coordinates and their height relative to
+their triangle as it moves (:func:`follow_triangles`)::
+
+    T = T^* + sum_j lam_j (X_j - X^*_j)                                      (TM4)
+"""
+
+import igl
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+
+KINDS = ("bgn", "mdr")
+"""The tangential motions: ``"bgn"`` (the new surface's Dirichlet energy) and ``"mdr"``
+(the displacement's, the minimal deformation rate)."""
+
+
+def p1_stiffness(F, faces):
+    """The P1 (cotangent) stiffness ``A = -igl.cotmatrix`` of the F-mesh.
+
+    Parameters
+    ----------
+    F : (n, 3) float array
+    faces : (m, 3) int array
+
+    Returns
+    -------
+    (n, n) scipy.sparse.csr_matrix
+        ``A_kj = int grad phi_k . grad phi_j``, symmetric positive semi-definite.
+    """
+    return sp.csr_matrix(-igl.cotmatrix(np.asarray(F, dtype=float), faces))
+
+
+def tangent_bases(N):
+    """Orthonormal bases of the planes orthogonal to the unit vectors ``N``.
+
+    Duff, Burgess, Christensen, Hery, Kensler, Liani, Villemin, "Building an
+    orthonormal basis, revisited", J. Comput. Graph. Tech. 6(1) (2017): branch-free,
+    continuous except across ``N_z = 0``.
+
+    Parameters
+    ----------
+    N : (n, 3) float array
+        Unit vectors.
+
+    Returns
+    -------
+    t1, t2 : (n, 3) float arrays
+        ``(t1, t2, N)`` is a right-handed orthonormal basis at every row.
+    """
+    x, y, z = np.asarray(N, dtype=float).T
+    sign = np.where(z >= 0.0, 1.0, -1.0)
+    a = -1.0 / (sign + z)
+    b = x * y * a
+    t1 = np.stack([1.0 + sign * x * x * a, sign * b, -sign * x], axis=1)
+    t2 = np.stack([b, sign + y * y * a, -y], axis=1)
+    return t1, t2
+
+
+def tangential_motion(F_old, F_new, faces, N, kind, fixed=None):
+    """The F-vertices of (TM1): ``F_new`` moved in the tangent planes of ``N``.
+
+    Parameters
+    ----------
+    F_old : (n, 3) float array
+        The old state ``X^{n-1}``: the surface whose stiffness ``A`` is used.
+    F_new : (n, 3) float array
+        The scheme's new F-vertices ``X^*`` (their normal displacement is kept).
+    faces : (m, 3) int array
+    N : (n, 3) float array
+        Unit normals at the F-vertices (the scheme's, of the old state).
+    kind : {"bgn", "mdr"}
+    fixed : (n,) bool array, optional
+        Vertices that do not move (Dirichlet); default none.
+
+    Returns
+    -------
+    (n, 3) float array
+        ``X`` with ``N_k . (X_k - F_new_k) = 0`` (TM3) and ``X_k = F_new_k`` at
+        fixed vertices.
+    """
+    if kind not in KINDS:
+        raise ValueError(f"unknown tangential motion {kind!r}; choose one of "
+                         f"{', '.join(KINDS)}")
+    F_old, F_new = np.asarray(F_old, dtype=float), np.asarray(F_new, dtype=float)
+    n = len(F_new)
+    free = np.ones(n, bool) if fixed is None else ~np.asarray(fixed, bool)
+    A = p1_stiffness(F_old, faces)
+    Y = F_new if kind == "bgn" else F_new - F_old
+    AY = (A @ Y)[free]                                           # (A Y)_k, free k
+    A = A[free][:, free].tocoo()
+    bases = [t[free] for t in tangent_bases(N)]
+    # (TM2) with the unknowns interleaved, (k, a) -> 2 k + a: S has the band of A
+    rows, cols, values = zip(*((2 * A.row + a, 2 * A.col + b,
+                                A.data * np.einsum("ij,ij->i", ta[A.row], tb[A.col]))
+                               for a, ta in enumerate(bases) for b, tb in enumerate(bases)))
+    m = 2 * A.shape[0]
+    S = sp.csc_matrix((np.concatenate(values), (np.concatenate(rows), np.concatenate(cols))),
+                      shape=(m, m))
+    r = np.stack([np.einsum("ij,ij->i", ta, AY) for ta in bases], axis=1).ravel()
+    s = splu(S, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True}).solve(-r)
+    X = F_new.copy()
+    X[free] += s[0::2, None] * bases[0] + s[1::2, None] * bases[1]
+    return X
+
+
+def follow_triangles(T, displacement, faces, lam):
+    """T-vertices moved with their triangles (TM4).
+
+    Parameters
+    ----------
+    T : (n_t, 3) float array
+    displacement : (n_f, 3) float array
+        Displacement of the F-vertices.
+    faces : (n_t, 3) int array
+    lam : (n_t, 3) float array
+        Barycentric coordinates of the T-vertices in their triangles.
+
+    Returns
+    -------
+    (n_t, 3) float array
+        ``T + sum_j lam_j displacement_j``: the barycentric coordinates are kept,
+        and the height above the triangle's plane to first order in its rotation.
+    """
+    return T + np.einsum("tk,tkj->tj", lam, displacement[faces])
