@@ -44,10 +44,16 @@ plane of its normal::
 
     N_k . (X_k - X^*_k) = 0                                                 (TM3)
 
-T-vertices keep their barycentric coordinates and their height relative to
-their triangle as it moves (:func:`follow_triangles`)::
+T-vertices follow their triangles (:func:`follow_triangles`): with ``lam``
+the barycentric coordinates of the projection of ``T^*`` into its triangle of
+``X^*``::
 
     T = T^* + sum_j lam_j (X_j - X^*_j)                                      (TM4)
+
+i.e. ``T - sum_j lam_j X_j = T^* - sum_j lam_j X^*_j``: the T-vertex keeps its
+height vector above the point of coordinates ``lam``, so its projection keeps
+``lam`` and its height up to the rotation of the triangle (``1 - cos`` of the
+angle for the height, ``height x sin`` for the projection).
 """
 
 import igl
@@ -164,7 +170,7 @@ def follow_triangles(T, displacement, faces, lam):
     Returns
     -------
     (n_t, 3) float array
-        ``T + sum_j lam_j displacement_j``: the barycentric coordinates are kept,
-        and the height above the triangle's plane to first order in its rotation.
+        ``T + sum_j lam_j displacement_j``: the offset of ``T`` from the point of
+        coordinates ``lam`` of its triangle is kept.
     """
     return T + np.einsum("tk,tkj->tj", lam, displacement[faces])
