@@ -5,10 +5,11 @@ normal part is the scheme's discrete ``h . N`` and whose tangential part is
 whatever the DDFV Laplacian of the new state has (on real meshes it lets the
 F-mesh degenerate, ``ddfv/README.md``). Here the normal displacement of each
 F-vertex is kept, and its tangential displacement is chosen as Barrett, Garcke
-& Nuernberg (J. Comput. Phys. 222 (2007) 441-467; 227 (2008) 4281-4307, the
-surface scheme (B1)-(B2) of :mod:`baselines.bgn`'s docstring) or Hu & Li
+& Nuernberg (J. Comput. Phys. 222 (2007) 441-467; 227 (2008) 4281-4307; SIAM
+J. Sci. Comput. 31 (2008) 225-253; the surface scheme (B1)-(B2) of the
+docstring of ``baselines/bgn.py``) or Hu & Li
 (Numer. Math. 152 (2022) 127-181, the minimal deformation rate) choose it for
-the P1 vertex scheme. Equation labels (TM1)-(TM5) are ours; the derivation
+the P1 vertex scheme. Equation labels (TM1)-(TM4) are ours; the derivation
 (ours: the papers' texts beyond their abstracts were not available) is in
 ``ddfv/README.md``, section "Tangential motion of the F-vertices".
 
