@@ -43,7 +43,7 @@ from .redistribution import (OMEGA, PECLET, TangentialPotential, carry_t_vertice
                              drift_system, neumann_stiffness, redistribution_source,
                              surface_components, vertex_gradients)
 from .t_vertices import initial_t_vertices
-from .tangential_motion import KINDS, follow_triangles, tangential_motion
+from .tangential_motion import KINDS, TangentialMotion, follow_triangles
 from .topology import diamond_mesh, locality_order
 
 TANGENTIAL = ("none", "eliminate", "redistribute", *KINDS)
@@ -182,6 +182,10 @@ class Flow:
         #: barycentric coordinates kept by ``t_motion="carried"`` (own numbering)
         self._lambda0 = self._barycentric[0].copy() if t_motion == "carried" else None
         self._potential = None      # the solver of (R3), kept along the flow
+        #: the solver of (TM1)-(TM2), kept along the flow
+        self._motion = TangentialMotion(self._mesh.faces, tangential,
+                                        fixed=self._mesh.boundary_vertices) \
+            if tangential in KINDS else None
 
     @property
     def X(self):
@@ -367,8 +371,7 @@ class Flow:
         mesh, n_f = self._mesh, self._mesh.n_f
         F_old, F_new, T_new = self._X[:, :n_f].T, X[:, :n_f].T, X[:, n_f:].T
         N = vertex_normals(mesh, self._geometry)[:, :n_f].T
-        F = tangential_motion(F_old, F_new, mesh.faces, N, self.tangential,
-                              fixed=mesh.boundary_vertices)
+        F = self._motion(F_old, F_new, N)
         lam = t_barycentric(F_new, T_new, mesh.faces, threads=self.threads)
         T = follow_triangles(T_new, F - F_new, mesh.faces, lam)
         self._tick("tangential", clock)

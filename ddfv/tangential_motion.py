@@ -109,51 +109,131 @@ def tangent_bases(N):
     return t1, t2
 
 
-def tangential_motion(F_old, F_new, faces, N, kind, fixed=None):
-    """The F-vertices of (TM1): ``F_new`` moved in the tangent planes of ``N``.
+class TangentialMotion:
+    """(TM1)-(TM3) along a flow, the factors of (TM2) kept from step to step.
+
+    (TM2) changes by ``O(tau)`` from one step to the next, so it is solved by
+    iterative refinement with the sparse LU of an earlier step's matrix,
+    ``s <- s + LU^{-1} (b - S s)`` from ``LU^{-1} b``, until
+    ``|b - S s| <= rtol |b|``; when that takes more than ``max_refinements``
+    passes, ``S`` is factorised again (SuperLU, symmetric mode, minimum-degree
+    ordering of ``S + S^T``). The unknowns are interleaved, ``(k, a) -> 2 k + a``,
+    so that ``S`` has the band of ``A`` in the caller's numbering. For the kept
+    factors to fit the next matrix, the tangent bases follow the normals: each
+    step's ``t1`` is the last one projected on the new tangent plane (a basis
+    from :func:`tangent_bases` where that projection is shorter than 1/2, and at
+    the first step), ``t2 = N x t1``. Any ``s`` keeps the normal displacement
+    exactly (TM3); the accuracy of ``s`` only decides how close the tangential
+    displacement is to the minimiser.
 
     Parameters
     ----------
-    F_old : (n, 3) float array
-        The old state ``X^{n-1}``: the surface whose stiffness ``A`` is used.
-    F_new : (n, 3) float array
-        The scheme's new F-vertices ``X^*`` (their normal displacement is kept).
     faces : (m, 3) int array
-    N : (n, 3) float array
-        Unit normals at the F-vertices (the scheme's, of the old state).
     kind : {"bgn", "mdr"}
     fixed : (n,) bool array, optional
         Vertices that do not move (Dirichlet); default none.
+    rtol : float
+        Relative residual of the refinement.
+    max_refinements : int
+
+    Attributes
+    ----------
+    factorisations, refinements : int
+        Factorisations and refinement passes so far.
+    """
+
+    def __init__(self, faces, kind, fixed=None, rtol=1e-12, max_refinements=6):
+        if kind not in KINDS:
+            raise ValueError(f"unknown tangential motion {kind!r}; choose one of "
+                             f"{', '.join(KINDS)}")
+        self.faces, self.kind = faces, kind
+        self.fixed = None if fixed is None else np.asarray(fixed, bool)
+        self.rtol, self.max_refinements = rtol, max_refinements
+        self._lu = self._t1 = None
+        self.factorisations = self.refinements = 0
+
+    def __call__(self, F_old, F_new, N):
+        """The F-vertices of (TM1): ``F_new`` moved in the tangent planes of ``N``.
+
+        Parameters
+        ----------
+        F_old : (n, 3) float array
+            The old state ``X^{n-1}``: the surface whose stiffness ``A`` is used.
+        F_new : (n, 3) float array
+            The scheme's new F-vertices ``X^*`` (their normal displacement is kept).
+        N : (n, 3) float array
+            Unit normals at the F-vertices (the scheme's, of the old state).
+
+        Returns
+        -------
+        (n, 3) float array
+            ``X`` with ``N_k . (X_k - F_new_k) = 0`` (TM3) and ``X_k = F_new_k`` at
+            fixed vertices.
+        """
+        F_old, F_new = np.asarray(F_old, dtype=float), np.asarray(F_new, dtype=float)
+        free = np.ones(len(F_new), bool) if self.fixed is None else ~self.fixed
+        A = p1_stiffness(F_old, self.faces)
+        Y = F_new if self.kind == "bgn" else F_new - F_old
+        AY = (A @ Y)[free]                                           # (A Y)_k, free k
+        A = A[free][:, free].tocoo()
+        bases = [t[free] for t in self._bases(np.asarray(N, dtype=float))]
+        # (TM2), unknowns interleaved
+        rows, cols, values = zip(*((2 * A.row + a, 2 * A.col + b,
+                                    A.data * np.einsum("ij,ij->i", ta[A.row], tb[A.col]))
+                                   for a, ta in enumerate(bases)
+                                   for b, tb in enumerate(bases)))
+        m = 2 * A.shape[0]
+        S = sp.csc_matrix((np.concatenate(values),
+                           (np.concatenate(rows), np.concatenate(cols))), shape=(m, m))
+        r = np.stack([np.einsum("ij,ij->i", ta, AY) for ta in bases], axis=1).ravel()
+        s = self._solve(S, -r)
+        X = F_new.copy()
+        X[free] += s[0::2, None] * bases[0] + s[1::2, None] * bases[1]
+        return X
+
+    def _bases(self, N):
+        """``t1, t2`` (n, 3) at the normals ``N``, ``t1`` following the last one."""
+        fresh, _ = tangent_bases(N)
+        if self._t1 is None:
+            t1 = fresh
+        else:
+            t1 = self._t1 - np.einsum("ij,ij->i", self._t1, N)[:, None] * N
+            length = np.linalg.norm(t1, axis=1, keepdims=True)
+            t1 = np.where(length > 0.5, t1 / np.where(length > 0.5, length, 1.0), fresh)
+        self._t1 = t1
+        return t1, np.cross(N, t1)
+
+    def _solve(self, S, b):
+        """``S^{-1} b`` by refinement with the kept factors, or a new factorisation."""
+        if self._lu is not None and self._lu.shape == S.shape:
+            x, norm = self._lu.solve(b), np.linalg.norm(b)
+            for _ in range(self.max_refinements):
+                residual = b - S @ x
+                if np.linalg.norm(residual) <= self.rtol * norm:
+                    return x
+                x += self._lu.solve(residual)
+                self.refinements += 1
+        self._lu = splu(S, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
+        self.factorisations += 1
+        return self._lu.solve(b)
+
+
+def tangential_motion(F_old, F_new, faces, N, kind, fixed=None):
+    """One step of (TM1)-(TM3): :class:`TangentialMotion` called once.
+
+    Parameters
+    ----------
+    F_old, F_new, N : (n, 3) float arrays
+        See :meth:`TangentialMotion.__call__`.
+    faces : (m, 3) int array
+    kind : {"bgn", "mdr"}
+    fixed : (n,) bool array, optional
 
     Returns
     -------
     (n, 3) float array
-        ``X`` with ``N_k . (X_k - F_new_k) = 0`` (TM3) and ``X_k = F_new_k`` at
-        fixed vertices.
     """
-    if kind not in KINDS:
-        raise ValueError(f"unknown tangential motion {kind!r}; choose one of "
-                         f"{', '.join(KINDS)}")
-    F_old, F_new = np.asarray(F_old, dtype=float), np.asarray(F_new, dtype=float)
-    n = len(F_new)
-    free = np.ones(n, bool) if fixed is None else ~np.asarray(fixed, bool)
-    A = p1_stiffness(F_old, faces)
-    Y = F_new if kind == "bgn" else F_new - F_old
-    AY = (A @ Y)[free]                                           # (A Y)_k, free k
-    A = A[free][:, free].tocoo()
-    bases = [t[free] for t in tangent_bases(N)]
-    # (TM2) with the unknowns interleaved, (k, a) -> 2 k + a: S has the band of A
-    rows, cols, values = zip(*((2 * A.row + a, 2 * A.col + b,
-                                A.data * np.einsum("ij,ij->i", ta[A.row], tb[A.col]))
-                               for a, ta in enumerate(bases) for b, tb in enumerate(bases)))
-    m = 2 * A.shape[0]
-    S = sp.csc_matrix((np.concatenate(values), (np.concatenate(rows), np.concatenate(cols))),
-                      shape=(m, m))
-    r = np.stack([np.einsum("ij,ij->i", ta, AY) for ta in bases], axis=1).ravel()
-    s = splu(S, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True}).solve(-r)
-    X = F_new.copy()
-    X[free] += s[0::2, None] * bases[0] + s[1::2, None] * bases[1]
-    return X
+    return TangentialMotion(faces, kind, fixed)(F_old, F_new, N)
 
 
 def follow_triangles(T, displacement, faces, lam):

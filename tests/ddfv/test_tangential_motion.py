@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from ddfv import Flow, variant_options
-from ddfv.tangential_motion import (follow_triangles, p1_stiffness, tangent_bases,
-                                    tangential_motion)
+from ddfv.tangential_motion import (TangentialMotion, follow_triangles, p1_stiffness,
+                                    tangent_bases, tangential_motion)
 from ddfv.geometry import t_barycentric, vertex_normals
 from mcfbench.geometry import surfaces
 from mcfbench.geometry.exact import SphereL2Error
@@ -97,6 +97,23 @@ def test_motion_does_not_depend_on_the_tangent_bases():
         X = tangential_motion(V, W, F, N, kind)
         XQ = tangential_motion(V @ Q.T, W @ Q.T, F, N @ Q.T, kind)
         np.testing.assert_allclose(XQ, X @ Q.T, atol=1e-13)
+
+
+@pytest.mark.parametrize("kind", ["bgn", "mdr"])
+def test_kept_factors_give_the_fresh_solution(kind):
+    """Along a flow the next step's (TM2) is solved by refinement with the first
+    step's factors (and bases that follow the normals): the same positions as a
+    fresh factorisation, without factorising again."""
+    V, F, N, W = _displaced_bumpy()
+    motion = TangentialMotion(F, kind)
+    motion(V, W, N)
+    rng = np.random.default_rng(6)
+    V2 = V + 1e-4 * rng.normal(size=V.shape)
+    N2 = _unit(N + 1e-3 * rng.normal(size=N.shape))
+    W2 = V2 + 0.02 * rng.normal(size=V.shape)
+    np.testing.assert_allclose(motion(V2, W2, N2), tangential_motion(V2, W2, F, N2, kind),
+                               atol=1e-13)
+    assert (motion.factorisations, motion.refinements > 0) == (1, True)
 
 
 def test_t_vertices_follow_their_triangles():
