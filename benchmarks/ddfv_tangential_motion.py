@@ -13,7 +13,9 @@ Parts:
 * ``long``: the committed meshes as a user's mesh (``tau = 0.1 h^2``, 40 steps, the
   setting of ``ddfv/README.md``'s real-mesh table): status, steps, area end / start,
   smallest angle at the end;
-* ``sphere``: the Table 3.1 setting, levels 1-3: the L2 error (3.2) and its EOC.
+* ``sphere``: the Table 3.1 setting, levels 1-3: the L2 error (3.2) and its EOC;
+* ``catenoid``: the cylinder between two fixed circles relaxing to the catenoid,
+  levels 1-2: the neck error and its EOC (a fixed boundary).
 
 The runs are those of the command line (:func:`mcfbench.running.run.run`, the sparse LU).
 """
@@ -86,14 +88,24 @@ def sphere(schemes, levels=(1, 2, 3)):
               f"{', '.join(f'{x:.3f}' for x in eoc)} |", flush=True)
 
 
+def catenoid(schemes, levels=(1, 2)):
+    print("| scheme | neck error, levels " + ", ".join(map(str, levels)) + " | EOC |")
+    print("| --- | --- | --- |")
+    for scheme in schemes:
+        errors = [run(scheme, "catenoid", level)[0].metrics["neck_error"] for level in levels]
+        eoc = np.log2(np.abs(np.array(errors[:-1]) / np.array(errors[1:])))
+        print(f"| {scheme} | {', '.join(f'{e:.4e}' for e in errors)} | "
+              f"{', '.join(f'{x:.3f}' for x in eoc)} |", flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--parts", nargs="+", default=["problems", "long", "sphere"],
-                        choices=["problems", "long", "sphere"])
+    parts = {"problems": problems, "long": long_runs, "sphere": sphere, "catenoid": catenoid}
+    parser.add_argument("--parts", nargs="+", default=list(parts), choices=list(parts))
     parser.add_argument("--schemes", nargs="+", default=list(SCHEMES))
     args = parser.parse_args()
     for part in args.parts:
-        {"problems": problems, "long": long_runs, "sphere": sphere}[part](args.schemes)
+        parts[part](args.schemes)
 
 
 if __name__ == "__main__":
