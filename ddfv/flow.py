@@ -43,9 +43,10 @@ from .redistribution import (OMEGA, PECLET, TangentialPotential, carry_t_vertice
                              drift_system, neumann_stiffness, redistribution_source,
                              surface_components, vertex_gradients)
 from .t_vertices import initial_t_vertices
+from .tangential_motion import KINDS, TangentialMotion, follow_triangles
 from .topology import diamond_mesh, locality_order
 
-TANGENTIAL = ("none", "eliminate", "redistribute")
+TANGENTIAL = ("none", "eliminate", "redistribute", *KINDS)
 T_MOTIONS = ("scheme", "carried")
 
 
@@ -83,12 +84,17 @@ class Flow:
         Initial T-vertices; by default from ``t_init``.
     t_init : {"paper", "barycenter", "exact"}
         T-vertex initialisation (see :mod:`ddfv.t_vertices`).
-    tangential : {"none", "eliminate", "redistribute"}
+    tangential : {"none", "eliminate", "redistribute", "bgn", "mdr"}
         ``"eliminate"`` removes the tangential part of the discrete mean
         curvature vector from the velocity (3.6); ``"redistribute"`` adds
         the area-oriented tangential velocity ``grad psi`` of
         :mod:`ddfv.redistribution` (R1)-(R5) semi-implicitly, as the
-        advection ``grad psi^{n-1} . grad X^n`` in the matrix (R6)-(R7).
+        advection ``grad psi^{n-1} . grad X^n`` in the matrix (R6)-(R7);
+        ``"bgn"``, ``"mdr"`` keep the normal displacement of each F-vertex
+        that the step computed and replace its tangential displacement by
+        the one of least Dirichlet energy of the new F-mesh (BGN) or of the
+        displacement (MDR) (:mod:`ddfv.tangential_motion`, (TM1)-(TM4)), the
+        T-vertices following their triangles.
     omega : float
         Relaxation rate of the redistribution (R2), in 1 / time on a surface
         of the unit sphere's area 4 pi (default :data:`ddfv.redistribution.OMEGA`):
@@ -117,7 +123,8 @@ class Flow:
         Current time level.
     timings : dict
         Seconds spent so far in ``"geometry"`` (including the covolumes and
-        the checks of each new state), ``"assembly"`` and ``"solve"``.
+        the checks of each new state), ``"assembly"``, ``"solve"`` and
+        ``"tangential"`` (the motion of ``tangential="bgn"`` or ``"mdr"``).
     """
 
     def __init__(self, vertices, faces, tau, *, T0=None, t_init="paper",
@@ -170,11 +177,15 @@ class Flow:
         self.n = 0
         self._X = np.ascontiguousarray(np.concatenate([F, T]).T)
         self._assembler = Assembler(self._mesh)
-        self.timings = {"geometry": 0.0, "assembly": 0.0, "solve": 0.0}
+        self.timings = {"geometry": 0.0, "assembly": 0.0, "solve": 0.0, "tangential": 0.0}
         self._J0 = self._geometry.J.mean()
         #: barycentric coordinates kept by ``t_motion="carried"`` (own numbering)
         self._lambda0 = self._barycentric[0].copy() if t_motion == "carried" else None
         self._potential = None      # the solver of (R3), kept along the flow
+        #: the solver of (TM1)-(TM2), kept along the flow
+        self._motion = TangentialMotion(self._mesh.faces, tangential,
+                                        fixed=self._mesh.boundary_vertices) \
+            if tangential in KINDS else None
 
     @property
     def X(self):
@@ -332,12 +343,17 @@ class Flow:
     def advance(self, X):
         """Accept ``X`` (3, n_f + n_t), own numbering, as the state ``n + 1``.
 
-        With ``t_motion="carried"`` every T-vertex is first carried back to
-        its initial barycentric coordinates in its triangle.
+        With ``tangential="bgn"`` or ``"mdr"`` the F-vertices are first moved
+        tangentially (TM1)-(TM3) from the current state, the T-vertices with
+        their triangles (TM4); with ``t_motion="carried"`` every T-vertex is
+        then carried back to its initial barycentric coordinates in its
+        triangle.
         """
         X = np.require(X, np.float64, ["C", "W"])   # the compiled passes take writable arrays
+        n_f = self._mesh.n_f
+        if self.tangential in KINDS:
+            X = self._moved_tangentially(X)
         if self.t_motion == "carried":       # a tangential move of the T-vertices
-            n_f = self._mesh.n_f
             X = X.copy()
             X[:, n_f:] = carry_t_vertices(X[:, :n_f].T, X[:, n_f:].T, self._mesh.faces,
                                           self._lambda0).T
@@ -345,6 +361,21 @@ class Flow:
         self.n += 1
         for name in ("_state", "_barycentric"):
             self.__dict__.pop(name, None)
+
+    def _moved_tangentially(self, X):
+        """``X`` (3, n_f + n_t), own numbering, with the F-vertices moved by
+        (TM1)-(TM3) from the current state (the old one: its F-mesh's stiffness,
+        the scheme's vertex normals (3.6) at the F-vertices) and the T-vertices
+        following their triangles (TM4)."""
+        clock = time.perf_counter()
+        mesh, n_f = self._mesh, self._mesh.n_f
+        F_old, F_new, T_new = self._X[:, :n_f].T, X[:, :n_f].T, X[:, n_f:].T
+        N = vertex_normals(mesh, self._geometry)[:, :n_f].T
+        F = self._motion(F_old, F_new, N)
+        lam = t_barycentric(F_new, T_new, mesh.faces, threads=self.threads)
+        T = follow_triangles(T_new, F - F_new, mesh.faces, lam)
+        self._tick("tangential", clock)
+        return np.ascontiguousarray(np.concatenate([F, T]).T)
 
     def _potential_of(self, at, A, dt, geometry, covolumes):
         """(n,) ``psi`` of (R3) at the state ``at``; ``A`` the scheme's step matrix at

@@ -29,6 +29,14 @@ scheme registry (``mcfbench/running/schemes.py``) names each one ``ddfv-<variant
     every T-vertex carried by its triangle (kept at the barycentric
     coordinates of its initial, curvature-corrected position; see
     ``ddfv/README.md``).
+``chord-bgn-carried``
+    Chord-length ``|gamma|``, the F-vertices' normal displacement the
+    scheme's and their tangential one BGN's (least Dirichlet energy of the
+    new F-mesh, :mod:`ddfv.tangential_motion`), every T-vertex carried by its
+    triangle.
+``chord-mdr-carried``
+    The same with MDR's tangential displacement (least Dirichlet energy of
+    the displacement: the minimal deformation rate).
 
 The T-vertex initialisation is a separate setting (``t_init``).
 """
@@ -43,6 +51,8 @@ VARIANTS = {
     "chord-carried": {"dual_length": "chord", "t_motion": "carried"},
     "chord-redistribute-carried": {"dual_length": "chord", "tangential": "redistribute",
                                    "t_motion": "carried"},
+    "chord-bgn-carried": {"dual_length": "chord", "tangential": "bgn", "t_motion": "carried"},
+    "chord-mdr-carried": {"dual_length": "chord", "tangential": "mdr", "t_motion": "carried"},
 }
 
 

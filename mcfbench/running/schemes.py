@@ -143,6 +143,14 @@ SCHEMES = {s.name: s for s in (
     _ddfv("chord-redistribute-carried", "DDFV, chord + redistribution, T carried", "k", "*",
           "-.", "DDFV with chord |gamma|, semi-implicit redistribution of the F-vertices "
           "and every T-vertex carried by its triangle"),
+    _ddfv("chord-bgn-carried", "DDFV, chord + BGN tangential, T carried", "indigo", "8", "--",
+          "DDFV with chord |gamma|, the F-vertices' tangential motion BGN's (least Dirichlet "
+          "energy of the new F-mesh at the scheme's normal displacement) and every T-vertex "
+          "carried by its triangle"),
+    _ddfv("chord-mdr-carried", "DDFV, chord + MDR tangential, T carried", "darkcyan", "x", "-.",
+          "DDFV with chord |gamma|, the F-vertices' tangential motion MDR's (least Dirichlet "
+          "energy of the displacement at the scheme's normal displacement) and every T-vertex "
+          "carried by its triangle"),
     Scheme("cotan", "cotangent", "baselines.cotan:CotanFlow", {"mass": "barycentric"},
            {"color": "C3", "marker": "v", "linestyle": "-"},
            "the cotangent scheme (Dziuk 1991), barycentric lumped mass", matrix="scaled-spd"),

@@ -16,7 +16,9 @@ def test_variants_are_options_of_the_flow():
                 "redistribute": ("broken", "redistribute", "scheme"),
                 "chord-redistribute": ("chord", "redistribute", "scheme"),
                 "chord-carried": ("chord", "none", "carried"),
-                "chord-redistribute-carried": ("chord", "redistribute", "carried")}
+                "chord-redistribute-carried": ("chord", "redistribute", "carried"),
+                "chord-bgn-carried": ("chord", "bgn", "carried"),
+                "chord-mdr-carried": ("chord", "mdr", "carried")}
     assert set(VARIANTS) == set(expected)
     for name, (dual_length, tangential, t_motion) in expected.items():
         flow = Flow(V, F, 0.01, **variant_options(name))

@@ -63,8 +63,11 @@ def test_cube_of_twelve_triangles_degenerates(scheme):
     """tau = 0.1 h^2 with 12 triangles: the cube vanishes in a few steps; every scheme
     ends ``degenerated`` before the solve (before, DDFV and BGN ended ``solver_stagnated``
     and the cotangent kernel divided by zero), except the DDFV schemes with the
-    elimination (3.6), whose mesh of F-vertices folds at step 3, before it has shrunk
-    to a point (``inverted``, the driver's invariant check), and MDR, whose valence-4
+    elimination (3.6) or MDR's tangential motion of the F-vertices (ddfv-chord-mdr-carried:
+    the least deformation, close to no tangential motion; distance from the centre 0.195
+    and 0.212 at step 3, the elimination 0.157 and 0.185), whose mesh of F-vertices folds
+    at step 3, before it has shrunk to a point (``inverted``, the driver's invariant
+    check), and MDR, whose valence-4
     corners run ahead of the valence-5 ones (distance from the centre 0.20 against 0.29
     at step 3; BGN, whose unnormalised normals make it shrink faster here, 0.0012 and
     0.0014): 8 triangles fold at step 3, before the cube has shrunk to a point; and KLL,
@@ -79,7 +82,7 @@ def test_cube_of_twelve_triangles_degenerates(scheme):
         assert "4 triangle(s) inverted" in traj.message
         return
     assert 3 <= traj.failed_step <= 5 and traj.steps_done == traj.failed_step
-    if scheme.endswith("eliminate"):
+    if scheme.endswith("eliminate") or scheme == "ddfv-chord-mdr-carried":
         assert traj.status == "inverted" and traj.failed_step == 3, traj.message
         assert "12 triangle(s) folded that were not at step 0" in traj.message
         return

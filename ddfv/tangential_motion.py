@@ -1,0 +1,257 @@
+"""Tangential motion of the F-vertices of least Dirichlet energy: BGN's and MDR's.
+
+The paper's step (2.1), (2.10)-(2.15) gives every F-vertex a velocity whose
+normal part is the scheme's discrete ``h . N`` and whose tangential part is
+whatever the DDFV Laplacian of the new state has (on real meshes it lets the
+F-mesh degenerate, ``ddfv/README.md``). Here the normal displacement of each
+F-vertex is kept, and its tangential displacement is chosen as Barrett, Garcke
+& Nuernberg (J. Comput. Phys. 222 (2007) 441-467; 227 (2008) 4281-4307; SIAM
+J. Sci. Comput. 31 (2008) 225-253; the surface scheme (B1)-(B2) of the
+docstring of ``baselines/bgn.py``) or Hu & Li
+(Numer. Math. 152 (2022) 127-181, the minimal deformation rate) choose it for
+the P1 vertex scheme. Equation labels (TM1)-(TM4) are ours; the derivation
+(ours: the papers' texts beyond their abstracts were not available) is in
+``ddfv/README.md``, section "Tangential motion of the F-vertices".
+
+The two as constrained minimisations. On the F-mesh ``Gamma^{n-1}`` (the
+triangles of the F-vertices of the old state), with ``A`` its P1 (cotangent)
+stiffness, ``N_k`` the unit normal at F-vertex ``k`` and ``d_k`` a prescribed
+normal displacement, BGN's (B2) for the new positions ``X`` with the test
+functions ``eta = phi_k t`` (``t . N_k = 0``) says ``P_k (A X)_k = 0``,
+``P_k = I - N_k N_k^T``: the stationarity of the Dirichlet energy of the new
+surface among the positions of the given normal displacement (``kappa`` of
+(B1)-(B2) is the multiplier of that constraint). MDR's (M1) is the same with
+the displacement ``X - X^{n-1}`` in place of ``X``. Both are::
+
+    X = argmin { 1/2 sum_c (Y + X - X^*)_c^T A (Y + X - X^*)_c :
+                 N_k . (X_k - X^*_k) = 0 for every k, X_k = X^*_k if k fixed }   (TM1)
+
+    Y = X^*              (BGN: the energy of the new surface)
+    Y = X^* - X^{n-1}    (MDR: the energy of the displacement)
+
+where ``X^*`` are the F-vertices of the scheme's step (the constraint keeps
+its normal displacement ``d_k = N_k . (X^*_k - X^{n-1}_k)``), ``c`` runs over
+the three coordinates. With ``E_k = [t1_k, t2_k]`` (3, 2) an orthonormal
+basis of the tangent plane of ``N_k``, ``X_k = X^*_k + E_k s_k`` and (TM1) is
+the symmetric positive definite ``2 n x 2 n`` system::
+
+    S s = -r,   S_(k a),(j b) = A_kj t_a,k . t_b,j,   r_(k a) = t_a,k . (A Y)_k   (TM2)
+
+(``S`` is positive definite on a closed surface: ``E s`` constant would be a
+vector tangent at every vertex, i.e. zero; at fixed vertices ``s = 0``). Its
+solution does not depend on the choice of the bases (a rotation of ``E_k`` is
+a change of the unknowns ``s_k``) and moves every F-vertex in the tangent
+plane of its normal::
+
+    N_k . (X_k - X^*_k) = 0                                                 (TM3)
+
+T-vertices follow their triangles (:func:`follow_triangles`): with ``lam``
+the barycentric coordinates of the projection of ``T^*`` into its triangle of
+``X^*``::
+
+    T = T^* + sum_j lam_j (X_j - X^*_j)                                      (TM4)
+
+i.e. ``T - sum_j lam_j X_j = T^* - sum_j lam_j X^*_j``: the T-vertex keeps its
+height vector above the point of coordinates ``lam``, so its projection keeps
+``lam`` and its height up to the rotation of the triangle (``1 - cos`` of the
+angle for the height, ``height x sin`` for the projection).
+"""
+
+import igl
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+
+KINDS = ("bgn", "mdr")
+"""The tangential motions: ``"bgn"`` (the new surface's Dirichlet energy) and ``"mdr"``
+(the displacement's, the minimal deformation rate)."""
+
+
+def p1_stiffness(F, faces):
+    """The P1 (cotangent) stiffness ``A = -igl.cotmatrix`` of the F-mesh.
+
+    Parameters
+    ----------
+    F : (n, 3) float array
+    faces : (m, 3) int array
+
+    Returns
+    -------
+    (n, n) scipy.sparse.csr_matrix
+        ``A_kj = int grad phi_k . grad phi_j``, symmetric positive semi-definite.
+    """
+    return sp.csr_matrix(-igl.cotmatrix(np.asarray(F, dtype=float), faces))
+
+
+def tangent_bases(N):
+    """Orthonormal bases of the planes orthogonal to the unit vectors ``N``.
+
+    Duff, Burgess, Christensen, Hery, Kensler, Liani, Villemin, "Building an
+    orthonormal basis, revisited", J. Comput. Graph. Tech. 6(1) (2017): branch-free,
+    continuous except across ``N_z = 0``.
+
+    Parameters
+    ----------
+    N : (n, 3) float array
+        Unit vectors.
+
+    Returns
+    -------
+    t1, t2 : (n, 3) float arrays
+        ``(t1, t2, N)`` is a right-handed orthonormal basis at every row.
+    """
+    x, y, z = np.asarray(N, dtype=float).T
+    sign = np.where(z >= 0.0, 1.0, -1.0)
+    a = -1.0 / (sign + z)
+    b = x * y * a
+    t1 = np.stack([1.0 + sign * x * x * a, sign * b, -sign * x], axis=1)
+    t2 = np.stack([b, sign + y * y * a, -y], axis=1)
+    return t1, t2
+
+
+class TangentialMotion:
+    """(TM1)-(TM3) along a flow, the factors of (TM2) kept from step to step.
+
+    (TM2) changes by ``O(tau)`` from one step to the next, so it is solved by
+    iterative refinement with the sparse LU of an earlier step's matrix,
+    ``s <- s + LU^{-1} (b - S s)`` from ``LU^{-1} b``, until
+    ``|b - S s| <= rtol |b|``; when that takes more than ``max_refinements``
+    passes, ``S`` is factorised again (SuperLU, symmetric mode, minimum-degree
+    ordering of ``S + S^T``). The unknowns are interleaved, ``(k, a) -> 2 k + a``,
+    so that ``S`` has the band of ``A`` in the caller's numbering. For the kept
+    factors to fit the next matrix, the tangent bases follow the normals: each
+    step's ``t1`` is the last one projected on the new tangent plane (a basis
+    from :func:`tangent_bases` where that projection is shorter than 1/2, and at
+    the first step), ``t2 = N x t1``. Any ``s`` keeps the normal displacement
+    exactly (TM3); the accuracy of ``s`` only decides how close the tangential
+    displacement is to the minimiser.
+
+    Parameters
+    ----------
+    faces : (m, 3) int array
+    kind : {"bgn", "mdr"}
+    fixed : (n,) bool array, optional
+        Vertices that do not move (Dirichlet); default none.
+    rtol : float
+        Relative residual of the refinement.
+    max_refinements : int
+
+    Attributes
+    ----------
+    factorisations, refinements : int
+        Factorisations and refinement passes so far.
+    """
+
+    def __init__(self, faces, kind, fixed=None, rtol=1e-12, max_refinements=6):
+        if kind not in KINDS:
+            raise ValueError(f"unknown tangential motion {kind!r}; choose one of "
+                             f"{', '.join(KINDS)}")
+        self.faces, self.kind = faces, kind
+        self.fixed = None if fixed is None else np.asarray(fixed, bool)
+        self.rtol, self.max_refinements = rtol, max_refinements
+        self._lu = self._t1 = None
+        self.factorisations = self.refinements = 0
+
+    def __call__(self, F_old, F_new, N):
+        """The F-vertices of (TM1): ``F_new`` moved in the tangent planes of ``N``.
+
+        Parameters
+        ----------
+        F_old : (n, 3) float array
+            The old state ``X^{n-1}``: the surface whose stiffness ``A`` is used.
+        F_new : (n, 3) float array
+            The scheme's new F-vertices ``X^*`` (their normal displacement is kept).
+        N : (n, 3) float array
+            Unit normals at the F-vertices (the scheme's, of the old state).
+
+        Returns
+        -------
+        (n, 3) float array
+            ``X`` with ``N_k . (X_k - F_new_k) = 0`` (TM3) and ``X_k = F_new_k`` at
+            fixed vertices.
+        """
+        F_old, F_new = np.asarray(F_old, dtype=float), np.asarray(F_new, dtype=float)
+        free = np.ones(len(F_new), bool) if self.fixed is None else ~self.fixed
+        A = p1_stiffness(F_old, self.faces)
+        Y = F_new if self.kind == "bgn" else F_new - F_old
+        AY = (A @ Y)[free]                                           # (A Y)_k, free k
+        A = A[free][:, free].tocoo()
+        bases = [t[free] for t in self._bases(np.asarray(N, dtype=float))]
+        # (TM2), unknowns interleaved
+        rows, cols, values = zip(*((2 * A.row + a, 2 * A.col + b,
+                                    A.data * np.einsum("ij,ij->i", ta[A.row], tb[A.col]))
+                                   for a, ta in enumerate(bases)
+                                   for b, tb in enumerate(bases)))
+        m = 2 * A.shape[0]
+        S = sp.csc_matrix((np.concatenate(values),
+                           (np.concatenate(rows), np.concatenate(cols))), shape=(m, m))
+        r = np.stack([np.einsum("ij,ij->i", ta, AY) for ta in bases], axis=1).ravel()
+        s = self._solve(S, -r)
+        X = F_new.copy()
+        X[free] += s[0::2, None] * bases[0] + s[1::2, None] * bases[1]
+        return X
+
+    def _bases(self, N):
+        """``t1, t2`` (n, 3) at the normals ``N``, ``t1`` following the last one."""
+        fresh, _ = tangent_bases(N)
+        if self._t1 is None:
+            t1 = fresh
+        else:
+            t1 = self._t1 - np.einsum("ij,ij->i", self._t1, N)[:, None] * N
+            length = np.linalg.norm(t1, axis=1, keepdims=True)
+            t1 = np.where(length > 0.5, t1 / np.where(length > 0.5, length, 1.0), fresh)
+        self._t1 = t1
+        return t1, np.cross(N, t1)
+
+    def _solve(self, S, b):
+        """``S^{-1} b`` by refinement with the kept factors, or a new factorisation."""
+        if self._lu is not None and self._lu.shape == S.shape:
+            x, norm = self._lu.solve(b), np.linalg.norm(b)
+            for _ in range(self.max_refinements):
+                residual = b - S @ x
+                if np.linalg.norm(residual) <= self.rtol * norm:
+                    return x
+                x += self._lu.solve(residual)
+                self.refinements += 1
+        self._lu = splu(S, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
+        self.factorisations += 1
+        return self._lu.solve(b)
+
+
+def tangential_motion(F_old, F_new, faces, N, kind, fixed=None):
+    """One step of (TM1)-(TM3): :class:`TangentialMotion` called once.
+
+    Parameters
+    ----------
+    F_old, F_new, N : (n, 3) float arrays
+        See :meth:`TangentialMotion.__call__`.
+    faces : (m, 3) int array
+    kind : {"bgn", "mdr"}
+    fixed : (n,) bool array, optional
+
+    Returns
+    -------
+    (n, 3) float array
+    """
+    return TangentialMotion(faces, kind, fixed)(F_old, F_new, N)
+
+
+def follow_triangles(T, displacement, faces, lam):
+    """T-vertices moved with their triangles (TM4).
+
+    Parameters
+    ----------
+    T : (n_t, 3) float array
+    displacement : (n_f, 3) float array
+        Displacement of the F-vertices.
+    faces : (n_t, 3) int array
+    lam : (n_t, 3) float array
+        Barycentric coordinates of the T-vertices in their triangles.
+
+    Returns
+    -------
+    (n_t, 3) float array
+        ``T + sum_j lam_j displacement_j``: the offset of ``T`` from the point of
+        coordinates ``lam`` of its triangle is kept.
+    """
+    return T + np.einsum("tk,tkj->tj", lam, displacement[faces])
