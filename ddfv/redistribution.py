@@ -491,15 +491,17 @@ def bernoulli(x):
     return np.where(x == 0.0, 1.0, b)
 
 
-def drift_system(A, geom, mesh, chi, dt, psi, peclet=np.inf):
+def drift_system(assembler, A, geom, chi, dt, psi, peclet=np.inf):
     """The matrix of (R7) in row-scaled form: ``A + dt diag(1/chi) D``.
 
     Parameters
     ----------
+    assembler : ddfv.assembly.Assembler
+        The assembler of ``A``: ``D`` is added into its pattern.
     A : (n, n) scipy.sparse.csr_matrix
-        The scheme's system ``I + dt diag(1/chi) K`` at the same state.
+        The scheme's system ``I + dt diag(1/chi) K`` at the same state
+        (:meth:`ddfv.assembly.Assembler.system`).
     geom : DiamondGeometry
-    mesh : DiamondMesh
     chi : (n,) float array
         Covolume areas, F-vertices first.
     dt : float
@@ -512,27 +514,29 @@ def drift_system(A, geom, mesh, chi, dt, psi, peclet=np.inf):
     Returns
     -------
     (n, n) scipy.sparse.csr_matrix
-        ``D`` multiplies the F-row part of each inner diamond's fluxes by
-        ``w - 1``, ``w_a = B(psi_a - psi_b)`` in the row of ``a`` and
-        ``w_b = B(psi_b - psi_a)`` in the row of ``b`` (:func:`bernoulli`); T-rows,
-        boundary diamonds and Dirichlet rows are those of ``A``. With ``psi``
-        constant, ``A`` itself.
+        In the pattern of ``A`` (same ``indices`` and ``indptr``). ``D``
+        multiplies the F-row part of each inner diamond's fluxes by ``w - 1``,
+        ``w_a = B(psi_a - psi_b)`` in the row of ``a`` and ``w_b = B(psi_b -
+        psi_a)`` in the row of ``b`` (:func:`bernoulli`); T-rows, boundary
+        diamonds and Dirichlet rows are those of ``A``. With ``psi`` constant,
+        ``A`` itself.
     """
-    n_f, n = mesh.n_f, mesh.n_unknowns
-    inner = mesh.diamonds[:, 3] >= 0
-    a, b, t1, t2 = (mesh.diamonds[inner, k] for k in range(4))
-    alpha, beta = (np.asarray(c)[inner] for c in flux_coefficients(geom)[:2])
-    d = np.clip(psi[b] - psi[a], -peclet, peclet)
-    wa, wb = bernoulli(-d) - 1.0, bernoulli(d) - 1.0
-    free = ~np.r_[mesh.boundary_vertices, np.zeros(mesh.n_t, bool)]
-    wa, wb = wa * free[a], wb * free[b]
-    # (K f)_a = alpha (f_a - f_b) + beta (f_t2 - f_t1) = -(K f)_b: each row times w - 1
-    rows = np.concatenate([np.tile(a, 4), np.tile(b, 4)])
-    cols = np.tile(np.concatenate([a, b, n_f + t2, n_f + t1]), 2)
-    vals = np.concatenate([wa * alpha, -wa * alpha, wa * beta, -wa * beta,
-                           -wb * alpha, wb * alpha, -wb * beta, wb * beta])
-    D = sp.csr_matrix((vals * (dt / chi[rows]), (rows, cols)), shape=(n, n))
-    return (A + D).tocsr()
+    from .geometry import _diamond_indices
+    from .kernels import drift_kernel
+
+    mesh = assembler._mesh
+    if A.shape != assembler.shape or A.nnz != assembler.nnz:
+        raise ValueError(f"A ({A.shape}, {A.nnz} nonzeros) is not in the pattern of the "
+                         f"assembler ({assembler.shape}, {assembler.nnz} nonzeros)")
+    scale = np.zeros(mesh.n_unknowns)
+    free = ~mesh.boundary_vertices
+    scale[:mesh.n_f][free] = dt / np.asarray(chi, dtype=np.float64)[:mesh.n_f][free]
+    factors = (np.asarray(getattr(geom, name), dtype=np.float64)
+               for name in ("gamma_t", "gamma_f", "J", "len_u", "len_v", "uv"))
+    data = A.data.copy()
+    drift_kernel(assembler._inner, *factors, assembler._slots, _diamond_indices(mesh),
+                 np.ascontiguousarray(psi, dtype=np.float64), scale, float(peclet), data)
+    return sp.csr_matrix((data, A.indices, A.indptr), shape=A.shape)
 
 
 def carry_t_vertices(F, T, faces, lam):

@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 
 from ddfv import Flow, variant_options
-from ddfv.assembly import Assembler
+from ddfv.assembly import Assembler, flux_coefficients
 from ddfv.geometry import covolume_areas, diamond_geometry, vertex_normals
-from ddfv.redistribution import (TangentialPotential, carry_t_vertices, diamond_gradients,
-                                 iterative_refinement, neumann_stiffness,
+from ddfv.redistribution import (TangentialPotential, bernoulli, carry_t_vertices,
+                                 diamond_gradients, drift_system, iterative_refinement,
+                                 neumann_stiffness,
                                  preconditioned_cg, redistribution_source,
                                  tangential_potential, vertex_gradients)
 from ddfv.t_vertices import initial_t_vertices
@@ -172,6 +173,37 @@ def test_kept_factor_matches_a_direct_solve_along_a_moving_surface(surface, dual
         assert np.linalg.norm(psi - exact) <= 1e-6 * np.linalg.norm(exact)
     assert solver.factorisations == 1 and solver._iterate is iteration
     assert 3 <= solver.iterations
+
+
+@pytest.mark.parametrize("surface", ["sphere", "plane"])
+@pytest.mark.parametrize("peclet", [np.inf, 0.1])
+def test_drift_system_is_the_weighted_flux_form(surface, peclet):
+    """The compiled drift (R7) against its definition assembled entry by entry
+    (numpy, COO): each inner diamond's F-row fluxes times ``B(-+d) - 1`` and
+    ``dt / chi``, none at the fixed boundary; ``psi`` constant gives ``A``."""
+    import scipy.sparse as sp
+
+    V, F = icosphere(2) if surface == "sphere" else _jittered_plane()
+    mesh, T, geom, chi = _setup(V, F, "barycenter")
+    assembler, dt = Assembler(mesh), 0.01
+    A = assembler.system(geom, chi, dt)
+    psi = 0.3 * np.random.default_rng(2).standard_normal(mesh.n_unknowns)
+    n_f, n = mesh.n_f, mesh.n_unknowns
+    inner = mesh.diamonds[:, 3] >= 0
+    a, b, t1, t2 = (mesh.diamonds[inner, k] for k in range(4))
+    alpha, beta = (np.asarray(c)[inner] for c in flux_coefficients(geom)[:2])
+    d = np.clip(psi[b] - psi[a], -peclet, peclet)
+    free = ~mesh.boundary_vertices
+    wa, wb = (bernoulli(-d) - 1.0) * free[a], (bernoulli(d) - 1.0) * free[b]
+    rows = np.concatenate([np.tile(a, 4), np.tile(b, 4)])
+    cols = np.tile(np.concatenate([a, b, n_f + t2, n_f + t1]), 2)
+    vals = np.concatenate([wa * alpha, -wa * alpha, wa * beta, -wa * beta,
+                           -wb * alpha, wb * alpha, -wb * beta, wb * beta])
+    D = sp.csr_matrix((vals * (dt / chi[rows]), (rows, cols)), shape=(n, n))
+    drift = drift_system(assembler, A, geom, chi, dt, psi, peclet)
+    assert abs(drift - (A + D)).max() < 1e-14 * abs(A).max()      # rounding of A + D
+    assert (drift.indices == A.indices).all() and (drift.indptr == A.indptr).all()
+    assert abs(drift_system(assembler, A, geom, chi, dt, np.full(n, 2.5), peclet) - A).max() == 0
 
 
 def test_potential_on_a_surface_with_boundary_is_the_affine_solution():
