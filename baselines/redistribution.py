@@ -128,7 +128,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .kernels import vertex_gradients
+from .kernels import drift_weights, vertex_gradients
 
 REDISTRIBUTIONS = (None, "area")
 PECLET = 0.1
@@ -464,19 +464,18 @@ def drift_laplacian(L, psi, peclet=np.inf):
     Returns
     -------
     (n, n) scipy.sparse.csr_matrix
-        Same pattern; off-diagonal ``-c_ij B(psi_i - psi_j)`` (:func:`bernoulli`),
-        diagonal the negated sum of its row's off-diagonal entries (zero row
-        sums). Not symmetric, but where no difference is clipped
-        ``diag(e^psi) L_psi`` is (``psi`` constant: ``L`` itself).
+        Same pattern (its ``indices`` and ``indptr``, shared); off-diagonal
+        ``-c_ij B(psi_i - psi_j)`` (:func:`bernoulli`), diagonal the negated sum
+        of its row's off-diagonal entries (zero row sums): one compiled pass
+        (:func:`baselines.kernels.drift_weights`). Not symmetric, but where no
+        difference is clipped ``diag(e^psi) L_psi`` is (``psi`` constant: ``L``
+        itself).
     """
     L = sp.csr_matrix(L)
-    n = L.shape[0]
-    rows = np.repeat(np.arange(n), np.diff(L.indptr))
-    off = rows != L.indices
-    weights = bernoulli(np.clip(psi[rows] - psi[L.indices], -peclet, peclet))
-    data = np.where(off, L.data * weights, 0.0)
-    data[~off] = -np.bincount(rows, data, minlength=n)[rows[~off]]
-    return sp.csr_matrix((data, L.indices.copy(), L.indptr.copy()), shape=L.shape)
+    data = np.empty(L.nnz)
+    drift_weights(L.indptr, L.indices, np.ascontiguousarray(L.data, dtype=np.float64),
+                  np.ascontiguousarray(psi, dtype=np.float64), float(peclet), data)
+    return sp.csr_matrix((data, L.indices, L.indptr), shape=L.shape)
 
 
 def surface_components(faces, n_vertices):
