@@ -314,14 +314,14 @@ class PotentialSolver:
     ``2 psi^{n-1} - psi^{n-2}`` of the last two solutions, until ``|b - A x|
     <= rtol |b|``; ``A`` is factorised anew when that takes more than
     ``max_iterations``. Measured at level 5 of the sphere (10 242 vertices,
-    CPU time per step, ``benchmarks/bench_potential.py``): one CG iteration
-    per step, 4 x cheaper than the iterative refinement of a kept sparse LU
-    (SuperLU, 2-3 LU solves per step, the solve 2.3 x the Cholesky's) it
+    CPU time per solve over 80 of the flow's systems, ``baselines/README.md``):
+    0.8 ms, against 3.2 ms for the iterative refinement of a kept sparse LU
+    (SuperLU, 2-3 LU solves per step, each 2.3 x a Cholesky solve) it
     replaces; algebraic multigrid (``pyamg``, smoothed aggregation, hierarchy
-    kept) needed 7 V-cycles of 1.6 times a Cholesky solve each; Jacobi-CG
-    ~150 iterations (~1200 on sliver-rich meshes). Where ``A`` is not
-    numerically positive definite the factorisation is a sparse LU (SuperLU)
-    and the iteration :func:`iterative_refinement`. (As
+    kept) + CG 7.0 ms (7 V-cycles); Jacobi-CG ~150 iterations (~1200 on
+    sliver-rich meshes); along the whole run 1.75 CG iterations per step.
+    Where ``A`` is not numerically positive definite the factorisation is a
+    sparse LU (SuperLU) and the iteration :func:`iterative_refinement`. (As
     :class:`ddfv.redistribution.TangentialPotential`, which this package may
     not import.) ``psi`` only sets a tangential velocity: ``rtol = 1e-7``
     moves the points by ``1e-7`` of the redistribution's own displacement.
