@@ -301,15 +301,15 @@ class TangentialPotential:
             return pinned_matrix(K, keep)
 
         psi = self._solve(apply, matrix, -np.asarray(source, dtype=float) * keep, "psi")
-        w = np.r_[np.zeros(n_f), np.ones(self.mesh.n_t)]
-        if self.mesh.has_boundary:
-            e = np.zeros(len(keep))
-            e[n_f] = 1.0
-            w = e + self._solve(apply, matrix, -keep * (K @ e), "w")
 
         def offset(x):      # sum_t chi_t (x_t - mean of x over the corners of t)
             return np.dot(chi[n_f:], x[n_f:] - x[faces].mean(axis=1))
 
+        if not self.mesh.has_boundary:      # w: 1 on the T-vertices, offset(w) = sum chi_t
+            return np.r_[psi[:n_f], psi[n_f:] - offset(psi) / chi[n_f:].sum()]
+        e = np.zeros(len(keep))
+        e[n_f] = 1.0
+        w = e + self._solve(apply, matrix, -keep * (K @ e), "w")
         return psi - offset(psi) / offset(w) * w
 
 
