@@ -313,13 +313,13 @@ class PotentialSolver:
     factor (:func:`preconditioned_cg`), started from the linear extrapolation
     ``2 psi^{n-1} - psi^{n-2}`` of the last two solutions, until ``|b - A x|
     <= rtol |b|``; ``A`` is factorised anew when that takes more than
-    ``max_iterations``. Measured at level 5 of the sphere (10 242 vertices,
-    CPU time per solve over 80 of the flow's systems, ``baselines/README.md``):
-    0.8 ms, against 3.2 ms for the iterative refinement of a kept sparse LU
-    (SuperLU, 2-3 LU solves per step, each 2.3 x a Cholesky solve) it
-    replaces; algebraic multigrid (``pyamg``, smoothed aggregation, hierarchy
-    kept) + CG 7.0 ms (7 V-cycles); Jacobi-CG ~150 iterations (~1200 on
-    sliver-rich meshes); along the whole run 1.75 CG iterations per step.
+    ``max_iterations``. Chosen by measurement (``benchmarks/bench_potential.py
+    --solvers``, level 5 of the sphere, 10 242 vertices, CPU time per solve of
+    a flow's sequence of systems, ``baselines/README.md``): 1.7 ms and about
+    one CG iteration, against 5.6 ms for the iterative refinement of a kept
+    sparse LU (SuperLU, 2.4 LU solves) it replaces; algebraic multigrid
+    (``pyamg``, smoothed aggregation, hierarchy kept) + CG 4.2 ms (3.4
+    V-cycles); Jacobi-CG 12 ms (120 iterations; ~1200 on sliver-rich meshes).
     Where ``A`` is not numerically positive definite the factorisation is a
     sparse LU (SuperLU) and the iteration :func:`iterative_refinement`. (As
     :class:`ddfv.redistribution.TangentialPotential`, which this package may
