@@ -350,6 +350,18 @@ def test_registry_entry():
     assert flow.omega == 10.0 and flow.peclet == 0.1 and flow.target == "triangle"
 
 
+def test_flow_keeps_one_factor_and_times_the_potential():
+    """Along 5 steps of the sphere: one Cholesky factorisation, the later potentials
+    by CG with it, and the potential's time recorded as part of the assembly's."""
+    V, F = icosphere(3)
+    flow = redistributing(V, F, 0.001)
+    simulate(flow, 5, save_every=0, solver=Solver())
+    solver = flow._potential_solver
+    assert solver.factorisations == 1 and solver._iterate is preconditioned_cg
+    assert 4 <= solver.iterations <= 10
+    assert 0.0 < flow.timings["potential"] < flow.timings["assembly"]
+
+
 def test_redistribution_refuses_a_surface_of_two_components():
     V, F = icosphere(1)
     two = np.vstack([V, V + 3.0]), np.vstack([F, F + len(V)])

@@ -329,6 +329,22 @@ def _run(V, F, tau=0.002, steps=5, **options):
     return traj.frames["F"], traj.frames["T"]
 
 
+@pytest.mark.parametrize("variant, iteration", [("redistribute", iterative_refinement),
+                                                ("chord-redistribute-carried",
+                                                 preconditioned_cg)])
+def test_flow_keeps_one_factor_and_times_the_potential(bumpy, variant, iteration):
+    """Along 5 steps: one factorisation, the later potentials by the kept factor (the
+    broken line's K is not symmetric: LU; the chord's is: Cholesky and CG), and the
+    potential's time recorded as part of the assembly's."""
+    V, F = bumpy
+    flow = Flow(V, F, 0.002, **variant_options(variant))
+    simulate(flow, 5, save_every=0, solver=Solver())
+    solver = flow._potential
+    assert solver.factorisations == 1 and solver._iterate is iteration
+    assert 0.0 < flow.timings["potential"] < flow.timings["assembly"]
+    assert "potential" not in Flow(V, F, 0.002).timings
+
+
 @pytest.mark.parametrize("variant", ["redistribute", "chord-redistribute-carried"])
 def test_flow_invariant_under_rigid_motion(bumpy, variant):
     V, F = bumpy
