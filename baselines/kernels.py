@@ -467,3 +467,36 @@ def gradient_norm_weights(V, faces, u, w, squared):
         w[i1] += share
         w[i2] += share
     return degenerate
+
+
+@njit(cache=True)
+def drift_weights(indptr, indices, L_data, psi, peclet, out):
+    """Values of the drift stiffness (R4) of :mod:`baselines.redistribution` in the
+    pattern of ``L``: off-diagonal ``L_ij B(psi_i - psi_j)``, the difference clipped
+    to ``[-peclet, peclet]``, ``B(x) = x / (e^x - 1)`` (``B(0) = 1``), and the
+    diagonal minus the sum of its row's off-diagonal values (zero row sums).
+
+    Parameters
+    ----------
+    indptr : (n + 1,) int array
+    indices : (nnz,) int array
+        Each row's diagonal stored (it is overwritten).
+    L_data : (nnz,) float64 array
+    psi : (n,) float64 array
+    peclet : float
+    out : (nnz,) float64 array, output
+    """
+    for i in range(len(indptr) - 1):
+        total = 0.0
+        diagonal = -1
+        for p in range(indptr[i], indptr[i + 1]):
+            j = indices[p]
+            if j == i:
+                diagonal = p
+                continue
+            x = min(max(psi[i] - psi[j], -peclet), peclet)
+            w = L_data[p] * (x / np.expm1(x) if x != 0.0 else 1.0)
+            out[p] = w
+            total += w
+        if diagonal >= 0:
+            out[diagonal] = -total

@@ -35,6 +35,7 @@ import time
 from functools import cached_property
 
 import numpy as np
+import scipy.sparse as sp
 
 from .assembly import Assembler
 from .geometry import diamond_geometry, t_barycentric, vertex_normals
@@ -124,7 +125,10 @@ class Flow:
     timings : dict
         Seconds spent so far in ``"geometry"`` (including the covolumes and
         the checks of each new state), ``"assembly"``, ``"solve"`` and
-        ``"tangential"`` (the motion of ``tangential="bgn"`` or ``"mdr"``).
+        ``"tangential"`` (the motion of ``tangential="bgn"`` or ``"mdr"``); with
+        ``tangential="redistribute"`` also ``"potential"``, the part of
+        ``"assembly"`` spent on the potential (R3) (its source, stiffness and
+        solve).
     """
 
     def __init__(self, vertices, faces, tau, *, T0=None, t_init="paper",
@@ -186,6 +190,8 @@ class Flow:
         self._motion = TangentialMotion(self._mesh.faces, tangential,
                                         fixed=self._mesh.boundary_vertices) \
             if tangential in KINDS else None
+        if tangential == "redistribute":
+            self.timings["potential"] = 0.0
 
     @property
     def X(self):
@@ -332,9 +338,10 @@ class Flow:
             rhs = base - dt * (h - (h * N).sum(axis=0) * N)           # (3.6)
         elif self.tangential == "redistribute":                       # (R6)-(R7)
             psi = self._potential_of(at, A, dt, geometry, covolumes)
-            drift = drift_system(A, geometry, self._mesh, covolumes, dt, psi, self.peclet)
+            drift = drift_system(self._assembler, A, geometry, covolumes, dt, psi, self.peclet)
             N = vertex_normals(self._mesh, geometry)
-            drifted = ((drift - A) @ at.T).T                          # -dt x drift of X*
+            D = sp.csr_matrix((drift.data - A.data, A.indices, A.indptr), shape=A.shape)
+            drifted = (D @ at.T).T                                    # -dt x drift of X*
             rhs = base + (drifted * N).sum(axis=0) * N                # + dt g*: normal part back
             A = drift
         self._tick("assembly", clock)
@@ -380,6 +387,7 @@ class Flow:
     def _potential_of(self, at, A, dt, geometry, covolumes):
         """(n,) ``psi`` of (R3) at the state ``at``; ``A`` the scheme's step matrix at
         ``at`` with step ``dt`` (its discrete Laplacian gives ``h``, as in (3.6))."""
+        clock = time.perf_counter()
         mesh = self._mesh
         N = vertex_normals(mesh, geometry)
         h = (at - (A @ at.T).T) / dt                             # h*, zero at fixed F
@@ -391,7 +399,9 @@ class Flow:
                                        rate)                     # (R3)
         if self._potential is None:
             self._potential = TangentialPotential(mesh)
-        return self._potential(neumann_stiffness(self._assembler, geometry), source, covolumes)
+        psi = self._potential(neumann_stiffness(self._assembler, geometry), source, covolumes)
+        self._tick("potential", clock)
+        return psi
 
     def _tangential_velocity(self, at, A, dt, geometry, covolumes):
         """(3, n) ``v_T = grad psi`` (R4)-(R5) of the state ``at``, zero at Dirichlet

@@ -444,6 +444,62 @@ def system_kernel(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, order, st
         data[diag[i]] += shift
 
 
+@numba.njit("float64(float64)", **_OPTIONS, inline="always")
+def _bernoulli(x):
+    """``x / (e^x - 1)``, 1 at 0 (``ddfv.redistribution.bernoulli``)."""
+    if x == 0.0:
+        return 1.0
+    return x / np.expm1(x)
+
+
+@numba.njit("void(boolean[::1], float64[:], float64[:], float64[:], float64[:], float64[:], "
+            "float64[:], uint32[:, ::1], uint64[:, :], float64[::1], float64[::1], "
+            "float64, float64[::1])", **_OPTIONS)
+def drift_kernel(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, diamonds, psi, scale,
+                 peclet, data):
+    """Adds ``diag(scale) D`` of the drift (R7) into ``data`` (the CSR values of
+    :class:`ddfv.assembly.Assembler`'s pattern; :func:`ddfv.redistribution.drift_system`).
+
+    Each inner diamond ``(a, b, t1, t2)`` multiplies the F-row part of its
+    fluxes (``(K f)_a = alpha (f_a - f_b) + beta (f_t2 - f_t1) = -(K f)_b``,
+    :func:`system_kernel`) by ``B(-d) - 1`` in the row of ``a`` and ``B(d) - 1``
+    in the row of ``b``, ``d = psi_b - psi_a`` clipped to ``[-peclet,
+    peclet]``, ``B`` the Bernoulli function; each row is scaled by
+    ``scale`` (``dt / chi``, zero at Dirichlet rows). One sequential pass
+    (the rows of neighbouring diamonds share entries).
+
+    Parameters
+    ----------
+    inner : (n_d,) bool array
+    gamma_t, gamma_f, J, len_u, len_v, uv : (n_d,) float64 arrays
+    slots : (n_d, N_SLOTS) uint32 array
+    diamonds : (4, n_d) uint64 array
+        ``a, b, t1, t2`` (:func:`ddfv.geometry._diamond_indices`).
+    psi : (n,) float64 array
+    scale : (n,) float64 array
+    peclet : float
+    data : (nnz,) float64 array, updated
+    """
+    for d in range(len(inner)):
+        if not inner[d]:
+            continue
+        alpha, beta, _, _ = flux_coefficients_kernel(
+            gamma_t[d], gamma_f[d], J[d], len_u[d], len_v[d], uv[d])
+        a, b = diamonds[0, d], diamonds[1, d]
+        x = min(max(psi[b] - psi[a], -peclet), peclet)
+        ca = (_bernoulli(-x) - 1.0) * scale[a]
+        cb = (_bernoulli(x) - 1.0) * scale[b]
+        s = slots[d]
+        data[s[SLOT_AA]] += ca * alpha
+        data[s[SLOT_AB]] -= ca * alpha
+        data[s[SLOT_A_T2]] += ca * beta
+        data[s[SLOT_A_T1]] -= ca * beta
+        data[s[SLOT_BA]] -= cb * alpha
+        data[s[SLOT_BB]] += cb * alpha
+        data[s[SLOT_B_T2]] -= cb * beta
+        data[s[SLOT_B_T1]] += cb * beta
+
+
 @numba.njit("float64(float64[:, :], float64[:, :], uint64[:, :], float64[:, ::1])", **_OPTIONS)
 def t_barycentric_kernel(F, T, faces, out):
     """Barycentric coordinates of the projection of ``T_i`` into triangle ``i``.

@@ -117,6 +117,7 @@ applied at the end of the step (see ``ddfv/README.md``).
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 from scipy.sparse.linalg import splu
 
 from .assembly import flux_coefficients
@@ -222,18 +223,26 @@ class TangentialPotential:
     ``sum_t chi_t (psi_t - mean of psi over the corners of t) = 0``: the
     T-values are on average those of their triangles.
 
-    The rows of F-vertex 0 and T-vertex 0 of ``K`` (sums of the others) are
-    replaced by ``psi = 0``; the matrix ``M`` obtained is factorised
-    (sparse LU, ordering of ``A + A^T``) and the factors are kept: the next
-    systems, whose geometry moved by ``O(tau)``, are solved by iterative
-    refinement with the kept factors, ``x <- x + LU^{-1} (b - M x)`` from the
-    last solution, until ``|b - M x| <= rtol |b|``; when that takes more than
-    ``max_refinements`` passes the matrix is factorised again. One solve for
-    a particular solution and, on a surface with boundary, one for the
-    kernel vector ``w`` (``w_F0 = 0``, ``w_T0 = 1``; on a closed surface
-    ``w`` is 1 on the T-vertices, 0 on the F-vertices). ``psi`` needs no
-    more accuracy than the positions' solve: any tangential velocity leaves
-    the shape alone.
+    F-vertex 0 and T-vertex 0 are pinned: ``A = P K P + I - P`` (``P``
+    zeroes those two entries; :func:`pinned_matrix`), symmetric positive
+    definite where ``K`` is symmetric (the chord ``|gamma|`` on a closed
+    surface), and ``A x = b`` with ``b = 0`` at the pinned entries. ``A`` is
+    factorised (:func:`factorisation`: sparse Cholesky where symmetric
+    positive definite, else sparse LU with the ordering of ``A + A^T``) and
+    the factor is kept: the next systems, whose geometry moved by ``O(tau)``,
+    are solved with the kept factor, by preconditioned conjugate gradients
+    (Cholesky) or iterative refinement (LU), from the linear extrapolation
+    ``2 x^{n-1} - x^{n-2}`` of the last two solutions, until ``|b - A x| <=
+    rtol |b|``; when that takes more than ``max_iterations`` ``A`` is
+    factorised again. Measured at level 5 of the sphere (30 722 unknowns,
+    ``benchmarks/bench_potential.py``): the Cholesky solve is 0.55 x the
+    LU's. One solve for a particular solution and, on a surface with
+    boundary, one for the kernel vector ``w`` (``w_F0 = 0``, ``w_T0 = 1``:
+    ``w = e_T0 + y``, ``A y = -P K e_T0``; on a closed surface ``w`` is 1 on
+    the T-vertices, 0 on the F-vertices). ``psi`` needs no more accuracy
+    than the positions' solve: any tangential velocity leaves the shape
+    alone. (The helpers repeat those of ``baselines.redistribution``, which
+    this package may not import.)
 
     Parameters
     ----------
@@ -242,34 +251,36 @@ class TangentialPotential:
         Relative residual of each solve (1e-7: an error of ``psi`` only
         changes a tangential velocity, by ``rtol tau |v_T|`` per step, below
         the positions' own solver tolerance).
-    max_refinements : int
+    max_iterations : int
     """
 
-    def __init__(self, mesh, rtol=1e-7, max_refinements=6):
-        self.mesh, self.rtol, self.max_refinements = mesh, rtol, max_refinements
+    def __init__(self, mesh, rtol=1e-7, max_iterations=4):
+        self.mesh, self.rtol, self.max_iterations = mesh, rtol, max_iterations
         n, n_f = mesh.n_unknowns, mesh.n_f
         self._keep = np.ones(n)
         self._keep[[0, n_f]] = 0.0
-        self._unit = 1.0 - self._keep
-        self._lu = None
-        self._last = None
-        #: number of factorisations and of refinement passes so far
-        self.factorisations = self.refinements = 0
+        self._factor = self._iterate = None
+        self._history = {"psi": [], "w": []}        # the last two solutions of each
+        #: number of factorisations and of iterations with a kept factor so far
+        self.factorisations = self.iterations = 0
 
-    def _solve(self, M, b, x):
-        if self._lu is not None and x is not None:
-            norm = np.linalg.norm(b)
-            for _ in range(self.max_refinements):
-                r = b - M @ x
-                if np.linalg.norm(r) <= self.rtol * norm:
-                    return x
-                x = x + self._lu.solve(r)
-                self.refinements += 1
-            if np.linalg.norm(b - M @ x) <= self.rtol * norm:
+    def _solve(self, apply, matrix, b, name):
+        """``A x = b`` with the kept factor from the extrapolated start, else factorised."""
+        history = self._history[name]
+        if self._factor is not None:
+            start = (self._factor(b) if not history else history[-1] if len(history) == 1
+                     else 2.0 * history[-1] - history[-2])
+            x, k, converged = self._iterate(apply, b, start, self._factor, self.rtol,
+                                            self.max_iterations)
+            self.iterations += k
+            if converged:
+                self._history[name] = history[-1:] + [x]
                 return x
-        self._lu = splu(M.tocsc(), permc_spec="MMD_AT_PLUS_A")
+        self._factor, self._iterate = factorisation(matrix())
         self.factorisations += 1
-        return self._lu.solve(b)
+        x = self._factor(b)
+        self._history[name] = [x]
+        return x
 
     def __call__(self, K, source, chi):
         """``psi`` with ``K psi = -source`` (:func:`neumann_stiffness`,
@@ -280,20 +291,112 @@ class TangentialPotential:
         -------
         (n,) float array
         """
-        n_f, faces = self.mesh.n_f, self.mesh.faces
-        M = (sp.diags(self._keep) @ K + sp.diags(self._unit)).tocsr()
-        psi0, w0 = (None, None) if self._last is None else self._last
-        psi = self._solve(M, -np.asarray(source, dtype=float) * self._keep, psi0)
-        if self.mesh.has_boundary:
-            w = self._solve(M, self._unit * (np.arange(len(self._unit)) == n_f), w0)
-        else:               # closed: the kernel vector is the constant on the T-vertices
-            w = np.r_[np.zeros(n_f), np.ones(self.mesh.n_t)]
-        self._last = psi, w
+        n_f, faces, keep = self.mesh.n_f, self.mesh.faces, self._keep
+        K = sp.csr_matrix(K)
+
+        def apply(x):                                  # A x = P K P x + (I - P) x
+            return keep * (K @ (keep * x)) + (1.0 - keep) * x
+
+        def matrix():
+            return pinned_matrix(K, keep)
+
+        psi = self._solve(apply, matrix, -np.asarray(source, dtype=float) * keep, "psi")
 
         def offset(x):      # sum_t chi_t (x_t - mean of x over the corners of t)
             return np.dot(chi[n_f:], x[n_f:] - x[faces].mean(axis=1))
 
+        if not self.mesh.has_boundary:      # w: 1 on the T-vertices, offset(w) = sum chi_t
+            return np.r_[psi[:n_f], psi[n_f:] - offset(psi) / chi[n_f:].sum()]
+        e = np.zeros(len(keep))
+        e[n_f] = 1.0
+        w = e + self._solve(apply, matrix, -keep * (K @ e), "w")
         return psi - offset(psi) / offset(w) * w
+
+
+def cholesky_solve(A):
+    """``b -> A^{-1} b`` by the sparse Cholesky factorisation of ``A`` (symmetric,
+    (n, n) sparse; one triangle is read): CHOLMOD's, with its own fill-reducing
+    ordering, through ``cholespy`` (which ships it); None when ``A`` is not
+    numerically positive definite."""
+    from cholespy import CholeskySolverD, MatrixType
+
+    A = sp.csr_matrix(A, dtype=np.float64)
+    A.sum_duplicates()
+    try:
+        factor = CholeskySolverD(A.shape[0], A.indptr.astype(np.int32),
+                                 A.indices.astype(np.int32), A.data, MatrixType.CSR)
+    except ValueError:                               # not positive definite
+        return None
+
+    def solve(b):
+        x = np.empty(len(b))
+        factor.solve(np.ascontiguousarray(b, dtype=np.float64), x)
+        return x
+    return solve
+
+
+def factorisation(A):
+    """``(solve, iterate)``: the kept factorisation of ``A`` (n, n) sparse, sparse
+    Cholesky (:func:`cholesky_solve`) where ``A`` is symmetric (to 1e-12 relative,
+    infinity norm) and positive definite, with :func:`preconditioned_cg`; else
+    sparse LU (SuperLU, ordering of ``A + A^T``) with :func:`iterative_refinement`."""
+    A = sp.csr_matrix(A)
+    if spla.norm(A - A.T, np.inf) <= 1e-12 * spla.norm(A, np.inf):
+        solve = cholesky_solve(A)
+        if solve is not None:
+            return solve, preconditioned_cg
+    return splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A").solve, iterative_refinement
+
+
+def preconditioned_cg(apply, b, x, precondition, rtol, max_iterations):
+    """Conjugate gradients for ``A x = b`` from ``x`` (n,), ``apply: x -> A x`` and
+    ``precondition: r -> P^{-1} r`` symmetric positive definite, until
+    ``|b - A x| <= rtol |b|`` (recursive residual) or ``max_iterations``.
+
+    Returns
+    -------
+    x : (n,) float array
+    iterations : int
+    converged : bool
+    """
+    r = b - apply(x)
+    tol = rtol * np.linalg.norm(b)
+    if np.linalg.norm(r) <= tol:
+        return x, 0, True
+    z = precondition(r)
+    p, rz = z, r @ z
+    for k in range(1, max_iterations + 1):
+        q = apply(p)
+        a = rz / (p @ q)
+        x, r = x + a * p, r - a * q
+        if np.linalg.norm(r) <= tol:
+            return x, k, True
+        z = precondition(r)
+        rz, rz_old = r @ z, rz
+        p = z + (rz / rz_old) * p
+    return x, max_iterations, False
+
+
+def iterative_refinement(apply, b, x, precondition, rtol, max_iterations):
+    """``x <- x + P^{-1} (b - A x)`` until ``|b - A x| <= rtol |b|``: the stationary
+    iteration of a kept factorisation ``P`` of a nearby matrix (any ``A``); the
+    signature and returns of :func:`preconditioned_cg`."""
+    norm = np.linalg.norm(b)
+    for k in range(max_iterations + 1):
+        r = b - apply(x)
+        if np.linalg.norm(r) <= rtol * norm:
+            return x, k, True
+        if k < max_iterations:
+            x = x + precondition(r)
+    return x, max_iterations, False
+
+
+def pinned_matrix(K, keep):
+    """``P K P + I - P`` (n, n) CSR, ``P = diag(keep)`` (``keep`` 1, 0 at the pinned
+    entries): ``K`` with the rows and columns of the pinned entries replaced by
+    those of the identity (symmetric when ``K`` is)."""
+    P = sp.diags(keep)
+    return (P @ sp.csr_matrix(K) @ P + sp.diags(1.0 - keep)).tocsr()
 
 
 def tangential_potential(K, source, mesh, chi):
@@ -388,15 +491,17 @@ def bernoulli(x):
     return np.where(x == 0.0, 1.0, b)
 
 
-def drift_system(A, geom, mesh, chi, dt, psi, peclet=np.inf):
+def drift_system(assembler, A, geom, chi, dt, psi, peclet=np.inf):
     """The matrix of (R7) in row-scaled form: ``A + dt diag(1/chi) D``.
 
     Parameters
     ----------
+    assembler : ddfv.assembly.Assembler
+        The assembler of ``A``: ``D`` is added into its pattern.
     A : (n, n) scipy.sparse.csr_matrix
-        The scheme's system ``I + dt diag(1/chi) K`` at the same state.
+        The scheme's system ``I + dt diag(1/chi) K`` at the same state
+        (:meth:`ddfv.assembly.Assembler.system`).
     geom : DiamondGeometry
-    mesh : DiamondMesh
     chi : (n,) float array
         Covolume areas, F-vertices first.
     dt : float
@@ -409,27 +514,29 @@ def drift_system(A, geom, mesh, chi, dt, psi, peclet=np.inf):
     Returns
     -------
     (n, n) scipy.sparse.csr_matrix
-        ``D`` multiplies the F-row part of each inner diamond's fluxes by
-        ``w - 1``, ``w_a = B(psi_a - psi_b)`` in the row of ``a`` and
-        ``w_b = B(psi_b - psi_a)`` in the row of ``b`` (:func:`bernoulli`); T-rows,
-        boundary diamonds and Dirichlet rows are those of ``A``. With ``psi``
-        constant, ``A`` itself.
+        In the pattern of ``A`` (same ``indices`` and ``indptr``). ``D``
+        multiplies the F-row part of each inner diamond's fluxes by ``w - 1``,
+        ``w_a = B(psi_a - psi_b)`` in the row of ``a`` and ``w_b = B(psi_b -
+        psi_a)`` in the row of ``b`` (:func:`bernoulli`); T-rows, boundary
+        diamonds and Dirichlet rows are those of ``A``. With ``psi`` constant,
+        ``A`` itself.
     """
-    n_f, n = mesh.n_f, mesh.n_unknowns
-    inner = mesh.diamonds[:, 3] >= 0
-    a, b, t1, t2 = (mesh.diamonds[inner, k] for k in range(4))
-    alpha, beta = (np.asarray(c)[inner] for c in flux_coefficients(geom)[:2])
-    d = np.clip(psi[b] - psi[a], -peclet, peclet)
-    wa, wb = bernoulli(-d) - 1.0, bernoulli(d) - 1.0
-    free = ~np.r_[mesh.boundary_vertices, np.zeros(mesh.n_t, bool)]
-    wa, wb = wa * free[a], wb * free[b]
-    # (K f)_a = alpha (f_a - f_b) + beta (f_t2 - f_t1) = -(K f)_b: each row times w - 1
-    rows = np.concatenate([np.tile(a, 4), np.tile(b, 4)])
-    cols = np.tile(np.concatenate([a, b, n_f + t2, n_f + t1]), 2)
-    vals = np.concatenate([wa * alpha, -wa * alpha, wa * beta, -wa * beta,
-                           -wb * alpha, wb * alpha, -wb * beta, wb * beta])
-    D = sp.csr_matrix((vals * (dt / chi[rows]), (rows, cols)), shape=(n, n))
-    return (A + D).tocsr()
+    from .geometry import _diamond_indices
+    from .kernels import drift_kernel
+
+    mesh = assembler._mesh
+    if A.shape != assembler.shape or A.nnz != assembler.nnz:
+        raise ValueError(f"A ({A.shape}, {A.nnz} nonzeros) is not in the pattern of the "
+                         f"assembler ({assembler.shape}, {assembler.nnz} nonzeros)")
+    scale = np.zeros(mesh.n_unknowns)
+    free = ~mesh.boundary_vertices
+    scale[:mesh.n_f][free] = dt / np.asarray(chi, dtype=np.float64)[:mesh.n_f][free]
+    factors = (np.asarray(getattr(geom, name), dtype=np.float64)
+               for name in ("gamma_t", "gamma_f", "J", "len_u", "len_v", "uv"))
+    data = A.data.copy()
+    drift_kernel(assembler._inner, *factors, assembler._slots, _diamond_indices(mesh),
+                 np.ascontiguousarray(psi, dtype=np.float64), scale, float(peclet), data)
+    return sp.csr_matrix((data, A.indices, A.indptr), shape=A.shape)
 
 
 def carry_t_vertices(F, T, faces, lam):

@@ -9,11 +9,13 @@ import numpy as np
 import pytest
 
 from ddfv import Flow, variant_options
-from ddfv.assembly import Assembler
+from ddfv.assembly import Assembler, flux_coefficients
 from ddfv.geometry import covolume_areas, diamond_geometry, vertex_normals
-from ddfv.redistribution import (carry_t_vertices, diamond_gradients, neumann_stiffness,
-                                 redistribution_source, tangential_potential,
-                                 vertex_gradients)
+from ddfv.redistribution import (TangentialPotential, bernoulli, carry_t_vertices,
+                                 diamond_gradients, drift_system, iterative_refinement,
+                                 neumann_stiffness,
+                                 preconditioned_cg, redistribution_source,
+                                 tangential_potential, vertex_gradients)
 from ddfv.t_vertices import initial_t_vertices
 from ddfv.topology import diamond_mesh
 from mcfbench.geometry import surfaces
@@ -144,6 +146,66 @@ def test_potential_solves_the_poisson_problem_on_the_sphere():
     np.testing.assert_allclose(psi[n_f:] - psi[n_f], z[n_f:] - z[n_f], atol=1e-10)
 
 
+@pytest.mark.parametrize("surface, dual_length, iteration", [
+    ("sphere", "chord", preconditioned_cg),            # K symmetric: Cholesky and CG
+    ("sphere", "broken", iterative_refinement),        # broken line: K not symmetric, LU
+    ("plane", "chord", iterative_refinement),          # boundary ghost: not symmetric, LU
+])
+def test_kept_factor_matches_a_direct_solve_along_a_moving_surface(surface, dual_length,
+                                                                   iteration):
+    """One factorisation for the sequence: the later states (each 1e-4 further from
+    the first, at most 1e-3 of an edge) are solved with the first factor from the
+    extrapolated start to the residual 1e-7 of the default; the potential agrees with a
+    direct solve (a fresh factorisation of the state's own matrix) to 1e-6 relative."""
+    V, F = icosphere(2) if surface == "sphere" else _jittered_plane()
+    rng = np.random.default_rng(4)
+    bump = 1e-4 * rng.standard_normal(V.shape)
+    if surface == "plane":
+        bump[:, 2] = 0.0
+    solver = None
+    for k in range(4):
+        mesh, T, geom, chi = _setup(V + k * bump, F, "barycenter", dual_length)
+        K = neumann_stiffness(Assembler(mesh), geom)
+        hV = (np.r_[V, T][:, 0] + 2.0) ** 2
+        source = redistribution_source(chi, hV, mesh.n_f, mesh.boundary_vertices)
+        solver = solver or TangentialPotential(mesh)
+        psi, exact = solver(K, source, chi), tangential_potential(K, source, mesh, chi)
+        assert np.linalg.norm(psi - exact) <= 1e-6 * np.linalg.norm(exact)
+    assert solver.factorisations == 1 and solver._iterate is iteration
+    assert 3 <= solver.iterations
+
+
+@pytest.mark.parametrize("surface", ["sphere", "plane"])
+@pytest.mark.parametrize("peclet", [np.inf, 0.1])
+def test_drift_system_is_the_weighted_flux_form(surface, peclet):
+    """The compiled drift (R7) against its definition assembled entry by entry
+    (numpy, COO): each inner diamond's F-row fluxes times ``B(-+d) - 1`` and
+    ``dt / chi``, none at the fixed boundary; ``psi`` constant gives ``A``."""
+    import scipy.sparse as sp
+
+    V, F = icosphere(2) if surface == "sphere" else _jittered_plane()
+    mesh, T, geom, chi = _setup(V, F, "barycenter")
+    assembler, dt = Assembler(mesh), 0.01
+    A = assembler.system(geom, chi, dt)
+    psi = 0.3 * np.random.default_rng(2).standard_normal(mesh.n_unknowns)
+    n_f, n = mesh.n_f, mesh.n_unknowns
+    inner = mesh.diamonds[:, 3] >= 0
+    a, b, t1, t2 = (mesh.diamonds[inner, k] for k in range(4))
+    alpha, beta = (np.asarray(c)[inner] for c in flux_coefficients(geom)[:2])
+    d = np.clip(psi[b] - psi[a], -peclet, peclet)
+    free = ~mesh.boundary_vertices
+    wa, wb = (bernoulli(-d) - 1.0) * free[a], (bernoulli(d) - 1.0) * free[b]
+    rows = np.concatenate([np.tile(a, 4), np.tile(b, 4)])
+    cols = np.tile(np.concatenate([a, b, n_f + t2, n_f + t1]), 2)
+    vals = np.concatenate([wa * alpha, -wa * alpha, wa * beta, -wa * beta,
+                           -wb * alpha, wb * alpha, -wb * beta, wb * beta])
+    D = sp.csr_matrix((vals * (dt / chi[rows]), (rows, cols)), shape=(n, n))
+    drift = drift_system(assembler, A, geom, chi, dt, psi, peclet)
+    assert abs(drift - (A + D)).max() < 1e-14 * abs(A).max()      # rounding of A + D
+    assert (drift.indices == A.indices).all() and (drift.indptr == A.indptr).all()
+    assert abs(drift_system(assembler, A, geom, chi, dt, np.full(n, 2.5), peclet) - A).max() == 0
+
+
 def test_potential_on_a_surface_with_boundary_is_the_affine_solution():
     """Flat patch: psi = affine solves K psi = K affine; the fix of the kernel
     returns it (up to the constant) on every vertex."""
@@ -265,6 +327,22 @@ def _run(V, F, tau=0.002, steps=5, **options):
     traj = simulate(Flow(V, F, tau, **options), steps, save_every=1,
                     solver=Solver(rtol=1e-13, maxiter=1000))
     return traj.frames["F"], traj.frames["T"]
+
+
+@pytest.mark.parametrize("variant, iteration", [("redistribute", iterative_refinement),
+                                                ("chord-redistribute-carried",
+                                                 preconditioned_cg)])
+def test_flow_keeps_one_factor_and_times_the_potential(bumpy, variant, iteration):
+    """Along 5 steps: one factorisation, the later potentials by the kept factor (the
+    broken line's K is not symmetric: LU; the chord's is: Cholesky and CG), and the
+    potential's time recorded as part of the assembly's."""
+    V, F = bumpy
+    flow = Flow(V, F, 0.002, **variant_options(variant))
+    simulate(flow, 5, save_every=0, solver=Solver())
+    solver = flow._potential
+    assert solver.factorisations == 1 and solver._iterate is iteration
+    assert 0.0 < flow.timings["potential"] < flow.timings["assembly"]
+    assert "potential" not in Flow(V, F, 0.002).timings
 
 
 @pytest.mark.parametrize("variant", ["redistribute", "chord-redistribute-carried"])

@@ -1,0 +1,268 @@
+"""Cost of a redistributing step against the same scheme's plain step, before and after
+the potential's kept Cholesky factor and CG (issue #32), in one process.
+
+The redistributing schemes solve, at every step, the potential's Laplacian
+(``baselines.redistribution.PotentialSolver``, ``ddfv.redistribution.TangentialPotential``)
+and then the positions' system with the drift (R4) / (R7). "before" is the
+packages ``ddfv`` and ``baselines`` of commit ``BEFORE`` (a kept sparse LU
+refined at every step, the drift built as a COO matrix), extracted by ``git
+archive`` into a temporary directory as ``ddfv_before`` and ``baselines_before``
+and driven by this harness; "after" is this tree. Each pair (plain scheme,
+redistributing scheme) is stepped on the shrinking sphere at ``--level``
+(Table 3.1's time step, every step of the run, or the first ``--steps``) by
+:func:`mcfbench.running.driver.simulate`, both versions interleaved (the
+order reversed on odd repeats), after a level-1 run of every variant (no
+compilation or first call timed). Printed: the median CPU milliseconds per
+step, the potential's share of the step (its source, stiffness and solve:
+``flow.timings["potential"]``, the before-DDFV's timed by wrapping its
+``_potential_of``), the ratio of each redistributing step to the plain step
+of the same version (target of issue #32: at most 2 at level 5), and after /
+before. ``--solvers``: instead, the choice of the potential's solver: the
+systems (R2) of the first ``--steps`` (default 64) steps of ``cotan-redistribute``
+at ``--level`` are recorded, then solved in sequence by each candidate (a
+factorisation or preconditioner of the first system kept, each later system
+from the previous solution or the extrapolation of the last two, to the
+relative residual 1e-7; factorised again when the iteration fails): CPU ms
+per solve (the first, the factorisation, apart), iterations per solve and
+the largest relative difference to a direct solve. Algebraic multigrid
+(``pyamg``, smoothed aggregation) is measured when ``pyamg`` is importable
+(it is not a dependency). Usage::
+
+    python benchmarks/bench_potential.py [--level 5] [--repeats 3] [--steps N]
+        [--pairs cotan:cotan-redistribute ddfv-chord-carried:ddfv-chord-redistribute-carried]
+    python benchmarks/bench_potential.py --solvers [--level 5] [--steps 64]
+"""
+
+import os
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("MKL_NUM_THREADS", "1")
+os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+
+import argparse  # noqa: E402
+import dataclasses  # noqa: E402
+import importlib  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+from _harness import ROOT, footing, machine_line, median, one_core  # noqa: E402
+
+from mcfbench.geometry.spheres import icosphere  # noqa: E402
+from mcfbench.running.driver import simulate  # noqa: E402
+from mcfbench.running.problems import get_problem  # noqa: E402
+from mcfbench.running.schemes import get_scheme  # noqa: E402
+from mcfbench.running.solver import Solver  # noqa: E402
+from mcfbench.storage.memory import tune_malloc  # noqa: E402
+
+BEFORE = "acf8b58"
+TARGET = 2.0
+PAIRS = ["cotan:cotan-redistribute", "ddfv-chord-carried:ddfv-chord-redistribute-carried"]
+
+
+def before_packages(tree):
+    """``ddfv`` and ``baselines`` of :data:`BEFORE` as ``ddfv_before``, ``baselines_before``
+    (their imports are relative) under ``tree``, importable; the DDFV potential timed."""
+    archive = subprocess.run(["git", "archive", BEFORE, "ddfv", "baselines"], cwd=ROOT,
+                             capture_output=True, check=True).stdout
+    subprocess.run(["tar", "-x", "-C", tree], input=archive, check=True)
+    for package in ("ddfv", "baselines"):
+        Path(tree, package).rename(Path(tree, f"{package}_before"))
+    sys.path.insert(0, tree)
+    flow = importlib.import_module("ddfv_before.flow").Flow
+    potential_of = flow._potential_of
+
+    def timed(self, *args):
+        clock = time.perf_counter()
+        psi = potential_of(self, *args)
+        self.timings["potential"] = (self.timings.get("potential", 0.0)
+                                     + time.perf_counter() - clock)
+        return psi
+    flow._potential_of = timed
+
+
+def variant(name, version):
+    """The registry scheme ``name``, its flow class from this tree or from :data:`BEFORE`."""
+    scheme = get_scheme(name)
+    if version == "after":
+        return scheme
+    module, _, cls = scheme.flow.partition(":")
+    package, _, rest = module.partition(".")
+    return dataclasses.replace(scheme, flow=f"{package}_before.{rest}:{cls}")
+
+
+def step_cost(scheme, level, steps):
+    """``(CPU ms per step, the potential's share of the step)`` of one run of the sphere
+    at ``level`` (the share: the flow's wall-clock timing of the potential over the
+    run's wall-clock time, so that load on the machine cancels)."""
+    sphere = get_problem("sphere")
+    V, F = icosphere(level)
+    tau = sphere.tau(level)
+    steps = sphere.time_steps(tau) if steps is None else steps
+    flow = scheme.make(V, F, tau)
+    clock, wall = time.process_time(), time.perf_counter()
+    traj = simulate(flow, steps, solver=Solver(), save_every=0)
+    cpu, wall = time.process_time() - clock, time.perf_counter() - wall
+    if not traj.ok:
+        raise RuntimeError(f"{scheme.name} ({scheme.flow}): {traj.message}")
+    timings = flow.timings
+    potential = timings.get("potential", timings.get("redistribution", 0.0))
+    return 1e3 * cpu / steps, potential / wall
+
+
+def recorded_systems(level, steps):
+    """``(A, b)`` of the pinned potential systems of the first ``steps`` steps of
+    ``cotan-redistribute`` on the sphere at ``level`` (as ``PotentialSolver`` forms them)."""
+    from baselines.redistribution import pinned_matrix
+
+    sphere = get_problem("sphere")
+    V, F = icosphere(level)
+    flow = get_scheme("cotan-redistribute").make(V, F, sphere.tau(level))
+    solver, systems = flow._potential_solver, []
+
+    def record(L, mass, f):
+        b = -mass * f
+        b -= b.mean()
+        keep = np.ones(len(b))
+        keep[0] = b[0] = 0.0
+        systems.append((pinned_matrix(L, keep), b))
+        return solver(L, mass, f)
+    flow._potential_solver = record
+    simulate(flow, steps, solver=Solver(), save_every=0)
+    return systems
+
+
+def candidates():
+    """name -> ``(factorise, iterate, extrapolate, max_iterations)``."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    from baselines.redistribution import (cholesky_solve, iterative_refinement,
+                                          preconditioned_cg)
+
+    def lu(A):
+        return spla.splu(sp.csc_matrix(A)).solve
+
+    def jacobi(A):
+        inverse = 1.0 / A.diagonal()
+        return lambda r: inverse * r
+
+    found = {"LU kept + refinement (before)": (lu, iterative_refinement, False, 6),
+             "LU kept + CG, extrapolated": (lu, preconditioned_cg, True, 4),
+             "Cholesky kept + CG": (cholesky_solve, preconditioned_cg, False, 4),
+             "Cholesky kept + CG, extrapolated (after)": (cholesky_solve, preconditioned_cg,
+                                                          True, 4),
+             "Jacobi + CG, extrapolated": (jacobi, preconditioned_cg, True, 5000)}
+    try:
+        import pyamg
+    except ImportError:
+        print("pyamg is not importable: algebraic multigrid not measured")
+        return found
+
+    def amg(A):
+        hierarchy = pyamg.smoothed_aggregation_solver(sp.csr_matrix(A), symmetry="hermitian")
+        return hierarchy.aspreconditioner(cycle="V").matvec
+    found[f"AMG (pyamg {pyamg.__version__} SA) kept + CG, extrapolated"] = (
+        amg, preconditioned_cg, True, 100)
+    return found
+
+
+def solve_sequence(systems, factorise, iterate, extrapolate, max_iterations, rtol=1e-7):
+    """``(first ms, ms per later solve, iterations per later solve, largest relative
+    difference to a direct solve)`` of the systems solved in sequence."""
+    import scipy.sparse.linalg as spla
+
+    times, iterations, history, factor, worst = [], [], [], None, 0.0
+    for A, b in systems:
+        clock = time.process_time()
+        x, k = None, 0
+        if factor is not None:
+            start = (2.0 * history[-1] - history[-2] if extrapolate and len(history) == 2
+                     else history[-1])
+            x, k, converged = iterate(A.dot, b, start, factor, rtol, max_iterations)
+            x = x if converged else None
+        if x is None:
+            factor = factorise(A)
+            x, k, _ = iterate(A.dot, b, factor(b), factor, rtol, max_iterations)
+        times.append(time.process_time() - clock)
+        iterations.append(k)
+        history = history[-1:] + [x]
+        exact = spla.spsolve(A.tocsc(), b)
+        worst = max(worst, float(np.linalg.norm(x - exact) / np.linalg.norm(exact)))
+    return 1e3 * times[0], 1e3 * median(times[1:]), float(np.mean(iterations[1:])), worst
+
+
+def choose_solver(level, steps):
+    systems = recorded_systems(level, steps)
+    n = systems[0][0].shape[0]
+    print(f"the potential (R2) of cotan-redistribute, sphere level {level}: {n} unknowns, "
+          f"{len(systems)} systems in sequence; CPU ms")
+    print(f"{'solver':52s} {'first':>8s} {'per solve':>10s} {'iterations':>11s} "
+          f"{'vs direct':>10s}")
+    for name, (factorise, iterate, extrapolate, cap) in candidates().items():
+        first, per, its, worst = solve_sequence(systems, factorise, iterate, extrapolate, cap)
+        print(f"{name:52s} {first:8.1f} {per:10.2f} {its:11.2f} {worst:10.1e}")
+    print("iterations: of the kept factor or preconditioner on the later systems (LU "
+          "refinement: passes); vs direct: largest |x - x_direct| / |x_direct|.")
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--level", type=int, default=5)
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--steps", type=int, default=None,
+                        help="steps of each run (default: the whole run, t = 0.08)")
+    parser.add_argument("--pairs", nargs="+", default=PAIRS,
+                        help="plain:redistributing registry names")
+    parser.add_argument("--solvers", action="store_true",
+                        help="compare the potential's solvers instead")
+    args = parser.parse_args(argv)
+    tune_malloc()
+    one_core()
+    print(machine_line())
+    if args.solvers:
+        choose_solver(args.level, 64 if args.steps is None else args.steps)
+        return
+    pairs = [tuple(p.split(":")) for p in args.pairs]
+    names = [name for pair in pairs for name in pair]
+    versions = ("before", "after")
+    with tempfile.TemporaryDirectory(prefix=f"potential-{BEFORE}-") as tree:
+        before_packages(tree)
+        schemes = {(n, v): variant(n, v) for n in names for v in versions}
+        for scheme in schemes.values():                   # warm-up: compilation, caches
+            step_cost(scheme, 1, None)
+        cost = {key: [] for key in schemes}
+        for repeat in range(args.repeats):
+            keys = list(schemes) if repeat % 2 == 0 else list(schemes)[::-1]
+            for key in keys:
+                cost[key].append(step_cost(schemes[key], args.level, args.steps))
+    ms = {k: median([c[0] for c in v]) for k, v in cost.items()}
+    pot = {k: median([c[1] for c in v]) for k, v in cost.items()}
+    print(f"sphere level {args.level}, CPU ms per step (median of {args.repeats}, "
+          f"{'every step' if args.steps is None else f'{args.steps} steps'}), "
+          f"before = {BEFORE}")
+    print(f"{'scheme':34s} {'version':>7s} {'ms/step':>9s} {'potential %':>12s} "
+          f"{'x plain':>8s} {'after/before':>13s}  verdict")
+    for plain, redistributing in pairs:
+        for name in (plain, redistributing):
+            for version in versions:
+                key = (name, version)
+                ratio = ms[key] / ms[(plain, version)]
+                change = ms[(name, "after")] / ms[(name, "before")]
+                verdict = ("" if name == plain else
+                           "ok" if ratio <= TARGET else f"above {TARGET:g}")
+                print(f"{name:34s} {version:>7s} {ms[key]:9.2f} {100 * pot[key]:12.1f} "
+                      f"{ratio:8.2f} {change if version == 'after' else float('nan'):13.2f}"
+                      f"  {verdict}")
+    print("potential %: the share of the step spent in the potential (R2)/(R3) (its "
+          "source, stiffness and solve); x plain: CPU time per step over the plain "
+          "scheme's of the same version.")
+    print(footing())
+
+
+if __name__ == "__main__":
+    main()
