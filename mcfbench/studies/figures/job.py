@@ -276,6 +276,7 @@ def job(name, outputs, log):
     from mcfbench.geometry.quality import COLUMNS
     from mcfbench.presentation.quality_plots import plot_quality
     from mcfbench.presentation.render import DPI, rasterize_meshes
+    from mcfbench.presentation.tables import csv
     from mcfbench.storage.atomic import json_text, write_files
     from mcfbench.storage.frames import save_frames
     from mcfbench.storage.provenance import provenance
@@ -307,7 +308,7 @@ def job(name, outputs, log):
     }
     for key, r in results.items():
         save_frames(frames_file(outputs["frames"], key), r.frames)
-    write_files({outputs["csv"]: table[["run", *COLUMNS]].to_csv(index=False),
+    write_files({outputs["csv"]: csv(table[["run", *COLUMNS]]),
                  outputs["plot"]: (plot, {"dpi": DPI}), outputs["png"]: (figure, {"dpi": DPI}),
                  outputs["pdf"]: (figure, {"dpi": 2 * DPI}),
                  outputs["record"]: json_text(record)})

@@ -1,4 +1,4 @@
-"""The tables of the benchmark matrix: the long table (one row per run and metric, EOC (3.1) of every error), the table of one problem, the summary (problem x scheme), their Markdown and LaTeX, and the gallery's table.
+"""The tables of the benchmark matrix: the long table (one row per run and metric, EOC (3.1) of every error), the table of one problem, the summary (problem x scheme) and its cells (written by :mod:`mcfbench.presentation.tables`).
 
 Errors and EOC
 --------------
@@ -28,6 +28,10 @@ TIMING_NOTE = TIMING_BASE[:-1] + (
     "; the matrix uses BiCGStab on the refinement series but the robust solver on the "
     "real-world-like meshes, so compare timings within one problem only."
 )
+
+
+FLOAT_FORMAT = "%.10g"
+"""The floats of the matrix's and the gallery's CSV tables: ten significant digits."""
 
 
 # metric observer (Problem.metrics) -> preferred main metrics, best first
@@ -373,31 +377,6 @@ def problem_table(table, problem, schemes=None, labels=None):
         row["CPU s (finest)"] = format_or_missing(finest["cpu_seconds"], ".3g")
         rows.append(row)
     return pd.DataFrame(rows), metric
-
-
-def markdown(frame, notes=()):
-    """A pipe table (:func:`mcfbench.presentation.formats.md_table`), then ``notes`` as paragraphs."""
-    from mcfbench.presentation.formats import md_table
-
-    lines = [md_table(list(frame.columns), frame.itertuples(index=False))]
-    lines += [f"\n{note}" for note in notes]
-    return "\n".join(lines) + "\n"
-
-
-def latex(frame, caption="", notes=()):
-    """A ``table`` with a booktabs ``tabular`` (:func:`mcfbench.presentation.formats.tex_tabular`),
-    the notes below it."""
-    from mcfbench.presentation.formats import tex_escape, tex_tabular
-
-    lines = [r"\begin{table}[ht]",
-             tex_tabular([tex_escape(c) for c in frame.columns],
-                         [[tex_escape(v) for v in row] for row in frame.itertuples(index=False)],
-                         "l" + "r" * (len(frame.columns) - 1))]
-    if caption:
-        lines.append(r"\caption{" + tex_escape(caption) + "}")
-    lines += [r"\par\smallskip{\footnotesize " + tex_escape(note) + "}" for note in notes]
-    lines.append(r"\end{table}")
-    return "\n".join(lines) + "\n"
 
 
 SUMMARY_TEXT = ("levels", "eoc_levels", "eocs", "values", "failed", "metric", "status",
