@@ -59,7 +59,7 @@ def write_tables(table, out_dir, plan):
         write_text(out / f"{problem}.tex", tex)
     summary = summary_table(table, problems, plan["schemes"])
     write_text(out / "summary.csv", csv(summary, FLOAT_FORMAT))
-    wide = summary_views(summary, problems, plan["schemes"], labels)
+    wide = summary_views(summary, table, problems, plan["schemes"], labels)
     notes = ["Each cell: the EOC (3.1) between the two finest finished levels and the "
              "finest finished level's value of the problem's main metric (in brackets "
              "after the problem), or the status and breakdown time of the coarsest run "

@@ -31,7 +31,7 @@ from mcfbench.presentation.formats import sci, sig
 from mcfbench.presentation.tables import Table, html
 from mcfbench.studies.matrix.tables import (
     is_error,
-    main_metric,
+    main_runs,
     read_long_table,
     read_summary,
     TIMING_NOTE,
@@ -84,14 +84,6 @@ def print_width(png):
         return round(image.width * 96.0 / dpi)
 
 
-def problem_runs(table, problem):
-    """The runs of ``problem`` on its main metric: the rows of the long table
-    (``matrix.csv``) in its order, index reset, and the metric's name."""
-    part = table[table["problem"] == problem]
-    metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
-    return part[part["metric"] == metric].reset_index(drop=True), metric
-
-
 def html_table(frame, columns, table_id, caption=""):
     """The ``columns`` (``(name, header, format)``) of ``frame`` as a sortable HTML
     table (:func:`mcfbench.presentation.tables.html`), ``data-column`` the names."""
@@ -112,7 +104,7 @@ def findings_html(text, base, shift=2):
 def _problem_section(table, problem):
     from mcfbench.running.problems import PROBLEMS
 
-    runs, metric = problem_runs(table, problem)
+    runs, metric = main_runs(table, problem)
     p = PROBLEMS.get(problem)
     notes = [f"Main metric: <code>{_html.escape(metric)}</code>"
              + (" (an error: EOC (3.1) between consecutive levels)." if is_error(metric)
