@@ -25,6 +25,7 @@ from mcfbench.running.problems import Problem
 from mcfbench.running.run import framed_run
 from mcfbench.running.schemes import get_scheme
 from mcfbench.running.solver import Solver
+from mcfbench.storage.frames import surface_points
 from mcfbench.storage.records import RunResult
 from mcfbench.studies.figures.experiments import EXPERIMENTS, Run, validate
 
@@ -43,12 +44,12 @@ class FigureRun:
     @property
     def F(self):
         """(frames, n_f, 3): the F-vertices (DDFV) or the vertices."""
-        return self.frames["F"] if "F" in self.frames else self.frames["V"]
+        return surface_points(self.frames)[0]
 
     @property
     def T(self):
         """(frames, n_t, 3) T-vertices; None for the vertex schemes."""
-        return self.frames.get("T")
+        return surface_points(self.frames)[1]
 
     @property
     def steps(self):
