@@ -164,9 +164,8 @@ def markdown(table):
 # -- LaTeX -----------------------------------------------------------------------------
 
 
-def tabular(header, rows, spec):
-    """A booktabs ``tabular`` of cells already in LaTeX, centred and shrunk to
-    the line width when wider."""
+def _tabular(header, rows, spec):
+    """A booktabs ``tabular`` of cells already in LaTeX (see :func:`latex`)."""
     lines = [rf"\begin{{tabular}}{{{spec}}}", r"\toprule", " & ".join(header) + r" \\",
              r"\midrule"]
     lines += [" & ".join(r) + r" \\" for r in rows]
@@ -192,11 +191,11 @@ def latex(table, head=tex_header, cell=tex_number, text=str, caption_below=False
     Returns
     -------
     str
-        The ``tabular`` (:func:`tabular`); with a caption, a label or notes, in a
-        ``table`` float: the caption, the label, the ``tabular``, the notes in
-        small print.
+        The booktabs ``tabular``, centred and shrunk to the line width when
+        wider; with a caption, a label or notes, in a ``table`` float: the
+        caption, the label, the ``tabular``, the notes in small print.
     """
-    body = tabular([head(h) for h in table.header],
+    body = _tabular([head(h) for h in table.header],
                    [[cell(c) for c in row] for row in table.cells()], table.align)
     if not (table.caption or table.label or table.notes):
         return body
