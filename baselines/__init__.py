@@ -1,6 +1,6 @@
 """Schemes compared with the DDFV scheme, on the mesh vertices only.
 
-Every scheme is one class following the contract of ``mcfbench.running.flow.Flow``
+Every scheme is one class following the contract of ``mcfbench.running.flow.SchemeFlow``
 (constructor ``(vertices, faces, tau, **options)``, ``step(solve)``,
 ``defects()``, ``frame()``, ...) and is registered in
 ``mcfbench/running/schemes.py``; this package imports nothing from ``ddfv`` or

@@ -52,7 +52,7 @@ enters the matrix as the advection ``grad psi . grad X^n``:
 ``c_ij B(psi_i - psi_j)``), the right-hand side stays ``X^{n-1}``.
 
 This module also holds :class:`VertexFlow`, what every vertex-based
-baseline shares: the state, the contract of ``mcfbench.running.flow.Flow``, the
+baseline shares: the state, the contract of ``mcfbench.running.flow.SchemeFlow``, the
 warm start and the checks of a state (:meth:`VertexFlow.defects`).
 """
 
@@ -281,7 +281,7 @@ def dirichlet_rows(A, fixed):
 
 
 class VertexFlow:
-    """What every vertex-based baseline shares (the ``mcfbench.running.flow.Flow`` contract).
+    """What every vertex-based baseline shares (the ``mcfbench.running.flow.SchemeFlow`` contract).
 
     The state is the mesh vertices, stored by components ``X`` (3, n).
     Subclasses implement ``_system(at, base, dt)``, the linear system of

@@ -252,10 +252,10 @@ def _study(args):
 
 
 def _write_csv(path, table, config):
-    from mcfbench.storage.atomic import atomic_path
+    from mcfbench.presentation.tables import csv
+    from mcfbench.storage.atomic import write_text
 
-    with atomic_path(path) as tmp:
-        table.to_csv(tmp, index=False)
+    write_text(path, csv(table))
     write_json(f"{path}.json", provenance(config))
     print(f"wrote {path}")
 

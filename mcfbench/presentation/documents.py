@@ -18,7 +18,6 @@ from mcfbench.presentation.formats import (
     MISSING,
     fix,
     int_or,
-    md_cell,
     num,
     pct,
     pct0,
@@ -28,8 +27,8 @@ from mcfbench.presentation.formats import (
     tex_escape,
     tex_inline,
     tex_number,
-    tex_tabular,
 )
+from mcfbench.presentation.tables import Table, latex, markdown as markdown_table, md_cell
 
 MARKDOWN_EXTENSIONS = ["tables", "md_in_html", "attr_list", "fenced_code", "sane_lists", "toc"]
 
@@ -51,8 +50,16 @@ def verdict(ok, text=""):
             else f'<span class="fail">✗{text}</span>')
 
 
+def csv_markdown(table):
+    """A CSV file's table of the report (``header``, ``rows`` of text) as Markdown,
+    every column left-aligned."""
+    return markdown_table(Table(table["header"], table["rows"],
+                                align="l" * len(table["header"])))
+
+
 FILTERS = {"sci": sci, "fix": fix, "sig": sig, "signed": signed, "pct": pct, "pct0": pct0,
-           "num": num, "int_or": int_or, "listing": as_list, "verdict": verdict, "cell": md_cell}
+           "num": num, "int_or": int_or, "listing": as_list, "verdict": verdict, "cell": md_cell,
+           "table": csv_markdown}
 
 
 @functools.lru_cache(maxsize=4)
@@ -236,8 +243,8 @@ def _cells(line):
 def _tex_pipe_table(lines):
     header = _cells(lines[0])
     rows = [_cells(x) for x in lines[2:]] if len(lines) > 1 else []
-    return tex_tabular([tex_inline(h) for h in header],
-                       [[tex_inline(c) for c in r] for r in rows])
+    return latex(Table(header, rows, align="l" * len(header)), head=tex_inline,
+                 cell=tex_inline)
 
 
 def _tex_verdict(ok, text=""):
@@ -290,21 +297,15 @@ def latex_fragments(context, figure_prefix="figures/"):
              fix(r["paper"]["cpu_seconds"], 2).replace(MISSING, "--"),
              sig(r["ours"]["cpu_seconds"], 3).replace(MISSING, "--"),
              sig(r["cpu_ratio"], 3).replace(MISSING, "--")] for r in context["table"]]
-    frags["table_3_1"] = head + "\n".join([
-        r"\begin{table}[ht]",
-        r"\caption{Table~3.1 of the paper against this reproduction (DDFV): $L_2$ error (3.2) "
-        r"with the tolerance it is held to, and EOC (3.1). Checks: "
-        r"\texttt{paper/checks.yaml}.}",
-        r"\label{tab:reproduction-accuracy}",
-        tex_tabular(header, rows, "r" * len(header)),
-        r"\end{table}", "",
-        r"\begin{table}[ht]",
-        r"\caption{Cost: total BiCGStab iterations and CPU seconds, the paper's and ours "
-        r"(compared, not checked).}",
-        r"\label{tab:reproduction-cost}",
-        tex_tabular(cost_header, cost, "r" * len(cost_header)),
-        r"\end{table}",
-    ]) + "\n"
+    accuracy = Table(header, rows, align="r" * len(header), label="tab:reproduction-accuracy",
+                     caption=r"Table~3.1 of the paper against this reproduction (DDFV): $L_2$ "
+                     r"error (3.2) with the tolerance it is held to, and EOC (3.1). Checks: "
+                     r"\texttt{paper/checks.yaml}.")
+    costs = Table(cost_header, cost, align="r" * len(cost_header),
+                  label="tab:reproduction-cost", caption="Cost: total BiCGStab iterations and "
+                  "CPU seconds, the paper's and ours (compared, not checked).")
+    frags["table_3_1"] = head + latex(accuracy, head=str, cell=str) + "\n\n" \
+        + latex(costs, head=str, cell=str) + "\n"
 
     diff = context["differences"]
     parts = [head]
@@ -353,9 +354,7 @@ def latex_fragments(context, figure_prefix="figures/"):
             parts.append(markdown_to_tex(d["text"]))
         for t in beyond["tables"]:
             parts.append(rf"\subsection*{{{tex_inline(t['title'])}}}")
-            parts.append(tex_tabular([tex_inline(h) for h in t["header"]],
-                                     [[tex_number(c) for c in row] for row in t["rows"]],
-                                     "l" + "r" * (len(t["header"]) - 1)))
+            parts.append(latex(Table(t["header"], t["rows"]), head=tex_inline))
         for image in beyond["images"]:
             path = re.sub(r"^results/", "", image["path"])
             parts.append("\n".join([
@@ -380,11 +379,10 @@ def latex_fragments(context, figure_prefix="figures/"):
                               f"{tex_escape(prov['created_last'] or '--')}"]]
     rows += [[tex_escape(name), ", ".join(tex_escape(v) for v in versions)]
              for name, versions in prov["packages"].items()]
-    frags["provenance"] = head + "\n".join([
-        r"\begin{table}[ht]",
-        r"\caption{Provenance of the result files (from their JSON records).}",
-        r"\label{tab:reproduction-provenance}",
-        tex_tabular(["", "value"], rows, "ll"), r"\end{table}"]) + "\n"
+    frags["provenance"] = head + latex(
+        Table(["", "value"], rows, align="ll", label="tab:reproduction-provenance",
+              caption="Provenance of the result files (from their JSON records)."),
+        head=str, cell=str) + "\n"
     return frags
 
 

@@ -1,4 +1,5 @@
-"""Number formats, Markdown and LaTeX: every table of the suite is written with these."""
+"""Number formats and LaTeX text: the cells of every table of the suite
+(:mod:`mcfbench.presentation.tables` writes the tables)."""
 
 import math
 import re
@@ -65,19 +66,6 @@ def int_or(x, fallback=None):
     if v is None:
         v = finite_value(fallback)
     return MISSING if v is None else str(int(round(v)))
-
-
-def md_cell(text):
-    """Text for a Markdown table cell: pipes escaped, no line breaks."""
-    return str("" if text is None else text).replace("|", "\\|").replace("\n", " ")
-
-
-def md_table(header, rows):
-    """A Markdown pipe table, the first column left-aligned, the others right."""
-    lines = ["| " + " | ".join(md_cell(h) for h in header) + " |",
-             "|" + "|".join("---" if i == 0 else "---:" for i in range(len(header))) + "|"]
-    lines += ["| " + " | ".join(md_cell(c) for c in row) + " |" for row in rows]
-    return "\n".join(lines)
 
 
 _TEX_SPECIAL = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#",
@@ -177,35 +165,3 @@ _TEX_WORDS = {"n_V": "$n_V$", "n_F": "$n_F$", "n_T": "$n_T$", "tau": r"$\tau$", 
 def tex_header(text):
     """A column header as LaTeX: ``n_V``, ``tau``, ``L2``, ``t_f``, ... as math."""
     return " ".join(_TEX_WORDS.get(word, tex_inline(word)) for word in str(text).split(" "))
-
-
-def tex_tabular(header, rows, spec=None, resize=True):
-    """A booktabs ``tabular`` of cells already in LaTeX, centred and shrunk to
-    the line width when wider."""
-    spec = spec or "l" * len(header)
-    lines = [rf"\begin{{tabular}}{{{spec}}}", r"\toprule", " & ".join(header) + r" \\",
-             r"\midrule"]
-    lines += [" & ".join(r) + r" \\" for r in rows]
-    lines += [r"\bottomrule", r"\end{tabular}"]
-    table = "\n".join(lines)
-    if resize:
-        table = "\\resizebox{\\ifdim\\width>\\linewidth\\linewidth\\else\\width\\fi}{!}{%\n" \
-                + table + "}"
-    return "{\\centering\\footnotesize\n" + table + "\\par}"
-
-
-def tex_table(header, rows, caption, label):
-    """A floating table of formatted cells (:func:`tex_header`, :func:`tex_number`);
-    ``caption`` is LaTeX."""
-    return "\n".join([
-        r"\begin{table}[ht]", rf"\caption{{{caption}}}", rf"\label{{{label}}}",
-        tex_tabular([tex_header(h) for h in header],
-                    [[tex_number(c) for c in row] for row in rows],
-                    "l" + "r" * (len(header) - 1)),
-        r"\end{table}"])
-
-
-def csv_text(table):
-    """A table as CSV, floats in their shortest round-trip form (exact and
-    deterministic: two runs differ in the timing columns only)."""
-    return table.to_csv(index=False, lineterminator="\n")

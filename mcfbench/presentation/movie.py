@@ -22,6 +22,7 @@ from matplotlib.animation import FuncAnimation, PillowWriter
 
 from mcfbench.presentation.render import draw_mesh, project
 from mcfbench.storage.atomic import write_files
+from mcfbench.storage.frames import surface_points
 
 OK_COLOR, DEFECT_COLOR = "#1a7f37", "#c0261c"
 
@@ -105,18 +106,18 @@ def write_movie(arrays, out, *, title="", view=(20.0, -60.0), fps=4, size=4.0, d
     out = Path(out)
     if out.suffix.lower() != ".gif":
         raise ValueError(f"{out}: the animation is a GIF; name it *.gif")
-    ddfv = "F" in arrays
-    F = np.asarray(arrays["F" if ddfv else "V"], dtype=float)
     # a DDFV run the scheme refused (status unsupported) kept its surface, no T-vertices
-    T = np.asarray(arrays["T"], dtype=float) if "T" in arrays else None
+    V, T = surface_points(arrays)
+    V = np.asarray(V if V is not None else [], dtype=float)
+    T = None if T is None else np.asarray(T, dtype=float)
     faces, t = np.asarray(arrays["faces"]), np.asarray(arrays["t"], dtype=float)
-    if len(t) == 0 or len(F) != len(t):
-        raise ValueError(f"{out}: no frames to animate ({len(F)} frames, {len(t)} times)")
+    if len(t) == 0 or len(V) != len(t):
+        raise ValueError(f"{out}: no frames to animate ({len(V)} frames, {len(t)} times)")
     steps = np.asarray(arrays.get("steps", np.arange(len(t))))
     status = str(arrays.get("status", "ok"))
     message = str(arrays.get("message", ""))
     statuses = frame_status(steps, status, int(arrays.get("failed_step", -1)))
-    centre, half = view_box([np.concatenate([F[k], T[k]]) if T is not None else F[k]
+    centre, half = view_box([np.concatenate([V[k], T[k]]) if T is not None else V[k]
                              for k in range(len(t))], view)
     fig, ax = plt.subplots(figsize=(size, size))
     fig.subplots_adjust(left=0.02, right=0.98, top=0.9, bottom=0.12)
@@ -127,9 +128,9 @@ def write_movie(arrays, out, *, title="", view=(20.0, -60.0), fps=4, size=4.0, d
         ax.set_ylim(centre[1] - half, centre[1] + half)
         ax.set_aspect("equal")
         ax.set_axis_off()
-        finite = np.isfinite(F[k]).all() and (T is None or np.isfinite(T[k]).all())
+        finite = np.isfinite(V[k]).all() and (T is None or np.isfinite(T[k]).all())
         if finite:
-            draw_mesh(ax, F[k], None if T is None else T[k], faces, view=view,
+            draw_mesh(ax, V[k], None if T is None else T[k], faces, view=view,
                       points_per_unit=72.0 * size / (2 * half))
         else:
             ax.text(0.5, 0.5, "non-finite coordinates", transform=ax.transAxes,

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from mcfbench.geometry.frame_fields import ddfv_frame_fields, vertex_frame_fields
-from mcfbench.storage.frames import load_frames
+from mcfbench.storage.frames import load_frames, surface_points
 from mcfbench.storage.paraview import Piece, write_pvd
 from mcfbench.storage.provenance import provenance
 from mcfbench.storage.records import load_json
@@ -61,8 +61,9 @@ def run_pieces(arrays):
     Parameters
     ----------
     arrays : dict
-        ``faces`` (m, 3), ``V`` (frames, n, 3) or ``F`` (frames, n_f, 3) and
-        ``T`` (frames, m, 3).
+        ``faces`` (m, 3) and the points of
+        :func:`~mcfbench.storage.frames.surface_points` (a DDFV run's
+        T-vertices, (frames, m, 3), as their own piece).
 
     Returns
     -------
@@ -70,15 +71,16 @@ def run_pieces(arrays):
         Per frame: ``surface`` (and ``t_vertices`` for DDFV).
     """
     faces = np.asarray(arrays["faces"], dtype=np.int64)
-    if "V" in arrays:
-        V = np.asarray(arrays["V"], dtype=np.float64)
+    V, T = surface_points(arrays)
+    V = np.asarray(V, dtype=np.float64)
+    if T is None:
         return [{"surface": Piece(V[k], faces, point_data)}
                 for k, point_data in enumerate(vertex_frame_fields(V, faces))]
-    F, T = np.asarray(arrays["F"], dtype=np.float64), np.asarray(arrays["T"], dtype=np.float64)
+    T = np.asarray(T, dtype=np.float64)
     single = np.arange(len(faces))[:, None]
-    return [{"surface": Piece(F[k], faces, fields["F"], fields["triangles"]),
+    return [{"surface": Piece(V[k], faces, fields["F"], fields["triangles"]),
              "t_vertices": Piece(T[k], single, fields["T"])}
-            for k, fields in enumerate(ddfv_frame_fields(F, T, faces))]
+            for k, fields in enumerate(ddfv_frame_fields(V, T, faces))]
 
 
 def run_provenance(arrays, source=None):

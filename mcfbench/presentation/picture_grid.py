@@ -9,20 +9,21 @@ import numpy as np  # noqa: E402
 
 from mcfbench.presentation.plots import SMALLEST_TEXT  # noqa: E402
 from mcfbench.storage.atomic import save_figure  # noqa: E402
+from mcfbench.storage.frames import surface_points  # noqa: E402
 
 DIAMONDS_UP_TO = 1500
 """Draw the DDFV diamond mesh (T-vertices) of meshes with at most this many triangles."""
 
 
 def frame_surface(frames, which=-1):
-    """``(F, T, faces)`` of a saved frame (``T`` None for vertex schemes)."""
+    """``(vertices, extra, faces)`` of a saved frame (:func:`surface_points`: ``extra``
+    the DDFV T-vertices, None for vertex schemes; ``vertices`` None without frames)."""
     faces = np.asarray(frames["faces"])
-    if "F" in frames:
-        T = frames["T"][which] if "T" in frames and len(frames["T"]) else None
-        return np.asarray(frames["F"][which]), T, faces
-    if "V" in frames and len(frames["V"]):
-        return np.asarray(frames["V"][which]), None, faces
-    return None, None, faces
+    vertices, extra = surface_points(frames)
+    if vertices is None or not len(vertices):
+        return None, None, faces
+    return (np.asarray(vertices[which]),
+            extra[which] if extra is not None and len(extra) else None, faces)
 
 
 def draw_grid(cells, row_labels, col_labels, paths, title, views=None, share="column",

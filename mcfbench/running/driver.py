@@ -1,14 +1,14 @@
 """The time-stepping driver shared by every scheme.
 
-:func:`simulate` steps a :class:`~mcfbench.running.flow.Flow` with the shared
+:func:`simulate` steps a :class:`~mcfbench.running.flow.SchemeFlow` with the shared
 linear solver, checks every state it reaches (the initial one included)
 through :class:`mcfbench.geometry.collapse.CollapseCheck` (a component shrunk to a
 point or a line, before the scheme assembles a matrix on it),
-:meth:`Flow.defects` (what the scheme knows is wrong with its state) and
+:meth:`SchemeFlow.defects` (what the scheme knows is wrong with its state) and
 :class:`mcfbench.geometry.invariants.FlowInvariants` (what every mean
 curvature flow must do: the area never grows, the mesh does not fold; a
 solver failure on a mesh whose quality collapsed is the mesh's verdict),
-calls observers at every time level and keeps frames. Every way a run can end is one :class:`~mcfbench.running.flow.FlowBreakdown`
+calls observers at every time level and keeps frames. Every way a run can end is one :class:`~mcfbench.running.flow.SchemeFlowBreakdown`
 with one message format, ``"{status} at step {n} (t = {t}): {detail}"``.
 """
 
@@ -36,7 +36,7 @@ class Trajectory:
     Attributes
     ----------
     frames : dict of str -> (frames, ...) float arrays
-        The arrays of :meth:`Flow.frame` stacked over the kept frames
+        The arrays of :meth:`SchemeFlow.frame` stacked over the kept frames
         (DDFV: ``"F"``, ``"T"``; the others: ``"V"``). Frame 0 is the
         initial state, the last frame the last state computed.
     steps : (frames,) int array
@@ -106,7 +106,7 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
 
     Parameters
     ----------
-    flow : mcfbench.running.flow.Flow
+    flow : mcfbench.running.flow.SchemeFlow
     steps : int
     solver : mcfbench.running.solver.Solver, optional
         Default ``Solver()`` (BiCGStab, rtol 1e-9).
@@ -122,7 +122,7 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
         ``observer(flow)`` at every time level reached, ``n = 0`` included,
         in order.
     on_defect : {"stop", "record"}
-        What an invalid state (:meth:`Flow.defects`) does: end the run
+        What an invalid state (:meth:`SchemeFlow.defects`) does: end the run
         (default; the invalid state is kept as the last frame) or be
         recorded (its first occurrence per status) while the run goes on.
         Solver failures always end the run (the state stays at the last
@@ -136,7 +136,7 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
         has lasted :data:`PROGRESS_DELAY` seconds, removed when it ends.
         The command line asks for it when standard error is a terminal.
     collapse : bool
-        Check every state, before the scheme's own :meth:`Flow.defects` and
+        Check every state, before the scheme's own :meth:`SchemeFlow.defects` and
         before the next solve, for a component that shrank to a point or a
         line or has non-finite coordinates
         (:class:`mcfbench.geometry.collapse.CollapseCheck`): status

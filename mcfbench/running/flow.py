@@ -1,16 +1,16 @@
 """The contract every scheme follows, and the ways a run can end.
 
 A scheme is a class whose instances are one flow of one surface
-(:class:`Flow`); the harness builds it from ``(vertices, faces, tau,
-**options)``, steps it with one of its time integrators
+(:class:`SchemeFlow`, the contract; DDFV's own class is ``ddfv.Flow``); the
+harness builds it from ``(vertices, faces, tau, **options)``, steps it with one of its time integrators
 (:mod:`mcfbench.running.integrators`) and the shared linear solver, and
 checks every new state. The scheme provides the spatial part: its state
 and the linear system of one step with its operators assembled at a given
-state (:meth:`Flow.system`); the integrator chooses that state, solves and
-hands the solution back (:meth:`Flow.advance`). The schemes (``ddfv``,
+state (:meth:`SchemeFlow.system`); the integrator chooses that state, solves and
+hands the solution back (:meth:`SchemeFlow.advance`). The schemes (``ddfv``,
 ``baselines``) import nothing from the harness, and a scheme reports what
 is wrong with a state as plain ``(status, description)`` pairs
-(:meth:`Flow.defects`), which the driver turns into one
+(:meth:`SchemeFlow.defects`), which the driver turns into one
 :class:`FlowBreakdown` with one message format.
 
 The statuses a run can end with are :data:`mcfbench.storage.statuses.STATUSES`.
@@ -22,7 +22,7 @@ import numpy as np
 
 
 @runtime_checkable
-class Flow(Protocol):
+class SchemeFlow(Protocol):
     """One flow of one surface, stepped by the driver.
 
     Built as ``scheme_class(vertices, faces, tau, **options)`` with
@@ -103,7 +103,9 @@ class Flow(Protocol):
 
     def frame(self) -> dict:
         """Arrays that make one saved frame, copied: ``{"F": ..., "T": ...}``
-        for DDFV, ``{"V": ...}`` for the others."""
+        for DDFV, ``{"V": ...}`` for the others (the frame-file layout of
+        :mod:`mcfbench.storage.frames`, whose ``surface_points`` reads the points
+        of either alike)."""
 
 
 class FlowBreakdown(RuntimeError):

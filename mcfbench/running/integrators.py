@@ -1,7 +1,7 @@
 """The time integrators, one for every scheme: semi-implicit Euler and linearly implicit BDF2, BDF3.
 
-A scheme provides its spatial operators at a state (:meth:`Flow.system
-<mcfbench.running.flow.Flow.system>`): the linear system of
+A scheme provides its spatial operators at a state (:meth:`SchemeFlow.system
+<mcfbench.running.flow.SchemeFlow.system>`): the linear system of
 
     M(X*) (X^{n+1} - B) / dt + L(X*) X^{n+1} = g(X*)                        (I1)
 
@@ -52,7 +52,7 @@ operators at the extrapolated state, Kovacs, Li, Lubich, Numer. Math. 143 (2019)
     extrapolated-Euler start instead, ``ddfv-chord`` on the level-1 sphere (the
     study below) has 2.9e-5 instead of 7.9e-4 at tau = 0.005, but EOC 1.5 and
     1.8 over the next two halvings. The half step's state is a solution of the
-    scheme's system that is not handed to :meth:`Flow.advance`, so a scheme's
+    scheme's system that is not handed to :meth:`SchemeFlow.advance`, so a scheme's
     post-processing there (DDFV's carried T-vertices) does not apply to it.
 
     Measured (shrinking sphere, level-1 icosphere, ``t = 0.02``, taus 0.005 /
@@ -172,7 +172,7 @@ class Euler:
 
     def evaluation(self, X, past, tau):
         """``(X*, B, dt)`` of (I1) from ``X = X^n`` and ``past = (X^{n-1}, ...)``;
-        ``None`` for the current state (:meth:`mcfbench.running.flow.Flow.system`)."""
+        ``None`` for the current state (:meth:`mcfbench.running.flow.SchemeFlow.system`)."""
         return None, None, tau
 
     def initial_guess(self, X, past, at):
@@ -188,7 +188,7 @@ class Euler:
 
         Parameters
         ----------
-        flow : mcfbench.running.flow.Flow
+        flow : mcfbench.running.flow.SchemeFlow
         solve : callable
             ``solve(A, b, x0) -> (x, info)``; when it raises, the flow
             stays at ``n``.

@@ -26,6 +26,7 @@ from mcfbench.running.driver import simulate
 from mcfbench.running.problems import get_problem
 from mcfbench.running.schemes import get_scheme
 from mcfbench.running.solver import Solver
+from mcfbench.storage.frames import surface_points
 from mcfbench.storage.records import RunResult
 
 
@@ -419,8 +420,8 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
         result, traj = run(scheme, problem, level, tau=tau, t_final=t_final, solver=solver,
                            integrator=integrator, **options)
         X = np.concatenate([traj.frames[k][-1] for k in traj.frames]).T
-        vertices = traj.frames["F" if "F" in traj.frames else "V"][-1]   # the mesh's
-        return result, X, volume(vertices, traj.faces)
+        vertices, _ = surface_points(traj.frames)
+        return result, X, volume(vertices[-1], traj.faces)
 
     ref_result, ref, ref_volume = final(min(taus) / reference_factor)
     if ref_result.status != "ok":

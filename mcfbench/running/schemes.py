@@ -2,7 +2,7 @@
 
 One entry per scheme; the command line, the studies, the pipeline, the
 tables, the figures and the report all look schemes up here, so a new
-scheme is one module (a class following :class:`mcfbench.running.flow.Flow`) plus
+scheme is one module (a class following :class:`mcfbench.running.flow.SchemeFlow`) plus
 one entry of :data:`SCHEMES`. The flow class is named as
 ``"module:Class"`` and imported on first use.
 
@@ -45,7 +45,7 @@ class Scheme:
     label : str
         Name in tables, legends and the report.
     flow : str
-        ``"module:Class"`` of its :class:`mcfbench.running.flow.Flow` class.
+        ``"module:Class"`` of its :class:`mcfbench.running.flow.SchemeFlow` class.
     options : dict
         Keyword options of the class that make up this entry.
     style : dict

@@ -10,7 +10,8 @@ Keys (every study's frames file, the ``run`` command's ``--out``):
 * anything else the writer adds (the ``run`` command: status, provenance).
 
 A run whose mesh was refused before any frame (the gallery) has empty
-``faces``, ``steps`` and ``t`` and no vertices. :func:`save_frames` writes
+``faces``, ``steps`` and ``t`` and no vertices. :func:`surface_points` reads
+the points of any run's frames alike. :func:`save_frames` writes
 (atomically, :func:`mcfbench.storage.atomic.save_npz`), :func:`load_frames`
 reads; both check the layout.
 """
@@ -40,6 +41,15 @@ def check_frames(arrays, path):
     if missing or (len(arrays["t"]) and not ("V" in arrays or "F" in arrays)):
         raise ValueError(f"{path}: not a run's frames file: it has {sorted(arrays)}, expected "
                          f"faces, steps, t and V (or F and T)")
+
+
+def surface_points(frames):
+    """``(vertices, extra)`` of a run's frames (a frames file's arrays, or the
+    trajectory's): the surface mesh's vertices (frames, n, 3), a DDFV run's
+    F-vertices, and the extra points (frames, k, 3), DDFV's T-vertices, or None.
+    ``vertices`` is None when the run kept no frame. What reads a frame takes its
+    points from here, whatever the scheme."""
+    return frames.get("F", frames.get("V")), frames.get("T")
 
 
 def save_frames(path, frames):

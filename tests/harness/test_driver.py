@@ -9,12 +9,12 @@ import pytest
 import scipy.sparse as sp
 
 from mcfbench.running.driver import simulate
-from mcfbench.running.flow import Flow
+from mcfbench.running.flow import SchemeFlow
 from mcfbench.running.solver import Solver
 
 
 class Decay:
-    """A minimal :class:`mcfbench.running.flow.Flow`: implicit Euler for x' = -x."""
+    """A minimal :class:`mcfbench.running.flow.SchemeFlow`: implicit Euler for x' = -x."""
 
     def __init__(self, vertices, faces, tau, *, defect_at=None, status="t_escaped"):
         self.tau, self.n = float(tau), 0
@@ -49,7 +49,7 @@ FACES = np.array([[0, 1, 2], [0, 2, 3]])
 
 
 def test_decay_follows_the_contract():
-    assert isinstance(Decay(V0, FACES, 0.1), Flow)
+    assert isinstance(Decay(V0, FACES, 0.1), SchemeFlow)
 
 
 def test_states_and_frames_are_exact():

@@ -12,7 +12,7 @@ from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.shapes import cylinder
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate
-from mcfbench.running.flow import Flow
+from mcfbench.running.flow import SchemeFlow
 from mcfbench.running.integrators import (BDF2, BDF3, INTEGRATORS, Euler, bdf_formula,
                                           get_integrator)
 from mcfbench.running.run import time_convergence
@@ -65,7 +65,7 @@ def radius_error(integrator, tau, t_final=0.1):
 def test_each_integrator_has_its_order_on_the_toy_scheme(integrator):
     """Against the exact radius: EOC 1 (Euler), 2 (BDF2, first step Euler) and 3 (BDF3,
     extrapolated Euler and BDF2 to start; measured 2.97-3.00)."""
-    assert isinstance(ShrinkingPoints(*icosphere(1), 0.1), Flow)
+    assert isinstance(ShrinkingPoints(*icosphere(1), 0.1), SchemeFlow)
     errors = np.array([radius_error(integrator, 0.1 / 2 ** k) for k in range(3, 8)])
     low, high = ORDER[integrator]
     orders = eoc(errors)[1:]

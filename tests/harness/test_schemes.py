@@ -5,7 +5,7 @@ import pytest
 
 from mcfbench.geometry.spheres import icosphere, random_bumpy_sphere
 from mcfbench.running.driver import simulate
-from mcfbench.running.flow import Flow
+from mcfbench.running.flow import SchemeFlow
 from mcfbench.running.integrators import Euler
 from mcfbench.running.schemes import SCHEMES, get_scheme
 
@@ -15,7 +15,7 @@ def test_every_scheme_follows_the_contract_and_runs(name):
     scheme = get_scheme(name)
     V, F = random_bumpy_sphere(2)
     flow = scheme.make(V, F, 0.001)
-    assert isinstance(flow, Flow)
+    assert isinstance(flow, SchemeFlow)
     assert flow.n == 0 and flow.tau == 0.001 and flow.defects() == []
     assert flow.X.shape[0] == 3 and not flow.X.flags.writeable
     assert flow.vertices.shape == V.shape and np.array_equal(flow.faces, F)

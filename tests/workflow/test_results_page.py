@@ -20,8 +20,8 @@ import pytest
 
 from mcfbench.presentation.documents import external_references
 from mcfbench.storage.frames import load_frames
-from mcfbench.studies.matrix.page import PAGE_FIGURES, problem_runs, write_matrix_page
-from mcfbench.studies.matrix.tables import read_long_table, read_summary
+from mcfbench.studies.matrix.page import PAGE_FIGURES, write_matrix_page
+from mcfbench.studies.matrix.tables import main_runs, read_long_table, read_summary
 
 pytestmark = pytest.mark.e2e
 
@@ -73,8 +73,8 @@ def page(tmp_path_factory):
     for path, s in runs.items():
         matrix_job.job(s, path, matrix_plan.frames_path(s["problem"], s["scheme"], s["level"], str(root)))
     table, _ = matrix_aggregate.aggregate(runs, plan, root / "tables")
-    matrix_findings.findings(root / "tables" / "summary.csv", root / "findings.md", plan,
-                             root / "tables" / "matrix.csv")
+    matrix_findings.findings(root / "tables" / "summary.csv", root / "tables" / "matrix.csv",
+                             root / "findings.md", plan)
     problems, schemes, figures = list(plan["problems"]), plan["schemes"], root / "figures"
     error_figure(table, [figures / "errors.png"], problems, schemes)
     work_precision_figure(table, [figures / "work_precision.png"], problems, schemes)
@@ -144,7 +144,7 @@ def _frames(root):
     table = read_long_table(root / "tables" / "matrix.csv")
     frames = {"summary": read_summary(root / "tables" / "summary.csv")}
     for problem in dict.fromkeys(table["problem"]):
-        frames[f"runs-{problem}"] = problem_runs(table, problem)[0]
+        frames[f"runs-{problem}"] = main_runs(table, problem)[0]
     return frames
 
 

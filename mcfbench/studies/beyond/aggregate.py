@@ -25,7 +25,7 @@ def aggregate(expected, inputs, plan, settings, paper, outputs, log):
         ``space_convergence``, and ``t_monitor`` (the T monitor at every time
         level), ``provenance`` -> path.
     """
-    from mcfbench.presentation.formats import csv_text
+    from mcfbench.presentation.tables import csv
     from mcfbench.storage.atomic import json_text, write_files
     from mcfbench.storage.provenance import sidecar
     from mcfbench.storage.records import read_records
@@ -36,7 +36,7 @@ def aggregate(expected, inputs, plan, settings, paper, outputs, log):
     docs = beyond_documents(tables, plan, settings, paper)
     texts = {str(outputs[f"{name}_{ext}"]): text
              for name, doc in docs.items() for ext, text in doc.items()}
-    texts[str(outputs["t_monitor"])] = csv_text(series)
+    texts[str(outputs["t_monitor"])] = csv(series)
     provenance = sidecar({"rule": "beyond_tables", "beyond": plan, **settings}, records, texts)
     write_files({**texts, str(outputs["provenance"]): json_text(provenance)})
     log.info("wrote %d files\n%s\n%s", len(texts) + 1, docs["levels"]["md"],

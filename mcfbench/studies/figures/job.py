@@ -25,6 +25,7 @@ from mcfbench.running.problems import Problem
 from mcfbench.running.run import framed_run
 from mcfbench.running.schemes import get_scheme
 from mcfbench.running.solver import Solver
+from mcfbench.storage.frames import surface_points
 from mcfbench.storage.records import RunResult
 from mcfbench.studies.figures.experiments import EXPERIMENTS, Run, validate
 
@@ -43,12 +44,12 @@ class FigureRun:
     @property
     def F(self):
         """(frames, n_f, 3): the F-vertices (DDFV) or the vertices."""
-        return self.frames["F"] if "F" in self.frames else self.frames["V"]
+        return surface_points(self.frames)[0]
 
     @property
     def T(self):
         """(frames, n_t, 3) T-vertices; None for the vertex schemes."""
-        return self.frames.get("T")
+        return surface_points(self.frames)[1]
 
     @property
     def steps(self):
@@ -276,6 +277,7 @@ def job(name, outputs, log):
     from mcfbench.geometry.quality import COLUMNS
     from mcfbench.presentation.quality_plots import plot_quality
     from mcfbench.presentation.render import DPI, rasterize_meshes
+    from mcfbench.presentation.tables import csv
     from mcfbench.storage.atomic import json_text, write_files
     from mcfbench.storage.frames import save_frames
     from mcfbench.storage.provenance import provenance
@@ -307,7 +309,7 @@ def job(name, outputs, log):
     }
     for key, r in results.items():
         save_frames(frames_file(outputs["frames"], key), r.frames)
-    write_files({outputs["csv"]: table[["run", *COLUMNS]].to_csv(index=False),
+    write_files({outputs["csv"]: csv(table[["run", *COLUMNS]]),
                  outputs["plot"]: (plot, {"dpi": DPI}), outputs["png"]: (figure, {"dpi": DPI}),
                  outputs["pdf"]: (figure, {"dpi": 2 * DPI}),
                  outputs["record"]: json_text(record)})

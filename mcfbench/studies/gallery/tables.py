@@ -2,7 +2,8 @@
 
 import numpy as np
 
-from mcfbench.studies.matrix.tables import TIMING_BASE, format_or_missing, markdown
+from mcfbench.presentation.tables import Table, markdown
+from mcfbench.studies.matrix.tables import TIMING_BASE, format_or_missing
 
 
 GALLERY_COLUMNS = ["mesh", "scheme", "status", "steps_done", "steps", "t_failed", "min_angle",
@@ -41,4 +42,4 @@ def gallery_markdown(table, plan):
              "Min angle and flipped triangles: worst over the sampled time levels; "
              "T monitor: smallest barycentric coordinate of a T-vertex (DDFV only).",
              TIMING_BASE]
-    return "# Gallery\n\n" + markdown(view, notes)
+    return f"# Gallery\n\n{markdown(Table.of_frame(view, notes=notes))}\n"

@@ -3,18 +3,18 @@ table), one table per problem and the summary (:mod:`mcfbench.studies.matrix.tab
 
 from pathlib import Path
 
+from mcfbench.presentation.formats import tex_escape
+from mcfbench.presentation.tables import Table, csv, latex, markdown
 from mcfbench.storage.records import read_records
 from mcfbench.studies.matrix.plan import solver_method
 from mcfbench.studies.matrix.tables import (
+    FLOAT_FORMAT,
     TIMING_NOTE,
-    latex,
     long_table,
-    markdown,
     problem_table,
     summary_table,
     summary_views,
 )
-
 
 def problem_notes(problem, plan=None):
     """Lines under a problem's table: what it is, the exact answer, the solver."""
@@ -29,6 +29,16 @@ def problem_notes(problem, plan=None):
     return notes
 
 
+def documents(frame, title, caption, notes):
+    """A view of the matrix (cells already text) as ``(Markdown, LaTeX)``: the
+    Markdown under the heading ``title``, the LaTeX with ``caption`` under the
+    table, the notes below both; text escaped as plain text."""
+    table = Table.of_frame(frame, caption=caption, notes=notes)
+    return (f"# {title}\n\n{markdown(table)}\n",
+            latex(table, head=tex_escape, cell=tex_escape, text=tex_escape,
+                  caption_below=True) + "\n")
+
+
 def write_tables(table, out_dir, plan):
     """Write ``matrix.csv``, ``{problem}.md/.tex`` and ``summary.md/.tex/.csv``."""
     from mcfbench.running.schemes import scheme_label
@@ -37,24 +47,26 @@ def write_tables(table, out_dir, plan):
     out = Path(out_dir)
     labels = {s: scheme_label(s) for s in plan["schemes"]}
     problems = [p for p in plan["problems"] if p in set(table["problem"])]
-    write_text(out / "matrix.csv", table.to_csv(index=False, float_format="%.10g"))
+    write_text(out / "matrix.csv", csv(table, FLOAT_FORMAT))
     for problem in problems:
         frame, metric = problem_table(table, problem, plan["schemes"], labels)
         notes = [f"Main metric: `{metric}` per level (value, or the status of a run that "
                  f"did not finish); EOC (3.1) between consecutive levels."] + \
             problem_notes(problem, plan) + [TIMING_NOTE]
-        write_text(out / f"{problem}.md", f"# Matrix: {problem}\n\n" + markdown(frame, notes))
-        write_text(out / f"{problem}.tex",
-                   latex(frame, f"Benchmark matrix, problem {problem}", notes))
+        md, tex = documents(frame, f"Matrix: {problem}", f"Benchmark matrix, problem {problem}",
+                            notes)
+        write_text(out / f"{problem}.md", md)
+        write_text(out / f"{problem}.tex", tex)
     summary = summary_table(table, problems, plan["schemes"])
-    write_text(out / "summary.csv", summary.to_csv(index=False, float_format="%.10g"))
-    wide = summary_views(summary, problems, plan["schemes"], labels)
+    write_text(out / "summary.csv", csv(summary, FLOAT_FORMAT))
+    wide = summary_views(summary, table, problems, plan["schemes"], labels)
     notes = ["Each cell: the EOC (3.1) between the two finest finished levels and the "
              "finest finished level's value of the problem's main metric (in brackets "
              "after the problem), or the status and breakdown time of the coarsest run "
              "that did not finish.", TIMING_NOTE]
-    write_text(out / "summary.md", "# Matrix summary\n\n" + markdown(wide, notes))
-    write_text(out / "summary.tex", latex(wide, "Benchmark matrix: summary", notes))
+    md, tex = documents(wide, "Matrix summary", "Benchmark matrix: summary", notes)
+    write_text(out / "summary.md", md)
+    write_text(out / "summary.tex", tex)
     return summary
 
 

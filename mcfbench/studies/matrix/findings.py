@@ -1,6 +1,6 @@
-"""The findings of the benchmark matrix in words, from its summary table only: which scheme
-converges at which order on which problem, which breaks down where, and the
-recommendation.
+"""The findings of the benchmark matrix in words, from its tables only (the summary and
+the long table, whose rows give each level's value): which scheme converges at which
+order on which problem, which breaks down where, and the recommendation.
 
 A verdict is the scheme's, not its linear solver's: a run that ended with a
 ``solver_*`` status and that the robust solver (``direct``) finished when run
@@ -14,11 +14,14 @@ import numpy as np
 
 from mcfbench.studies.matrix import mesh_problems
 from mcfbench.studies.matrix.tables import (
+    format_or_missing,
     levels_text,
     is_error,
-    main_metric,
+    main_runs,
     read_long_table,
     read_summary,
+    summary_table,
+    with_levels,
 )
 
 ORDER_BAND = (1.7, 2.3)
@@ -61,7 +64,7 @@ def _classify(row):
     ``not_converging``, ``one_level``, ``exact`` (round-off), ``broke_down`` or
     ``no_error``. A row whose runs broke down but whose error was
     measured on every level before (the volume before a pinch) is judged by it."""
-    values = [abs(float(v)) for v in str(row["values"]).split(";") if v]
+    values = [abs(v) for v in row["values"] if not np.isnan(v)]
     measured = row["error"] and sum(np.isfinite(v) for v in values) == row["runs"]
     if row["runs_ok"] < row["runs"] and not measured:
         return "broke_down"
@@ -97,9 +100,8 @@ def cheapest_to_reach(table):
     """
     rows = []
     for problem in dict.fromkeys(table["problem"]):
-        part = table[table["problem"] == problem]
-        metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
-        runs = part[(part["metric"] == metric) & np.isfinite(part["value"])]
+        runs, metric = main_runs(table, problem)
+        runs = runs[np.isfinite(runs["value"])]
         if not is_error(metric) or runs.empty:
             continue
         runs = runs.assign(error=np.abs(runs["value"]))
@@ -138,32 +140,31 @@ def work_precision_section(rows):
 
 
 def _where(failed):
-    """``"level 3: solver_failed at t = 0.03; ..."`` from ``"3:solver_failed:0.03;..."``."""
-    return "; ".join(f"level {lv}: {st}" + (f" at t = {float(t):.4g}" if t else "")
-                     for lv, st, t in (f.split(":") for f in str(failed).split(";") if f))
+    """``"level 3: solver_failed at t = 0.03; ..."`` from ``[(3, "solver_failed", 0.03), ...]``."""
+    return "; ".join(f"level {lv}: {st}" + (f" at t = {t:.4g}" if not np.isnan(t) else "")
+                     for lv, st, t in failed)
 
 
 def scheme_view(summary):
     """The summary with the robust solver's re-runs in place of the runs whose failure
     they remove, and a ``solver_note`` column saying so.
 
-    A row whose every failure is such a solver failure becomes a finished row
-    (``runs_ok``, ``eoc``, ``values``, ``finest_*`` from the ``robust_*``
-    columns of :func:`mcfbench.studies.matrix.tables.summary_table`,
-    ``status`` ``ok``); a row with other failures keeps them and only gets the
-    note. Summaries written before the re-runs existed are returned unchanged
-    (empty notes).
+    A row (of :func:`mcfbench.studies.matrix.tables.with_levels`) whose every
+    failure is such a solver failure becomes a finished row (``runs_ok``,
+    ``eoc``, ``values``, ``finest_*`` from the ``robust_*`` columns of
+    :func:`mcfbench.studies.matrix.tables.summary_table`, ``status`` ``ok``); a
+    row with other failures keeps them and only gets the note.
     """
     summary = summary.copy()
     notes = []
     for i, r in summary.iterrows():
-        fixed = str(r.get("solver_only", "") or "")
+        fixed = r["solver_only"]
         if not fixed:
             notes.append("")
             continue
         notes.append(f"A solver verdict, not a scheme verdict: the matrix's solver failed "
                      f"({_where(fixed)}) and the robust solver (direct) finished "
-                     f"{'that run' if ';' not in fixed else 'those runs'} when run again.")
+                     f"{'that run' if len(fixed) == 1 else 'those runs'} when run again.")
         if r["runs_robust_ok"] == r["runs"]:
             for column in ("eoc", "eoc_levels", "finest_level", "finest_value", "values"):
                 summary.at[i, column] = r[f"robust_{column}"]
@@ -171,7 +172,7 @@ def scheme_view(summary):
             summary.at[i, "status"] = "ok"
     summary["solver_note"] = notes
     for i, r in summary.iterrows():
-        failed = str(r.get("robust_failed", "") or "")
+        failed = r["robust_failed"]
         if failed:
             summary.at[i, "solver_note"] = (
                 r["solver_note"] + " " if r["solver_note"] else "") + (
@@ -217,14 +218,18 @@ def scope_lines(plan, all_schemes, all_problems, labels=None):
                           + ", ".join(named) + ".", ""] if named else [])
 
 
-def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summary.csv",
-                    work_precision=(), scope=()):
-    """The findings, Markdown, written from the summary table only.
+def matrix_findings(table, summary=None, labels=None, mesh_problems=(),
+                    source="tables/summary.csv", work_precision=(), scope=()):
+    """The findings, Markdown, written from the tables only.
 
     Parameters
     ----------
-    summary : pandas.DataFrame
-        :func:`summary_table` (or ``summary.csv`` read back).
+    table : pandas.DataFrame
+        The long table (:func:`mcfbench.studies.matrix.tables.long_table`, or
+        ``matrix.csv`` read back): each level's value of the main metric.
+    summary : pandas.DataFrame, optional
+        Its summary (``summary.csv`` read back; default: :func:`summary_table` of
+        ``table``).
     labels : dict, optional
         Scheme name -> label.
     mesh_problems : sequence of str
@@ -234,7 +239,8 @@ def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summa
     scope : list of str
         :func:`scope_lines` (after the introduction).
     """
-    summary = scheme_view(summary)
+    summary = scheme_view(with_levels(summary_table(table) if summary is None else summary,
+                                      table))
     problems = list(dict.fromkeys(summary["problem"]))
     schemes = list(dict.fromkeys(summary["scheme"]))
     lines = ["# Findings of the benchmark matrix", "",
@@ -260,9 +266,9 @@ def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summa
         for _, r in part.iterrows():
             verdict[(problem, r["scheme"])] = r
             name = f"**{r['scheme']}**"
-            values = [float(v) if v else float("nan") for v in str(r["values"]).split(";")]
+            values = list(r["values"])
             shown = ", ".join(_number(v) if np.isfinite(v) else "–" for v in values)
-            eocs = str(r["eocs"]) if isinstance(r["eocs"], str) else ""
+            eocs = ", ".join(format_or_missing(v, ".2f", "") for v in r["eocs"])
             if r["class"] == "order2":
                 two = " from two levels only" if sum(np.isfinite(values)) == 2 else ""
                 text = (f"{name} converges at order ~2{two}: EOC {r['eoc']:.2f} (levels "
@@ -276,7 +282,7 @@ def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summa
                         f"from two levels only, the order is not settled; errors {shown}.")
             elif r["class"] == "not_converging":
                 text = (f"{name} does not converge: the error is not decreasing (EOCs "
-                        f"{eocs.replace(';', ', ') or '–'}; errors {shown})")
+                        f"{eocs or '–'}; errors {shown})")
                 ratio = abs(r["finest_value"]) / smallest if smallest > 0 else \
                     np.inf if smallest == 0 else np.nan   # nan: no scheme finished
                 if ratio >= WRONG_LIMIT:
@@ -293,11 +299,8 @@ def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summa
                 text = (f"{name} finished every level; {metric} at the finest level "
                         f"{r['finest_value']:.4g}.")
             else:
-                fails = [f.split(":") for f in str(r["failed"]).split(";") if f]
-                where = "; ".join(f"level {lv}: {st}" + (f" at t = {float(t):.4g}" if t else "")
-                                  for lv, st, t in fails)
                 text = (f"{name} broke down in {r['runs'] - r['runs_ok']} of {r['runs']} runs "
-                        f"({where}).")
+                        f"({_where(r['failed'])}).")
                 if np.isfinite(r["finest_value"]):
                     text += (f" Finished levels: {metric} {shown}"
                              + (f", EOC {r['eoc']:.2f}" if np.isfinite(r["eoc"]) else "") + ".")
@@ -312,8 +315,7 @@ def matrix_findings(summary, labels=None, mesh_problems=(), source="tables/summa
         lines += work_precision_section(work_precision)
     lines += real_mesh_section(summary, verdict, problems, schemes)
     lines += recommendation(summary, verdict, problems, schemes, mesh_problems)
-    solver = summary[summary["solver_only"] != ""] if "solver_only" in summary \
-        else summary.iloc[:0]
+    solver = summary[[bool(fixed) for fixed in summary["solver_only"]]]
     if len(solver):
         lines += ["## Solver verdicts", "",
                   "Runs whose failure the robust solver removes: the failure belongs to "
@@ -517,18 +519,18 @@ def _order_caveat(scheme, exact, cls, verdict, needs_order2):
     return (" It does not show order ~2 everywhere: " + "; ".join(notes) + ".") if notes else ""
 
 
-def findings(summary_csv, out, plan, long_csv=None):
-    """``findings.md`` from ``summary.csv`` and, for the cost of accuracy, the long
-    table ``matrix.csv`` (numbers from the tables only)."""
+def findings(summary_csv, long_csv, out, plan):
+    """``findings.md`` from ``summary.csv`` and the long table ``matrix.csv`` (each
+    level's value, the cost of accuracy): numbers from the tables only."""
     from mcfbench.running.problems import PROBLEMS
     from mcfbench.running.schemes import SCHEMES, scheme_label
     from mcfbench.storage.atomic import write_text
 
-    summary = read_summary(summary_csv)
+    table = read_long_table(long_csv)
     labels = {s: scheme_label(s) for s in plan["schemes"]}
-    costs = cheapest_to_reach(read_long_table(long_csv)) if long_csv else ()
-    text = matrix_findings(summary, labels, mesh_problems(plan),
-                           source=Path(summary_csv).as_posix(), work_precision=costs,
+    text = matrix_findings(table, read_summary(summary_csv), labels, mesh_problems(plan),
+                           source=Path(summary_csv).as_posix(),
+                           work_precision=cheapest_to_reach(table),
                            scope=scope_lines(plan, list(SCHEMES), list(PROBLEMS), labels))
     write_text(out, text)
     return text

@@ -14,7 +14,6 @@ no CDN, no font, no script but the page's own.
 """
 
 import html as _html
-import math
 import re
 from pathlib import Path
 
@@ -28,10 +27,11 @@ from mcfbench.presentation.documents import (
     external_references,
     unlink_files,
 )
-from mcfbench.presentation.formats import MISSING, sci, sig
+from mcfbench.presentation.formats import sci, sig
+from mcfbench.presentation.tables import Table, html
 from mcfbench.studies.matrix.tables import (
     is_error,
-    main_metric,
+    main_runs,
     read_long_table,
     read_summary,
     TIMING_NOTE,
@@ -84,51 +84,11 @@ def print_width(png):
         return round(image.width * 96.0 / dpi)
 
 
-def problem_runs(table, problem):
-    """The runs of ``problem`` on its main metric: the rows of the long table
-    (``matrix.csv``) in its order, index reset, and the metric's name."""
-    part = table[table["problem"] == problem]
-    metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
-    return part[part["metric"] == metric].reset_index(drop=True), metric
-
-
-def sort_key(value):
-    """The ``data-sort`` of a cell: a number in its shortest round-trip form
-    (``Infinity`` for inf, JavaScript's spelling), ``""`` for NaN or None, text as is."""
-    if value is None:
-        return ""
-    if isinstance(value, bool):
-        return str(value)
-    if isinstance(value, (int, float)) or hasattr(value, "dtype"):
-        value = float(value)
-        if math.isnan(value):
-            return ""
-        if math.isinf(value):
-            return "Infinity" if value > 0 else "-Infinity"
-        return str(int(value)) if value.is_integer() and abs(value) < 2 ** 53 else repr(value)
-    return str(value)
-
-
 def html_table(frame, columns, table_id, caption=""):
-    """A sortable table for the template: ``{"id", "caption", "header", "rows"}``;
-    header cells ``{"column", "text", "numeric"}``, row cells ``{"text", "key"}``."""
-    import pandas as pd
-
-    present = [c for c in columns if c[0] in frame.columns]
-    header = [{"column": name, "text": text,
-               "numeric": bool(pd.api.types.is_numeric_dtype(frame[name]))
-               and not pd.api.types.is_bool_dtype(frame[name])}
-              for name, text, _ in present]
-    rows = []
-    for record in frame.to_dict("records"):
-        cells = []
-        for name, _, fmt in present:
-            value = record[name]
-            key = sort_key(value)
-            text = fmt(value) if fmt else (MISSING if key == "" else str(value))
-            cells.append({"text": text, "key": key})
-        rows.append(cells)
-    return {"id": table_id, "caption": caption, "header": header, "rows": rows}
+    """The ``columns`` (``(name, header, format)``) of ``frame`` as a sortable HTML
+    table (:func:`mcfbench.presentation.tables.html`), ``data-column`` the names."""
+    table = Table.of_frame(frame, columns, caption=caption)
+    return html(table, table_id, [name for name, _, _ in columns if name in frame.columns])
 
 
 def findings_html(text, base, shift=2):
@@ -144,7 +104,7 @@ def findings_html(text, base, shift=2):
 def _problem_section(table, problem):
     from mcfbench.running.problems import PROBLEMS
 
-    runs, metric = problem_runs(table, problem)
+    runs, metric = main_runs(table, problem)
     p = PROBLEMS.get(problem)
     notes = [f"Main metric: <code>{_html.escape(metric)}</code>"
              + (" (an error: EOC (3.1) between consecutive levels)." if is_error(metric)
@@ -153,10 +113,9 @@ def _problem_section(table, problem):
         notes.append(_html.escape(f"{p.label}. {p.description}".strip()))
         if getattr(p, "exact", None):
             notes.append(_html.escape(f"Exact answer: {p.exact}."))
-    section = html_table(runs, RUN_COLUMNS, f"runs-{problem}",
-                         f"{problem}: every run, value of {metric}")
-    section.update(problem=problem, metric=metric, notes=notes)
-    return section
+    return {"problem": problem, "metric": metric, "notes": notes,
+            "table": html_table(runs, RUN_COLUMNS, f"runs-{problem}",
+                                f"{problem}: every run, value of {metric}")}
 
 
 def matrix_page(matrix_dir, plan=None, title="Benchmark matrix: results"):

@@ -22,7 +22,7 @@ from mcfbench.presentation.picture_grid import draw_grid, frame_surface, run_not
 from mcfbench.presentation.plots import SMALLEST_TEXT  # noqa: E402
 from mcfbench.presentation.plots import style as scheme_style  # noqa: E402
 from mcfbench.storage.atomic import save_figure  # noqa: E402
-from mcfbench.studies.matrix.tables import is_error, main_metric  # noqa: E402
+from mcfbench.studies.matrix.tables import is_error, main_runs  # noqa: E402
 
 T_FLOOR = -0.5
 """Lower limit of the T monitor axes (values below are clipped and noted)."""
@@ -74,9 +74,7 @@ def error_figure(table, paths, problems=None, schemes=None):
     rows_ = int(np.ceil(len(problems) / PER_ROW))
     fig, axes = _grid(len(problems), rows=rows_)
     for problem, ax in zip(problems, axes.ravel()):
-        part = table[table["problem"] == problem]
-        metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
-        runs = part[part["metric"] == metric]
+        runs, metric = main_runs(table, problem)
         error = is_error(metric)
         points, broke, exact = [], [], []
         for scheme in schemes:
@@ -153,10 +151,9 @@ def work_precision_figure(table, paths, problems=None, schemes=None):
     schemes = schemes or list(dict.fromkeys(table["scheme"]))
     shown = []
     for problem in problems:
-        part = table[table["problem"] == problem]
-        metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
+        runs, metric = main_runs(table, problem)
         if is_error(metric):
-            shown.append((problem, metric, part[part["metric"] == metric]))
+            shown.append((problem, metric, runs))
     rows_ = max(1, int(np.ceil(len(shown) / PER_ROW)))
     fig, axes = _grid(max(1, len(shown)), rows=rows_)
     drawn = {}

@@ -1,4 +1,4 @@
-"""The tables of the benchmark matrix: the long table (one row per run and metric, EOC (3.1) of every error), the table of one problem, the summary (problem x scheme), their Markdown and LaTeX, and the gallery's table.
+"""The tables of the benchmark matrix: the long table (one row per run and metric, EOC (3.1) of every error), the table of one problem, the summary (problem x scheme) and its cells (written by :mod:`mcfbench.presentation.tables`).
 
 Errors and EOC
 --------------
@@ -30,6 +30,10 @@ TIMING_NOTE = TIMING_BASE[:-1] + (
 )
 
 
+FLOAT_FORMAT = "%.10g"
+"""The floats of the matrix's and the gallery's CSV tables: ten significant digits."""
+
+
 # metric observer (Problem.metrics) -> preferred main metrics, best first
 MAIN_METRICS = {
     "sphere_l2": ("l2_error",),
@@ -50,12 +54,15 @@ ZERO_METRICS = ("max_height", "l2_height", "max_displacement")
 
 # modules that do not change what a run computes (left out of the code digest)
 LONG_COLUMNS = ["scheme", "problem", "level", "h", "tau", "steps", "steps_done", "metric",
-                "value", "eoc", "status", "t_failed", "min_angle", "max_flipped",
+                "main", "value", "eoc", "status", "t_failed", "min_angle", "max_flipped",
                 "t_min_barycentric", "iterations", "cpu_seconds", "robust_status",
                 "robust_value", "robust_t_failed"]
-"""Columns of the long table. ``robust_*``: the re-run of a run that ended with a
-``solver_*`` status with the robust solver (:func:`mcfbench.studies.matrix.job`;
-``robust_status`` empty without a re-run)."""
+"""Columns of the long table. ``main``: the metric is its problem's main metric
+(:func:`main_metric`, decided here once: the summary, the problem tables, the
+plots, the page and the findings take these rows, :func:`main_runs`).
+``robust_*``: the re-run of a run that ended with a ``solver_*`` status with
+the robust solver (:func:`mcfbench.studies.matrix.job`; ``robust_status`` empty
+without a re-run)."""
 
 
 def is_error(metric):
@@ -113,6 +120,7 @@ def long_table(records, schemes=None, problems=None):
     for r in records:
         names = by_problem.setdefault(r["problem"], [])
         names.extend(m for m in _metric_names(r) if m not in names)
+    main = {problem: main_metric(problem, names) for problem, names in by_problem.items()}
     rows = []
     for r in records:
         for metric in by_problem[r["problem"]] or [""]:
@@ -121,7 +129,7 @@ def long_table(records, schemes=None, problems=None):
                 "scheme": r["scheme"], "problem": r["problem"], "level": int(r["level"]),
                 "h": r["h"], "tau": r["tau"], "steps": int(r["N"]),
                 "steps_done": int(r["steps_done"]), "metric": metric,
-                "value": float("nan") if value is None else float(value), "eoc": float("nan"),
+                "main": metric == main[r["problem"]], "value": float("nan") if value is None else float(value), "eoc": float("nan"),
                 "status": r["status"], "t_failed": r["t_failed"], "min_angle": r["min_angle"],
                 "max_flipped": r["max_flipped"], "t_min_barycentric": r["t_min_barycentric"],
                 "iterations": int(r["iterations"]), "cpu_seconds": r["cpu_seconds"],
@@ -143,6 +151,13 @@ def _robust(record, metric):
     return {"robust_status": record.get("robust_status") or "",
             "robust_value": float("nan") if value is None else float(value),
             "robust_t_failed": float("nan") if t_failed is None else float(t_failed)}
+
+
+def main_runs(table, problem):
+    """The rows of ``problem``'s main metric (``main``) of the long table, in its
+    order, index reset, and the metric's name (``""`` if the problem has no rows)."""
+    runs = table[(table["problem"] == problem) & table["main"]].reset_index(drop=True)
+    return runs, (runs["metric"].iloc[0] if len(runs) else "")
 
 
 def solver_only(row):
@@ -211,14 +226,12 @@ def summary_table(table, problems=None, schemes=None):
         eoc, eoc_levels, finest_level, finest_value, eocs, values, status,
         failed_level, t_failed, min_angle, t_min_barycentric,
         cpu_seconds`` (CPU of the finest finished level). ``status`` is
-        ``ok`` or that of the coarsest run that did not finish; ``eocs``
-        and ``values`` list every EOC and value by level (``;``-separated).
-        The scheme's own verdict, with the robust solver's re-run in place of
-        a run whose failure it removes (:func:`solver_only`): ``solver_only``
-        (those runs, ``level:status:t_failed``), ``robust_failed`` (the re-runs
-        that failed too, ``level:robust_status:robust_t_failed``), ``runs_robust_ok``,
-        ``robust_values``, ``robust_eoc``, ``robust_eoc_levels``,
-        ``robust_finest_level``, ``robust_finest_value``.
+        ``ok`` or that of the coarsest run that did not finish. The scheme's
+        own verdict, with the robust solver's re-run in place of a run whose
+        failure it removes (:func:`solver_only`): ``runs_robust_ok``,
+        ``robust_eoc``, ``robust_eoc_levels``, ``robust_finest_level``,
+        ``robust_finest_value``. One value a cell: the values by level stay in
+        the long table (:func:`with_levels`).
     """
     import pandas as pd
 
@@ -226,13 +239,9 @@ def summary_table(table, problems=None, schemes=None):
     schemes = schemes or list(dict.fromkeys(table["scheme"]))
     rows = []
     for problem in problems:
-        part = table[table["problem"] == problem]
-        if not len(part):
-            continue
-        metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
+        part, metric = main_runs(table, problem)
         for scheme in schemes:
-            runs = part[(part["scheme"] == scheme) & (part["metric"] == metric)] \
-                .sort_values("level")
+            runs = part[part["scheme"] == scheme].sort_values("level")
             if not len(runs):
                 continue
             ok = runs[runs["status"] == "ok"]
@@ -253,13 +262,9 @@ def summary_table(table, problems=None, schemes=None):
                 f"{int(last_eoc['level']) - 1}-{int(last_eoc['level'])}",
                 "finest_level": np.nan if finest is None else int(finest["level"]),
                 "finest_value": np.nan if finest is None else finest["value"],
-                "eocs": ";".join(format_or_missing(v, ".2f", "") for v in runs["eoc"].iloc[1:]),
-                "values": ";".join(format_or_missing(v, ".4e", "") for v in runs["value"]),
                 "status": "ok" if first_fail is None else first_fail["status"],
                 "failed_level": np.nan if first_fail is None else int(first_fail["level"]),
                 "t_failed": np.nan if first_fail is None else first_fail["t_failed"],
-                "failed": ";".join(f"{int(r.level)}:{r.status}:{format_or_missing(r.t_failed, '.6g', '')}"
-                                   for r in failed.itertuples()),
                 "min_angle": runs["min_angle"].min(),
                 "t_min_barycentric": runs["t_min_barycentric"].min(),
                 "cpu_seconds": np.nan if finest is None else finest["cpu_seconds"],
@@ -268,29 +273,30 @@ def summary_table(table, problems=None, schemes=None):
     return pd.DataFrame(rows)
 
 
+def _robust_values(runs):
+    """The values of ``runs`` (one scheme on one problem, its main metric, by level),
+    each run whose failure the robust solver removes (:func:`solver_only`) replaced by
+    its re-run, NaN for the other runs that did not finish."""
+    if not len(runs):
+        return np.array([])
+    fixed = [solver_only(r) for _, r in runs.iterrows()]
+    return np.where(fixed, runs["robust_value"],
+                    np.where(runs["status"] == "ok", runs["value"], np.nan))
+
+
 def _robust_summary(runs, metric):
     """The summary's ``robust_*`` columns of one scheme on one problem (its runs of the
     main metric, by level): each run whose failure the robust solver removes replaced
     by its re-run."""
-    fixed = runs[[solver_only(r) for _, r in runs.iterrows()]] if len(runs) else runs
-    values = np.where([solver_only(r) for _, r in runs.iterrows()], runs["robust_value"],
-                      np.where(runs["status"] == "ok", runs["value"], np.nan)) \
-        if len(runs) else np.array([])
+    values = _robust_values(runs)
+    fixed = sum(solver_only(r) for _, r in runs.iterrows())
     levels = runs["level"].to_numpy()
     eocs = eoc(values, levels=levels) if is_error(metric) and len(values) \
         else np.full(len(values), np.nan)
     finite = np.flatnonzero(np.isfinite(values))
     with_eoc = np.flatnonzero(np.isfinite(eocs))
-    rerun = runs[[r["robust_status"] not in ("", "ok") for _, r in runs.iterrows()]] \
-        if len(runs) else runs
     return {
-        "robust_failed": ";".join(f"{int(r.level)}:{r.robust_status}:"
-                                  f"{format_or_missing(r.robust_t_failed, '.6g', '')}"
-                                  for r in rerun.itertuples()),
-        "solver_only": ";".join(f"{int(r.level)}:{r.status}:{format_or_missing(r.t_failed, '.6g', '')}"
-                                for r in fixed.itertuples()),
-        "runs_robust_ok": int((runs["status"] == "ok").sum()) + len(fixed),
-        "robust_values": ";".join(format_or_missing(v, ".4e", "") for v in values),
+        "runs_robust_ok": int((runs["status"] == "ok").sum()) + fixed,
         "robust_eoc": eocs[with_eoc[-1]] if len(with_eoc) else np.nan,
         "robust_eoc_levels": f"{int(levels[with_eoc[-1]]) - 1}-{int(levels[with_eoc[-1]])}"
         if len(with_eoc) else "",
@@ -299,8 +305,44 @@ def _robust_summary(runs, metric):
     }
 
 
+LEVEL_LISTS = ("values", "eocs", "failed", "solver_only", "robust_failed", "robust_values")
+"""The columns :func:`with_levels` adds to the summary."""
+
+
+def with_levels(summary, table):
+    """``summary`` with the lists behind its cells, taken from the long table (the
+    tidy data: one row per run and metric) at the main metric, by level.
+
+    The columns :data:`LEVEL_LISTS`: ``values`` (every level's value, NaN where none
+    was measured), ``eocs`` (every level's EOC but the first's), ``failed`` (the runs
+    that did not finish, ``(level, status, t_failed)``), ``solver_only`` (those whose
+    failure the robust solver removes, :func:`solver_only`), ``robust_failed`` (the
+    re-runs that failed too, ``(level, robust_status, robust_t_failed)``) and
+    ``robust_values`` (the values with the robust re-runs in place).
+    """
+    import pandas as pd
+
+    lists = {name: [] for name in LEVEL_LISTS}
+    for problem, scheme in zip(summary["problem"], summary["scheme"]):
+        part, _ = main_runs(table, problem)
+        runs = part[part["scheme"] == scheme].sort_values("level")
+        rows = list(runs.itertuples())
+        lists["values"].append([float(v) for v in runs["value"]])
+        lists["eocs"].append([float(v) for v in runs["eoc"].iloc[1:]])
+        lists["failed"].append([(int(r.level), r.status, r.t_failed) for r in rows
+                                if r.status != "ok"])
+        lists["solver_only"].append([(int(r.level), r.status, r.t_failed) for r in rows
+                                     if solver_only(r._asdict())])
+        lists["robust_failed"].append([(int(r.level), r.robust_status, r.robust_t_failed)
+                                       for r in rows if r.robust_status not in ("", "ok")])
+        lists["robust_values"].append([float(v) for v in _robust_values(runs)])
+    return summary.assign(**{name: pd.Series(values, index=summary.index, dtype=object)
+                             for name, values in lists.items()})
+
+
 def summary_cell(row):
-    """One cell of the summary: ``"2.01 · 1.23e-03 (L4)"`` or the breakdown."""
+    """One cell of the summary (a row of :func:`with_levels`): ``"2.01 · 1.23e-03 (L4)"``
+    or the breakdown."""
     parts = []
     if row["error"] and np.isfinite(row["eoc"]):
         parts.append(f"EOC {row['eoc']:.2f}")
@@ -308,18 +350,19 @@ def summary_cell(row):
         parts.append(f"{row['finest_value']:.3e} (L{int(row['finest_level'])})")
     if row["status"] != "ok":
         parts.append(breakdown_text(row["status"], row["t_failed"], row["failed_level"]))
-        if row.get("solver_only", ""):
+        if row["solver_only"]:
             parts.append("the robust solver finishes " + (
                 "every level" if row["runs_robust_ok"] == row["runs"] else
-                "level(s) " + ", ".join(f.split(":")[0]
-                                        for f in str(row["solver_only"]).split(";"))))
+                "level(s) " + ", ".join(str(level) for level, _, _ in row["solver_only"])))
     return "; ".join(parts) or "–"
 
 
-def summary_views(summary, problems=None, schemes=None, labels=None):
-    """The summary as a wide frame (problem rows, scheme columns) of cells."""
+def summary_views(summary, table, problems=None, schemes=None, labels=None):
+    """The summary as a wide frame (problem rows, scheme columns) of cells; ``table``:
+    the long table it was made from."""
     import pandas as pd
 
+    summary = with_levels(summary, table)
     problems = problems or list(dict.fromkeys(summary["problem"]))
     schemes = schemes or list(dict.fromkeys(summary["scheme"]))
     labels = labels or {}
@@ -341,15 +384,13 @@ def problem_table(table, problem, schemes=None, labels=None):
     status, the mesh quality over all levels and the finest level's cost."""
     import pandas as pd
 
-    part = table[table["problem"] == problem]
-    metric = main_metric(problem, list(dict.fromkeys(part["metric"])))
+    part, metric = main_runs(table, problem)
     schemes = schemes or list(dict.fromkeys(part["scheme"]))
     labels = labels or {}
     levels = sorted(part["level"].unique())
     rows = []
     for scheme in schemes:
-        runs = part[(part["scheme"] == scheme) & (part["metric"] == metric)] \
-            .sort_values("level").set_index("level")
+        runs = part[part["scheme"] == scheme].sort_values("level").set_index("level")
         if not len(runs):
             continue
         row = {"scheme": labels.get(scheme, scheme)}
@@ -375,33 +416,7 @@ def problem_table(table, problem, schemes=None, labels=None):
     return pd.DataFrame(rows), metric
 
 
-def markdown(frame, notes=()):
-    """A pipe table (:func:`mcfbench.presentation.formats.md_table`), then ``notes`` as paragraphs."""
-    from mcfbench.presentation.formats import md_table
-
-    lines = [md_table(list(frame.columns), frame.itertuples(index=False))]
-    lines += [f"\n{note}" for note in notes]
-    return "\n".join(lines) + "\n"
-
-
-def latex(frame, caption="", notes=()):
-    """A ``table`` with a booktabs ``tabular`` (:func:`mcfbench.presentation.formats.tex_tabular`),
-    the notes below it."""
-    from mcfbench.presentation.formats import tex_escape, tex_tabular
-
-    lines = [r"\begin{table}[ht]",
-             tex_tabular([tex_escape(c) for c in frame.columns],
-                         [[tex_escape(v) for v in row] for row in frame.itertuples(index=False)],
-                         "l" + "r" * (len(frame.columns) - 1))]
-    if caption:
-        lines.append(r"\caption{" + tex_escape(caption) + "}")
-    lines += [r"\par\smallskip{\footnotesize " + tex_escape(note) + "}" for note in notes]
-    lines.append(r"\end{table}")
-    return "\n".join(lines) + "\n"
-
-
-SUMMARY_TEXT = ("levels", "eoc_levels", "eocs", "values", "failed", "metric", "status",
-                "solver_only", "robust_failed", "robust_values", "robust_eoc_levels")
+SUMMARY_TEXT = ("levels", "eoc_levels", "metric", "status", "robust_eoc_levels")
 
 
 def read_summary(path):
@@ -417,12 +432,13 @@ def read_summary(path):
 
 
 def read_long_table(path):
-    """``matrix.csv`` back (metric names as text)."""
+    """``matrix.csv`` back (metric names and statuses as text, empty as "")."""
     import pandas as pd
 
     table = pd.read_csv(path, dtype={"metric": str, "status": str, "scheme": str,
-                                     "problem": str})
-    table["metric"] = table["metric"].fillna("")
+                                     "problem": str, "robust_status": str})
+    for column in ("metric", "robust_status"):
+        table[column] = table[column].fillna("")
     return table
 
 

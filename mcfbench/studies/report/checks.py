@@ -4,7 +4,7 @@
 from pathlib import Path
 
 from mcfbench.running.schemes import get_scheme
-from mcfbench.storage.frames import load_frames
+from mcfbench.storage.frames import load_frames, surface_points
 from mcfbench.studies.convergence.tables import label
 from mcfbench.studies.report.inputs import (
     SNAKEMAKE,
@@ -23,10 +23,8 @@ def _run_sizes(folder, keys):
     for key in keys:
         path = Path(folder) / f"{key}.npz"
         if path.is_file():
-            frames = load_frames(path)
-            vertices = frames["F"] if "F" in frames else frames["V"]
-            sizes[key] = int(vertices.shape[1]) + (int(frames["T"].shape[1])
-                                                   if "T" in frames else 0)
+            vertices, extra = surface_points(load_frames(path))
+            sizes[key] = int(vertices.shape[1]) + (0 if extra is None else int(extra.shape[1]))
     return sizes
 
 

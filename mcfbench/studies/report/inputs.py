@@ -15,6 +15,7 @@ import pandas as pd
 import yaml
 
 from mcfbench.presentation.formats import (
+    MISSING,
     finite_value,
 )
 from mcfbench.storage.provenance import provenance
@@ -330,14 +331,23 @@ def _strip_first_heading(text):
     return re.sub(r"\A\s*#{1,6}\s+.+\n", "", text, count=1)
 
 
+def _csv_cell(x):
+    """A value of a CSV table shown in the report: floats to 6 digits."""
+    if isinstance(x, float):
+        return MISSING if not math.isfinite(x) else f"{x:.6g}"
+    return str(x)
+
+
 def _csv_table(path, max_rows=None):
+    """The first rows of a CSV file as text (``header``, ``rows``: the cells of a
+    :class:`~mcfbench.presentation.tables.Table`, floats to 6 digits) and its size."""
     table = pd.read_csv(path)
     shown = table.head(max_rows or MAX_TABLE_ROWS)
 
     def cell(x):
         if isinstance(x, float):
-            return "–" if not math.isfinite(x) else f"{x:.6g}"
-        return str(x).replace("|", "\\|")
+            return MISSING if not math.isfinite(x) else f"{x:.6g}"
+        return str(x)
 
     return {"header": [str(c) for c in shown.columns],
             "rows": [[cell(x) for x in r] for r in shown.itertuples(index=False)],

@@ -168,7 +168,8 @@ def test_tiny_tables_and_findings(tiny):
         assert (out / name).is_file(), name
     for name in ("sphere.md", "catenoid.md", "summary.md"):
         assert "same footing" in (out / name).read_text()
-    text = matrix_findings.findings(out / "summary.csv", root / "findings.md", plan)
+    text = matrix_findings.findings(out / "summary.csv", out / "matrix.csv", root / "findings.md",
+                                    plan)
     for problem in plan["problems"]:
         assert f"### {problem}" in text
     for r in summary.itertuples():  # every status is shown, in the tables and the text
@@ -254,8 +255,15 @@ def test_eoc_is_log2_of_the_error_ratio(tmp_path):
     assert a["finest_value"] == 6.0e-4 and a["status"] == "ok"
     c = summary[summary["problem"] == "catenoid"].iloc[0]
     assert c["status"] == "t_escaped" and c["t_failed"] == 0.25 and c["failed_level"] == 2
-    assert "t_escaped at t = 0.25 (level 2)" in matrix_tables.summary_cell(c)
-    text = matrix_findings.matrix_findings(summary)
+    lists = matrix_tables.with_levels(summary, table)
+    cat = lists[lists["problem"] == "catenoid"].iloc[0]
+    assert cat["values"][0] == -0.01 and math.isnan(cat["values"][1])
+    assert math.isnan(cat["eocs"][0]) and cat["failed"] == [(2, "t_escaped", 0.25)]
+    a_lists = lists[(lists["problem"] == "sphere") & (lists["scheme"] == "a")].iloc[0]
+    assert a_lists["values"] == errors["a"] and a_lists["robust_values"] == errors["a"]
+    assert a_lists["eocs"] == pytest.approx([math.log2(4.0), math.log2(2.5e-3 / 6.0e-4)])
+    assert "t_escaped at t = 0.25 (level 2)" in matrix_tables.summary_cell(cat)
+    text = matrix_findings.matrix_findings(table, summary)
     assert "**a** converges at order ~2" in text
     assert "**b** does not converge" in text
     assert "broke down in 1 of 2 runs (level 2: t_escaped at t = 0.25)" in text
@@ -269,7 +277,7 @@ def test_recommendation_when_one_scheme_wins():
             records += [_record(scheme, problem, k, c * 4.0 ** -k,
                                 metric="l2_error" if problem == "sphere" else "max_height")
                         for k in (1, 2, 3)]
-    text = matrix_findings.matrix_findings(matrix_tables.summary_table(matrix_tables.long_table(records)))
+    text = matrix_findings.matrix_findings(matrix_tables.long_table(records))
     assert "**Recommendation: good**" in text
 
 
@@ -294,10 +302,14 @@ def test_solver_failure_is_rerun_with_the_robust_solver(tmp_path):
     assert (table["robust_status"] == "ok").all() and np.isfinite(table["robust_value"]).all()
     cotan = summary[summary["scheme"] == "cotan"].iloc[0]
     assert cotan["runs_ok"] == 0 and cotan["runs_robust_ok"] == 2
-    assert cotan["solver_only"] == "1:solver_failed:0.04;2:solver_failed:0.01"
+    lists = matrix_tables.with_levels(summary, table)
+    assert lists[lists["scheme"] == "cotan"].iloc[0]["solver_only"] == [
+        (1, "solver_failed", 0.04), (2, "solver_failed", 0.01)]
     assert 1.7 < cotan["robust_eoc"] < 2.3 and cotan["robust_eoc_levels"] == "1-2"
     assert "the robust solver finishes every level" in (tmp_path / "tables" / "summary.md").read_text()
-    text = matrix_findings.findings(tmp_path / "tables" / "summary.csv", tmp_path / "findings.md", plan)
+    text = matrix_findings.findings(tmp_path / "tables" / "summary.csv",
+                                    tmp_path / "tables" / "matrix.csv", tmp_path / "findings.md",
+                                    plan)
     assert "**cotan** converges at order ~2" in text
     assert "A solver verdict, not a scheme verdict: the matrix's solver failed (level 1: " \
            "solver_failed at t = 0.04; level 2: solver_failed at t = 0.01)" in text
@@ -325,13 +337,17 @@ def test_findings_tell_solver_verdicts_from_scheme_verdicts():
         records[-1].update(status="solver_failed", t_failed=0.03, l2_error=float("nan"),
                            robust_status="ok" if scheme == "a" else "solver_breakdown",
                            robust_metrics={"l2_error": c * 4.0 ** -3 if scheme == "a" else None})
-    summary = matrix_tables.summary_table(matrix_tables.long_table(records))
+    table = matrix_tables.long_table(records)
+    summary = matrix_tables.with_levels(matrix_tables.summary_table(table), table)
     a = summary[summary["scheme"] == "a"].iloc[0]
     assert a["status"] == "solver_failed" and a["runs_robust_ok"] == 3
     assert a["robust_eoc"] == pytest.approx(2.0) and a["robust_finest_value"] == 4.0 ** -3
+    assert a["robust_values"] == pytest.approx([0.25, 4.0 ** -2, 4.0 ** -3])
     b = summary[summary["scheme"] == "b"].iloc[0]
-    assert b["runs_robust_ok"] == 2 and b["solver_only"] == ""
-    text = matrix_findings.matrix_findings(summary)
+    assert b["runs_robust_ok"] == 2 and b["solver_only"] == []
+    ((level, status, t_failed),) = b["robust_failed"]     # the re-run states no time
+    assert (level, status) == (3, "solver_breakdown") and math.isnan(t_failed)
+    text = matrix_findings.matrix_findings(table)
     assert "**a** converges at order ~2: EOC 2.00 (levels 2-3)" in text
     assert "A solver verdict, not a scheme verdict" in text
     assert "**b** broke down in 1 of 3 runs (level 3: solver_failed at t = 0.03)" in text
@@ -412,7 +428,7 @@ def test_cheapest_to_reach_reads_the_long_table():
 
     rows = [("a", 1, 1e-2, 1.0), ("a", 2, 2.5e-3, 4.0), ("b", 1, 4e-3, 3.0), ("b", 2, 1e-3, 9.0)]
     table = pd.DataFrame([{"problem": "sphere", "scheme": s, "level": lv, "metric": "l2_error",
-                           "value": e, "cpu_seconds": c} for s, lv, e, c in rows])
+                           "main": True, "value": e, "cpu_seconds": c} for s, lv, e, c in rows])
     (verdict,) = cheapest_to_reach(table)
     assert verdict["target"] == 2.5e-3                    # a's smallest error; b reaches it too
     assert verdict["costs"] == {"a": 4.0, "b": 9.0}
@@ -423,11 +439,11 @@ def test_cheapest_to_reach_reads_the_long_table():
 # ------------------------------------------------------------ findings that read straight (#33)
 
 
-def _summary(rows, problem="sphere", metric="l2_error"):
-    """The summary of synthetic runs: ``{scheme: [error per level 1, 2, ...]}``."""
-    return matrix_tables.summary_table(matrix_tables.long_table(
+def _table(rows, problem="sphere", metric="l2_error"):
+    """The long table of synthetic runs: ``{scheme: [error per level 1, 2, ...]}``."""
+    return matrix_tables.long_table(
         [_record(s, problem, k + 1, e, metric=metric) for s, es in rows.items()
-         for k, e in enumerate(es)]))
+         for k, e in enumerate(es)])
 
 
 def test_findings_state_their_scope():
@@ -445,15 +461,15 @@ def test_findings_state_their_scope():
     assert text.startswith("Scope: the full matrix, every scheme of the registry (4 with the "
                            "other integrators) on every problem (2), at the levels sphere 1-3; "
                            "torus 1.")
-    summary = _summary({"cotan": [1e-2, 2.5e-3]})
+    table = _table({"cotan": [1e-2, 2.5e-3]})
     assert "Scope: the full" in matrix_findings.matrix_findings(
-        summary, scope=matrix_findings.scope_lines(full, registry_schemes, registry_problems))
+        table, scope=matrix_findings.scope_lines(full, registry_schemes, registry_problems))
 
 
 def test_every_problem_with_an_exact_error_is_listed_even_a_real_world_like_one():
-    summary = pd.concat([_summary({"a": [1e-2, 2.5e-3, 6e-4]}),
-                         _summary({"a": [2e-2, 5e-3, 1.2e-3]}, problem="perturbed_sphere")])
-    text = matrix_findings.matrix_findings(summary, mesh_problems=["perturbed_sphere"])
+    table = pd.concat([_table({"a": [1e-2, 2.5e-3, 6e-4]}),
+                       _table({"a": [2e-2, 5e-3, 1.2e-3]}, problem="perturbed_sphere")])
+    text = matrix_findings.matrix_findings(table, mesh_problems=["perturbed_sphere"])
     assert "Problems with an exact error: sphere, perturbed_sphere." in text
     assert "Real-world-like meshes (a breakdown disqualifies): perturbed_sphere." in text
 
@@ -461,10 +477,10 @@ def test_every_problem_with_an_exact_error_is_listed_even_a_real_world_like_one(
 def test_a_recommendation_never_hides_an_order_the_verdicts_call_off():
     """On the torus no scheme reaches order ~2, so b (EOC 1.58 there) may still win, but
     the recommendation says what the torus verdict says."""
-    summary = pd.concat([_summary({"b": [1e-2, 2.5e-3, 6.25e-4], "c": [3e-2, 7.5e-3, 1.9e-3]}),
-                         _summary({"b": [1e-2, 5e-3, 1.67e-3], "c": [1e-2, 6e-3, 3e-3]},
-                                  problem="torus", metric="volume_error")])
-    text = matrix_findings.matrix_findings(summary)
+    table = pd.concat([_table({"b": [1e-2, 2.5e-3, 6.25e-4], "c": [3e-2, 7.5e-3, 1.9e-3]}),
+                       _table({"b": [1e-2, 5e-3, 1.67e-3], "c": [1e-2, 6e-3, 3e-3]},
+                              problem="torus", metric="volume_error")])
+    text = matrix_findings.matrix_findings(table)
     assert "**b** converges at order 1.58 (levels 2-3), not ~2" in text
     assert "**Recommendation: b**" in text
     assert ("It does not show order ~2 everywhere: EOC 1.58 on torus, not ~2 (no scheme "
@@ -473,23 +489,24 @@ def test_a_recommendation_never_hides_an_order_the_verdicts_call_off():
 
 def test_an_eoc_from_two_levels_does_not_disqualify():
     """a: EOC 2.0 on the sphere; b: EOC 2.6 on the sphere from two levels only."""
-    summary = _summary({"a": [1e-2, 2.5e-3], "b": [6e-3, 1e-3]})
-    text = matrix_findings.matrix_findings(summary)
+    table = _table({"a": [1e-2, 2.5e-3], "b": [6e-3, 1e-3]})
+    text = matrix_findings.matrix_findings(table)
     assert "**b** converges, EOC 2.58 (levels 1-2): from two levels only, the order is " \
            "not settled" in text
     assert "Left out" not in text
     assert "**a** converges at order ~2 from two levels only: EOC 2.00" in text
     assert "**Recommendation: b**" in text
     assert "EOC 2.58 on sphere from two levels only (the order is not settled)" in text
-    three = _summary({"a": [4e-2, 1e-2, 2.5e-3], "b": [3.6e-2, 6e-3, 1e-3]})
+    three = _table({"a": [4e-2, 1e-2, 2.5e-3], "b": [3.6e-2, 6e-3, 1e-3]})
     text = matrix_findings.matrix_findings(three)           # three levels: it counts
     assert "Left out: b (EOC 2.58 on sphere)." in text and "**Recommendation: a**" in text
 
 
 def test_findings_show_values_as_the_tables_do():
     """A relative error is a number, as in the summary table, never a percentage."""
-    summary = _summary({"a": [-3.2e-2, -8.424e-4]}, problem="catenoid", metric="neck_error")
-    text = matrix_findings.matrix_findings(summary)
+    table = _table({"a": [-3.2e-2, -8.424e-4]}, problem="catenoid", metric="neck_error")
+    text = matrix_findings.matrix_findings(table)
+    summary = matrix_tables.with_levels(matrix_tables.summary_table(table), table)
     assert "-8.424e-04" in text and matrix_tables.summary_cell(summary.iloc[0]).count("-8.424e-04")
     assert "%" not in text.split("## Across problems")[0].split("## Per problem")[1]
 
@@ -526,13 +543,32 @@ def test_series_job_writes_every_level_and_logs_to_one_file(tmp_path):
     assert "sphere level 1" in text and "sphere level 2" in text
 
 
+def test_the_main_metric_is_decided_once_in_the_long_table():
+    """Two metrics per run: ``main`` marks the problem's main metric (sphere: l2_error),
+    and the summary and the problem table follow the column, not a rule of their own."""
+    records = []
+    for k, e in ((1, 1e-2), (2, 2.5e-3)):
+        r = _record("a", "sphere", k, e)
+        r.update(volume=4.0 - k, metric_names=["volume", "l2_error"])
+        records.append(r)
+    table = matrix_tables.long_table(records)
+    assert table.loc[table["main"], "metric"].tolist() == ["l2_error", "l2_error"]
+    assert (table["main"] == (table["metric"] == "l2_error")).all()
+    assert matrix_tables.summary_table(table)["metric"].tolist() == ["l2_error"]
+    swapped = table.assign(main=table["metric"] == "volume")
+    (row,) = matrix_tables.summary_table(swapped).to_dict("records")
+    assert row["metric"] == "volume" and row["finest_value"] == 2.0
+    frame, metric = matrix_tables.problem_table(swapped, "sphere")
+    assert metric == "volume" and frame["L2"].tolist() == ["2.000e+00"]
+
+
 def test_summary_keeps_a_value_measured_before_a_later_breakdown():
     """The torus's volume at t = 0.1 is measured before the run stops at the pinch:
     the summary shows it and its EOC, and still names the breakdown."""
     rows = [("cotan", 1, 0.0156, "solver_stagnated"), ("cotan", 2, 0.0039, "inverted")]
     table = pd.DataFrame([{"scheme": s, "problem": "torus", "level": lv, "h": 0.1 / lv,
                            "tau": 0.004, "steps": 50, "steps_done": 30, "metric": "volume_error",
-                           "value": v, "eoc": np.nan, "status": st, "t_failed": 0.13,
+                           "main": True, "value": v, "eoc": np.nan, "status": st, "t_failed": 0.13,
                            "min_angle": 20.0, "max_flipped": 0, "t_min_barycentric": np.nan,
                            "iterations": 10, "cpu_seconds": 1.0, "robust_status": "",
                            "robust_value": np.nan, "robust_t_failed": np.nan}
@@ -546,10 +582,10 @@ def test_summary_keeps_a_value_measured_before_a_later_breakdown():
 def test_a_pinch_after_the_measurement_is_judged_by_the_measured_error():
     from mcfbench.studies.matrix.findings import _classify as classify_row  # noqa: PLC2701
 
-    row = {"runs": 3, "runs_ok": 0, "error": True, "values": "0.164;0.0463;0.0129",
+    row = {"runs": 3, "runs_ok": 0, "error": True, "values": [0.164, 0.0463, 0.0129],
            "eoc": 1.84}
     assert classify_row(row) == "order2"
-    assert classify_row({**row, "values": "0.164;0.0463"}) == "broke_down"
+    assert classify_row({**row, "values": [0.164, 0.0463, float("nan")]}) == "broke_down"
 
 
 def test_figures_fit_a_laptop_column_with_text_of_8_pt_at_least(monkeypatch, tmp_path):
@@ -606,8 +642,8 @@ def test_the_real_meshes_get_a_survival_count_and_a_breakdown_there_disqualifies
                 _record("b", "real_spot", 1, 7e-3, metric="area_error"),
                 _record("b", "real_spot", 2, float("nan"), "inverted", 0.001,
                         metric="area_error")]
-    summary = matrix_tables.summary_table(matrix_tables.long_table(records))
-    text = matrix_findings.matrix_findings(summary, mesh_problems=["real_nut", "real_spot"])
+    text = matrix_findings.matrix_findings(matrix_tables.long_table(records),
+                                           mesh_problems=["real_nut", "real_spot"])
     section = text.split("## On the real meshes")[1].split("## ")[0]
     assert "- **a**: 2 of 2, median error 2.000e-02." in section
     assert "- **b**: 1 of 2, median error 1.500e-02; broke down on real_spot." in section

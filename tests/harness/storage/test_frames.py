@@ -1,0 +1,56 @@
+"""The one frame-file layout (mcfbench.storage.frames): a run's frames written and read
+back unchanged, the points of any scheme's frames read alike (surface_points), and a
+file of another layout named."""
+
+import numpy as np
+import pytest
+
+from mcfbench.geometry.spheres import icosphere
+from mcfbench.running.driver import simulate
+from mcfbench.running.schemes import get_scheme
+from mcfbench.running.solver import Solver
+from mcfbench.storage.frames import load_frames, save_frames, surface_points
+
+
+def _frames(name, steps=2):
+    """Two kept frames of ``name`` on the level-1 icosphere, and its flow."""
+    V, F = icosphere(1)
+    flow = get_scheme(name).make(V, F, 1e-3)
+    traj = simulate(flow, steps, solver=Solver("direct"), save_every=steps)
+    return dict(traj.frames, faces=traj.faces, steps=traj.steps, t=traj.t), flow
+
+
+@pytest.mark.parametrize("name", ["ddfv", "cotan"])
+def test_the_points_of_any_scheme_read_alike_and_survive_the_file(name, tmp_path):
+    frames, flow = _frames(name)
+    vertices, extra = surface_points(frames)
+    # the surface mesh's vertices of the last state; DDFV's T-vertices as the extra points
+    np.testing.assert_array_equal(vertices[-1], flow.vertices)
+    assert vertices.shape == (2, 42, 3)
+    if name == "ddfv":
+        assert extra.shape == (2, 80, 3)
+        np.testing.assert_array_equal(np.concatenate([vertices[-1], extra[-1]]), flow.X.T)
+    else:
+        assert extra is None
+    save_frames(tmp_path / "run.npz", frames)
+    back = load_frames(tmp_path / "run.npz")
+    assert list(back) == list(frames)
+    for key, value in frames.items():
+        np.testing.assert_array_equal(back[key], value)
+    for a, b in zip(surface_points(back), (vertices, extra)):
+        assert (a is None and b is None) or np.array_equal(a, b)
+
+
+def test_a_run_without_frames_has_no_points(tmp_path):
+    empty = {"faces": np.zeros((0, 3), int), "steps": np.zeros(0, int), "t": np.zeros(0)}
+    save_frames(tmp_path / "refused.npz", empty)
+    assert surface_points(load_frames(tmp_path / "refused.npz")) == (None, None)
+
+
+def test_another_layout_is_named(tmp_path):
+    with pytest.raises(ValueError, match=r"x\.npz: not a run's frames file: it has \['t'\]"):
+        save_frames(tmp_path / "x.npz", {"t": np.zeros(1)})
+    np.savez(tmp_path / "points.npz", faces=np.zeros((1, 3), int), steps=np.zeros(1, int),
+             t=np.zeros(1), X=np.zeros((1, 3, 3)))
+    with pytest.raises(ValueError, match="expected faces, steps, t and V"):
+        load_frames(tmp_path / "points.npz")
