@@ -26,102 +26,6 @@ import scipy.sparse.linalg as spla
 SYMMETRY = 1e-12
 
 
-class KeptFactorSolver:
-    """Solver of a sequence of nearby sparse systems ``A_k x = b_k`` with a kept factor.
-
-    Each system is solved with the factorisation of an earlier matrix of the
-    sequence (:func:`factorise`), iterated from a start until ``|b - A x| <= rtol
-    |b|``: the caller's start, else, for a named sequence of solutions, the linear
-    extrapolation ``2 x_{k-1} - x_{k-2}`` of its last two (the last one alone
-    after one), else ``P^{-1} b``. When that takes more than ``max_iterations``
-    (or the size changed) ``A`` is factorised and the system solved directly.
-
-    Parameters
-    ----------
-    rtol : float
-        Relative residual of every solve.
-    max_iterations : int
-        Iterations with the kept factor before factorising anew.
-
-    Attributes
-    ----------
-    factorisations, iterations : int
-        Factorisations and iterations with a kept factor so far.
-    method : {"cholesky-cg", "lu-refinement"} or None
-        The kept factorisation and its iteration (None before the first).
-    """
-
-    def __init__(self, rtol=1e-7, max_iterations=4):
-        self.rtol, self.max_iterations = rtol, max_iterations
-        self.factorisations = self.iterations = 0
-        self.method = self._factor = None
-        self._history = {}                              # sequence -> its last two solutions
-
-    def solve(self, b, apply, matrix, start=None, sequence=None):
-        """``x`` (n,) with ``|b - A x| <= rtol |b|``.
-
-        Parameters
-        ----------
-        b : (n,) float array
-        apply : callable (n,) -> (n,)
-            ``x -> A x``.
-        matrix : (n, n) sparse matrix or callable () -> (n, n) sparse matrix
-            ``A`` itself, asked for only when it is factorised.
-        start : (n,) float array, optional
-            The first iterate; default the extrapolation of ``sequence``.
-        sequence : hashable, optional
-            Name of the sequence of solutions ``x`` belongs to (its last two are
-            kept for the next start).
-
-        Returns
-        -------
-        (n,) float array
-        """
-        b = np.asarray(b, dtype=float)
-        history = [x for x in self._history.get(sequence, []) if len(x) == len(b)]
-        x = None
-        if self._factor is not None and self._factor[1] == len(b):
-            if start is None:
-                start = (history[-1] if len(history) == 1 else
-                         2.0 * history[-1] - history[-2] if history else None)
-            x, k = self._iterate(apply, b, start)
-            self.iterations += k
-        if x is None:
-            self.method, solve = factorise(matrix() if callable(matrix) else matrix)
-            self._factor = solve, len(b)
-            self.factorisations += 1
-            x, history = solve(b), []
-        if sequence is not None:
-            self._history[sequence] = history[-1:] + [x]
-        return x
-
-    def _iterate(self, apply, b, start):
-        """``(x, iterations)`` from ``start`` (None: ``P^{-1} b``) with the kept
-        factor, ``x`` None when ``max_iterations`` did not reach ``rtol``."""
-        solve, n = self._factor
-        x = solve(b) if start is None else np.array(start, dtype=float)
-        tol = self.rtol * np.linalg.norm(b)
-        if self.method == "cholesky-cg":
-            operator = spla.LinearOperator((n, n), matvec=apply, dtype=float)
-            count = [0]
-
-            def counted(_):
-                count[0] += 1
-            x, info = spla.cg(operator, b, x, rtol=0.0, atol=tol, M=spla.LinearOperator(
-                (n, n), matvec=solve, dtype=float), maxiter=self.max_iterations,
-                callback=counted)
-            # cg checks its residual before an iteration: after the last, here
-            converged = info == 0 or np.linalg.norm(b - apply(x)) <= tol
-            return (x if converged else None), count[0]
-        for k in range(self.max_iterations + 1):         # refinement of the LU
-            r = b - apply(x)
-            if np.linalg.norm(r) <= tol:
-                return x, k
-            if k < self.max_iterations:
-                x = x + solve(r)
-        return None, self.max_iterations
-
-
 def cholesky_solve(A):
     """``b -> A^{-1} b`` by the sparse Cholesky factorisation of ``A``, or None.
 
@@ -161,11 +65,11 @@ def factorise(A):
 
     Returns
     -------
-    method : {"cholesky-cg", "lu-refinement"}
-        Sparse Cholesky (:func:`cholesky_solve`) where ``A`` is symmetric (to
-        :data:`SYMMETRY`, infinity norm) and positive definite, kept with
-        conjugate gradients; else sparse LU (SuperLU, minimum degree ordering of
-        ``A + A^T``), kept with iterative refinement.
+    method : {"cg", "refinement"}
+        ``"cg"``: sparse Cholesky (:func:`cholesky_solve`), where ``A`` is
+        symmetric (to :data:`SYMMETRY`, infinity norm) and positive definite,
+        kept with conjugate gradients; ``"refinement"``: else sparse LU (SuperLU,
+        minimum degree ordering of ``A + A^T``), kept with iterative refinement.
     solve : callable (n,) -> (n,)
         ``b -> A^{-1} b``.
     """
@@ -173,8 +77,8 @@ def factorise(A):
     if spla.norm(A - A.T, np.inf) <= SYMMETRY * spla.norm(A, np.inf):
         solve = cholesky_solve(A)
         if solve is not None:
-            return "cholesky-cg", solve
-    return "lu-refinement", spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A").solve
+            return "cg", solve
+    return "refinement", spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A").solve
 
 
 def pinned(K, keep):
@@ -207,3 +111,110 @@ def pinned(K, keep):
         P = sp.diags(keep)
         return (P @ K @ P + sp.diags(1.0 - keep)).tocsr()
     return apply, matrix
+
+
+class KeptFactorSolver:
+    """Solver of a sequence of nearby sparse systems ``A_k x = b_k`` with a kept factor.
+
+    Each system is solved with the factorisation ``P`` of an earlier matrix of
+    the sequence (``factorise``, default :func:`factorise`), iterated from a
+    start until ``|b - A x| <= rtol |b|``: the caller's start, else, for a named
+    sequence of solutions, the linear extrapolation ``2 x_{k-1} - x_{k-2}`` of its
+    last two (the last one alone after one), else ``P^{-1} b``. When that takes
+    more than ``max_iterations`` (or the size changed), ``A`` is factorised and
+    the iteration runs from ``P^{-1} b`` of the new factor (for an exact
+    factorisation one residual check).
+
+    Parameters
+    ----------
+    rtol : float
+        Relative residual of every solve.
+    max_iterations : int
+        Iterations with a kept factor before factorising anew.
+    factorise : callable
+        ``A -> (method, solve)``, default :func:`factorise`; ``solve`` may be an
+        approximate inverse (a preconditioner), symmetric positive definite for
+        ``"cg"``.
+
+    Attributes
+    ----------
+    factorisations, iterations : int
+        Factorisations and iterations so far.
+    method : {"cg", "refinement"} or None
+        The iteration of the kept factor (None before the first).
+    """
+
+    def __init__(self, rtol=1e-7, max_iterations=4, factorise=factorise):
+        self.rtol, self.max_iterations = rtol, max_iterations
+        self._factorise = factorise
+        self.factorisations = self.iterations = 0
+        self.method = self._factor = None
+        self._history = {}                              # sequence -> its last two solutions
+
+    def solve(self, b, apply, matrix, start=None, sequence=None):
+        """``x`` (n,) with ``|b - A x| <= rtol |b|``.
+
+        Parameters
+        ----------
+        b : (n,) float array
+        apply : callable (n,) -> (n,)
+            ``x -> A x``.
+        matrix : (n, n) sparse matrix or callable () -> (n, n) sparse matrix
+            ``A`` itself, asked for only when it is factorised.
+        start : (n,) float array, optional
+            The first iterate with a kept factor; default the extrapolation of
+            ``sequence``.
+        sequence : hashable, optional
+            Name of the sequence of solutions ``x`` belongs to (its last two are
+            kept for the next start).
+
+        Returns
+        -------
+        (n,) float array
+        """
+        b = np.asarray(b, dtype=float)
+        history = [x for x in self._history.get(sequence, []) if len(x) == len(b)]
+        converged = False
+        if self._factor is not None and self._factor[1] == len(b):
+            if start is None:
+                start = (history[-1] if len(history) == 1 else
+                         2.0 * history[-1] - history[-2] if history else None)
+            x, converged = self._iterate(apply, b, start)
+        if not converged:
+            self.method, solve = self._factorise(matrix() if callable(matrix) else matrix)
+            self._factor = solve, len(b)
+            self.factorisations += 1
+            x, _ = self._iterate(apply, b, None)
+            history = []
+        if sequence is not None:
+            self._history[sequence] = history[-1:] + [x]
+        return x
+
+    def _iterate(self, apply, b, start):
+        """``(x, converged)`` from ``start`` (None: ``P^{-1} b``) with the kept factor
+        ``P``: CG preconditioned by ``P`` or iterative refinement, at most
+        ``max_iterations``."""
+        solve, n = self._factor
+        x = solve(b) if start is None else np.array(start, dtype=float)
+        tol = self.rtol * np.linalg.norm(b)
+        if self.method == "cg":
+            count = [0]
+
+            def counted(_):
+                count[0] += 1
+            x, info = spla.cg(spla.LinearOperator((n, n), matvec=apply, dtype=float), b, x,
+                              rtol=0.0, atol=tol, maxiter=self.max_iterations,
+                              M=spla.LinearOperator((n, n), matvec=solve, dtype=float),
+                              callback=counted)
+            self.iterations += count[0]
+            # cg checks the residual before each iteration: after the last one, here
+            return x, info == 0 or np.linalg.norm(b - apply(x)) <= tol
+        for k in range(self.max_iterations + 1):         # refinement
+            r = b - apply(x)
+            if np.linalg.norm(r) <= tol:
+                self.iterations += k
+                return x, True
+            if k < self.max_iterations:
+                x = x + solve(r)
+        self.iterations += self.max_iterations
+        return x, False

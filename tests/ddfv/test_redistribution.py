@@ -146,9 +146,9 @@ def test_potential_solves_the_poisson_problem_on_the_sphere():
 
 
 @pytest.mark.parametrize("surface, dual_length, method", [
-    ("sphere", "chord", "cholesky-cg"),                # K symmetric: Cholesky and CG
-    ("sphere", "broken", "lu-refinement"),             # broken line: K not symmetric, LU
-    ("plane", "chord", "lu-refinement"),               # boundary ghost: not symmetric, LU
+    ("sphere", "chord", "cg"),                   # K symmetric: Cholesky and CG
+    ("sphere", "broken", "refinement"),          # broken line: K not symmetric, LU
+    ("plane", "chord", "refinement"),            # boundary ghost: not symmetric, LU
 ])
 def test_kept_factor_matches_a_direct_solve_along_a_moving_surface(surface, dual_length,
                                                                    method):
@@ -328,8 +328,8 @@ def _run(V, F, tau=0.002, steps=5, **options):
     return traj.frames["F"], traj.frames["T"]
 
 
-@pytest.mark.parametrize("variant, method", [("redistribute", "lu-refinement"),
-                                             ("chord-redistribute-carried", "cholesky-cg")])
+@pytest.mark.parametrize("variant, method", [("redistribute", "refinement"),
+                                             ("chord-redistribute-carried", "cg")])
 def test_flow_keeps_one_factor_and_times_the_potential(bumpy, variant, method):
     """Along 5 steps: one factorisation, the later potentials by the kept factor (the
     broken line's K is not symmetric: LU; the chord's is: Cholesky and CG), and the
