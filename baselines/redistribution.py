@@ -39,7 +39,7 @@ Covolume of vertex ``i`` = its lumped mass ``m_i`` (the scheme's own), so
 
 ``<|h|^2> = sum m_i |h_i|^2 / |G|``. ``sum_i m_i f_i = 0`` exactly, so
 (R2) is consistent; the right-hand side is projected onto ``sum = 0``
-(rounding), solved with ``psi_0`` pinned by a sparse LU factorisation and
+(rounding), solved with ``psi_0`` pinned (:class:`PotentialSolver`) and
 normalised by ``sum m_i psi_i = 0`` (the constant projected out; it does
 not enter ``grad psi``).
 
@@ -126,7 +126,8 @@ i.e. no point crosses the fixed boundary.
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
+
+from kept_factor import KeptFactorSolver, pinned
 
 from .kernels import drift_weights, vertex_gradients
 
@@ -213,131 +214,38 @@ def redistribution_source(L, mass, X, fixed, omega, shares=None):
     return f
 
 
-def cholesky_solve(A):
-    """``b -> A^{-1} b`` by the sparse Cholesky factorisation of ``A``, or None.
-
-    CHOLMOD's supernodal factorisation with its own fill-reducing ordering
-    (through ``cholespy``, which ships it: no system library).
-
-    Parameters
-    ----------
-    A : (n, n) sparse matrix
-        Symmetric (one triangle is read).
-
-    Returns
-    -------
-    callable or None
-        ``solve(b)`` for (n,) ``b``; None when ``A`` is not numerically
-        positive definite.
-    """
-    from cholespy import CholeskySolverD, MatrixType
-
-    A = sp.csr_matrix(A, dtype=np.float64)
-    A.sum_duplicates()
-    try:
-        factor = CholeskySolverD(A.shape[0], A.indptr.astype(np.int32),
-                                 A.indices.astype(np.int32), A.data, MatrixType.CSR)
-    except ValueError:                               # not positive definite
-        return None
-
-    def solve(b):
-        x = np.empty(len(b))
-        factor.solve(np.ascontiguousarray(b, dtype=np.float64), x)
-        return x
-    return solve
-
-
-def preconditioned_cg(apply, b, x, precondition, rtol, max_iterations):
-    """Conjugate gradients for ``A x = b`` from ``x``, preconditioned by ``precondition``.
-
-    Parameters
-    ----------
-    apply, precondition : callables (n,) -> (n,)
-        ``x -> A x`` and ``r -> P^{-1} r``, both symmetric positive definite.
-    b, x : (n,) float arrays
-        Right-hand side, start.
-    rtol : float
-        Stop at ``|b - A x| <= rtol |b|`` (the recursive residual).
-    max_iterations : int
-
-    Returns
-    -------
-    x : (n,) float array
-    iterations : int
-    converged : bool
-    """
-    r = b - apply(x)
-    tol = rtol * np.linalg.norm(b)
-    if np.linalg.norm(r) <= tol:
-        return x, 0, True
-    z = precondition(r)
-    p, rz = z, r @ z
-    for k in range(1, max_iterations + 1):
-        q = apply(p)
-        a = rz / (p @ q)
-        x, r = x + a * p, r - a * q
-        if np.linalg.norm(r) <= tol:
-            return x, k, True
-        z = precondition(r)
-        rz, rz_old = r @ z, rz
-        p = z + (rz / rz_old) * p
-    return x, max_iterations, False
-
-
-def iterative_refinement(apply, b, x, precondition, rtol, max_iterations):
-    """``x <- x + P^{-1} (b - A x)`` until ``|b - A x| <= rtol |b|``: the stationary
-    iteration of a kept factorisation ``P`` of a nearby matrix (any ``A``); the
-    signature and returns of :func:`preconditioned_cg`."""
-    norm = np.linalg.norm(b)
-    for k in range(max_iterations + 1):
-        r = b - apply(x)
-        if np.linalg.norm(r) <= rtol * norm:
-            return x, k, True
-        if k < max_iterations:
-            x = x + precondition(r)
-    return x, max_iterations, False
-
-
-class PotentialSolver:
+class PotentialSolver(KeptFactorSolver):
     """``psi`` of (R2) along a flow: ``L psi = -M f``, normalised to ``sum m_i psi_i = 0``.
 
     ``L`` is singular (kernel: the constants). The right-hand side is
     projected onto its range (``sum = 0``) and ``psi_0 = 0`` is pinned: the
     system ``A psi = b`` with ``A = P L P + e_0 e_0^T`` (``P`` zeroes entry 0;
-    symmetric positive definite for a connected mesh) and ``b_0 = 0``. The
-    constant is then projected out.
+    symmetric positive definite for a connected mesh; :func:`kept_factor.pinned`)
+    and ``b_0 = 0``. The constant is then projected out.
 
-    ``A`` is factorised by sparse Cholesky (:func:`factorisation`) and the
-    factor is kept: the next steps' systems, whose geometry moved by
-    ``O(tau)``, are solved by conjugate gradients preconditioned with the kept
-    factor (:func:`preconditioned_cg`), started from the linear extrapolation
-    ``2 psi^{n-1} - psi^{n-2}`` of the last two solutions, until ``|b - A x|
-    <= rtol |b|``; ``A`` is factorised anew when that takes more than
-    ``max_iterations``. Chosen by measurement (``benchmarks/bench_potential.py
-    --solvers``, level 5 of the sphere, 10 242 vertices, CPU time per solve of
-    a flow's sequence of systems, ``baselines/README.md``): 1.7 ms and about
-    one CG iteration, against 5.6 ms for the iterative refinement of a kept
-    sparse LU (SuperLU, 2.4 LU solves) it replaces; algebraic multigrid
-    (``pyamg``, smoothed aggregation, hierarchy kept) + CG 4.2 ms (3.4
-    V-cycles); Jacobi-CG 12 ms (120 iterations; ~1200 on sliver-rich meshes).
-    Where ``A`` is not numerically positive definite the factorisation is a
-    sparse LU (SuperLU) and the iteration :func:`iterative_refinement`. (As
-    :class:`ddfv.redistribution.TangentialPotential`, which this package may
-    not import.) ``psi`` only sets a tangential velocity: ``rtol = 1e-7``
-    moves the points by ``1e-7`` of the redistribution's own displacement.
+    The systems of a flow, whose geometry moves by ``O(tau)`` a step, are
+    solved with a kept factorisation (:class:`kept_factor.KeptFactorSolver`):
+    sparse Cholesky, and conjugate gradients preconditioned with the kept
+    factor, started from the linear extrapolation ``2 psi^{n-1} - psi^{n-2}``
+    of the last two solutions, until ``|b - A x| <= rtol |b|``; ``A`` is
+    factorised anew when that takes more than ``max_iterations``. Chosen by
+    measurement (``benchmarks/bench_potential.py --solvers``, level 5 of the
+    sphere, 10 242 vertices, CPU time per solve of a flow's sequence of
+    systems, ``baselines/README.md``): 1.7 ms and about one CG iteration,
+    against 5.6 ms for the iterative refinement of a kept sparse LU (SuperLU,
+    2.4 LU solves) it replaces; algebraic multigrid (``pyamg``, smoothed
+    aggregation, hierarchy kept) + CG 4.2 ms (3.4 V-cycles); Jacobi-CG 12 ms
+    (120 iterations; ~1200 on sliver-rich meshes). Where ``A`` is not
+    numerically positive definite the factorisation is a sparse LU (SuperLU)
+    and the iteration a refinement. ``psi`` only sets a tangential velocity:
+    ``rtol = 1e-7`` moves the points by ``1e-7`` of the redistribution's own
+    displacement.
 
     Parameters
     ----------
     rtol : float
     max_iterations : int
     """
-
-    def __init__(self, rtol=1e-7, max_iterations=4):
-        self.rtol, self.max_iterations = rtol, max_iterations
-        self._factor = self._iterate = None
-        self._history = []                           # the last two solutions
-        #: number of factorisations and of iterations with a kept factor so far
-        self.factorisations = self.iterations = 0
 
     def __call__(self, L, mass, f):
         """``psi`` (n,) for the stiffness ``L`` (n, n, symmetric positive
@@ -347,62 +255,10 @@ class PotentialSolver:
         n = len(b)
         if n < 2 or not np.any(b):
             return np.zeros(n)
-        L = sp.csr_matrix(L)
         keep = np.ones(n)
         keep[0] = b[0] = 0.0                           # psi_0 = 0
-
-        def apply(x):                                  # A x = P L P x + e_0 e_0^T x
-            return keep * (L @ (keep * x)) + (1.0 - keep) * x
-
-        psi = self._solve(apply, lambda: pinned_matrix(L, keep), b)
+        psi = self.solve(b, *pinned(L, keep), sequence="psi")
         return psi - (mass * psi).sum() / mass.sum()
-
-    def _solve(self, apply, matrix, b):
-        """``A x = b`` with the kept factor from the extrapolated start, else factorised."""
-        history = [x for x in self._history if len(x) == len(b)]
-        if self._factor is not None:
-            start = (self._factor(b) if not history else history[-1] if len(history) == 1
-                     else 2.0 * history[-1] - history[-2])
-            x, k, converged = self._iterate(apply, b, start, self._factor, self.rtol,
-                                            self.max_iterations)
-            self.iterations += k
-            if converged:
-                self._history = history[-1:] + [x]
-                return x
-        self._factor, self._iterate = factorisation(matrix())
-        self.factorisations += 1
-        x = self._factor(b)
-        self._history = [x]
-        return x
-
-
-def factorisation(A):
-    """The kept factorisation of ``A`` (n, n) sparse and the iteration that goes with it.
-
-    Returns
-    -------
-    solve : callable (n,) -> (n,)
-        ``b -> A^{-1} b``: sparse Cholesky (:func:`cholesky_solve`) where ``A`` is
-        symmetric (to 1e-12 relative, infinity norm) and positive definite, else
-        sparse LU (SuperLU, COLAMD ordering).
-    iterate : callable
-        :func:`preconditioned_cg` with the Cholesky factor, else
-        :func:`iterative_refinement`.
-    """
-    A = sp.csr_matrix(A)
-    if spla.norm(A - A.T, np.inf) <= 1e-12 * spla.norm(A, np.inf):
-        solve = cholesky_solve(A)
-        if solve is not None:
-            return solve, preconditioned_cg
-    return spla.splu(sp.csc_matrix(A)).solve, iterative_refinement
-
-
-def pinned_matrix(L, keep):
-    """``P L P + I - P`` (n, n) CSR, ``P = diag(keep)`` (``keep`` 1, 0 at the pinned
-    entries): ``L`` with the rows and columns of the pinned entries replaced by
-    those of the identity (symmetric when ``L`` is)."""
-    P = sp.diags(keep)
-    return (P @ sp.csr_matrix(L) @ P + sp.diags(1.0 - keep)).tocsr()
 
 
 def solve_potential(L, mass, f):

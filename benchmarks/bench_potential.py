@@ -117,7 +117,7 @@ def step_cost(scheme, level, steps):
 def recorded_systems(level, steps):
     """``(A, b)`` of the pinned potential systems of the first ``steps`` steps of
     ``cotan-redistribute`` on the sphere at ``level`` (as ``PotentialSolver`` forms them)."""
-    from baselines.redistribution import pinned_matrix
+    from kept_factor import pinned
 
     sphere = get_problem("sphere")
     V, F = icosphere(level)
@@ -129,7 +129,7 @@ def recorded_systems(level, steps):
         b -= b.mean()
         keep = np.ones(len(b))
         keep[0] = b[0] = 0.0
-        systems.append((pinned_matrix(L, keep), b))
+        systems.append((pinned(L, keep)[1](), b))
         return solver(L, mass, f)
     flow._potential_solver = record
     simulate(flow, steps, solver=Solver(), save_every=0)
@@ -137,26 +137,26 @@ def recorded_systems(level, steps):
 
 
 def candidates():
-    """name -> ``(factorise, iterate, extrapolate, max_iterations)``."""
+    """name -> ``(factorise, extrapolate, max_iterations)``, ``factorise: A -> (method,
+    solve)`` as :func:`kept_factor.factorise` (``solve`` exact or a preconditioner)."""
     import scipy.sparse as sp
     import scipy.sparse.linalg as spla
 
-    from baselines.redistribution import (cholesky_solve, iterative_refinement,
-                                          preconditioned_cg)
+    from kept_factor import cholesky_solve
 
-    def lu(A):
-        return spla.splu(sp.csc_matrix(A)).solve
+    def lu(method):
+        return lambda A: (method, spla.splu(sp.csc_matrix(A)).solve)
 
     def jacobi(A):
         inverse = 1.0 / A.diagonal()
-        return lambda r: inverse * r
+        return "cg", lambda r: inverse * r
 
-    found = {"LU kept + refinement (before)": (lu, iterative_refinement, False, 6),
-             "LU kept + CG, extrapolated": (lu, preconditioned_cg, True, 4),
-             "Cholesky kept + CG": (cholesky_solve, preconditioned_cg, False, 4),
-             "Cholesky kept + CG, extrapolated (after)": (cholesky_solve, preconditioned_cg,
+    found = {"LU kept + refinement (before)": (lu("refinement"), False, 6),
+             "LU kept + CG, extrapolated": (lu("cg"), True, 4),
+             "Cholesky kept + CG": (lambda A: ("cg", cholesky_solve(A)), False, 4),
+             "Cholesky kept + CG, extrapolated (after)": (lambda A: ("cg", cholesky_solve(A)),
                                                           True, 4),
-             "Jacobi + CG, extrapolated": (jacobi, preconditioned_cg, True, 5000)}
+             "Jacobi + CG, extrapolated": (jacobi, True, 5000)}
     try:
         import pyamg
     except ImportError:
@@ -165,32 +165,27 @@ def candidates():
 
     def amg(A):
         hierarchy = pyamg.smoothed_aggregation_solver(sp.csr_matrix(A), symmetry="hermitian")
-        return hierarchy.aspreconditioner(cycle="V").matvec
-    found[f"AMG (pyamg {pyamg.__version__} SA) kept + CG, extrapolated"] = (
-        amg, preconditioned_cg, True, 100)
+        return "cg", hierarchy.aspreconditioner(cycle="V").matvec
+    found[f"AMG (pyamg {pyamg.__version__} SA) kept + CG, extrapolated"] = (amg, True, 100)
     return found
 
 
-def solve_sequence(systems, factorise, iterate, extrapolate, max_iterations, rtol=1e-7):
+def solve_sequence(systems, factorise, extrapolate, max_iterations, rtol=1e-7):
     """``(first ms, ms per later solve, iterations per later solve, largest relative
-    difference to a direct solve)`` of the systems solved in sequence."""
+    difference to a direct solve)`` of the systems solved in sequence by a
+    :class:`kept_factor.KeptFactorSolver` (from the last solution, or the extrapolation
+    of the last two)."""
     import scipy.sparse.linalg as spla
 
-    times, iterations, history, factor, worst = [], [], [], None, 0.0
+    from kept_factor import KeptFactorSolver
+
+    solver = KeptFactorSolver(rtol, max_iterations, factorise)
+    times, iterations, x, worst = [], [], None, 0.0
     for A, b in systems:
-        clock = time.process_time()
-        x, k = None, 0
-        if factor is not None:
-            start = (2.0 * history[-1] - history[-2] if extrapolate and len(history) == 2
-                     else history[-1])
-            x, k, converged = iterate(A.dot, b, start, factor, rtol, max_iterations)
-            x = x if converged else None
-        if x is None:
-            factor = factorise(A)
-            x, k, _ = iterate(A.dot, b, factor(b), factor, rtol, max_iterations)
+        clock, done = time.process_time(), solver.iterations
+        x = solver.solve(b, A.dot, A, start=None if extrapolate else x, sequence="x")
         times.append(time.process_time() - clock)
-        iterations.append(k)
-        history = history[-1:] + [x]
+        iterations.append(solver.iterations - done)
         exact = spla.spsolve(A.tocsc(), b)
         worst = max(worst, float(np.linalg.norm(x - exact) / np.linalg.norm(exact)))
     return 1e3 * times[0], 1e3 * median(times[1:]), float(np.mean(iterations[1:])), worst
@@ -203,8 +198,8 @@ def choose_solver(level, steps):
           f"{len(systems)} systems in sequence; CPU ms")
     print(f"{'solver':52s} {'first':>8s} {'per solve':>10s} {'iterations':>11s} "
           f"{'vs direct':>10s}")
-    for name, (factorise, iterate, extrapolate, cap) in candidates().items():
-        first, per, its, worst = solve_sequence(systems, factorise, iterate, extrapolate, cap)
+    for name, (factorise, extrapolate, cap) in candidates().items():
+        first, per, its, worst = solve_sequence(systems, factorise, extrapolate, cap)
         print(f"{name:52s} {first:8.1f} {per:10.2f} {its:11.2f} {worst:10.1e}")
     print("iterations: of the kept factor or preconditioner on the later systems (LU "
           "refinement: passes); vs direct: largest |x - x_direct| / |x_direct|.")

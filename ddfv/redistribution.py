@@ -117,8 +117,8 @@ applied at the end of the step (see ``ddfv/README.md``).
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
-from scipy.sparse.linalg import splu
+
+from kept_factor import KeptFactorSolver, pinned
 
 from .assembly import flux_coefficients
 
@@ -210,7 +210,7 @@ def redistribution_source(chi, hV, n_f, fixed=None, omega=OMEGA):
     return chi * hV + omega * (target - chi)
 
 
-class TangentialPotential:
+class TangentialPotential(KeptFactorSolver):
     """Solver of (R3) along a flow: ``K psi = -s``, its two free constants fixed.
 
     The F-rows and the T-rows of ``K`` each sum to zero, so ``K`` has a
@@ -224,25 +224,23 @@ class TangentialPotential:
     T-values are on average those of their triangles.
 
     F-vertex 0 and T-vertex 0 are pinned: ``A = P K P + I - P`` (``P``
-    zeroes those two entries; :func:`pinned_matrix`), symmetric positive
+    zeroes those two entries; :func:`kept_factor.pinned`), symmetric positive
     definite where ``K`` is symmetric (the chord ``|gamma|`` on a closed
-    surface), and ``A x = b`` with ``b = 0`` at the pinned entries. ``A`` is
-    factorised (:func:`factorisation`: sparse Cholesky where symmetric
-    positive definite, else sparse LU with the ordering of ``A + A^T``) and
-    the factor is kept: the next systems, whose geometry moved by ``O(tau)``,
-    are solved with the kept factor, by preconditioned conjugate gradients
-    (Cholesky) or iterative refinement (LU), from the linear extrapolation
-    ``2 x^{n-1} - x^{n-2}`` of the last two solutions, until ``|b - A x| <=
-    rtol |b|``; when that takes more than ``max_iterations`` ``A`` is
-    factorised again. Measured at level 5 of the sphere (30 722 unknowns,
+    surface), and ``A x = b`` with ``b = 0`` at the pinned entries. The
+    systems of a flow, whose geometry moves by ``O(tau)`` a step, are solved
+    with a kept factorisation (:class:`kept_factor.KeptFactorSolver`: sparse
+    Cholesky and conjugate gradients where ``A`` is symmetric positive
+    definite, else sparse LU and iterative refinement, from the linear
+    extrapolation ``2 x^{n-1} - x^{n-2}`` of the last two solutions, until
+    ``|b - A x| <= rtol |b|``, factorised again when that takes more than
+    ``max_iterations``). Measured at level 5 of the sphere (30 722 unknowns,
     ``benchmarks/bench_potential.py``): the Cholesky solve is 0.55 x the
     LU's. One solve for a particular solution and, on a surface with
     boundary, one for the kernel vector ``w`` (``w_F0 = 0``, ``w_T0 = 1``:
     ``w = e_T0 + y``, ``A y = -P K e_T0``; on a closed surface ``w`` is 1 on
     the T-vertices, 0 on the F-vertices). ``psi`` needs no more accuracy
     than the positions' solve: any tangential velocity leaves the shape
-    alone. (The helpers repeat those of ``baselines.redistribution``, which
-    this package may not import.)
+    alone.
 
     Parameters
     ----------
@@ -255,32 +253,10 @@ class TangentialPotential:
     """
 
     def __init__(self, mesh, rtol=1e-7, max_iterations=4):
-        self.mesh, self.rtol, self.max_iterations = mesh, rtol, max_iterations
-        n, n_f = mesh.n_unknowns, mesh.n_f
-        self._keep = np.ones(n)
-        self._keep[[0, n_f]] = 0.0
-        self._factor = self._iterate = None
-        self._history = {"psi": [], "w": []}        # the last two solutions of each
-        #: number of factorisations and of iterations with a kept factor so far
-        self.factorisations = self.iterations = 0
-
-    def _solve(self, apply, matrix, b, name):
-        """``A x = b`` with the kept factor from the extrapolated start, else factorised."""
-        history = self._history[name]
-        if self._factor is not None:
-            start = (self._factor(b) if not history else history[-1] if len(history) == 1
-                     else 2.0 * history[-1] - history[-2])
-            x, k, converged = self._iterate(apply, b, start, self._factor, self.rtol,
-                                            self.max_iterations)
-            self.iterations += k
-            if converged:
-                self._history[name] = history[-1:] + [x]
-                return x
-        self._factor, self._iterate = factorisation(matrix())
-        self.factorisations += 1
-        x = self._factor(b)
-        self._history[name] = [x]
-        return x
+        super().__init__(rtol, max_iterations)
+        self.mesh = mesh
+        self._keep = np.ones(mesh.n_unknowns)
+        self._keep[[0, mesh.n_f]] = 0.0
 
     def __call__(self, K, source, chi):
         """``psi`` with ``K psi = -source`` (:func:`neumann_stiffness`,
@@ -293,14 +269,8 @@ class TangentialPotential:
         """
         n_f, faces, keep = self.mesh.n_f, self.mesh.faces, self._keep
         K = sp.csr_matrix(K)
-
-        def apply(x):                                  # A x = P K P x + (I - P) x
-            return keep * (K @ (keep * x)) + (1.0 - keep) * x
-
-        def matrix():
-            return pinned_matrix(K, keep)
-
-        psi = self._solve(apply, matrix, -np.asarray(source, dtype=float) * keep, "psi")
+        system = pinned(K, keep)
+        psi = self.solve(-np.asarray(source, dtype=float) * keep, *system, sequence="psi")
 
         def offset(x):      # sum_t chi_t (x_t - mean of x over the corners of t)
             return np.dot(chi[n_f:], x[n_f:] - x[faces].mean(axis=1))
@@ -309,94 +279,8 @@ class TangentialPotential:
             return np.r_[psi[:n_f], psi[n_f:] - offset(psi) / chi[n_f:].sum()]
         e = np.zeros(len(keep))
         e[n_f] = 1.0
-        w = e + self._solve(apply, matrix, -keep * (K @ e), "w")
+        w = e + self.solve(-keep * (K @ e), *system, sequence="w")
         return psi - offset(psi) / offset(w) * w
-
-
-def cholesky_solve(A):
-    """``b -> A^{-1} b`` by the sparse Cholesky factorisation of ``A`` (symmetric,
-    (n, n) sparse; one triangle is read): CHOLMOD's, with its own fill-reducing
-    ordering, through ``cholespy`` (which ships it); None when ``A`` is not
-    numerically positive definite."""
-    from cholespy import CholeskySolverD, MatrixType
-
-    A = sp.csr_matrix(A, dtype=np.float64)
-    A.sum_duplicates()
-    try:
-        factor = CholeskySolverD(A.shape[0], A.indptr.astype(np.int32),
-                                 A.indices.astype(np.int32), A.data, MatrixType.CSR)
-    except ValueError:                               # not positive definite
-        return None
-
-    def solve(b):
-        x = np.empty(len(b))
-        factor.solve(np.ascontiguousarray(b, dtype=np.float64), x)
-        return x
-    return solve
-
-
-def factorisation(A):
-    """``(solve, iterate)``: the kept factorisation of ``A`` (n, n) sparse, sparse
-    Cholesky (:func:`cholesky_solve`) where ``A`` is symmetric (to 1e-12 relative,
-    infinity norm) and positive definite, with :func:`preconditioned_cg`; else
-    sparse LU (SuperLU, ordering of ``A + A^T``) with :func:`iterative_refinement`."""
-    A = sp.csr_matrix(A)
-    if spla.norm(A - A.T, np.inf) <= 1e-12 * spla.norm(A, np.inf):
-        solve = cholesky_solve(A)
-        if solve is not None:
-            return solve, preconditioned_cg
-    return splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A").solve, iterative_refinement
-
-
-def preconditioned_cg(apply, b, x, precondition, rtol, max_iterations):
-    """Conjugate gradients for ``A x = b`` from ``x`` (n,), ``apply: x -> A x`` and
-    ``precondition: r -> P^{-1} r`` symmetric positive definite, until
-    ``|b - A x| <= rtol |b|`` (recursive residual) or ``max_iterations``.
-
-    Returns
-    -------
-    x : (n,) float array
-    iterations : int
-    converged : bool
-    """
-    r = b - apply(x)
-    tol = rtol * np.linalg.norm(b)
-    if np.linalg.norm(r) <= tol:
-        return x, 0, True
-    z = precondition(r)
-    p, rz = z, r @ z
-    for k in range(1, max_iterations + 1):
-        q = apply(p)
-        a = rz / (p @ q)
-        x, r = x + a * p, r - a * q
-        if np.linalg.norm(r) <= tol:
-            return x, k, True
-        z = precondition(r)
-        rz, rz_old = r @ z, rz
-        p = z + (rz / rz_old) * p
-    return x, max_iterations, False
-
-
-def iterative_refinement(apply, b, x, precondition, rtol, max_iterations):
-    """``x <- x + P^{-1} (b - A x)`` until ``|b - A x| <= rtol |b|``: the stationary
-    iteration of a kept factorisation ``P`` of a nearby matrix (any ``A``); the
-    signature and returns of :func:`preconditioned_cg`."""
-    norm = np.linalg.norm(b)
-    for k in range(max_iterations + 1):
-        r = b - apply(x)
-        if np.linalg.norm(r) <= rtol * norm:
-            return x, k, True
-        if k < max_iterations:
-            x = x + precondition(r)
-    return x, max_iterations, False
-
-
-def pinned_matrix(K, keep):
-    """``P K P + I - P`` (n, n) CSR, ``P = diag(keep)`` (``keep`` 1, 0 at the pinned
-    entries): ``K`` with the rows and columns of the pinned entries replaced by
-    those of the identity (symmetric when ``K`` is)."""
-    P = sp.diags(keep)
-    return (P @ sp.csr_matrix(K) @ P + sp.diags(1.0 - keep)).tocsr()
 
 
 def tangential_potential(K, source, mesh, chi):

@@ -60,7 +60,8 @@ angle for the height, ``height x sin`` for the projection).
 import igl
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
+
+from kept_factor import KeptFactorSolver
 
 KINDS = ("bgn", "mdr")
 """The tangential motions: ``"bgn"`` (the new surface's Dirichlet energy) and ``"mdr"``
@@ -109,15 +110,16 @@ def tangent_bases(N):
     return t1, t2
 
 
-class TangentialMotion:
-    """(TM1)-(TM3) along a flow, the factors of (TM2) kept from step to step.
+class TangentialMotion(KeptFactorSolver):
+    """(TM1)-(TM3) along a flow, the factor of (TM2) kept from step to step.
 
-    (TM2) changes by ``O(tau)`` from one step to the next, so it is solved by
-    iterative refinement with the sparse LU of an earlier step's matrix,
-    ``s <- s + LU^{-1} (b - S s)`` from ``LU^{-1} b``, until
-    ``|b - S s| <= rtol |b|``; when that takes more than ``max_refinements``
-    passes, ``S`` is factorised again (SuperLU, symmetric mode, minimum-degree
-    ordering of ``S + S^T``). The unknowns are interleaved, ``(k, a) -> 2 k + a``,
+    (TM2) changes by ``O(tau)`` from one step to the next, so it is solved with
+    the factorisation of an earlier step's matrix
+    (:class:`kept_factor.KeptFactorSolver`: sparse Cholesky and conjugate
+    gradients, ``S`` being symmetric positive definite; sparse LU and iterative
+    refinement otherwise), from ``S_old^{-1} b``, until ``|b - S s| <= rtol
+    |b|``; when that takes more than ``max_iterations``, ``S`` is factorised
+    again. The unknowns are interleaved, ``(k, a) -> 2 k + a``,
     so that ``S`` has the band of ``A`` in the caller's numbering. For the kept
     factors to fit the next matrix, the tangent bases follow the normals: each
     step's ``t1`` is the last one projected on the new tangent plane (a basis
@@ -133,24 +135,23 @@ class TangentialMotion:
     fixed : (n,) bool array, optional
         Vertices that do not move (Dirichlet); default none.
     rtol : float
-        Relative residual of the refinement.
-    max_refinements : int
+        Relative residual of each solve.
+    max_iterations : int
 
     Attributes
     ----------
-    factorisations, refinements : int
-        Factorisations and refinement passes so far.
+    factorisations, iterations : int
+        Factorisations and iterations with a kept factor so far.
     """
 
-    def __init__(self, faces, kind, fixed=None, rtol=1e-12, max_refinements=6):
+    def __init__(self, faces, kind, fixed=None, rtol=1e-12, max_iterations=6):
         if kind not in KINDS:
             raise ValueError(f"unknown tangential motion {kind!r}; choose one of "
                              f"{', '.join(KINDS)}")
+        super().__init__(rtol, max_iterations)
         self.faces, self.kind = faces, kind
         self.fixed = None if fixed is None else np.asarray(fixed, bool)
-        self.rtol, self.max_refinements = rtol, max_refinements
-        self._lu = self._t1 = None
-        self.factorisations = self.refinements = 0
+        self._t1 = None
 
     def __call__(self, F_old, F_new, N):
         """The F-vertices of (TM1): ``F_new`` moved in the tangent planes of ``N``.
@@ -186,7 +187,7 @@ class TangentialMotion:
         S = sp.csc_matrix((np.concatenate(values),
                            (np.concatenate(rows), np.concatenate(cols))), shape=(m, m))
         r = np.stack([np.einsum("ij,ij->i", ta, AY) for ta in bases], axis=1).ravel()
-        s = self._solve(S, -r)
+        s = self.solve(-r, S.dot, S)
         X = F_new.copy()
         X[free] += s[0::2, None] * bases[0] + s[1::2, None] * bases[1]
         return X
@@ -202,20 +203,6 @@ class TangentialMotion:
             t1 = np.where(length > 0.5, t1 / np.where(length > 0.5, length, 1.0), fresh)
         self._t1 = t1
         return t1, np.cross(N, t1)
-
-    def _solve(self, S, b):
-        """``S^{-1} b`` by refinement with the kept factors, or a new factorisation."""
-        if self._lu is not None and self._lu.shape == S.shape:
-            x, norm = self._lu.solve(b), np.linalg.norm(b)
-            for _ in range(self.max_refinements):
-                residual = b - S @ x
-                if np.linalg.norm(residual) <= self.rtol * norm:
-                    return x
-                x += self._lu.solve(residual)
-                self.refinements += 1
-        self._lu = splu(S, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
-        self.factorisations += 1
-        return self._lu.solve(b)
 
 
 def tangential_motion(F_old, F_new, faces, N, kind, fixed=None):

@@ -18,7 +18,7 @@ import sys
 from importlib import metadata
 from pathlib import Path
 
-SOURCE_PACKAGES = ("ddfv", "baselines", "mcfbench")
+SOURCE_PACKAGES = ("ddfv", "baselines", "kept_factor", "mcfbench")
 DISTRIBUTION = "ddfv-mcf"
 BLAS_THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 

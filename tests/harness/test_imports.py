@@ -1,6 +1,8 @@
-"""Imports flow one way: workflow -> mcfbench -> {ddfv, baselines}.
+"""Imports flow one way: workflow -> mcfbench -> {ddfv, baselines} -> kept_factor.
 
-The scheme packages import neither the harness nor each other; ``import
+The scheme packages import neither the harness nor each other; what they
+share (the kept factorisation of a sequence of nearby sparse systems) is
+``kept_factor``, which imports numpy, scipy and cholespy only. ``import
 ddfv`` changes nothing process-wide (no malloc tuning, no threads).
 """
 
@@ -12,7 +14,8 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-FORBIDDEN = {"ddfv": ("mcfbench", "baselines"), "baselines": ("mcfbench", "ddfv")}
+FORBIDDEN = {"ddfv": ("mcfbench", "baselines"), "baselines": ("mcfbench", "ddfv"),
+             "kept_factor": ("mcfbench", "ddfv", "baselines")}
 
 
 def _imported_tops(path):
@@ -35,6 +38,13 @@ def test_scheme_packages_do_not_import_the_harness_or_each_other(package):
         if bad:
             offending[str(path.relative_to(ROOT))] = sorted(bad)
     assert offending == {}
+
+
+def test_kept_factor_imports_numpy_scipy_and_cholespy_only():
+    imported = {str(path.relative_to(ROOT)): sorted(_imported_tops(path))
+                for path in sorted((ROOT / "kept_factor").rglob("*.py"))}
+    assert imported and all(set(names) <= {"numpy", "scipy", "cholespy"}
+                            for names in imported.values()), imported
 
 
 @pytest.mark.parametrize("package", sorted(FORBIDDEN))

@@ -18,7 +18,7 @@ ROOT = Path(__file__).resolve().parents[2]
 def test_provenance_names_code_dependencies_and_settings():
     p = provenance({"level": 3})
     assert p["config"] == {"level": 3} and p["config_hash"] == config_hash({"level": 3})
-    assert set(p["source_hash"]) == {"ddfv", "baselines", "mcfbench"}
+    assert set(p["source_hash"]) == {"ddfv", "baselines", "kept_factor", "mcfbench"}
     assert all(len(h) == 16 for h in p["source_hash"].values())
     for name in ("numpy", "scipy", "libigl", "snakemake", "numba"):
         assert name in p["packages"], name

@@ -1,0 +1,220 @@
+"""``A_k x_k = b_k`` for a sequence of nearby sparse matrices ``A_k``, one factorisation kept.
+
+Along a flow the matrix of a step moves by ``O(tau)`` from the last one's, so
+the factorisation ``P`` of an earlier ``A`` is a preconditioner for which
+``P^{-1} A`` is within ``O(tau)`` of the identity: started from a good guess,
+a few iterations reach the tolerance at the cost of a few triangular solves,
+against a new factorisation (tens of solves' worth). The factorisation is
+sparse Cholesky (CHOLMOD, through ``cholespy``) where ``A`` is symmetric
+positive definite, with conjugate gradients (``scipy.sparse.linalg.cg``,
+``M`` the kept factor's solve); else sparse LU (SuperLU, ordering of ``A +
+A^T``) with iterative refinement ``x <- x + P^{-1} (b - A x)``. The iteration
+stops at ``|b - A x| <= rtol |b|``; when it takes more than
+``max_iterations``, ``A`` is factorised anew.
+
+GMRES (``scipy.sparse.linalg.gmres``) instead of the refinement was not taken:
+it is left-preconditioned and spends one more factor solve per call on
+``|P^{-1} b|`` for its inner tolerance, while the refinement of a nearby
+factor needs one or two solves (``P^{-1} A`` is within ``O(tau)`` of ``I``).
+"""
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+#: relative asymmetry ``|A - A^T|_inf / |A|_inf`` below which ``A`` counts as symmetric
+SYMMETRY = 1e-12
+
+
+def cholesky_solve(A):
+    """``b -> A^{-1} b`` by the sparse Cholesky factorisation of ``A``, or None.
+
+    CHOLMOD's supernodal factorisation with its own fill-reducing ordering,
+    through ``cholespy`` (which ships it: no system library).
+
+    Parameters
+    ----------
+    A : (n, n) sparse matrix
+        Symmetric (one triangle is read).
+
+    Returns
+    -------
+    callable or None
+        ``solve(b)`` for (n,) ``b``; None when ``A`` is not numerically
+        positive definite.
+    """
+    from cholespy import CholeskySolverD, MatrixType
+
+    A = sp.csr_matrix(A, dtype=np.float64)
+    A.sum_duplicates()
+    try:
+        factor = CholeskySolverD(A.shape[0], A.indptr.astype(np.int32),
+                                 A.indices.astype(np.int32), A.data, MatrixType.CSR)
+    except ValueError:                                   # not positive definite
+        return None
+
+    def solve(b):
+        x = np.empty(len(b))
+        factor.solve(np.ascontiguousarray(b, dtype=np.float64), x)
+        return x
+    return solve
+
+
+def factorise(A):
+    """``(method, solve)``: the factorisation of ``A`` (n, n) sparse and its iteration.
+
+    Returns
+    -------
+    method : {"cg", "refinement"}
+        ``"cg"``: sparse Cholesky (:func:`cholesky_solve`), where ``A`` is
+        symmetric (to :data:`SYMMETRY`, infinity norm) and positive definite,
+        kept with conjugate gradients; ``"refinement"``: else sparse LU (SuperLU,
+        minimum degree ordering of ``A + A^T``), kept with iterative refinement.
+    solve : callable (n,) -> (n,)
+        ``b -> A^{-1} b``.
+    """
+    A = sp.csr_matrix(A)
+    if spla.norm(A - A.T, np.inf) <= SYMMETRY * spla.norm(A, np.inf):
+        solve = cholesky_solve(A)
+        if solve is not None:
+            return "cg", solve
+    return "refinement", spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A").solve
+
+
+def pinned(K, keep):
+    """The pinned system ``A = P K P + I - P``, ``P = diag(keep)``, as ``(apply, matrix)``.
+
+    ``K`` with the rows and columns of the pinned entries (``keep`` 0 there, 1
+    elsewhere) replaced by those of the identity: symmetric when ``K`` is, and
+    positive definite when ``K`` is positive semi-definite with a kernel that
+    no vector vanishing at the pinned entries meets (a Laplacian pinned once
+    per kernel constant).
+
+    Parameters
+    ----------
+    K : (n, n) sparse matrix
+    keep : (n,) float array
+
+    Returns
+    -------
+    apply : callable (n,) -> (n,)
+        ``x -> A x`` without forming ``A``.
+    matrix : callable () -> (n, n) scipy.sparse.csr_matrix
+        ``A``.
+    """
+    K = sp.csr_matrix(K)
+
+    def apply(x):
+        return keep * (K @ (keep * x)) + (1.0 - keep) * x
+
+    def matrix():
+        P = sp.diags(keep)
+        return (P @ K @ P + sp.diags(1.0 - keep)).tocsr()
+    return apply, matrix
+
+
+class KeptFactorSolver:
+    """Solver of a sequence of nearby sparse systems ``A_k x = b_k`` with a kept factor.
+
+    Each system is solved with the factorisation ``P`` of an earlier matrix of
+    the sequence (``factorise``, default :func:`factorise`), iterated from a
+    start until ``|b - A x| <= rtol |b|``: the caller's start, else, for a named
+    sequence of solutions, the linear extrapolation ``2 x_{k-1} - x_{k-2}`` of its
+    last two (the last one alone after one), else ``P^{-1} b``. When that takes
+    more than ``max_iterations`` (or the size changed), ``A`` is factorised and
+    the iteration runs from ``P^{-1} b`` of the new factor (for an exact
+    factorisation one residual check).
+
+    Parameters
+    ----------
+    rtol : float
+        Relative residual of every solve.
+    max_iterations : int
+        Iterations with a kept factor before factorising anew.
+    factorise : callable
+        ``A -> (method, solve)``, default :func:`factorise`; ``solve`` may be an
+        approximate inverse (a preconditioner), symmetric positive definite for
+        ``"cg"``.
+
+    Attributes
+    ----------
+    factorisations, iterations : int
+        Factorisations and iterations so far.
+    method : {"cg", "refinement"} or None
+        The iteration of the kept factor (None before the first).
+    """
+
+    def __init__(self, rtol=1e-7, max_iterations=4, factorise=factorise):
+        self.rtol, self.max_iterations = rtol, max_iterations
+        self._factorise = factorise
+        self.factorisations = self.iterations = 0
+        self.method = self._factor = None
+        self._history = {}                              # sequence -> its last two solutions
+
+    def solve(self, b, apply, matrix, start=None, sequence=None):
+        """``x`` (n,) with ``|b - A x| <= rtol |b|``.
+
+        Parameters
+        ----------
+        b : (n,) float array
+        apply : callable (n,) -> (n,)
+            ``x -> A x``.
+        matrix : (n, n) sparse matrix or callable () -> (n, n) sparse matrix
+            ``A`` itself, asked for only when it is factorised.
+        start : (n,) float array, optional
+            The first iterate with a kept factor; default the extrapolation of
+            ``sequence``.
+        sequence : hashable, optional
+            Name of the sequence of solutions ``x`` belongs to (its last two are
+            kept for the next start).
+
+        Returns
+        -------
+        (n,) float array
+        """
+        b = np.asarray(b, dtype=float)
+        history = [x for x in self._history.get(sequence, []) if len(x) == len(b)]
+        converged = False
+        if self._factor is not None and self._factor[1] == len(b):
+            if start is None:
+                start = (history[-1] if len(history) == 1 else
+                         2.0 * history[-1] - history[-2] if history else None)
+            x, converged = self._iterate(apply, b, start)
+        if not converged:
+            self.method, solve = self._factorise(matrix() if callable(matrix) else matrix)
+            self._factor = solve, len(b)
+            self.factorisations += 1
+            x, _ = self._iterate(apply, b, None)
+            history = []
+        if sequence is not None:
+            self._history[sequence] = history[-1:] + [x]
+        return x
+
+    def _iterate(self, apply, b, start):
+        """``(x, converged)`` from ``start`` (None: ``P^{-1} b``) with the kept factor
+        ``P``: CG preconditioned by ``P`` or iterative refinement, at most
+        ``max_iterations``."""
+        solve, n = self._factor
+        x = solve(b) if start is None else np.array(start, dtype=float)
+        tol = self.rtol * np.linalg.norm(b)
+        if self.method == "cg":
+            count = [0]
+
+            def counted(_):
+                count[0] += 1
+            x, info = spla.cg(spla.LinearOperator((n, n), matvec=apply, dtype=float), b, x,
+                              rtol=0.0, atol=tol, maxiter=self.max_iterations,
+                              M=spla.LinearOperator((n, n), matvec=solve, dtype=float),
+                              callback=counted)
+            self.iterations += count[0]
+            # cg checks the residual before each iteration: after the last one, here
+            return x, info == 0 or np.linalg.norm(b - apply(x)) <= tol
+        for k in range(self.max_iterations + 1):         # refinement
+            r = b - apply(x)
+            if np.linalg.norm(r) <= tol:
+                self.iterations += k
+                return x, True
+            if k < self.max_iterations:
+                x = x + solve(r)
+        self.iterations += self.max_iterations
+        return x, False

@@ -1,0 +1,118 @@
+"""A sequence of nearby sparse systems with a kept factorisation (kept_factor/nearby_systems.py).
+
+The systems are ``(I + L_k) x = b_k``, ``L_k`` the cotangent stiffness of an
+icosphere moved a little further at every step: solved to ``rtol`` against a
+direct solve, with one factorisation while the matrices stay near and a new one
+when they jump; the nonsymmetric fallback; the extrapolated start.
+"""
+
+import igl
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from kept_factor import KeptFactorSolver, cholesky_solve, factorise, pinned
+from mcfbench.geometry.spheres import icosphere
+
+V, F = icosphere(2)
+BUMP = np.random.default_rng(0).standard_normal(V.shape)
+
+
+def _matrix(k, step=1e-3):
+    """``I + L`` of the sphere moved ``k step`` along a fixed random field, (n, n) CSR."""
+    L = -igl.cotmatrix(V + k * step * BUMP, F)
+    return sp.csr_matrix(sp.eye(len(V)) + L)
+
+
+def _rhs(k):
+    """A right-hand side that moves smoothly with ``k``: ``(n,)``."""
+    return np.cos(V[:, 0] + 0.01 * k) + V[:, 2] ** 2
+
+
+def _solve(solver, A, b, **options):
+    return solver.solve(b, A.dot, A, **options)
+
+
+def test_slowly_moving_sequence_keeps_one_cholesky_factor():
+    solver = KeptFactorSolver(rtol=1e-10)
+    for k in range(6):
+        A, b = _matrix(k), _rhs(k)
+        x = _solve(solver, A, b, sequence="x")
+        assert np.linalg.norm(b - A @ x) <= 1e-10 * np.linalg.norm(b)
+        np.testing.assert_allclose(x, spla.spsolve(A.tocsc(), b), rtol=0, atol=1e-9)
+    assert (solver.factorisations, solver.method) == (1, "cg")
+    assert 5 <= solver.iterations <= 5 * solver.max_iterations
+
+
+def test_a_jump_of_the_matrix_factorises_again():
+    """The matrix of a sphere moved by 0.3 (a third of the radius) is too far from
+    the kept one for four CG iterations: a second factorisation, then kept again."""
+    solver = KeptFactorSolver(rtol=1e-10)
+    for k in (0, 1, 300, 301):
+        A, b = _matrix(k), _rhs(k)
+        x = _solve(solver, A, b)
+        assert np.linalg.norm(b - A @ x) <= 1e-10 * np.linalg.norm(b)
+    assert solver.factorisations == 2
+
+
+def test_nonsymmetric_or_indefinite_matrices_get_lu_and_refinement():
+    """A nonsymmetric matrix (an upwind term) and a symmetric negative definite one
+    get a sparse LU; the refinement solves the nearby nonsymmetric sequence."""
+    A = _matrix(0)
+    upwind = (A + sp.diags(0.1 * np.ones(len(V) - 1), 1)).tocsr()
+    b = _rhs(0)
+    for matrix, method in ((A, "cg"), (upwind, "refinement"),
+                           (-A, "refinement")):
+        found, solve = factorise(matrix)
+        assert found == method
+        assert np.linalg.norm(matrix @ solve(b) - b) < 1e-12 * np.linalg.norm(b)
+    assert cholesky_solve(-A) is None
+    solver = KeptFactorSolver(rtol=1e-10)
+    for k in range(4):
+        M = (_matrix(k) + sp.diags(0.1 * np.ones(len(V) - 1), 1)).tocsr()
+        x = _solve(solver, M, _rhs(k), sequence="x")
+        assert np.linalg.norm(_rhs(k) - M @ x) <= 1e-10 * np.linalg.norm(_rhs(k))
+    assert (solver.factorisations, solver.method) == (1, "refinement")
+    assert solver.iterations >= 3
+
+
+def test_extrapolated_start():
+    """With the matrix kept fixed and ``b_k`` affine in ``k``, ``x_k`` is affine
+    in ``k`` too: from the third solve on the extrapolation of the last two is the
+    solution, and no iteration is needed; the caller's start overrides it."""
+    A = _matrix(0)
+    solver = KeptFactorSolver(rtol=1e-9)
+    b0, b1 = _rhs(0), V[:, 1]
+    for k in range(4):
+        _solve(solver, A, b0 + k * b1, sequence="x")
+        _solve(solver, A, np.ones(len(V)), sequence="other")   # a second sequence
+    assert solver.factorisations == 1
+    before = solver.iterations
+    x = _solve(solver, A, b0 + 4 * b1, sequence="x")
+    assert solver.iterations == before
+    np.testing.assert_allclose(x, spla.spsolve(A.tocsc(), b0 + 4 * b1), atol=1e-8)
+    _solve(solver, A, b0, start=np.zeros(len(V)))           # a far start: iterations
+    assert solver.iterations > before
+
+
+def test_size_change_factorises_again():
+    solver = KeptFactorSolver()
+    _solve(solver, _matrix(0), _rhs(0), sequence="x")
+    A = sp.eye(5, format="csr") * 2.0
+    np.testing.assert_allclose(_solve(solver, A, np.ones(5), sequence="x"), 0.5)
+    assert solver.factorisations == 2
+
+
+def test_pinned_system():
+    """``P K P + I - P``: ``apply`` and ``matrix`` agree, and a Laplacian pinned at
+    one vertex (kernel: the constants) is symmetric positive definite."""
+    K = sp.csr_matrix(-igl.cotmatrix(V, F))
+    keep = np.ones(len(V))
+    keep[3] = 0.0
+    apply, matrix = pinned(K, keep)
+    x = np.random.default_rng(1).standard_normal(len(V))
+    A = matrix()
+    np.testing.assert_allclose(apply(x), A @ x, atol=1e-14)
+    assert A[3, 3] == 1.0 and A[3].nnz == 1 and A[:, 3].nnz == 1
+    assert factorise(A)[0] == "cg"
+
