@@ -137,7 +137,7 @@ def test_provenance(workdir, table):
     assert record["provenance"]["blas_threads"] == dict.fromkeys(BLAS_THREAD_VARIABLES, "1")
     assert record["l2_error"] == table.set_index(["scheme", "level"]).loc[
         ("cotan", 2), "l2_error"]
-    assert record["settings"]["code"].keys() == {"ddfv", "baselines", "mcfbench"}
+    assert record["settings"]["code"].keys() == {"ddfv", "baselines", "kept_factor", "mcfbench"}
     assert len(record["series"]["t_min_barycentric"]) == record["N"] + 1
     assert record["wall_seconds"] > 0 and record["peak_rss_mb"] > 10   # the job's peak, MB
     assert record["checksum"] == checksum(record)
