@@ -14,6 +14,10 @@ from mcfbench.storage.frames import surface_points  # noqa: E402
 DIAMONDS_UP_TO = 1500
 """Draw the DDFV diamond mesh (T-vertices) of meshes with at most this many triangles."""
 
+PANEL_DPI = 120
+"""Resolution of one panel's image: the grid's own (its figures are saved at 120 dpi,
+where the meshes were rasterized before too)."""
+
 
 def frame_surface(frames, which=-1):
     """``(vertices, extra, faces)`` of a saved frame (:func:`surface_points`: ``extra``
@@ -29,8 +33,9 @@ def frame_surface(frames, which=-1):
 def draw_grid(cells, row_labels, col_labels, paths, title, views=None, share="column",
                size=1.9):
     """Draw ``cells[i][j] = (F, T, faces, note)`` or None; one length scale per
-    column (``share="column"``) or per row (``"row"``)."""
-    from mcfbench.presentation.render import draw_mesh, project
+    column (``share="column"``) or per row (``"row"``); each mesh an image
+    (:func:`panel_image`)."""
+    from mcfbench.presentation.render import project
 
     rows, cols = len(row_labels), len(col_labels)
     fig, axes = plt.subplots(rows, cols, figsize=(size * cols + 1.2, size * rows + 0.5),
@@ -75,19 +80,47 @@ def draw_grid(cells, row_labels, col_labels, paths, title, views=None, share="co
             if T is not None and len(faces) > DIAMONDS_UP_TO:
                 T = None  # the diamonds of a fine mesh are a solid colour at this size
             centre, half = scale[group(i, j)]
-            draw_mesh(ax, F, T, faces, view=views[j], points_per_unit=72.0 * size / (2 * half))
-            ax.set_xlim(centre[0] - half, centre[0] + half)
-            ax.set_ylim(centre[1] - half, centre[1] + half)
+            extent = (centre[0] - half, centre[0] + half, centre[1] - half, centre[1] + half)
+            ax.imshow(panel_image(F, T, faces, views[j], extent, size), extent=extent,
+                      interpolation="antialiased")
+            ax.set_xlim(*extent[:2])
+            ax.set_ylim(*extent[2:])
             ax.set_aspect("equal")
             if note:
                 ax.text(0.5, 0.01, note, ha="center", va="bottom", fontsize=SMALLEST_TEXT,
                         transform=ax.transAxes)
     fig.suptitle(title, fontsize=9)
     fig.tight_layout()
-    for ax in fig.axes:
-        for coll in ax.collections:
-            coll.set_rasterized(True)
     save_figure(fig, *paths, dpi=120)
+
+
+def panel_image(F, T, faces, view, extent, size, dpi=PANEL_DPI):
+    """One mesh drawn alone into a ``size`` x ``size`` inch RGBA image covering
+    ``extent`` (x0, x1, y0, y1 in the projected plane), the figure closed at once.
+
+    A grid of hundreds of panels keeps one image each instead of every panel's
+    polygons (the full matrix's 23 x 25 grid of meshes up to 19 000 triangles
+    grew past 16 GB as polygons).
+
+    Returns
+    -------
+    (h, w, 4) uint8 array
+    """
+    from mcfbench.presentation.render import draw_mesh
+
+    fig = plt.figure(figsize=(size, size), dpi=dpi)
+    try:
+        ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
+        ax.set_axis_off()
+        draw_mesh(ax, F, T, faces, view=view,
+                  points_per_unit=72.0 * size / (extent[1] - extent[0]))
+        ax.set_xlim(*extent[:2])
+        ax.set_ylim(*extent[2:])
+        ax.set_aspect("equal")
+        fig.canvas.draw()
+        return np.asarray(fig.canvas.buffer_rgba()).copy()
+    finally:
+        plt.close(fig)
 
 
 def run_note(record):
