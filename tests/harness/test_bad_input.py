@@ -72,7 +72,7 @@ def test_unreferenced_vertices_are_dropped_with_a_note(tmp_path, capsys):
     assert code == 0, err
     assert "dropped 2 unreferenced vertices" in out
     run = np.load(tmp_path / "run.npz")
-    assert run["V"].shape == (3, 42, 3) and run["vertex_map"].tolist() == list(range(42))
+    assert run["vertices"].shape == (3, 42, 3) and run["vertex_map"].tolist() == list(range(42))
 
 
 def test_single_triangle_is_an_open_surface_that_stays_put(tmp_path, capsys):
@@ -81,7 +81,7 @@ def test_single_triangle_is_an_open_surface_that_stays_put(tmp_path, capsys):
     assert code == 0, err
     assert "1 boundary loop" in out
     run = np.load(tmp_path / "run.npz")
-    np.testing.assert_array_equal(run["V"][-1], run["V"][0])
+    np.testing.assert_array_equal(run["vertices"][-1], run["vertices"][0])
 
 
 def test_disconnected_components_flow_each_on_its_own(tmp_path, capsys):
@@ -91,7 +91,7 @@ def test_disconnected_components_flow_each_on_its_own(tmp_path, capsys):
     assert code == 0, err
     assert "2 components" in out
     run = np.load(tmp_path / "run.npz")
-    np.testing.assert_allclose(run["V"][-1, :42], run["V"][-1, 42:] - 3.0, atol=1e-9)
+    np.testing.assert_allclose(run["vertices"][-1, :42], run["vertices"][-1, 42:] - 3.0, atol=1e-9)
 
 
 @pytest.mark.parametrize("name, text, message", [

@@ -94,9 +94,9 @@ def test_run_writes_frames(tmp_path):
                  "--save-every", "2", "--solver", "bicgstab", "--out", str(out)]) == 0
     run = np.load(out)
     assert str(run["scheme"]) == "ddfv"
-    assert run["F"].shape == (4, len(V), 3) and run["T"].shape == (4, len(F), 3)
+    assert run["vertices"].shape == (4, len(V), 3) and run["extra_points"].shape == (4, len(F), 3)
     np.testing.assert_array_equal(run["faces"], F)
-    np.testing.assert_allclose(run["F"][0], V, atol=1e-6)     # OBJ keeps ~7 digits
+    np.testing.assert_allclose(run["vertices"][0], V, atol=1e-6)     # OBJ keeps ~7 digits
     np.testing.assert_allclose(run["t"], [0, 0.002, 0.004, 0.005])
     assert len(run["iterations"]) == 5 and str(run["status"]) == "ok"
     assert json.loads(str(run["provenance"]))["config"]["steps"] == 5
@@ -112,7 +112,7 @@ def test_run_holds_the_boundary_of_open_meshes(tmp_path):
     assert str(np.load(out)["scheme"]) == "ddfv-eliminate"
     run = np.load(out)
     rim = np.abs(np.abs(V[:, 2]) - 0.5) < 1e-12
-    np.testing.assert_allclose(run["F"][-1][rim], run["F"][0][rim])
+    np.testing.assert_allclose(run["vertices"][-1][rim], run["vertices"][0][rim])
 
 
 def test_run_reports_a_breakdown_and_keeps_frames(tmp_path, capsys):

@@ -91,7 +91,7 @@ def run_mesh(scheme, V, F, tau_edge):
     (``tau = tau_edge h^2``, the robust solver); ``(result, last vertices)``."""
     problem = Problem.user_mesh("hypothesis", STEPS, tau_edge)
     result, traj = run(scheme, problem, 0, mesh=(V, F), solver=Solver("direct"))
-    frames = traj.frames["F" if "F" in traj.frames else "V"]
+    frames = traj.frames["vertices"]
     return result, frames[-1]
 
 
