@@ -66,7 +66,7 @@ class Scheme:
     matrix : str
         The kind of its linear system, a key of :data:`MATRICES`:
         ``"nonsymmetric"`` or ``"scaled-spd"`` (checked on a bumpy sphere by
-        ``tests/harness/test_schemes.py``). :attr:`suited_solver` says which
+        ``tests/mcfbench/running/test_schemes.py``). :attr:`suited_solver` says which
         solver suits it.
     robust_solver : str
         The shared solver's method that re-runs a run that ended with a

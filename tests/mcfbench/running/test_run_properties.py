@@ -15,7 +15,7 @@
 
 Profiles (``tests/conftest.py``): ``ci``, the default, is derandomized (the same examples
 on every run) with few examples per test, so this file runs in a few seconds;
-``HYPOTHESIS_PROFILE=nightly python -m pytest tests/harness/test_properties.py`` draws
+``HYPOTHESIS_PROFILE=nightly python -m pytest tests/mcfbench/running/test_run_properties.py`` draws
 fresh examples, 25 times as many per test.
 """
 
