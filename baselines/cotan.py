@@ -368,8 +368,8 @@ class VertexFlow:
         return self.n * self.tau
 
     def frame(self):
-        """``{"V": (n, 3)}`` copy of the current vertices."""
-        return {"V": self._X.T.copy()}
+        """``{"vertices": (n, 3)}``: a copy of the current mesh vertices."""
+        return {"vertices": self._X.T.copy()}
 
     @cached_property
     def geometry(self):

@@ -69,7 +69,7 @@ def long_runs(schemes, steps=40):
         for scheme in schemes:
             result, traj = run(scheme, Problem.user_mesh(mesh, steps, 0.1), 0, mesh=(V, F),
                                solver=Solver(method="direct"))
-            end = traj.frames["F" if "F" in traj.frames else "V"][-1]   # DDFV or vertex
+            end = traj.frames["vertices"][-1]
             print(f"| {mesh} ({start:.3g}) | {scheme} | {result.status} | "
                   f"{result.steps_done} | {metrics.area(end, F) / area_0:.3f} | "
                   f"{metrics.min_angle(end, F):.3g} |", flush=True)

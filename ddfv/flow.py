@@ -283,8 +283,10 @@ class Flow:
         return self._barycentric[1]
 
     def frame(self):
-        """``{"F": (n_f, 3), "T": (n_t, 3)}`` copies of the current state."""
-        return {"F": self.F, "T": self.T}
+        """``{"vertices": (n_f, 3), "extra_points": (n_t, 3)}``: copies of the current
+        F-vertices (the mesh vertices) and T-vertices, the harness's frame of a state
+        with points besides the mesh vertices."""
+        return {"vertices": self.F, "extra_points": self.T}
 
     @property
     def state(self):

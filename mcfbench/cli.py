@@ -196,7 +196,7 @@ def _options(args, scheme):
                "on_defect": args.on_defect, "threads": args.threads, "force": args.force}
     ddfv_only = {"t_init": args.t_init}
     given = {k: v for k, v in ddfv_only.items() if v is not None}
-    if given and scheme.family != "ddfv":
+    if given and not scheme.extra_points:
         raise ValueError(f"--{next(iter(given)).replace('_', '-')} applies to the DDFV "
                          f"schemes only, not to {scheme.name}")
     return {**options, **given}
@@ -351,7 +351,7 @@ def _run(args):
           f"{int(traj.iterations.sum())} solver iterations, smallest angle "
           f"{result.min_angle:.3g} deg"
           + (f", min T barycentric {result.t_min_barycentric:.3f}"
-             if scheme.family == "ddfv" else ""))
+             if scheme.extra_points else ""))
     if args.movie is not None:
         from mcfbench.presentation.movie import write_movie
 

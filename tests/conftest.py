@@ -20,7 +20,7 @@ cylinder = functools.partial(surfaces.cylinder, diagonals="parallel")
 
 __all__ = ["approaches_the_catenoid", "bumpy_sphere", "cylinder", "flat_lattice", "twin_sphere"]
 
-# hypothesis (tests/harness/test_properties.py): "ci", the default, draws the same few
+# hypothesis (tests/mcfbench/running/test_run_properties.py): "ci", the default, draws the same few
 # examples on every run (derandomized, no example database); HYPOTHESIS_PROFILE=nightly
 # draws fresh ones, 25 times as many.
 settings.register_profile("ci", max_examples=10, derandomize=True, database=None, deadline=None,

@@ -77,9 +77,10 @@ def ddfv_frame_fields(F, T, faces):
     Returns
     -------
     list of dict
-        Per frame ``{"F": {"displacement", "covolume"}, "T": {"displacement",
-        "covolume", "t_monitor"}, "triangles": {"t_monitor"}}``: point fields
-        of the F- and T-vertices and the cell field of the triangles.
+        Per frame ``{"vertices": {"displacement", "covolume"}, "extra_points":
+        {"displacement", "covolume", "t_monitor"}, "triangles": {"t_monitor"}}``:
+        point fields of the F-vertices (the mesh's) and of the T-vertices (the
+        frame's ``extra_points``), and the cell field of the triangles.
     """
     from ddfv.geometry import covolume_areas, diamond_geometry, t_barycentric
     from ddfv.topology import diamond_mesh
@@ -95,8 +96,8 @@ def ddfv_frame_fields(F, T, faces):
     for k in range(len(F)):
         chi_f, chi_t = covolume_areas(mesh, diamond_geometry(mesh, F[k], T[k]))
         monitor = t_barycentric(F[k], T[k], faces).min(axis=1)
-        out.append({"F": {"displacement": moved_f[k], "covolume": chi_f.copy()},
-                    "T": {"displacement": moved_t[k], "covolume": chi_t.copy(),
+        out.append({"vertices": {"displacement": moved_f[k], "covolume": chi_f.copy()},
+                    "extra_points": {"displacement": moved_t[k], "covolume": chi_t.copy(),
                           "t_monitor": monitor},
                     "triangles": {"t_monitor": monitor}})
     return out

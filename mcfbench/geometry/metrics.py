@@ -431,7 +431,7 @@ def quality(vertices, faces, neighbours=None):
         raise ValueError(f"neighbours must be two equally long arrays of triangle indices "
                          f"in [0, {len(F)})")
     # one compiled pass over the triangles and one over the neighbour pairs (checked
-    # against plain numpy evaluations of the same formulas in tests/harness/test_metrics.py);
+    # against plain numpy evaluations of the same formulas in tests/mcfbench/geometry/test_metrics.py);
     # the arctan2 of the smallest angles is numpy's
     work = np.empty((4, len(F), 3))
     aspect, a_min, a_max = _quality_kernel()(V, F.astype(np.int64, copy=False), work)

@@ -170,8 +170,9 @@ def vertex_quality(vertices, faces):
 class MeshQuality:
     """Observer collecting the monitors at every time level.
 
-    A DDFV flow (one with T-vertices, ``flow.T``) gets :func:`mesh_quality`,
-    any other flow :func:`vertex_quality` of ``flow.vertices``,
+    A flow whose frame has extra points (DDFV's T-vertices,
+    :meth:`mcfbench.running.flow.SchemeFlow.frame`) gets :func:`mesh_quality`,
+    any other flow :func:`vertex_quality` of its frame's vertices and
     ``flow.faces``.
 
     Examples
@@ -191,12 +192,13 @@ class MeshQuality:
 
     def __call__(self, flow):
         row = {"n": int(flow.n), "t": float(flow.n * flow.tau)}
-        if getattr(flow, "T", None) is not None:
+        frame = flow.frame()      # the mesh vertices, and DDFV's T-vertices
+        if "extra_points" in frame:
             if self._mesh is None:
-                self._mesh = diamond_mesh(flow.faces, len(flow.F))
-            row.update(mesh_quality(self._mesh, flow.F, flow.T))
+                self._mesh = diamond_mesh(flow.faces, len(frame["vertices"]))
+            row.update(mesh_quality(self._mesh, frame["vertices"], frame["extra_points"]))
         else:
-            row.update(vertex_quality(flow.vertices, flow.faces))
+            row.update(vertex_quality(frame["vertices"], flow.faces))
         self.rows.append(row)
 
     def frame(self):

@@ -30,7 +30,7 @@ position of a vertex does not change when the mesh is subdivided first.
 libigl's ``igl.loop`` is not used: it weights old vertices with Warren's
 simplified ``beta = 3 / (8 n)`` (``3/16`` for ``n = 3``), not Loop's
 ``beta_n``, and the limit mask must use the ``beta`` of the steps it
-continues (``tests/harness/test_subdivision.py`` shows the difference).
+continues (``tests/mcfbench/geometry/test_subdivision.py`` shows the difference).
 
 Everything is sparse matrices on the unique edges: no loop over vertices or
 edges. Only closed surfaces (every edge in two triangles): a boundary needs

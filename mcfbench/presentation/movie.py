@@ -78,8 +78,8 @@ def write_movie(arrays, out, *, title="", view=(20.0, -60.0), fps=4, size=4.0, d
     Parameters
     ----------
     arrays : dict
-        ``faces`` (m, 3), ``t`` (frames,), ``V`` (frames, n, 3) or ``F``
-        (frames, n_f, 3) and ``T`` (frames, m, 3); optional ``steps``
+        ``faces`` (m, 3), ``t`` (frames,), ``vertices`` (frames, n, 3) and, for
+        DDFV, ``extra_points`` (frames, m, 3), the T-vertices; optional ``steps``
         (frames,), ``status``, ``message``, ``failed_step`` (a run ``.npz``).
     out : str or Path
         Ends in ``.gif``.

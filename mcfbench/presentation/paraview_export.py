@@ -2,7 +2,7 @@
 
 Reads the frames a run kept (the ``run`` command's ``.npz``, or a frames
 file of the matrix or the gallery, :func:`mcfbench.running.run.framed_run`:
-``V`` or ``F`` and ``T``, ``faces``, ``t``) and writes one ``.vtu`` per frame
+``vertices``, DDFV's ``extra_points``, ``faces``, ``t``) and writes one ``.vtu`` per frame
 and part through :func:`mcfbench.storage.paraview.write_pvd`:
 
 ``surface``
@@ -42,16 +42,12 @@ def load_frames_file(path):
     Raises
     ------
     ValueError
-        Not a frames file, no frame (a gallery run whose mesh was refused), or
-        ``F`` without ``T`` (a DDFV run that refused the surface); the message
-        names the file.
+        Not a frames file, or no frame (a gallery run whose mesh was refused); the
+        message names the file.
     """
     arrays = load_frames(path)
     if len(arrays["t"]) == 0:
         raise ValueError(f"{path}: the run has no frames (its mesh was refused; see its record)")
-    if "V" not in arrays and "T" not in arrays:
-        raise ValueError(f"{path}: not a run's frames file: it has {sorted(arrays)}, expected "
-                         f"faces, t and V (or F and T)")
     return arrays
 
 
@@ -78,8 +74,8 @@ def run_pieces(arrays):
                 for k, point_data in enumerate(vertex_frame_fields(V, faces))]
     T = np.asarray(T, dtype=np.float64)
     single = np.arange(len(faces))[:, None]
-    return [{"surface": Piece(V[k], faces, fields["F"], fields["triangles"]),
-             "t_vertices": Piece(T[k], single, fields["T"])}
+    return [{"surface": Piece(V[k], faces, fields["vertices"], fields["triangles"]),
+             "t_vertices": Piece(T[k], single, fields["extra_points"])}
             for k, fields in enumerate(ddfv_frame_fields(V, T, faces))]
 
 

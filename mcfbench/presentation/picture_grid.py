@@ -32,7 +32,8 @@ def frame_surface(frames, which=-1):
 
 def draw_grid(cells, row_labels, col_labels, paths, title, views=None, share="column",
                size=1.9):
-    """Draw ``cells[i][j] = (F, T, faces, note)`` or None; one length scale per
+    """Draw ``cells[i][j] = (vertices, extra, faces, note)`` (:func:`frame_surface`)
+    or None; one length scale per
     column (``share="column"``) or per row (``"row"``); each mesh an image
     (:func:`panel_image`)."""
     from mcfbench.presentation.render import project
@@ -76,12 +77,13 @@ def draw_grid(cells, row_labels, col_labels, paths, title, views=None, share="co
                 ax.text(0.5, 0.5, text, ha="center", va="center", fontsize=SMALLEST_TEXT,
                         transform=ax.transAxes)
                 continue
-            F, T, faces, note = cell
-            if T is not None and len(faces) > DIAMONDS_UP_TO:
-                T = None  # the diamonds of a fine mesh are a solid colour at this size
+            vertices, extra, faces, note = cell
+            if extra is not None and len(faces) > DIAMONDS_UP_TO:
+                extra = None  # the diamonds of a fine mesh are a solid colour at this size
             centre, half = scale[group(i, j)]
             extent = (centre[0] - half, centre[0] + half, centre[1] - half, centre[1] + half)
-            ax.imshow(panel_image(F, T, faces, views[j], extent, size), extent=extent,
+            ax.imshow(panel_image(vertices, extra, faces, views[j], extent, size),
+                      extent=extent,
                       interpolation="antialiased")
             ax.set_xlim(*extent[:2])
             ax.set_ylim(*extent[2:])
@@ -94,8 +96,9 @@ def draw_grid(cells, row_labels, col_labels, paths, title, views=None, share="co
     save_figure(fig, *paths, dpi=120)
 
 
-def panel_image(F, T, faces, view, extent, size, dpi=PANEL_DPI):
-    """One mesh drawn alone into a ``size`` x ``size`` inch RGBA image covering
+def panel_image(vertices, extra, faces, view, extent, size, dpi=PANEL_DPI):
+    """One mesh (``extra``: DDFV's T-vertices, their diamond mesh drawn, or None)
+    drawn alone into a ``size`` x ``size`` inch RGBA image covering
     ``extent`` (x0, x1, y0, y1 in the projected plane), the figure closed at once.
 
     A grid of hundreds of panels keeps one image each instead of every panel's
@@ -112,7 +115,7 @@ def panel_image(F, T, faces, view, extent, size, dpi=PANEL_DPI):
     try:
         ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
         ax.set_axis_off()
-        draw_mesh(ax, F, T, faces, view=view,
+        draw_mesh(ax, vertices, extra, faces, view=view,
                   points_per_unit=72.0 * size / (extent[1] - extent[0]))
         ax.set_xlim(*extent[:2])
         ax.set_ylim(*extent[2:])

@@ -53,8 +53,10 @@ def plot_quality(frames, title="", marks=()):
     return plot_series(frames, title, marks)
 
 
-def _family(df):
-    return "vertex" if vertex_rows(df).all() else "ddfv"
+def _with_t_vertices(df):
+    """Whether the rows monitor T-vertices and a diamond mesh (DDFV's), not only
+    the primal triangles (:func:`mcfbench.geometry.quality.vertex_rows`)."""
+    return not vertex_rows(df).all()
 
 
 def plot_levels(frames, title=""):
@@ -132,12 +134,11 @@ def plot_series(frames, title="", marks=()):
     fig, axes = plt.subplots(2, 2, figsize=(10, 6.6), sharex=True)
     (ax_b, ax_g), (ax_a, ax_v) = axes
     run_handles, described = [], []
-    ddfv = {name: df for name, df in frames.items() if _family(df) == "ddfv"}
+    with_t = {name: df for name, df in frames.items() if _with_t_vertices(df)}
     for k, (name, df) in enumerate(frames.items()):
         color = f"C{k}"
         n = df["n"].to_numpy()
-        family = _family(df)
-        if family == "ddfv":
+        if name in with_t:
             ax_b.plot(n, df["t_bary_min"].astype(float), color=color)
             ax_b.plot(n, df["t_bary_median"].astype(float), color=color, ls="--")
             ax_g.plot(n, df["angle_min_deg"].astype(float), color=color)
@@ -152,7 +153,7 @@ def plot_series(frames, title="", marks=()):
         label = name + (f": first violation at n = {bad}" if bad is not None
                         else ": no violation")
         run_handles.append(Line2D([], [], color=color, lw=2, label=label))
-        mesh = "diamond and primal mesh" if family == "ddfv" else "primal mesh"
+        mesh = "diamond and primal mesh" if name in with_t else "primal mesh"
         described.append(f"{name} ({mesh})")
         if bad is not None:
             for ax in axes.ravel():
@@ -160,8 +161,8 @@ def plot_series(frames, title="", marks=()):
     # (a) T barycentric coordinate
     ax_b.axhline(0.0, color="0.3", lw=0.9)
     ax_b.axhline(1.0 / 3.0, color="0.75", lw=0.8)
-    if ddfv:
-        low = min(float(df["t_bary_min"].astype(float).min()) for df in ddfv.values())
+    if with_t:
+        low = min(float(df["t_bary_min"].astype(float).min()) for df in with_t.values())
         if low < -SYMLOG_LINEAR:
             ax_b.set_yscale("symlog", linthresh=SYMLOG_LINEAR, linscale=3.0)
             ax_b.set_ylim(1.4 * low, 0.55)
@@ -185,7 +186,7 @@ def plot_series(frames, title="", marks=()):
     ax_b.set_ylabel("T-vertex barycentric coordinate")
     ax_b.set_title("(a) T-vertices in their triangles (DDFV)", fontsize=9)
     # (b) angles, (c) areas
-    styles = ([Line2D([], [], color="0.3", label="diamond mesh")] if ddfv else []) \
+    styles = ([Line2D([], [], color="0.3", label="diamond mesh")] if with_t else []) \
         + [Line2D([], [], color="0.3", ls="--", label="primal triangles")]
     ax_g.axhline(0.0, color="0.5", lw=0.8)
     ax_g.set_ylabel("smallest angle [deg]\n(< 0: folded over)")

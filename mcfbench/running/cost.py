@@ -74,7 +74,7 @@ def cost_class(scheme):
     options = getattr(entry, "options", {})
     redistributing = options.get("redistribution") is not None or \
         options.get("tangential") == "redistribute"
-    kind = "ddfv" if entry.family == "ddfv" else "vertex"
+    kind = entry.family                           # "ddfv" or "vertex": a key of COSTS
     return f"{kind}, redistributing" if redistributing else kind
 
 
@@ -166,7 +166,7 @@ def size(scheme, problem, level, *, mesh=None, tau=None, t_final=None):
         scale = 4.0 ** max(int(level) - first, 0)
         if tau is None:
             tau = problem.tau(level) if problem.tau_rule == "level" else first_tau / scale
-    points = n_vertices + (n_faces if scheme.family == "ddfv" else 0)
+    points = n_vertices + (n_faces if scheme.extra_points else 0)   # DDFV: + T-vertices
     if problem.tau_rule == "mesh" and t_final is None:
         steps = problem.steps
     else:

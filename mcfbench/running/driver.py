@@ -37,7 +37,7 @@ class Trajectory:
     ----------
     frames : dict of str -> (frames, ...) float arrays
         The arrays of :meth:`SchemeFlow.frame` stacked over the kept frames
-        (DDFV: ``"F"``, ``"T"``; the others: ``"V"``). Frame 0 is the
+        (``"vertices"``, and ``"extra_points"`` for DDFV). Frame 0 is the
         initial state, the last frame the last state computed.
     steps : (frames,) int array
         Time level of each frame.

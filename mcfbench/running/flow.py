@@ -102,10 +102,11 @@ class SchemeFlow(Protocol):
         """
 
     def frame(self) -> dict:
-        """Arrays that make one saved frame, copied: ``{"F": ..., "T": ...}``
-        for DDFV, ``{"V": ...}`` for the others (the frame-file layout of
-        :mod:`mcfbench.storage.frames`, whose ``surface_points`` reads the points
-        of either alike)."""
+        """Arrays that make one saved frame, copied, the same for every scheme:
+        ``{"vertices": (n, 3)}``, the surface mesh's vertices, and for a scheme
+        whose state has points besides them ``"extra_points": (k, 3)`` (DDFV's
+        T-vertices; :attr:`mcfbench.running.schemes.Scheme.extra_points`), in the
+        order of ``X`` (the frame-file layout of :mod:`mcfbench.storage.frames`)."""
 
 
 class FlowBreakdown(RuntimeError):

@@ -40,7 +40,7 @@ operators at the extrapolated state, Kovacs, Li, Lubich, Numer. Math. 143 (2019)
     ``O(tau^p)`` accurate): BDF2's ``X^1`` is an Euler step (local error
     ``O(tau^2)``). BDF3 needs ``X^1`` and ``X^2`` to ``O(tau^3)``, which an Euler
     step would spoil (measured: EOC 2.0 on the toy scheme of
-    ``tests/harness/test_integrators.py``): ``X^1 = 2 Z - W`` is the Richardson
+    ``tests/mcfbench/running/test_integrators.py``): ``X^1 = 2 Z - W`` is the Richardson
     extrapolation of the Euler step ``W`` (step ``tau``) and two Euler half steps
     ``Z`` (local errors ``C tau^2 + O(tau^3)`` and ``C tau^2 / 2 + O(tau^3)``;
     Hairer, Norsett, Wanner I, Section II.4), three solves; ``X^2`` is a BDF2 step
@@ -56,7 +56,7 @@ operators at the extrapolated state, Kovacs, Li, Lubich, Numer. Math. 143 (2019)
     post-processing there (DDFV's carried T-vertices) does not apply to it.
 
     Measured (shrinking sphere, level-1 icosphere, ``t = 0.02``, taus 0.005 /
-    0.0025 / 0.00125 against tau / 8, sparse LU; ``tests/harness/test_integrators.py``):
+    0.0025 / 0.00125 against tau / 8, sparse LU; ``tests/mcfbench/running/test_integrators.py``):
     pointwise EOC 2.97-3.18 for every scheme but the DDFV variants with carried
     T-vertices, which fall to 1.1-1.4 at errors of 3e-6 (their volume EOC
     2.9-3.1; with an Euler first step they keep order 2, and carrying the half

@@ -171,7 +171,7 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
     q = monitor.quality
     result = RunResult(
         scheme=scheme.name, problem=problem.name, level=int(level), nV=X.shape[1],
-        nF=len(V), nT=len(F) if scheme.family == "ddfv" else 0,
+        nF=len(V), nT=X.shape[1] - len(V),
         h=metrics.mean_edge_length(V, F), tau=tau, N=steps, steps_done=traj.steps_done,
         status=traj.status, message=traj.message, t_failed=traj.t_failed,
         t_end=flow.n * tau, steady=bool(timed.steady),
@@ -419,8 +419,8 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
     def final(tau):
         result, traj = run(scheme, problem, level, tau=tau, t_final=t_final, solver=solver,
                            integrator=integrator, **options)
-        X = np.concatenate([traj.frames[k][-1] for k in traj.frames]).T
-        vertices, _ = surface_points(traj.frames)
+        vertices, extra = surface_points(traj.frames)
+        X = (vertices[-1] if extra is None else np.concatenate([vertices[-1], extra[-1]])).T
         return result, X, volume(vertices[-1], traj.faces)
 
     ref_result, ref, ref_volume = final(min(taus) / reference_factor)
@@ -448,7 +448,7 @@ def _final_weights(scheme, problem, level, X, t_final, options):
     problem = get_problem(problem) if isinstance(problem, str) else problem
     V, F = validate_mesh(*problem.mesh(level))
     n = len(V)
-    extra = {"T0": X[:, n:].T} if scheme.family == "ddfv" else {}
+    extra = {"T0": X[:, n:].T} if scheme.extra_points else {}
     flow = scheme.make(X[:, :n].T, F, 1.0, **{**options, **extra})
     return np.asarray(flow.l2_weights)
 
@@ -474,7 +474,7 @@ class _Guarded:
     def __init__(self, scheme):
         self.scheme = scheme
         self.name, self.family, self.label = scheme.name, scheme.family, scheme.label
-        self.integrator = scheme.integrator
+        self.extra_points, self.integrator = scheme.extra_points, scheme.integrator
 
     def make(self, vertices, faces, tau, **options):
         try:
@@ -543,8 +543,7 @@ def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_ever
                                f"unsupported at step 0 (t = 0): {err}", steps=steps,
                                method=solver.method, mesh=(V, F), tau=tau,
                                seconds=time.process_time() - start)
-        key = "F" if scheme.family == "ddfv" else "V"
-        return result, {key: np.stack([V, V]), "faces": F, "steps": np.array([0, 0]),
+        return result, {"vertices": np.stack([V, V]), "faces": F, "steps": np.array([0, 0]),
                         "t": np.zeros(2)}
     frames = dict(traj.frames)
     frames.update(faces=traj.faces, steps=traj.steps, t=traj.t)

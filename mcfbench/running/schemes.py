@@ -53,12 +53,20 @@ class Scheme:
     description : str
         One sentence for the report and ``--help``.
     family : str
-        ``"ddfv"`` (F- and T-vertices; the T monitor applies) or
-        ``"vertex"`` (the mesh vertices only).
+        ``"ddfv"`` (the paper's scheme and its variants) or ``"vertex"``: the
+        kind of its cost model (:mod:`mcfbench.running.cost`) and, in the
+        figures' report, the runs compared with the paper's.
+    extra_points : bool
+        Its state has points besides the mesh vertices (DDFV's T-vertices, one
+        per triangle): its frames carry them as ``extra_points``
+        (:meth:`mcfbench.running.flow.SchemeFlow.frame`, :mod:`mcfbench.storage.frames`),
+        its flow class takes their positions as ``T0`` and their placement rule as
+        ``t_init``, and the T monitor applies. What the harness and the presentation
+        ask of a scheme instead of its family's name.
     matrix : str
         The kind of its linear system, a key of :data:`MATRICES`:
         ``"nonsymmetric"`` or ``"scaled-spd"`` (checked on a bumpy sphere by
-        ``tests/harness/test_schemes.py``). :attr:`suited_solver` says which
+        ``tests/mcfbench/running/test_schemes.py``). :attr:`suited_solver` says which
         solver suits it.
     robust_solver : str
         The shared solver's method that re-runs a run that ended with a
@@ -77,6 +85,7 @@ class Scheme:
     style: dict = field(default_factory=dict)
     description: str = ""
     family: str = "vertex"
+    extra_points: bool = False
     matrix: str = "nonsymmetric"
     robust_solver: str = "direct"
     integrator: str = "euler"
@@ -118,7 +127,7 @@ def _ddfv(variant, label, color, marker, linestyle, description):
 
     return Scheme(name, label, "ddfv.flow:Flow", variant_options(variant),
                   {"color": color, "marker": marker, "linestyle": linestyle},
-                  description, family="ddfv",
+                  description, family="ddfv", extra_points=True,
                   matrix="scaled-spd" if "chord" in variant and "redistribute" not in variant
                   else "nonsymmetric")
 

@@ -3,7 +3,7 @@ independent schemes on a refinement series.
 
 Used by ``benchmarks/real_mesh_references.py`` for the real-mesh problems
 (:mod:`mcfbench.running.real_mesh_problems`); tested on the sphere, whose
-answer is known (``tests/harness/test_two_scheme_references.py``).
+answer is known (``tests/mcfbench/running/test_two_scheme_references.py``).
 
 1. :func:`reference_runs`: every scheme on each of its levels ``l`` with
    ``tau_l = tau_0 / 4^(l - l_0)`` to the horizon ``steps tau_0`` (the direct

@@ -2,18 +2,23 @@
 
 Keys (every study's frames file, the ``run`` command's ``--out``):
 
-* ``V`` (frames, n, 3): the vertices of a vertex scheme, or ``F`` (frames,
-  n_f, 3) and ``T`` (frames, n_t, 3): the F- and T-vertices of a DDFV scheme
-  (``F`` alone when the scheme refused the surface: the initial surface);
+* ``vertices`` (frames, n, 3): the surface mesh's vertices, whatever the scheme
+  (DDFV's F-vertices);
+* ``extra_points`` (frames, k, 3), only for a scheme whose state has points
+  besides the mesh vertices (:attr:`mcfbench.running.schemes.Scheme.extra_points`:
+  DDFV's T-vertices, one per triangle; left out when the scheme refused the
+  surface: the initial surface);
 * ``faces`` (m, 3), ``steps`` (frames,) the time levels kept, ``t`` (frames,)
   their times;
 * anything else the writer adds (the ``run`` command: status, provenance).
 
-A run whose mesh was refused before any frame (the gallery) has empty
-``faces``, ``steps`` and ``t`` and no vertices. :func:`surface_points` reads
-the points of any run's frames alike. :func:`save_frames` writes
+The state of a frame is ``vertices`` then ``extra_points`` (the order of the
+scheme's ``X``). A run whose mesh was refused before any frame (the gallery) has
+empty ``faces``, ``steps`` and ``t`` and no vertices. :func:`surface_points`
+reads the points of any run's frames alike. :func:`save_frames` writes
 (atomically, :func:`mcfbench.storage.atomic.save_npz`), :func:`load_frames`
-reads; both check the layout.
+reads; both check the layout. Files written before this layout (keys ``V``, or
+``F`` and ``T``) are read as if written with it (:data:`LEGACY_KEYS`).
 """
 
 import zipfile
@@ -27,6 +32,10 @@ from mcfbench.storage.atomic import save_npz
 REQUIRED = ("faces", "steps", "t")
 """Keys of every frames file."""
 
+LEGACY_KEYS = {"V": "vertices", "F": "vertices", "T": "extra_points"}
+"""Keys of the frames files written before the one layout (a vertex scheme's ``V``,
+DDFV's F- and T-vertices ``F``, ``T``) -> theirs now: :func:`load_frames` renames them."""
+
 
 def check_frames(arrays, path):
     """Raise ValueError naming ``path`` unless ``arrays`` has the layout.
@@ -35,12 +44,12 @@ def check_frames(arrays, path):
     ------
     ValueError
         A key of :data:`REQUIRED` missing, or frames (``t`` not empty)
-        without ``V`` or ``F``.
+        without ``vertices``.
     """
     missing = [key for key in REQUIRED if key not in arrays]
-    if missing or (len(arrays["t"]) and not ("V" in arrays or "F" in arrays)):
+    if missing or (len(arrays["t"]) and "vertices" not in arrays):
         raise ValueError(f"{path}: not a run's frames file: it has {sorted(arrays)}, expected "
-                         f"faces, steps, t and V (or F and T)")
+                         f"faces, steps, t and vertices (and extra_points)")
 
 
 def surface_points(frames):
@@ -49,7 +58,7 @@ def surface_points(frames):
     F-vertices, and the extra points (frames, k, 3), DDFV's T-vertices, or None.
     ``vertices`` is None when the run kept no frame. What reads a frame takes its
     points from here, whatever the scheme."""
-    return frames.get("F", frames.get("V")), frames.get("T")
+    return frames.get("vertices"), frames.get("extra_points")
 
 
 def save_frames(path, frames):
@@ -79,7 +88,7 @@ def load_frames(path):
         raise ValueError(f"{path}: not a run's .npz (not a zip of NumPy arrays)")
     try:
         with np.load(path, allow_pickle=False) as data:
-            arrays = {key: data[key] for key in data.files}
+            arrays = {LEGACY_KEYS.get(key, key): data[key] for key in data.files}
     except ValueError as err:
         if "allow_pickle" in str(err):    # NumPy's advice to load it unsafely
             raise ValueError(f"{path}: not a run's .npz (it holds Python objects, "

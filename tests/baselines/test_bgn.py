@@ -130,7 +130,7 @@ def test_open_cylinder_keeps_its_boundary_and_approaches_the_catenoid():
     np.testing.assert_array_equal(A[rows], np.eye(len(A))[rows])
     traj = simulate(flow, 200, solver=Solver(), save_every=50)
     assert traj.status == "ok", traj.message
-    X = traj.frames["V"]
+    X = traj.frames["vertices"]
     np.testing.assert_array_equal(X[-1, flow.fixed], V[flow.fixed])
     approaches_the_catenoid(X)
 

@@ -47,8 +47,8 @@ def test_equals_the_cotangent_scheme_while_the_mesh_is_a_scaled_copy():
     # icosahedron (all vertices alike, the mesh stays a scaled copy) (K1)
     # and the cotangent scheme (C1) are the same scheme
     V, F = icosphere(0)
-    a = simulate(CMCFFlow(V, F, 0.01), 20, solver=EXACT).frames["V"]
-    b = simulate(CotanFlow(V, F, 0.01), 20, solver=EXACT).frames["V"]
+    a = simulate(CMCFFlow(V, F, 0.01), 20, solver=EXACT).frames["vertices"]
+    b = simulate(CotanFlow(V, F, 0.01), 20, solver=EXACT).frames["vertices"]
     np.testing.assert_allclose(a, b, rtol=0, atol=1e-13)
     radius = np.linalg.norm(a, axis=2)
     assert np.ptp(radius, axis=1).max() < 1e-13
@@ -63,7 +63,7 @@ def test_sphere_stays_a_sphere_and_shrinks_like_mcf():
     V, F = icosphere(3, R)
     traj = simulate(CMCFFlow(V, F, tau), 50, solver=Solver(), save_every=5)
     assert traj.status == "ok"
-    radius = np.linalg.norm(traj.frames["V"], axis=2)
+    radius = np.linalg.norm(traj.frames["vertices"], axis=2)
     r = sphere_radius(traj.t, R)
     # measured: radial spread <= 2.0e-3 r, |mean radius - r| <= 5.1e-3 r
     # (the cotangent scheme: 2.0e-3 and 5.1e-3)
@@ -98,7 +98,7 @@ def test_open_cylinder_tends_to_the_harmonic_map_not_the_catenoid():
     flow = CMCFFlow(V, F, 0.005)
     traj = simulate(flow, 200, solver=Solver(), save_every=50)
     assert traj.status == "ok"
-    X = traj.frames["V"]
+    X = traj.frames["vertices"]
     np.testing.assert_array_equal(X[-1, flow.fixed], V[flow.fixed])
     r, z = np.hypot(X[-1, :, 0], X[-1, :, 1]), X[-1, :, 2]
     np.testing.assert_allclose(r, np.cosh(z) / np.cosh(0.5), atol=5e-4)   # measured 1.3e-4

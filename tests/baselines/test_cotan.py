@@ -124,7 +124,7 @@ def test_assemblies_agree():
     V, F = icosphere(2)
     a = simulate(CotanFlow(V, F, 0.01), 8, solver=Solver())
     b = simulate(CotanFlow(V, F, 0.01, assembly="igl"), 8, solver=Solver())
-    np.testing.assert_allclose(a.frames["V"], b.frames["V"], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(a.frames["vertices"], b.frames["vertices"], rtol=0, atol=1e-12)
     np.testing.assert_array_equal(a.iterations, b.iterations)
 
 
@@ -145,7 +145,7 @@ def test_warm_start_and_state_handling():
     np.testing.assert_array_equal(seen[1], 2 * X1 - V.T)    # 2 X^1 - X^0
     assert flow.n == 2 and flow.X.shape == (3, len(V)) and not flow.X.flags.writeable
     frame = flow.frame()
-    assert set(frame) == {"V"} and not np.shares_memory(frame["V"], flow.X)
+    assert set(frame) == {"vertices"} and not np.shares_memory(frame["vertices"], flow.X)
 
 
 def test_failed_solve_propagates_and_keeps_the_state():
@@ -182,7 +182,7 @@ def test_open_cylinder_keeps_its_boundary_and_approaches_the_catenoid():
     flow = CotanFlow(V, F, 0.005)
     traj = simulate(flow, 200, solver=Solver(), save_every=50)
     assert traj.status == "ok", traj.message
-    X = traj.frames["V"]
+    X = traj.frames["vertices"]
     for frame in X:
         np.testing.assert_array_equal(frame[flow.fixed], V[flow.fixed])
     approaches_the_catenoid(X)

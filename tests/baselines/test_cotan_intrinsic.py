@@ -41,11 +41,11 @@ def test_on_a_delaunay_mesh_the_operators_are_the_cotangent_ones():
 
 def test_on_a_delaunay_mesh_the_flow_is_cotan_with_barycentric_mass():
     V, F = icosphere(2)
-    runs = [simulate(cls(V, F, 0.01), 8, solver=EXACT, save_every=0).frames["V"][-1]
+    runs = [simulate(cls(V, F, 0.01), 8, solver=EXACT, save_every=0).frames["vertices"][-1]
             for cls in (IntrinsicCotanFlow, CotanFlow)]
     np.testing.assert_allclose(runs[0], runs[1], rtol=0, atol=1e-13)
     voronoi = simulate(CotanFlow(V, F, 0.01, mass="voronoi"), 8, solver=EXACT,
-                       save_every=0).frames["V"][-1]
+                       save_every=0).frames["vertices"][-1]
     assert np.abs(runs[0] - voronoi).max() > 1e-4
 
 
@@ -90,9 +90,9 @@ def test_open_cylinder_keeps_its_boundary_and_follows_cotan_to_the_catenoid():
     traj = simulate(flow, 200, solver=EXACT, save_every=50)
     cotan = simulate(CotanFlow(V, F, 0.005), 200, solver=EXACT, save_every=50)
     assert traj.status == "ok", traj.message
-    for frame in traj.frames["V"]:
+    for frame in traj.frames["vertices"]:
         np.testing.assert_array_equal(frame[flow.fixed], V[flow.fixed])
-    np.testing.assert_allclose(traj.frames["V"], cotan.frames["V"], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(traj.frames["vertices"], cotan.frames["vertices"], rtol=0, atol=1e-12)
 
 
 def test_twin_point_sphere_completes_where_cotan_inverts():
@@ -104,7 +104,7 @@ def test_twin_point_sphere_completes_where_cotan_inverts():
             for cls in (CotanFlow, IntrinsicCotanFlow)]
     assert (runs[0].status, runs[0].steps_done) == ("inverted", 22)
     assert (runs[1].status, runs[1].steps_done) == ("ok", 24)
-    assert np.linalg.norm(runs[1].frames["V"][-1], axis=1).mean() == pytest.approx(0.296,
+    assert np.linalg.norm(runs[1].frames["vertices"][-1], axis=1).mean() == pytest.approx(0.296,
                                                                                   abs=1e-3)
 
 

@@ -230,7 +230,7 @@ def test_fixed_boundary_stays_and_velocity_vanishes_there():
     assert np.all(alpha[:, flow.fixed] == 0.0)
     traj = simulate(flow, 20, solver=Solver(), save_every=10)
     assert traj.status == "ok", traj.message
-    for frame in traj.frames["V"]:
+    for frame in traj.frames["vertices"]:
         np.testing.assert_array_equal(frame[flow.fixed], V[flow.fixed])
 
 

@@ -23,7 +23,7 @@ def simulate(V, F, tau, steps, *, save_every=1, rtol=1e-9, maxiter=1000, collaps
     """The DDFV flow driven by the harness; frames as ``traj.F``, ``traj.T``."""
     traj = drive(Flow(V, F, tau, **options), steps, save_every=save_every,
                  solver=Solver(rtol=rtol, maxiter=maxiter), collapse=collapse)
-    traj.F, traj.T = traj.frames["F"], traj.frames["T"]
+    traj.F, traj.T = traj.frames["vertices"], traj.frames["extra_points"]
     return traj
 
 
@@ -62,7 +62,7 @@ def test_public_arrays_are_in_the_callers_numbering(bumpy):
     np.testing.assert_array_equal(flow.faces, F)
     assert not flow.X.flags.writeable
     frame = flow.frame()
-    np.testing.assert_array_equal(frame["F"], V)
+    np.testing.assert_array_equal(frame["vertices"], V)
     mesh = diamond_mesh(F, len(V))
     chi_f, chi_t = covolume_areas(mesh, diamond_geometry(mesh, V, T0))
     np.testing.assert_allclose(flow.covolumes, np.r_[chi_f, chi_t], rtol=1e-13)

@@ -325,7 +325,7 @@ def _rotation(seed=0):
 def _run(V, F, tau=0.002, steps=5, **options):
     traj = simulate(Flow(V, F, tau, **options), steps, save_every=1,
                     solver=Solver(rtol=1e-13, maxiter=1000))
-    return traj.frames["F"], traj.frames["T"]
+    return traj.frames["vertices"], traj.frames["extra_points"]
 
 
 @pytest.mark.parametrize("variant, method", [("redistribute", "refinement"),

@@ -166,7 +166,7 @@ def _run(V, F, variant, tau=0.002, steps=4):
     traj = simulate(Flow(V, F, tau, **variant_options(variant)), steps, save_every=1,
                     solver=Solver(method="direct"))
     assert traj.status == "ok"
-    return traj.frames["F"], traj.frames["T"]
+    return traj.frames["vertices"], traj.frames["extra_points"]
 
 
 @pytest.mark.parametrize("variant", VARIANTS)

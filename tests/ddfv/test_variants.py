@@ -29,7 +29,7 @@ def test_variants_are_options_of_the_flow():
 def test_every_variant_is_a_registered_scheme():
     for name in VARIANTS:
         entry = SCHEMES["ddfv" if name == "paper" else f"ddfv-{name}"]
-        assert entry.options == variant_options(name) and entry.family == "ddfv"
+        assert entry.options == variant_options(name) and entry.family == "ddfv" and entry.extra_points
 
 
 def test_options_are_copies():

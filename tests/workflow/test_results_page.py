@@ -244,7 +244,7 @@ def test_summary_fits_a_laptop_and_figures_show_at_print_size(browser, page, tmp
     """At a 1280 px window: neither the page nor the summary table scrolls sideways
     (also with the registry's longest names), and every figure is shown at print size
     (96 px to the inch), so its text has the size it was drawn with, 8 pt at least
-    (tests/harness/studies/matrix/test_matrix.py checks the figures' fonts)."""
+    (tests/mcfbench/studies/matrix/test_matrix.py checks the figures' fonts)."""
     from mcfbench.studies.matrix.page import print_width
 
     root, _ = page

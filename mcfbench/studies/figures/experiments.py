@@ -184,7 +184,7 @@ class Experiment:
             scheme = get_scheme(r.scheme)
             what = f"{scheme.label} (``{scheme.name}``), shape ``{r.shape}`` ({params}), " \
                    f"tau = {r.tau:g}, {r.steps} steps"
-            if scheme.family == "ddfv":
+            if scheme.extra_points:
                 what += f", T-vertices ``{r.t_init}``"
             lines.append(f"- ``{r.key}``: {what}")
         steps = ", ".join(str(s.step) + (" (detail)" if s.zoom else "") for s in self.shots)

@@ -42,13 +42,13 @@ class FigureRun:
     quality: object = None  # pandas.DataFrame of mcfbench.geometry.quality.MeshQuality
 
     @property
-    def F(self):
-        """(frames, n_f, 3): the F-vertices (DDFV) or the vertices."""
+    def vertices(self):
+        """(frames, n, 3): the surface mesh's vertices (DDFV: the F-vertices)."""
         return surface_points(self.frames)[0]
 
     @property
-    def T(self):
-        """(frames, n_t, 3) T-vertices; None for the vertex schemes."""
+    def extra_points(self):
+        """(frames, n_t, 3): DDFV's T-vertices; None for the vertex schemes."""
         return surface_points(self.frames)[1]
 
     @property
@@ -113,7 +113,7 @@ def figure_run(run):
     FigureRun
     """
     scheme = get_scheme(run.scheme)
-    options = {"t_init": run.t_init} if scheme.family == "ddfv" else {}
+    options = {"t_init": run.t_init} if scheme.extra_points else {}
     quality = MeshQuality()   # diamond and primal monitors (DDFV), primal (the others)
     result, frames = framed_run(scheme, Problem.user_mesh(run.shape, run.steps), 0,
                                 solver=Solver(), mesh=make_surface(run.shape, **run.params),
@@ -155,14 +155,14 @@ def tracked(experiment, results):
     j = result.frame(track.step)
     if j < 0 or int(result.steps[j]) != track.step:
         return {}
-    F, T = result.F[j], None if result.T is None else result.T[j]
-    k = worst_element(F, T, result.faces, experiment.view, track.by)
+    extra = None if result.extra_points is None else result.extra_points[j]
+    k = worst_element(result.vertices[j], extra, result.faces, experiment.view, track.by)
     if track.by == "angle":
-        cells = tracked_cells(result.faces, k, F.shape[0])
+        cells = tracked_cells(result.faces, k, result.vertices.shape[1])
     else:
         from ddfv.topology import diamond_mesh
 
-        cells = np.unique(diamond_mesh(result.faces, F.shape[0]).halfedges[k])
+        cells = np.unique(diamond_mesh(result.faces, result.vertices.shape[1]).halfedges[k])
     return {track.run: cells}
 
 
@@ -188,19 +188,19 @@ def experiment_panels(experiment, results):
         """Centre and half-width of a zoom in frame ``i`` of ``result``."""
         if spec is None:
             return None
-        T = result.T
+        extra = result.extra_points
         if not isinstance(spec.at, str):
             return np.asarray(spec.at, dtype=float), spec.half
         if spec.at == "tracked":
             if run not in cells:
                 return None
-            return cells_centre(result.F[i], None if T is None else T[i], result.faces,
-                                cells[run]), spec.half
+            return cells_centre(result.vertices[i], None if extra is None else extra[i],
+                                result.faces, cells[run]), spec.half
         j = result.frame(spec.step) if spec.step is not None else i
-        k = worst_element(result.F[j], None if T is None else T[j], result.faces,
-                          experiment.view, spec.by)
-        centre = element_centre(result.F[i], None if T is None else T[i], result.faces, k,
-                                spec.by)
+        k = worst_element(result.vertices[j], None if extra is None else extra[j],
+                          result.faces, experiment.view, spec.by)
+        centre = element_centre(result.vertices[i], None if extra is None else extra[i],
+                                result.faces, k, spec.by)
         return centre, spec.half
 
     panels = []
@@ -208,8 +208,8 @@ def experiment_panels(experiment, results):
         result = results[shot.run]
         i = result.frame(shot.step)
         reached = int(result.steps[i])
-        n_f = result.F.shape[1]
-        n_t = 0 if result.T is None else result.T.shape[1]
+        n_f = result.vertices.shape[1]
+        n_t = 0 if result.extra_points is None else result.extra_points.shape[1]
         label = shot.label.format(n=reached, n_V=n_f + n_t, n_F=n_f, n_T=n_t,
                                   tau=result.run.tau)
         note = ""
@@ -218,8 +218,8 @@ def experiment_panels(experiment, results):
             note = f"{name}: not computed\n{_short(result.message)}"
         elif reached != shot.step:
             note = f"n = {shot.step} not reached:\n{_short(result.message or result.status)}"
-        T = None if result.T is None else result.T[i]
-        panels.append(Panel(result.F[i], T, result.faces, label=label,
+        extra = None if result.extra_points is None else result.extra_points[i]
+        panels.append(Panel(result.vertices[i], extra, result.faces, label=label,
                             zoom=zoom_of(shot.zoom, result, i, shot.run),
                             zoom_box=zoom_of(shot.box, result, i, shot.run),
                             note=note, highlight=cells.get(shot.run)))

@@ -50,11 +50,11 @@ def gallery_grid(entries, paths, meshes, schemes):
             if "faces" not in frames or not len(frames["faces"]):
                 cells[i][j + 1] = (None, None, None, record["status"])
                 continue
-            F, T, faces = frame_surface(frames, -1)
-            cells[i][j + 1] = (F, T, faces, run_note(record))
+            vertices, extra, faces = frame_surface(frames, -1)
+            cells[i][j + 1] = (vertices, extra, faces, run_note(record))
             if cells[i][0] is None:
-                F0, _, _ = frame_surface(frames, 0)
-                cells[i][0] = (F0, None, faces, f"{len(faces)} triangles")
+                initial, _, _ = frame_surface(frames, 0)
+                cells[i][0] = (initial, None, faces, f"{len(faces)} triangles")
     labels = ["initial"] + [scheme_style(s)[0] for s in schemes]
     draw_grid(cells, list(meshes), labels, paths, "Gallery: first and last frame per scheme",
                share="row")

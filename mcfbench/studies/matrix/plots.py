@@ -262,11 +262,12 @@ def picture_grid(entries, paths, problems, schemes):
             if entry is None:
                 continue
             record, frames = entry
-            F, T, faces = frame_surface(frames, -1)
-            cells[i + 1][j] = (F, T, faces, f"L{record['level']}: {run_note(record)}")
+            vertices, extra, faces = frame_surface(frames, -1)
+            note = f"L{record['level']}: {run_note(record)}"
+            cells[i + 1][j] = (vertices, extra, faces, note)
             if cells[0][j] is None:
-                F0, T0, _ = frame_surface(frames, 0)
-                cells[0][j] = (F0, None, faces, f"level {record['level']}, t = 0")
+                initial, _, _ = frame_surface(frames, 0)
+                cells[0][j] = (initial, None, faces, f"level {record['level']}, t = 0")
     labels = ["initial"] + [scheme_style(s)[0] for s in schemes]
     draw_grid(cells, labels, problems, paths, "Final surfaces (coarsest level of each problem)",
                views=[VIEWS.get(p, (20.0, -60.0)) for p in problems])

@@ -153,7 +153,7 @@ def check_paper_columns(conv, published, path):
                 raise ReportError(
                     f"{path}: paper_{column} of level {r.level} is {ours}, but "
                     f"paper/published/table_3_1.csv has {theirs}: mcfbench.studies.convergence.tables.PUBLISHED and "
-                    "the published table have drifted apart (tests/harness/studies/report/test_report.py checks them)")
+                    "the published table have drifted apart (tests/mcfbench/studies/report/test_report.py checks them)")
 
 
 def table_3_1(conv, published, checks):

@@ -188,7 +188,7 @@ def test_no_run_on_a_real_mesh_ends_ok_with_its_area_grown_or_its_mesh_folded(sc
     ends ``ok`` keeps both invariants on every state, recomputed here from the frames."""
     V, F = read_committed_mesh("nut")
     result, traj = run(scheme, Problem.user_mesh("nut", 12), 0, mesh=(V, F), save_every=1)
-    frames = traj.frames["F" if "F" in traj.frames else "V"]
+    frames = traj.frames["vertices"]
     areas = np.array([area(X, F) for X in frames])
     folded0 = ~(neighbour_cosines(V, F) >= 0)
     folded = [int((~(neighbour_cosines(X, F) >= 0) & ~folded0).sum()) for X in frames]

@@ -50,7 +50,7 @@ class ShrinkingPoints:
         return []
 
     def frame(self):
-        return {"V": self._X.T.copy()}
+        return {"vertices": self._X.T.copy()}
 
 
 def radius_error(integrator, tau, t_final=0.1):
@@ -58,7 +58,7 @@ def radius_error(integrator, tau, t_final=0.1):
     flow = ShrinkingPoints(V, F, tau)
     traj = simulate(flow, round(t_final / tau), solver=EXACT, integrator=integrator,
                     collapse=False)
-    return np.abs(np.linalg.norm(traj.frames["V"][-1], axis=1) - np.sqrt(1 - 4 * t_final)).max()
+    return np.abs(np.linalg.norm(traj.frames["vertices"][-1], axis=1) - np.sqrt(1 - 4 * t_final)).max()
 
 
 @pytest.mark.parametrize("integrator", list(INTEGRATORS))

@@ -38,7 +38,7 @@ from mcfbench.studies.figures.job import (
 def n_vertices(run):
     """The paper's n_V of a run: F- plus T-vertices for DDFV, the vertices otherwise."""
     V, faces = make_surface(run.shape, **run.params)
-    return len(V) + (len(faces) if get_scheme(run.scheme).family == "ddfv" else 0)
+    return len(V) + (len(faces) if get_scheme(run.scheme).extra_points else 0)
 
 
 @pytest.fixture(scope="module")
@@ -147,9 +147,9 @@ def test_fig_3_4_tracks_the_same_cells_in_every_panel(fig_3_4, fig_3_4_panels):
 
     mesh = diamond_mesh(result.faces)
     triangles = np.unique(mesh.diamonds[cells, 2:])
-    bary = t_barycentric(result.F[13], result.T[13], result.faces).min(axis=1)
+    bary = t_barycentric(result.vertices[13], result.extra_points[13], result.faces).min(axis=1)
     assert bary[triangles].min() < 0 <= t_barycentric(
-        result.F[12], result.T[12], result.faces).min()
+        result.vertices[12], result.extra_points[12], result.faces).min()
 
 
 def test_fig_3_4_details_share_one_half_width_and_follow_the_cells(fig_3_4, fig_3_4_panels):
@@ -162,7 +162,7 @@ def test_fig_3_4_details_share_one_half_width_and_follow_the_cells(fig_3_4, fig_
     extents = []
     for shot, panel in details:
         i = result.frame(shot.step)
-        F, T = result.F[i], result.T[i]
+        F, T = result.vertices[i], result.extra_points[i]
         centre = cells_centre(F, T, result.faces, panel.highlight)
         np.testing.assert_allclose(panel.zoom[0], centre)
         # every corner of the tracked cells lies inside the detail
@@ -256,8 +256,8 @@ def test_figure_job_keeps_one_frames_file_per_run_in_the_common_layout(small_com
         assert frames["steps"].tolist() == [0, 2, 4]
         np.testing.assert_allclose(frames["t"], [0, 0.005, 0.01])
         assert frames["faces"].shape == (384, 3)
-    assert ddfv["F"].shape == (3, 216, 3) and ddfv["T"].shape == (3, 384, 3)
-    assert cotan["V"].shape == (3, 216, 3) and "T" not in cotan
+    assert ddfv["vertices"].shape == (3, 216, 3) and ddfv["extra_points"].shape == (3, 384, 3)
+    assert cotan["vertices"].shape == (3, 216, 3) and "extra_points" not in cotan
     # the boundary circles stay where they were
-    np.testing.assert_array_equal(cotan["V"][-1][np.abs(cotan["V"][0][:, 2]) == 0.55],
-                                  cotan["V"][0][np.abs(cotan["V"][0][:, 2]) == 0.55])
+    np.testing.assert_array_equal(cotan["vertices"][-1][np.abs(cotan["vertices"][0][:, 2]) == 0.55],
+                                  cotan["vertices"][0][np.abs(cotan["vertices"][0][:, 2]) == 0.55])

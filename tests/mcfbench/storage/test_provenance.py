@@ -12,7 +12,7 @@ from mcfbench.storage.provenance import (
     source_hash,
 )
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 
 
 def test_provenance_names_code_dependencies_and_settings():

@@ -23,11 +23,12 @@ def test_every_scheme_follows_the_contract_and_runs(name):
                                 axis=1).sum()
     # the vertex schemes' lumped mass tiles the triangles; DDFV's covolumes tile the
     # diamond mesh, whose T-vertices lie off the triangles' planes (1.3 % more here)
-    rel = 0.02 if scheme.family == "ddfv" else 1e-10
+    rel = 0.02 if scheme.extra_points else 1e-10
     assert flow.l2_weights.sum() == pytest.approx(area, rel=rel)
     traj = simulate(flow, 3, save_every=1)
     assert traj.status == "ok" and traj.steps.tolist() == [0, 1, 2, 3]
-    assert set(traj.frames) == ({"F", "T"} if scheme.family == "ddfv" else {"V"})
+    expected = {"vertices", "extra_points"} if scheme.extra_points else {"vertices"}
+    assert set(traj.frames) == expected
     assert scheme.label and scheme.description and {"color", "marker"} <= set(scheme.style)
 
 
@@ -37,7 +38,7 @@ def test_every_scheme_shrinks_the_sphere_at_the_exact_rate(name):
     """r(t) = sqrt(1 - 4t) on the level-3 icosphere to 1 % at t = 0.05 (r = 0.894)."""
     V, F = icosphere(3)
     traj = simulate(get_scheme(name).make(V, F, 0.0025), 20, save_every=0)
-    points = traj.frames["F" if "F" in traj.frames else "V"][-1]
+    points = traj.frames["vertices"][-1]
     assert np.linalg.norm(points, axis=1).mean() == pytest.approx(np.sqrt(0.8), rel=0.01)
 
 

@@ -38,16 +38,16 @@ def test_exported_run_reads_back_with_meshio(tmp_path, capsys):
         [f"surface_{k:04d}.vtu" for k in range(4)]
     for k in range(4):
         frame = meshio.read(collection.files["surface"][k])
-        np.testing.assert_array_equal(frame.points, run["V"][k])
+        np.testing.assert_array_equal(frame.points, run["vertices"][k])
         np.testing.assert_array_equal(frame.cells_dict["triangle"], run["faces"])
-        moved = run["V"][k] - run["V"][k - 1] if k else np.zeros_like(run["V"][0])
+        moved = run["vertices"][k] - run["vertices"][k - 1] if k else np.zeros_like(run["vertices"][0])
         np.testing.assert_allclose(frame.point_data["displacement"], moved, atol=1e-15)
         # barycentric vertex areas: a third of each triangle, summing to the area
         assert frame.point_data["vertex_area"].sum() == pytest.approx(
-            area(run["V"][k], run["faces"]), rel=1e-12)
+            area(run["vertices"][k], run["faces"]), rel=1e-12)
     # the sphere shrinks: every vertex moves inwards over the first two steps
     first = meshio.read(collection.files["surface"][1])
-    inward = np.einsum("ij,ij->i", first.point_data["displacement"], run["V"][0])
+    inward = np.einsum("ij,ij->i", first.point_data["displacement"], run["vertices"][0])
     assert (inward < 0).all()
     meta = collection.provenance
     assert meta["run"]["scheme"] == "cotan" and meta["run"]["status"] == "ok"
@@ -81,8 +81,8 @@ def test_ddfv_run_writes_t_vertices_and_the_t_monitor(tmp_path, capsys):
     np.testing.assert_array_equal(collection.times, run["t"])
     last = len(run["t"]) - 1
     surface, points = collection.read("surface", last), collection.read("t_vertices", last)
-    np.testing.assert_array_equal(surface.points, run["F"][last])
-    np.testing.assert_array_equal(points.points, run["T"][last])
+    np.testing.assert_array_equal(surface.points, run["vertices"][last])
+    np.testing.assert_array_equal(points.points, run["extra_points"][last])
     np.testing.assert_array_equal(points.cells_dict["vertex"].ravel(), np.arange(len(F)))
     monitor = surface.cell_data["t_monitor"][0]
     np.testing.assert_array_equal(points.point_data["t_monitor"], monitor)

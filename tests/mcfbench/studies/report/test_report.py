@@ -117,11 +117,11 @@ def figure_frames(folder, name):
     """One frames file per run of the figure (mcfbench.storage.frames), one frame each."""
     for run in EXPERIMENTS[name].runs:
         sizes = {"bumpy_sphere": (642, 1280), "cylinder": (216, 384)}[run.shape]
-        ddfv = SCHEMES[run.scheme].family == "ddfv"
-        arrays = {"F" if ddfv else "V": np.zeros((1, sizes[0], 3)),
+        extra = SCHEMES[run.scheme].extra_points
+        arrays = {"vertices": np.zeros((1, sizes[0], 3)),
                   "faces": np.zeros((0, 3), int), "steps": np.zeros(1, int), "t": np.zeros(1)}
-        if ddfv:
-            arrays["T"] = np.zeros((1, sizes[1], 3))
+        if extra:
+            arrays["extra_points"] = np.zeros((1, sizes[1], 3))
         save_frames(folder / f"{run.key}.npz", arrays)
 
 

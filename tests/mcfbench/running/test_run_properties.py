@@ -15,7 +15,7 @@
 
 Profiles (``tests/conftest.py``): ``ci``, the default, is derandomized (the same examples
 on every run) with few examples per test, so this file runs in a few seconds;
-``HYPOTHESIS_PROFILE=nightly python -m pytest tests/harness/test_properties.py`` draws
+``HYPOTHESIS_PROFILE=nightly python -m pytest tests/mcfbench/running/test_run_properties.py`` draws
 fresh examples, 25 times as many per test.
 """
 
@@ -91,7 +91,7 @@ def run_mesh(scheme, V, F, tau_edge):
     (``tau = tau_edge h^2``, the robust solver); ``(result, last vertices)``."""
     problem = Problem.user_mesh("hypothesis", STEPS, tau_edge)
     result, traj = run(scheme, problem, 0, mesh=(V, F), solver=Solver("direct"))
-    frames = traj.frames["F" if "F" in traj.frames else "V"]
+    frames = traj.frames["vertices"]
     return result, frames[-1]
 
 

@@ -82,7 +82,7 @@ def test_gifti_ascii_surface(tmp_path):
 def test_results_readme_documents_each_packaged_mesh():
     from pathlib import Path
 
-    text = (Path(__file__).resolve().parents[2] / "results" / "README.md").read_text()
+    text = (Path(__file__).resolve().parents[3] / "results" / "README.md").read_text()
     for mesh in PACKAGED_MESHES.values():
         row = next((line for line in text.splitlines() if line.startswith(f"| `{mesh.name}` |")),
                    None)

@@ -40,7 +40,7 @@ class Decay:
         return []
 
     def frame(self):
-        return {"V": self._X.T.copy()}
+        return {"vertices": self._X.T.copy()}
 
 
 V0 = np.arange(12.0).reshape(4, 3) + 1.0
@@ -57,7 +57,7 @@ def test_states_and_frames_are_exact():
     np.testing.assert_array_equal(traj.steps, [0, 3, 6, 7])
     np.testing.assert_allclose(traj.t, [0.0, 0.3, 0.6, 0.7])
     expected = V0[None] / 1.1 ** traj.steps[:, None, None]
-    np.testing.assert_allclose(traj.frames["V"], expected, rtol=1e-13)
+    np.testing.assert_allclose(traj.frames["vertices"], expected, rtol=1e-13)
     assert traj.status == "ok" and traj.message == "" and traj.failed_step == -1
     assert traj.steps_done == 7 and len(traj.iterations) == 7 and np.isnan(traj.t_failed)
 
@@ -107,7 +107,7 @@ def test_solver_failure_keeps_the_last_valid_state():
     traj = simulate(flow, 4)
     assert traj.status.startswith("solver_") and traj.failed_step == 1
     assert traj.message.startswith(f"{traj.status} at step 1 (t = 0.5): ")
-    np.testing.assert_array_equal(traj.frames["V"][-1], V0)
+    np.testing.assert_array_equal(traj.frames["vertices"][-1], V0)
 
 
 def test_until_ends_the_run_at_a_steady_state():

@@ -93,7 +93,7 @@ def test_the_first_level_of_a_series_carries_no_warm_up():
     The issue's 1.5 x is measured by ``benchmarks/bench_warmup.py`` (0.89-1.12 for every
     scheme); here, on a shared machine, millisecond runs vary by up to 2 x (measured:
     cotan 2.0 ms against 1.1 ms in the full suite under load)."""
-    root = Path(__file__).resolve().parents[2]
+    root = Path(__file__).resolve().parents[3]
     env = {**os.environ, "PYTHONPATH": str(root)}
     out = subprocess.run([sys.executable, "-c", FIRST_AND_SECOND, "cotan", "ddfv-chord-carried"],
                          cwd=root, env=env, capture_output=True, text=True, check=True)

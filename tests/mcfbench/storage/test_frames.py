@@ -23,6 +23,9 @@ def _frames(name, steps=2):
 @pytest.mark.parametrize("name", ["ddfv", "cotan"])
 def test_the_points_of_any_scheme_read_alike_and_survive_the_file(name, tmp_path):
     frames, flow = _frames(name)
+    # one layout for every scheme: the mesh vertices, and DDFV's T-vertices besides them
+    assert set(frames) - {"faces", "steps", "t"} == (
+        {"vertices", "extra_points"} if get_scheme(name).extra_points else {"vertices"})
     vertices, extra = surface_points(frames)
     # the surface mesh's vertices of the last state; DDFV's T-vertices as the extra points
     np.testing.assert_array_equal(vertices[-1], flow.vertices)
@@ -52,5 +55,20 @@ def test_another_layout_is_named(tmp_path):
         save_frames(tmp_path / "x.npz", {"t": np.zeros(1)})
     np.savez(tmp_path / "points.npz", faces=np.zeros((1, 3), int), steps=np.zeros(1, int),
              t=np.zeros(1), X=np.zeros((1, 3, 3)))
-    with pytest.raises(ValueError, match="expected faces, steps, t and V"):
+    with pytest.raises(ValueError, match="expected faces, steps, t and vertices"):
         load_frames(tmp_path / "points.npz")
+
+
+@pytest.mark.parametrize("name", ["ddfv", "cotan"])
+def test_a_file_of_the_layout_before_reads_as_one_of_this_one(name, tmp_path):
+    """Frames files written before the one layout (``V``; DDFV's ``F`` and ``T``) read
+    as ``vertices`` and ``extra_points``, their arrays unchanged."""
+    frames, _ = _frames(name)
+    old = {"F" if name == "ddfv" else "V": frames["vertices"],
+           **({"T": frames["extra_points"]} if name == "ddfv" else {}),
+           "faces": frames["faces"], "steps": frames["steps"], "t": frames["t"]}
+    np.savez(tmp_path / "old.npz", **old)
+    back = load_frames(tmp_path / "old.npz")
+    assert set(back) == set(frames)
+    for key, value in frames.items():
+        np.testing.assert_array_equal(back[key], value)

@@ -185,3 +185,41 @@ def test_every_name_the_workflow_scripts_and_benchmarks_import_exists():
                             for a in node.names if not hasattr(module, a.name)
                             and importlib.util.find_spec(f"{node.module}.{a.name}") is None]
     assert missing == []
+
+
+TESTS = ROOT / "tests" / "mcfbench"
+CROSS_CUTTING = {
+    "running/test_run_properties.py": "run() of every scheme on random surfaces (hypothesis)",
+    "running/test_progress.py": "the progress bars of driver.simulate and run.level_sweep",
+    "running/test_reference_metrics.py": "the problems' reference answers",
+    "test_layout.py": "the harness's layers and this layout",
+}
+"""Test files of tests/mcfbench/ that test several modules, each under a name that
+says what (docs/tests.md)."""
+
+
+def _tested_module(rel):
+    """The module (or study package) that the test file ``rel`` (relative to
+    tests/mcfbench/) is named after, or None: ``<layer>/test_<module>.py`` ->
+    ``mcfbench/<layer>/<module>.py``; in a study's folder also ``test_<study>.py`` (the
+    study's package) and ``test_<study>_<module>.py`` (basenames are unique in tests/)."""
+    folder, name = HARNESS / rel.parent, rel.stem[len("test_"):]
+    candidates = [folder / f"{name}.py"]
+    if rel.parts[0] == "studies" and len(rel.parts) == 3:
+        study = rel.parent.name
+        candidates.append(folder / "__init__.py" if name == study else
+                          folder / f"{name.removeprefix(study + '_')}.py")
+    return next((c for c in candidates if c.is_file()), None)
+
+
+def test_every_test_file_is_named_after_a_module_of_its_folder():
+    """Tests mirror the harness's modules: tests/mcfbench/<layer>/test_<module>.py."""
+    files = sorted(p.relative_to(TESTS) for p in TESTS.rglob("test_*.py"))
+    assert len(files) > 40 and {str(f) for f in files} >= set(CROSS_CUTTING)
+    unnamed = [str(f) for f in files
+               if str(f) not in CROSS_CUTTING and _tested_module(f) is None]
+    assert unnamed == []
+    assert _tested_module(Path("running/test_run.py")) == HARNESS / "running" / "run.py"
+    assert _tested_module(Path("studies/matrix/test_matrix_page.py")) == \
+        HARNESS / "studies" / "matrix" / "page.py"
+    assert _tested_module(Path("running/test_bad_input.py")) is None

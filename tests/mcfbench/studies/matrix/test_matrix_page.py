@@ -1,6 +1,6 @@
 """The pieces of the matrix's results page (mcfbench.studies.matrix.page)
 without a browser: the table cells and the findings' headings (the sort keys:
-tests/harness/presentation/test_tables.py).
+tests/mcfbench/presentation/test_tables.py).
 The page in Chromium: tests/workflow/test_results_page.py."""
 
 import re

@@ -48,7 +48,7 @@ def test_the_estimate_has_the_order_of_magnitude_of_a_measured_run():
     """Level 5 of the sphere with cotan in a fresh process (its anonymous memory
     above the warmed-up process, sampled at every step, and its CPU time) against
     the fit."""
-    root = Path(__file__).resolve().parents[2]
+    root = Path(__file__).resolve().parents[3]
     out = subprocess.run([sys.executable, "-c", MEASURE], cwd=root, check=True, text=True,
                          capture_output=True, env={**os.environ, "PYTHONPATH": str(root)})
     n, steps, memory, seconds = json.loads(out.stdout)

@@ -16,7 +16,7 @@ SCALES = (1.0, 0.8, 0.6, 0.4)
 def _shrinking_run(status="ok", failed_step=-1):
     """A sphere scaled by :data:`SCALES` at steps 0, 5, 10, 15 (a vertex scheme's frames)."""
     V, F = icosphere(1)
-    return {"V": np.stack([s * V for s in SCALES]), "faces": F,
+    return {"vertices": np.stack([s * V for s in SCALES]), "faces": F,
             "t": np.array([0.0, 0.05, 0.1, 0.15]), "steps": np.array([0, 5, 10, 15]),
             "status": status, "message": f"{status} at step 10 (t = 0.1): triangle 3"
             if failed_step >= 0 else "", "failed_step": failed_step}
@@ -77,7 +77,7 @@ def test_export_of_a_matrix_frames_file_shows_the_status_of_its_record(tmp_path,
     record = tmp_path / "runs" / "sphere" / "cotan" / "level1.json"
     frames.parent.mkdir(parents=True)
     record.parent.mkdir(parents=True)
-    np.savez(frames, **{key: run[key] for key in ("V", "faces", "t", "steps")})
+    np.savez(frames, **{key: run[key] for key in ("vertices", "faces", "t", "steps")})
     record.write_text(json.dumps({"scheme": "cotan", "status": "inverted", "tau": 0.01,
                                   "message": "inverted at step 10 (t = 0.1): triangle 3",
                                   "t_failed": 0.1}))
@@ -145,7 +145,7 @@ def test_refused_ddfv_run_still_gets_its_one_frame_movie(tmp_path):
 
     V, F = icosphere(1)
     out = tmp_path / "refused.gif"
-    write_movie({"F": np.stack([V, V]), "faces": F, "steps": np.array([0, 0]),
+    write_movie({"vertices": np.stack([V, V]), "faces": F, "steps": np.array([0, 0]),
                  "t": np.zeros(2), "status": "unsupported",
                  "message": "unsupported at step 0 (t = 0): two components"}, out)
     assert out.read_bytes()[:6] in (b"GIF89a", b"GIF87a")
