@@ -56,8 +56,14 @@ solutions). (KL3) and (KL5) together, the state ``U = (X, nu, H)`` (7, n)::
     [ 0   0      S      ] [H ]   [B_H + dt w/m H*     ]
 
 ``S = I + dt diag(1/m) L`` (C3), ``dt H*`` and ``dt nu*`` diagonal: a (7n, 7n)
-block upper triangular matrix, not symmetric (BiCGStab or a sparse LU); its
-eigenvalues are 1 and those of ``S``.
+block upper triangular matrix, not symmetric; its eigenvalues are 1 and those
+of ``S``. Its lower right block is ``I_4 (x) S`` (``nu_1, nu_2, nu_3, H``
+decoupled, one matrix) and its leading block the identity, so the step is
+solved by blocks (:class:`BlockSystem`, which the harness's solver reduces):
+``S [nu_1 nu_2 nu_3 H] = [b_nu b_H]`` (one factorisation, or one block
+BiCGStab iteration, for four right-hand sides), then::
+
+    X_c = b_X,c - dt H* nu_c - dt nu*_c H                                    (KL7)
 
 Initial values (any mesh): ``nu^0`` the unit area-weighted vertex normals
 (:func:`baselines.mdr.unit_vertex_normals`), ``H^0_i = nu^0_i . (L X^0)_i / m_i`` the
@@ -109,6 +115,59 @@ def curvature_weights(vertices, faces, nu):
     return w, squared
 
 
+class BlockSystem:
+    """(KL6) by its blocks, ``[[I, D], [0, I_4 (x) S]]`` (``baselines/README.md``, "The
+    block solve"): the rows of ``(nu, H)`` are four systems with the one matrix ``S``,
+    and ``X`` follows from their solution by the substitution (KL7).
+
+    Parameters
+    ----------
+    S : (n, n) scipy.sparse.csr_matrix
+        ``I + dt diag(1/m) L``, shared by the rows ``nu_1, nu_2, nu_3, H``.
+    dtH : (n,) float array
+        ``dt H*``, the diagonal block of ``X_c`` against ``nu_c``.
+    dtnu : (3, n) float array
+        ``dt nu*``, the diagonal blocks of ``X_c`` against ``H``.
+
+    Attributes
+    ----------
+    shared : (n, n) scipy.sparse.csr_matrix
+        ``S``.
+    rows : int
+        4: the last rows of ``b`` (7, n) that ``shared`` solves.
+    shape : tuple
+        ``(7 n, 7 n)``, of the whole system acting on ``b.ravel()``.
+
+    Examples
+    --------
+    >>> S = sp.csr_matrix(2.0 * np.eye(2))
+    >>> T = BlockSystem(S, np.array([1.0, 0.5]), np.ones((3, 2)))
+    >>> T.shape, T.substitute(np.ones((4, 2)), np.full((7, 2), 3.0))[0].tolist()
+    ((14, 14), [1.0, 1.5])
+    """
+
+    rows = ROWS - 3
+
+    def __init__(self, S, dtH, dtnu):
+        self.shared, self._dtH, self._dtnu = S, dtH, dtnu
+        self.shape = (ROWS * S.shape[0],) * 2
+
+    def substitute(self, y, b):
+        """The rows of ``X`` from the solved ``y = (nu, H)`` (4, n) and ``b`` (7, n),
+        (KL7): ``X_c = b_c - dt H* nu_c - dt nu*_c H``; (3, n)."""
+        return b[:3] - self._dtH * y[:3] - self._dtnu * y[3]
+
+    def tocsr(self):
+        """The whole (7n, 7n) matrix of (KL6), for inspection and the tests."""
+        n = self.shared.shape[0]
+        I, Z = sp.identity(n, format="csr"), None
+        top = [[I if d == c else Z for d in range(3)]
+               + [sp.diags(self._dtH) if d == c else Z for d in range(3)]
+               + [sp.diags(self._dtnu[c])] for c in range(3)]
+        below = [[Z] * (3 + r) + [self.shared] + [Z] * (3 - r) for r in range(self.rows)]
+        return sp.bmat(top + below, format="csr")
+
+
 class KLLFlow(VertexFlow):
     """Mean curvature flow by the algorithm of Kovacs, Li and Lubich, (KL6), of one
     closed surface; state ``(X, nu, H)``.
@@ -132,8 +191,8 @@ class KLLFlow(VertexFlow):
     >>> F = np.array([[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])
     >>> flow = KLLFlow(V, F, 0.01)
     >>> A, b = flow.system()
-    >>> A.shape, b.shape, flow.state.shape
-    ((28, 28), (7, 4), (7, 4))
+    >>> A.shape, A.shared.shape, b.shape, flow.state.shape
+    ((28, 28), (4, 4), (7, 4), (7, 4))
     """
 
     def __init__(self, vertices, faces, tau):
@@ -145,15 +204,6 @@ class KLLFlow(VertexFlow):
         nu = unit_vertex_normals(self.faces, g.area_vectors, n)
         H = np.einsum("ic,ic->i", nu, self.assembler.laplacian(g.L_data) @ self.vertices) / g.mass
         self._adopt(np.vstack([self._X, nu.T, H[None]]))
-        # (KL6)'s CSR pattern: the X rows (X_c, nu_c, H), then four blocks of S
-        p = self.assembler.pattern
-        i = np.arange(n)
-        top = np.stack([[c * n + i, (3 + c) * n + i, 6 * n + i] for c in range(3)])
-        self._indices = np.concatenate([top.transpose(0, 2, 1).ravel()]
-                                       + [r * n + p.indices for r in range(3, ROWS)])
-        self._indptr = np.concatenate([3 * np.arange(3 * n)]
-                                      + [9 * n + k * p.nnz + p.indptr[:-1] for k in range(4)]
-                                      + [[9 * n + 4 * p.nnz]])
 
     def _adopt(self, U):
         """Make ``U`` (7, n) the state; ``X`` is a view of its first rows."""
@@ -190,7 +240,8 @@ class KLLFlow(VertexFlow):
 
         Returns
         -------
-        A : (7n, 7n) scipy.sparse.csr_matrix
+        A : BlockSystem
+            (KL6) by its blocks (``A.tocsr()`` the (7n, 7n) matrix).
         b : (7, n) float array
         """
         return super().system(self._U if at is None else at, base, dt)
@@ -202,16 +253,10 @@ class KLLFlow(VertexFlow):
         S = self.assembler.row_scaled(g.L_data, g.mass, dt, self.fixed)
         w = curvature_weights(X.T, self.faces, nu.T)[0]
         source = dt * np.divide(w, g.mass, out=np.zeros(n), where=g.mass > 0)
-        data = np.empty(len(self._indices))
-        top = data[:9 * n].reshape(3, n, 3)          # the X rows: (X_c, nu_c, H) entries
-        top[..., 0], top[..., 1], top[..., 2] = 1.0, dt * H, dt * nu
-        data[9 * n:].reshape(4, -1)[:] = S.data
-        A = sp.csr_matrix((data, self._indices, self._indptr), shape=(ROWS * n, ROWS * n),
-                          copy=False)
         b = np.array(base, dtype=np.float64)
         b[:3] += dt * H * nu
         b[3:] += source * at[3:]
-        return A, b
+        return BlockSystem(S, dt * H, dt * nu), b
 
     def advance(self, U):
         """Accept ``U`` (7, n) as the state ``n + 1``."""

@@ -13,7 +13,8 @@ potential is a sparse LU at every step: level 5, 29.9 MB and 78 ms a step for
 38 ms for ``ddfv-chord-redistribute-carried`` against 27.1 MB and 6 ms for
 ``ddfv``; ``bgn`` 16.4 MB and 4 ms; ``kll``, its 7n x 7n system, measured
 2026-11-26 beside ``cotan`` and ``bgn`` at load average 7: 25.4 MB and 6.7 ms
-against 14.0 MB and 2.1 ms for ``cotan``, 16.2 MB and 4.2 ms for ``bgn``):
+against 14.0 MB and 2.1 ms for ``cotan``, 16.2 MB and 4.2 ms for ``bgn``; that
+was before its system was solved by blocks, not refitted since):
 
 * the peak resident memory that grows with the mesh (mesh, flow, solver), above
   a process that made a level-1 run first, ``a n^p`` (slopes 1.06-1.12), plus
@@ -63,7 +64,7 @@ compiled kernels, scipy's solvers (the level-1 run after the imports)."""
 
 def cost_class(scheme):
     """The kind of a scheme (a name or a registry entry) in :data:`COSTS`: ``"bgn"``
-    (a coupled 3n x 3n system), ``"kll"`` (a coupled 7n x 7n one), ``"ddfv"`` or
+    (a coupled 3n x 3n system), ``"kll"`` (a 7n x 7n one, solved by blocks), ``"ddfv"`` or
     ``"vertex"`` (the other vertex
     schemes), with ``", redistributing"`` for a scheme with a tangential
     redistribution (a potential solved at every step)."""

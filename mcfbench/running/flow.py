@@ -84,7 +84,9 @@ class SchemeFlow(Protocol):
         explicitly (an elimination of tangential motion, a tangential
         velocity); fixed points keep ``B``. ``A`` is an (n, n) matrix shared
         by the three components or a (3n, 3n) one acting on ``b.ravel()``;
-        ``b`` is (3, n). The semi-implicit Euler step is ``at = base = None``
+        ``b`` is (3, n). (A scheme whose state has more rows, KLL's ``(X, nu,
+        H)``, returns ``b`` with them and may return ``A`` block triangular,
+        :mod:`mcfbench.running.solver`, "Systems".) The semi-implicit Euler step is ``at = base = None``
         (the state), ``dt = tau``.
         """
 

@@ -12,7 +12,17 @@ coordinate x, y, z) from an initial guess ``x0``:
   iteration costs two sparse products with the whole block (the three
   rows go through the matrix together, in one pass over its entries);
 * ``A`` of shape (3n, 3n) acts on ``b.ravel()`` (C order: all x, then all
-  y, then all z; the BGN scheme couples the components).
+  y, then all z; the BGN scheme couples the components);
+* ``A`` block upper triangular with an identity leading block (KLL's (KL6),
+  ``baselines/README.md``): an object with ``A.shape == (k n, k n)``, an
+  (n, n) matrix ``A.shared`` of the last ``A.rows`` rows of ``b``, which are
+  decoupled, and ``A.substitute(y, b)``, the first rows from their solution
+  ``y``. The solver solves ``A.shared y = b[-A.rows:]`` as a shared system
+  (from ``x0[-A.rows:]``; ``direct`` factorises ``A.shared`` once for its
+  ``A.rows`` right-hand sides, BiCGStab iterates on the (A.rows, n) block)
+  and returns ``[A.substitute(y, b); y]``. Its iterations, residual and
+  stopping test are those of the shared system (the substituted rows have
+  residual zero up to round-off).
 
 Iteration count
 ---------------
@@ -270,8 +280,9 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
 
     Parameters
     ----------
-    A : (n, n) or (k n, k n) scipy sparse matrix (or dense array)
-        Shared by the k rows of ``b``, or acting on ``b.ravel()``.
+    A : (n, n) or (k n, k n) scipy sparse matrix (or dense array), or block triangular
+        Shared by the k rows of ``b``, acting on ``b.ravel()``, or an object with
+        ``shared``, ``rows`` and ``substitute`` (module docstring).
     b, x0 : (k, n) float arrays
         ``x0=None`` starts from zero.
     method : str
@@ -314,6 +325,11 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
     if method not in METHODS:
         raise ValueError(f"unknown solver method {method!r}; choose one of "
                          f"{', '.join(METHODS)}")
+    if hasattr(A, "substitute"):             # block triangular (module docstring)
+        return _by_blocks(A, b, x0, method=method, rtol=rtol, maxiter=maxiter,
+                          stagnation_window=stagnation_window, ilu_drop_tol=ilu_drop_tol,
+                          ilu_fill_factor=ilu_fill_factor, overwrite_x0=overwrite_x0,
+                          threads=threads)
     check_threads(threads)
     b, x, cmean, cfull, to_block = _blocks(A, b, x0, overwrite_x0)
     csr = _csr(A)
@@ -359,6 +375,21 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
         detail = krylov.BREAKDOWN_DETAILS[dcode]
     return to_block(x), SolveInfo(int(it), float(residual), code == krylov.CONVERGED,
                                   krylov.STATUS_NAMES[code], method, detail)
+
+
+def _by_blocks(A, b, x0, **options):
+    """:func:`solve` for a block triangular ``A`` (module docstring): the shared rows,
+    then the substitution."""
+    b = np.asarray(b, dtype=float)
+    if b.ndim != 2 or A.shape != (b.size, b.size) or b.shape[0] <= A.rows:
+        raise ValueError(f"A is block triangular of shape {A.shape} with {A.rows} shared "
+                         f"rows; b has shape {b.shape}")
+    if x0 is not None and np.shape(x0) != b.shape:
+        raise ValueError(f"x0 has shape {np.shape(x0)}, b has {b.shape}")
+    rows = slice(b.shape[0] - A.rows, None)
+    y, info = solve(A.shared, b[rows], None if x0 is None else np.asarray(x0)[rows],
+                    **options)
+    return np.vstack([A.substitute(y, b), y]), info
 
 
 def _direct(A, csr, b, x0, cmean, cfull, rtol):

@@ -36,7 +36,8 @@ def plan(config, table):
         ``rtol`` of its runs, ``schemes``: the schemes whose rows of the
         L2/EOC table go on to that level; none by default), ``long_time`` (``level``, ``t_final``,
         ``tau``, ``schemes``), ``time_study`` (``level``, ``taus``
-        (descending), ``reference_factor``, ``t_final``, ``schemes``) and
+        (descending), ``reference_factor``, ``t_final``, ``rtol`` of its runs
+        (default the top-level one), ``schemes``) and
         ``space_study`` (``levels``, ``tau``, ``t_final``, ``schemes``); times
         as floats.
 
@@ -83,6 +84,8 @@ def plan(config, table):
                       "schemes": check_schemes("beyond.long_time.schemes", long["schemes"])},
         "time_study": {"level": int(time_["level"]), "taus": taus, "reference_factor": factor,
                        "t_final": time_t,
+                       "rtol": check_rtol("beyond.time_study.rtol",
+                                          time_.get("rtol", table["rtol"])),
                        "schemes": check_schemes("beyond.time_study.schemes",
                                                 time_.get("schemes", every_scheme()))},
         "space_study": {"levels": sorted({int(level) for level in space["levels"]}),
@@ -165,7 +168,7 @@ def time_settings(plan, table, scheme, code):
     return {"study": "time", "scheme": scheme, "problem": convergence.PROBLEM,
             "level": study["level"], "taus": study["taus"],
             "reference_factor": study["reference_factor"], "t_final": study["t_final"],
-            "rtol": table["rtol"], "threads": table["threads"], "code": code}
+            "rtol": study["rtol"], "threads": table["threads"], "code": code}
 
 
 def time_steps_total(plan):

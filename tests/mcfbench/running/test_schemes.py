@@ -74,7 +74,7 @@ def _symmetrizing_residual(A):
     import scipy.sparse as sp
     import scipy.sparse.linalg as sla
 
-    A = sp.csr_matrix(A)
+    A = A.tocsr() if hasattr(A, "substitute") else sp.csr_matrix(A)   # KLL's blocks
     C = sp.triu(A, k=1).tocoo()
     r, c, v = C.row, C.col, C.data
     keep = v != 0

@@ -122,6 +122,39 @@ def test_shared_and_coupled_matrices_agree(method):
         assert infos.residual == pytest.approx(infoc.residual, rel=1e-3)
 
 
+class _Triangular:
+    """``[[I, diag(d)], [0, S]]`` on a (2, n) block: the solver's block triangular form
+    (module docstring, "Systems"; KLL's (KL6) has three rows above four)."""
+
+    rows = 1
+
+    def __init__(self, S, d):
+        self.shared, self.d, self.shape = S, d, (2 * S.shape[0],) * 2
+
+    def substitute(self, y, b):
+        return b[:1] - self.d * y
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_block_triangular_system_is_solved_by_its_blocks(method):
+    """The shared block, then the substitution: the whole matrix's solution to 1e-10,
+    the shared system's iterations; shapes that do not fit are refused."""
+    A, b = ring_system(tau=1.0)
+    n = A.shape[0]
+    d = np.linspace(0.5, 2.0, n)
+    T, rhs = _Triangular(A, d), b[:2]
+    whole = sp.bmat([[sp.identity(n), sp.diags(d)], [None, A]], format="csc")
+    expected = spla.spsolve(whole, rhs.ravel()).reshape(rhs.shape)
+    x, info = Solver(method, rtol=1e-12)(T, rhs, rhs + 0.01)
+    _, shared = Solver(method, rtol=1e-12)(A, rhs[1:], rhs[1:] + 0.01)
+    assert np.abs(x - expected).max() < 1e-10 * np.abs(expected).max()
+    assert info.converged and info.iterations == shared.iterations
+    with pytest.raises(ValueError, match="block triangular of shape .* b has shape"):
+        Solver(method)(T, b, None)
+    with pytest.raises(ValueError, match="x0 has shape"):
+        Solver(method)(T, rhs, b)
+
+
 def test_coupled_matrix_acts_on_the_raveled_block():
     rng = np.random.default_rng(3)
     n = 50

@@ -429,6 +429,11 @@ def test_finest_level_adds_its_runs_only():
     # the finest level's own tolerance; every other run keeps the top-level one
     assert runs["results/runs/ddfv-chord/level7.json"]["rtol"] == 1e-11
     assert {s["rtol"] for p, s in runs.items() if "level7" not in p} == {1e-9}
+    # the time study's own tolerance (config: its BDF3 errors reach 1e-7); default the
+    # top-level one
+    assert {s["rtol"] for s in study_runs(pipeline)["time"].values()} == {1e-12}
+    del config["beyond"]["time_study"]["rtol"]
+    assert {s["rtol"] for s in study_runs(Plans(config, SCHEMAS))["time"].values()} == {1e-9}
     assert levels_of(pipeline.plan("beyond"), "ddfv-chord") == [1, 2, 3, 4, 5, 6, 7]
     assert levels_of(pipeline.plan("beyond"), "ddfv") == [1, 2, 3, 4, 5, 6]
     problem = problem_of(pipeline.plan("convergence"))
@@ -497,6 +502,7 @@ def test_main_schema_refuses_an_old_key():
     (("finest", "level"), 6,
      "config key 'beyond.finest.level': 6 is not above the levels of 'beyond.levels'"),
     (("finest", "rtol"), float("nan"), "config key 'beyond.finest.rtol': must lie in (0, 1)"),
+    (("time_study", "rtol"), 1.0, "config key 'beyond.time_study.rtol': must lie in (0, 1)"),
 ])
 def test_checks_across_keys_name_the_key(path, value, message):
     config = json.loads(json.dumps(CONFIG))
