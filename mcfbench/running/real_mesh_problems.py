@@ -168,8 +168,9 @@ class RealMeshShape:
     largest magnitude; NaN if a checkpoint was not reached); and
     ``distance_error``, the symmetric mean distance to the reference surface
     at ``t_final`` over the length scale
-    (:func:`mcfbench.geometry.surface_distance.mean_surface_distance`, measured
-    once, at ``t_final``; NaN if not reached; absent from a reference without
+    (:func:`mcfbench.geometry.surface_distance.mean_surface_distance`: the
+    state at ``t_final`` is kept and measured once, by :meth:`result`, outside
+    the run's timed part; NaN if not reached; absent from a reference without
     a surface). Values are kept when the run breaks down after the
     checkpoints (``keeps_before_breakdown``).
     """
@@ -187,7 +188,7 @@ class RealMeshShape:
         surface = ref.get("distance_reference")
         self.surface = None if surface is None else \
             (ref["mesh"], surface["level"], surface["faces_sha256"], ref["length_scale"])
-        self.distance = math.nan
+        self.final = None
 
     def __call__(self, flow):
         t = flow.n * flow.tau
@@ -195,10 +196,8 @@ class RealMeshShape:
             if math.isclose(t, tc, rel_tol=1e-9, abs_tol=1e-15):
                 self.samples[i] = (metrics.area(flow.vertices, flow.faces),
                                    metrics.volume(flow.vertices, flow.faces))
-                if i == len(self.times) - 1 and self.surface is not None:
-                    *key, length = self.surface
-                    self.distance = mean_surface_distance(
-                        flow.vertices, flow.faces, *reference_surface(*key)) / length
+                if i == len(self.times) - 1:      # measured in result(), not timed
+                    self.final = (np.array(flow.vertices, dtype=float), np.asarray(flow.faces))
 
     def values(self):
         """``{"area": [...], "volume": [...]}`` at the checkpoints (NaN where
@@ -217,5 +216,7 @@ class RealMeshShape:
             worst = max(errors, key=lambda e: -1.0 if math.isnan(e) else abs(e))
             out[f"{key}_error"] = math.nan if any(map(math.isnan, errors)) else worst
         if self.surface is not None:
-            out["distance_error"] = self.distance
+            *key, length = self.surface
+            out["distance_error"] = math.nan if self.final is None else \
+                mean_surface_distance(*self.final, *reference_surface(*key)) / length
         return out
