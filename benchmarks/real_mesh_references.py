@@ -1,7 +1,7 @@
 """The reference answers of the real-mesh problems, as the problems read them
 (``mcfbench/data/meshes/references/<name>.json``, :mod:`mcfbench.running.real_mesh_problems`).
 
-    nice python benchmarks/real_mesh_references.py                 # every mesh, about 20 min
+    nice python benchmarks/real_mesh_references.py                 # every mesh, about 12 min CPU
     nice python benchmarks/real_mesh_references.py --mesh nut spot # some meshes
 
 For each committed mesh: the mean edge ``h_0`` of level 0 of its Loop-limit

@@ -35,10 +35,10 @@ not stored: they are the level's, regenerated from the committed mesh
 (:func:`mcfbench.geometry.committed_meshes.real_mesh`, deterministic), and
 checked against the SHA-256 the JSON stores (:func:`reference_surface`).
 float32 because its rounding, ``2^-24`` of the coordinates' magnitude,
-moves the surface by less than ``1e-6 L`` on every mesh (the coordinates
-stay within a few ``L`` of the origin), far below the distance's accuracy
-(the difference of the reference runs, ``1e-3``-``1e-2 L``), and it halves
-the files.
+moves the surface by less than ``1e-7 L`` on every mesh (the coordinates
+stay within ``1.5 L`` of the origin), far below the distance's accuracy
+(the distances between the reference runs, ``4e-5``-``2e-3 L``), and it
+halves the files.
 """
 
 import functools
