@@ -1,7 +1,7 @@
 """The reference answers of the real-mesh problems, as the problems read them
 (``mcfbench/data/meshes/references/<name>.json``, :mod:`mcfbench.running.real_mesh_problems`).
 
-    nice python benchmarks/real_mesh_references.py                 # every mesh, about 20 min
+    nice python benchmarks/real_mesh_references.py                 # every mesh, about 12 min CPU
     nice python benchmarks/real_mesh_references.py --mesh nut spot # some meshes
 
 For each committed mesh: the mean edge ``h_0`` of level 0 of its Loop-limit
@@ -19,10 +19,17 @@ level 0 only (the budget: about 15 min CPU for twelve meshes of up to 10 044
 vertices on a shared 2-core machine), unless the
 cotangent scheme broke down before the horizon: BGN then carries the
 reference alone after the breakdown and runs level 1 too.
-``--reuse-runs`` recomputes the answers from the runs stored in the
-reference files and runs only those the rule above adds. One JSON per mesh,
-written atomically, with the command that remakes it. Prints the table of
-all meshes.
+Then the reference surface at ``t_final`` and the accuracy of the distance
+to it (:func:`mcfbench.running.two_scheme_references.distance_answers`):
+the finest cotangent run's vertex positions at ``t_final`` are stored in
+``references/<name>.npz`` (float32, see :mod:`mcfbench.running.real_mesh_problems`),
+its faces are the level's, regenerated from the committed mesh (their
+SHA-256 is stored in the JSON). ``--reuse-runs`` recomputes the answers from
+the runs stored in the reference files and runs only those the rule above
+adds and those whose final surfaces the distance needs (the two finest
+levels of each scheme: positions are not stored in the JSON). One JSON and
+one NPZ per mesh, written atomically, the JSON with the command that remakes
+both. Prints the table of all meshes.
 """
 
 import argparse
@@ -38,16 +45,20 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 from mcfbench.geometry.committed_meshes import mesh_manifest, real_mesh  # noqa: E402
 from mcfbench.geometry.metrics import mean_edge_length  # noqa: E402
 from mcfbench.running.real_mesh_problems import (  # noqa: E402
+    SURFACE_DTYPE,
     TAU_EDGE,
+    faces_digest,
     real_mesh_problem,
     reference_path,
+    surface_path,
 )
 from mcfbench.running.two_scheme_references import (  # noqa: E402
     QUANTITIES,
+    distance_answers,
     reference_answers,
     reference_runs,
 )
-from mcfbench.storage.atomic import write_json  # noqa: E402
+from mcfbench.storage.atomic import save_npz, write_json  # noqa: E402
 
 HORIZON = 10
 """Checkpoints searched: ``t = j tau_0``, ``j <= HORIZON``."""
@@ -65,7 +76,8 @@ def scheme_levels(vertices):
 
 def mesh_reference(name, stored=None):
     """The reference file's content for the committed mesh ``name`` (from the
-    runs of the ``stored`` content, if given, and the runs it lacks)."""
+    runs of the ``stored`` content, if given, and the runs it lacks), and the
+    reference surface's vertex positions at ``t_final`` (``None`` if ``N = 0``)."""
     cpu = time.process_time()
     V, F = real_mesh(name, 0)
     h0 = mean_edge_length(V, F)
@@ -84,26 +96,51 @@ def mesh_reference(name, stored=None):
         # the cotangent scheme broke down: BGN carries the reference alone
         # after it, so it needs two levels for an error estimate
         levels = {**levels, "bgn": (0, 1)}
+    # the distance needs the final surfaces of each scheme's two finest runs
+    finest = {(s, lv) for s, ls in levels.items() for lv in ls[-2:]}
+    cpu += sum(r["cpu_seconds"] for r in runs
+               if (r["scheme"], r["level"]) in finest and "surface" not in r)
+    runs = [r for r in runs if (r["scheme"], r["level"]) not in finest or "surface" in r]
     have = {(r["scheme"], r["level"]) for r in runs}
     for scheme, wanted in levels.items():
         missing = tuple(lv for lv in wanted if (scheme, lv) not in have)
         if missing:
             runs += reference_runs(provisional, {scheme: missing}, tau_0, HORIZON, level_0=0)
+    runs.sort(key=lambda r: (list(levels).index(r["scheme"]), r["level"]))
     answers = reference_answers(runs, tau_0, HORIZON)
+    distance, surface = ({}, None) if not answers["steps"] else \
+        distance_answers(runs, answers, tau_0)
+    if surface is not None:
+        distance["distance_reference"].update(file=surface_path(name).name,
+                                              dtype=SURFACE_DTYPE,
+                                              faces_sha256=faces_digest(surface[1]))
     return {"mesh": name,
             "command": f"nice python benchmarks/real_mesh_references.py --mesh {shlex.quote(name)}",
             "h0": h0, "tau0": tau_0, "t_final": answers["steps"] * tau_0,
             "levels": list(levels["cotan"]), "scheme_levels": levels,
             "vertices": {str(r["level"]): r["vertices"] for r in runs},
-            **answers, "runs": runs, "cpu_seconds": time.process_time() - cpu}
+            **answers, **distance,
+            "runs": [{k: v for k, v in r.items() if k != "surface"} for r in runs],
+            "cpu_seconds": time.process_time() - cpu}, None if surface is None else surface[0]
+
+
+def _distance_cell(ref):
+    """The distance accuracy of a reference, with its level and scheme parts."""
+    if "distance_accuracy" not in ref:
+        return "-"
+    surface = ref["distance_reference"]
+    parts = [f"{ref[f'distance_{k}_difference']:.1e}" if ref[f"distance_{k}_difference"]
+             is not None else "-" for k in ("level", "scheme")]
+    return (f"{ref['distance_accuracy']:.1e} ({'; '.join(parts)}; reference "
+            f"{surface['scheme']} {surface['level']}, L = {ref['length_scale']:.4g})")
 
 
 def table(references):
     """Markdown table: one row per mesh."""
     rows = ["| mesh | vertices per level | N | t_final | area (accuracy) | volume (accuracy) "
             "| first singularity; runs that broke down | observed orders (area, volume) "
-            "| schemes at t_final | cotan vs bgn |",
-            "|---|---|---|---|---|---|---|---|---|---|"]
+            "| schemes at t_final | cotan vs bgn | distance accuracy / L (levels; schemes) |",
+            "|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, ref in references.items():
         verts = ", ".join(f"{v}" for _, v in sorted(ref["vertices"].items()))
         levels = "; ".join(f"{s} {','.join(map(str, ls))}"
@@ -120,7 +157,8 @@ def table(references):
         disagree = {q: ref[f"{q}_disagree"] for q in ("area", "volume") if ref[f"{q}_disagree"]}
         if not ref["steps"]:
             rows.append(f"| {name} | {verts} ({levels}) | 0 | - | - | - | {when}"
-                        f"{'; ' + broke if broke else ''} | - | - | no checkpoint: not a problem |")
+                        f"{'; ' + broke if broke else ''} | - | - | no checkpoint: not a problem "
+                        "| - |")
             continue
         rows.append(
             f"| {name} | {verts} ({levels}) | {ref['steps']} | {ref['t_final']:.4g} "
@@ -128,7 +166,8 @@ def table(references):
             f"| {ref['volume'][-1]:.7g} ({ref['volume_accuracy'][-1]:.1e}) "
             f"| {when}{'; ' + broke if broke else ''} | {orders or '-'} "
             f"| {', '.join(ref['area_schemes'][-1])} "
-            f"| {'disagree at ' + str(disagree) if disagree else 'agree'} |")
+            f"| {'disagree at ' + str(disagree) if disagree else 'agree'} "
+            f"| {_distance_cell(ref)} |")
     return "\n".join(rows)
 
 
@@ -145,7 +184,9 @@ def main(argv=None):
     for name in args.mesh:
         if not args.table_only:
             stored = json.loads(reference_path(name).read_text()) if args.reuse_runs else None
-            ref = mesh_reference(name, stored)
+            ref, surface = mesh_reference(name, stored)
+            if surface is not None:
+                save_npz(surface_path(name), vertices=surface.astype(SURFACE_DTYPE))
             write_json(reference_path(name), ref)
             print(f"{name}: {ref['cpu_seconds']:.0f} s CPU, N = {ref['steps']}", file=sys.stderr,
                   flush=True)

@@ -45,6 +45,17 @@ answer is known (``tests/mcfbench/running/test_two_scheme_references.py``).
      :func:`mcfbench.geometry.extrapolation.observed_orders`) and the EOC of
      each scheme's errors against the reference there
      (:func:`mcfbench.geometry.exact.eoc`).
+3. :func:`distance_answers`: the reference *surface* at ``t_final`` and the
+   accuracy of the distance to it. The reference surface is the finest run
+   of the first scheme (in the order of ``levels``: the cotangent scheme
+   first) whose two finest runs reach ``t_final``, not extrapolated
+   (positions of different meshes do not extrapolate). The length scale is
+   ``L = sqrt(A)``, ``A`` the reference area at ``t_final``; the accuracy is
+   the larger of ``D / L`` between that run and the scheme's next coarser
+   level (a level difference: about 3 times the finest level's own error at
+   order 2) and ``D / L`` between it and every other scheme's finest run at
+   ``t_final`` (a scheme difference); ``D`` the symmetric mean surface
+   distance (:func:`mcfbench.geometry.surface_distance.mean_surface_distance`).
 """
 
 import math
@@ -54,6 +65,7 @@ import numpy as np
 from mcfbench.geometry import metrics
 from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.extrapolation import observed_orders
+from mcfbench.geometry.surface_distance import mean_surface_distance
 from mcfbench.storage.statuses import STATE_STATUSES
 
 AGREEMENT = 1.25
@@ -70,15 +82,17 @@ QUANTITIES = ("area", "volume")
 
 
 class _Checkpoints:
-    """Observer: area and volume at every ``stride``-th time level."""
+    """Observer: area, volume and vertex positions at every ``stride``-th time level."""
 
     def __init__(self, stride):
-        self.stride, self.values = stride, {}
+        self.stride, self.values, self.positions, self.faces = stride, {}, {}, None
 
     def __call__(self, flow):
         if flow.n % self.stride == 0:
             self.values[flow.n // self.stride] = (metrics.area(flow.vertices, flow.faces),
                                                   metrics.volume(flow.vertices, flow.faces))
+            self.positions[flow.n // self.stride] = np.array(flow.vertices, dtype=float)
+            self.faces = np.asarray(flow.faces)
 
 
 def reference_runs(problem, levels, tau_0, steps, solver=None, level_0=None):
@@ -105,7 +119,9 @@ def reference_runs(problem, levels, tau_0, steps, solver=None, level_0=None):
         Per run: ``scheme``, ``level``, ``vertices``, ``tau``, ``status``,
         ``message``, ``t_end``, ``cpu_seconds``, and ``area``, ``volume``:
         ``steps + 1`` values at ``t = j tau_0`` (``j = 0..steps``; NaN where
-        not reached).
+        not reached); ``surface``: ``{"faces": (m, 3) int array,
+        "positions": {j: (n, 3) float array}}`` at the checkpoints reached
+        (in memory only: not JSON).
     """
     from mcfbench.running.run import run
     from mcfbench.running.solver import Solver
@@ -123,7 +139,8 @@ def reference_runs(problem, levels, tau_0, steps, solver=None, level_0=None):
             runs.append({"scheme": scheme, "level": int(level), "vertices": result.nV,
                          "tau": result.tau, "status": result.status, "message": result.message,
                          "t_end": result.t_end, "cpu_seconds": result.cpu_seconds,
-                         "area": [a for a, _ in sampled], "volume": [v for _, v in sampled]})
+                         "area": [a for a, _ in sampled], "volume": [v for _, v in sampled],
+                         "surface": {"faces": sampler.faces, "positions": sampler.positions}})
     return runs
 
 
@@ -266,3 +283,57 @@ def _answers_to(N, schemes, usable):
                 "observed": [float(x) for x in observed_orders(final)] if len(rs) >= 3 else [],
                 "eoc_against_reference": [float(x) for x in eoc(np.asarray(final) - reference)[1:]]}
     return out
+
+
+def distance_answers(runs, answers, tau_0):
+    """The reference surface at ``t_final`` and the accuracy of the distance to
+    it (module docstring, item 3).
+
+    Parameters
+    ----------
+    runs : list of dict
+        From :func:`reference_runs` (each with its ``surface``), scheme by
+        scheme in the order of preference.
+    answers : dict
+        :func:`reference_answers` of these runs (``steps`` ``N >= 1``, ``area``).
+    tau_0 : float
+
+    Returns
+    -------
+    answers : dict
+        ``length_scale`` (``L``), ``distance_reference`` (``scheme``,
+        ``level``, ``checkpoint`` ``N``, ``vertices``), ``distance_level_difference``
+        and ``distance_scheme_difference`` (``D / L``; the latter NaN when no
+        other scheme reaches ``t_final``), ``distance_accuracy`` (their larger).
+    surface : ((n, 3) float array, (m, 3) int array)
+        The reference run's vertex positions at ``t_final`` and its faces.
+
+    Raises
+    ------
+    ValueError
+        No checkpoint (``N = 0``), or no scheme whose two finest runs reach it.
+    """
+    N = answers["steps"]
+    if N < 1:
+        raise ValueError("no checkpoint (N = 0): no reference surface")
+    schemes = _by_scheme([_valid_states(r, tau_0) for r in runs])
+    chosen = [s for s, rs in schemes.items()
+              if len(rs) >= 2 and all(np.isfinite(r["area"][N]) for r in rs[-2:])]
+    if not chosen:
+        raise ValueError(f"no scheme's two finest runs reach t_final = {N} tau_0")
+    scheme, length = chosen[0], math.sqrt(answers["area"][N - 1])
+
+    def surface(run):
+        return run["surface"]["positions"][N], run["surface"]["faces"]
+
+    finest = surface(schemes[scheme][-1])
+    level = mean_surface_distance(*finest, *surface(schemes[scheme][-2])) / length
+    others = [[r for r in rs if np.isfinite(r["area"][N])] for s, rs in schemes.items()
+              if s != scheme]
+    between = max((mean_surface_distance(*finest, *surface(rs[-1])) / length
+                   for rs in others if rs), default=math.nan)
+    return ({"length_scale": length,
+             "distance_reference": {"scheme": scheme, "level": schemes[scheme][-1]["level"],
+                                    "checkpoint": N, "vertices": len(finest[0])},
+             "distance_level_difference": level, "distance_scheme_difference": between,
+             "distance_accuracy": float(np.nanmax([level, between]))}, finest)

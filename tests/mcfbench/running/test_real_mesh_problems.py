@@ -1,7 +1,9 @@
 """The real-mesh problems (mcfbench.running.real_mesh_problems): one per committed
 mesh, generated from its manifest entry and reference file; the time rule
 tau_k = 0.1 h_0^2 / 4^k; the stored answers are what the reference machinery
-makes of the stored runs; the metric measures a run against them."""
+makes of the stored runs; the stored reference surface fits its level's
+regenerated faces and remakes its file byte for byte; the metric measures a
+run against them (area, volume, distance)."""
 
 import json
 import math
@@ -11,12 +13,18 @@ import pytest
 
 from mcfbench.geometry.committed_meshes import mesh_manifest
 from mcfbench.geometry.metrics import mean_edge_length
+from mcfbench.geometry.surface_distance import mean_surface_distance
 from mcfbench.running.problems import PROBLEMS
-from mcfbench.running.real_mesh_problems import reference_path
+from mcfbench.running.real_mesh_problems import (
+    RealMeshShape,
+    reference_path,
+    reference_surface,
+    surface_path,
+)
 from mcfbench.running.run import run
 from mcfbench.running.solver import Solver
 from mcfbench.running.two_scheme_references import QUANTITIES, reference_answers
-from mcfbench.storage.atomic import json_value
+from mcfbench.storage.atomic import json_value, save_npz
 
 NAMES = sorted(mesh_manifest())
 
@@ -60,15 +68,63 @@ def test_stored_answers_are_what_the_machinery_makes_of_the_stored_runs(name):
         assert np.all(np.asarray(ref[f"{q}_accuracy"]) < 0.05 * np.abs(ref[q]))
 
 
+@pytest.mark.parametrize("name", NAMES)
+def test_reference_surface_fits_its_regenerated_level_and_remakes_its_file(name, tmp_path):
+    ref = _stored(name)
+    surface = ref["distance_reference"]
+    assert (surface["scheme"], surface["level"]) == ("cotan", ref["scheme_levels"]["cotan"][-1])
+    assert surface["checkpoint"] == ref["steps"] and surface["file"] == f"{name}.npz"
+    V, F = reference_surface(name, surface["level"], surface["faces_sha256"])
+    assert V.shape == (surface["vertices"], 3) and surface["vertices"] == \
+        ref["vertices"][str(surface["level"])]
+    assert ref["length_scale"] == pytest.approx(math.sqrt(ref["area"][-1]), rel=1e-12)
+    # the accuracy: the larger of the finest levels' and the schemes' distances
+    assert ref["distance_accuracy"] == max(ref["distance_level_difference"],
+                                           ref["distance_scheme_difference"])
+    assert 0 < ref["distance_accuracy"] < 0.05
+    with np.load(surface_path(name)) as stored:
+        save_npz(tmp_path / "again.npz", vertices=stored["vertices"])
+        assert stored["vertices"].dtype == np.float32
+    assert (tmp_path / "again.npz").read_bytes() == surface_path(name).read_bytes()
+
+
+def test_reference_surface_whose_level_changed_is_refused():
+    surface = _stored("nut")["distance_reference"]
+    with pytest.raises(ValueError, match="does not fit level 1"):
+        reference_surface("nut", 1, surface["faces_sha256"])
+    with pytest.raises(ValueError, match="remake it"):
+        reference_surface("nut", surface["level"], "0" * 64)
+
+
+def test_distance_of_the_reference_surface_to_itself_is_zero():
+    ref = _stored("nut")
+    observer = RealMeshShape(PROBLEMS["real_nut"])
+    V, F = reference_surface("nut", ref["distance_reference"]["level"],
+                             ref["distance_reference"]["faces_sha256"])
+
+    class Flow:
+        vertices, faces, tau, n = V, F, ref["tau0"], ref["steps"]
+    observer(Flow)
+    assert observer.result()["distance_error"] == 0.0
+    assert math.isnan(RealMeshShape(PROBLEMS["real_nut"]).result()["distance_error"])
+
+
 def test_metric_measures_a_run_against_the_reference():
     """cotan on level 0 of the nut: the metric's errors are the stored run's
-    values at the checkpoints against the reference (worst in magnitude)."""
+    values at the checkpoints against the reference (worst in magnitude), and
+    its final surface's mean distance to the reference surface over L."""
     ref = _stored("nut")
-    result, _ = run("cotan", "real_nut", 0, solver=Solver(method="direct"))
+    result, traj = run("cotan", "real_nut", 0, solver=Solver(method="direct"))
     stored = next(r for r in ref["runs"] if (r["scheme"], r["level"]) == ("cotan", 0))
     for q in QUANTITIES:
         errors = [stored[q][j] / ref[q][j - 1] - 1 for j in ref["checkpoints"]]
         assert result.metrics[f"{q}_error"] == pytest.approx(max(errors, key=abs), rel=1e-9)
+    surface = ref["distance_reference"]
+    distance = mean_surface_distance(traj.frames["V"][-1], traj.faces, *reference_surface(
+        "nut", surface["level"], surface["faces_sha256"])) / ref["length_scale"]
+    assert result.metrics["distance_error"] == pytest.approx(distance, rel=1e-12)
+    # level 0 is farther from the reference than the finest levels from each other
+    assert ref["distance_accuracy"] < distance < 0.05
 
 
 def test_mesh_whose_reference_runs_all_broke_down_before_tau0_is_no_problem(tmp_path, monkeypatch):

@@ -1,7 +1,8 @@
 """The reference machinery (mcfbench.running.two_scheme_references) on a case with a
 known answer, the shrinking sphere r(t)^2 = 1 - 4t: its reference area and
-volume agree with the exact ones within the stated accuracy; and the
-singularity rule on synthetic runs."""
+volume agree with the exact ones within the stated accuracy, and so does its
+reference surface's distance to the exact sphere; and the singularity rule
+on synthetic runs."""
 
 import math
 
@@ -9,9 +10,12 @@ import numpy as np
 import pytest
 
 from mcfbench.geometry.metrics import mean_edge_length
+from mcfbench.geometry.spheres import icosphere
+from mcfbench.geometry.surface_distance import mean_surface_distance
 from mcfbench.running.problems import PROBLEMS
 from mcfbench.running.two_scheme_references import (
     ACCURACY,
+    distance_answers,
     first_singularity,
     reference_answers,
     reference_runs,
@@ -24,11 +28,11 @@ def sphere_answers():
     h = mean_edge_length(*problem.mesh(2))
     tau_0 = 0.1 * h ** 2
     runs = reference_runs(problem, {"cotan": (2, 3, 4), "bgn": (2, 3)}, tau_0, 4)
-    return tau_0, reference_answers(runs, tau_0, 4)
+    return tau_0, reference_answers(runs, tau_0, 4), runs
 
 
 def test_sphere_reference_is_within_its_stated_accuracy(sphere_answers):
-    tau_0, ref = sphere_answers
+    tau_0, ref, _ = sphere_answers
     assert ref["steps"] == 4 and ref["singularity"]["time"] is None
     t = tau_0 * np.asarray(ref["checkpoints"])
     exact = {"area": 4 * np.pi * (1 - 4 * t), "volume": 4 / 3 * np.pi * (1 - 4 * t) ** 1.5}
@@ -40,6 +44,33 @@ def test_sphere_reference_is_within_its_stated_accuracy(sphere_answers):
         assert ref[f"{q}_disagree"] == []
     cotan = ref["orders"]["cotan"]["volume"]["observed"]
     assert len(cotan) == 1 and 1.5 < cotan[0] < 2.5        # O(h^2 + tau), tau ~ h^2
+
+
+def test_sphere_reference_surface_is_within_its_stated_distance_accuracy(sphere_answers):
+    """The finest cotangent run at t_final against the exact sphere
+    r^2 = 1 - 4 t_final (a finer icosphere of that radius)."""
+    tau_0, ref, runs = sphere_answers
+    answers, (surface, faces) = distance_answers(runs, ref, tau_0)
+    radius = np.sqrt(1 - 4 * ref["steps"] * tau_0)
+    assert answers["distance_reference"] == {"scheme": "cotan", "level": 4, "checkpoint": 4,
+                                             "vertices": len(surface)}
+    assert answers["length_scale"] == pytest.approx(np.sqrt(4 * np.pi) * radius, rel=1e-3)
+    finest = next(r for r in runs if (r["scheme"], r["level"]) == ("cotan", 4))["surface"]
+    np.testing.assert_array_equal(faces, finest["faces"])
+    np.testing.assert_array_equal(surface, finest["positions"][4])
+    error = mean_surface_distance(surface, faces, *icosphere(6, radius)) / answers["length_scale"]
+    accuracy = answers["distance_accuracy"]
+    assert accuracy == max(answers["distance_level_difference"],
+                           answers["distance_scheme_difference"])
+    assert error <= accuracy < 1e-3, (error, accuracy)
+
+
+def test_distance_needs_a_checkpoint_and_two_levels_reaching_it(sphere_answers):
+    tau_0, ref, runs = sphere_answers
+    with pytest.raises(ValueError, match="no checkpoint"):
+        distance_answers(runs, {**ref, "steps": 0}, tau_0)
+    with pytest.raises(ValueError, match="two finest runs"):
+        distance_answers([r for r in runs if r["level"] == 2], ref, tau_0)
 
 
 def _run(scheme, level, status, t_end, tau_0=0.1, steps=10, spread=lambda j: 1e-3):
