@@ -120,7 +120,7 @@ def test_metric_measures_a_run_against_the_reference():
         errors = [stored[q][j] / ref[q][j - 1] - 1 for j in ref["checkpoints"]]
         assert result.metrics[f"{q}_error"] == pytest.approx(max(errors, key=abs), rel=1e-9)
     surface = ref["distance_reference"]
-    distance = mean_surface_distance(traj.frames["V"][-1], traj.faces, *reference_surface(
+    distance = mean_surface_distance(traj.frames["vertices"][-1], traj.faces, *reference_surface(
         "nut", surface["level"], surface["faces_sha256"])) / ref["length_scale"]
     assert result.metrics["distance_error"] == pytest.approx(distance, rel=1e-12)
     # level 0 is farther from the reference than the finest levels from each other
