@@ -30,6 +30,7 @@ import numpy as np
 from _harness import ROOT, THREAD_VARIABLES, machine_line
 
 from mcfbench.running.cost import cost_class
+from mcfbench.studies.beyond.scaling import power_fit
 
 ONE = """
 import json, sys
@@ -53,12 +54,6 @@ def measure(scheme, level):
                           sys.executable, "-c", ONE, scheme, str(level)],
                          cwd=ROOT, env=env, capture_output=True, text=True, check=True)
     return json.loads(out.stdout.splitlines()[-1])
-
-
-def fit(n, y):
-    """``(coefficient, slope)`` of ``y = c n^p``, least squares in log-log."""
-    slope, intercept = np.polyfit(np.log(n), np.log(y), 1)
-    return float(np.exp(intercept)), float(slope)
 
 
 def main():
@@ -86,8 +81,8 @@ def main():
         worst = {key: [max(row[key] for row in mine if row["level"] == level)
                        for level in levels] for key in ("unknowns", "memory_mb", "step_seconds", "fixed_mb")}
         big = [k for k, level in enumerate(levels) if level >= args.fit_from]
-        memory = fit(np.take(worst["unknowns"], big), np.take(worst["memory_mb"], big))
-        step = fit(np.take(worst["unknowns"], big), np.take(worst["step_seconds"], big))
+        memory = power_fit(np.take(worst["unknowns"], big), np.take(worst["memory_mb"], big))
+        step = power_fit(np.take(worst["unknowns"], big), np.take(worst["step_seconds"], big))
         print(f"{name}: memory_mb = {memory[0]:.4g} n^{memory[1]:.3f}, step_seconds = "
               f"{step[0]:.4g} n^{step[1]:.3f} (levels >= {args.fit_from}) "
               f"(the largest of {sorted({row['scheme'] for row in mine})} at each level), "

@@ -39,7 +39,7 @@ import scipy.sparse as sp
 
 from .assembly import Assembler
 from .geometry import diamond_geometry, t_barycentric, vertex_normals
-from .kernels import check_threads
+from .threads import check_threads
 from .redistribution import (OMEGA, PECLET, TangentialPotential, carry_t_vertices,
                              drift_system, neumann_stiffness, redistribution_source,
                              surface_components, vertex_gradients)
@@ -114,7 +114,7 @@ class Flow:
         or the chord (see :func:`ddfv.geometry.diamond_geometry`).
     threads : int
         Threads of the compiled passes (geometry, covolumes, matrix fill, T
-        monitor; :func:`ddfv.kernels.for_threads`).
+        monitor; :func:`ddfv.threads.for_threads`).
 
     Attributes
     ----------

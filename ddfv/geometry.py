@@ -114,7 +114,7 @@ def diamond_geometry(mesh, F, T, dual_length="broken", threads=1, vectors=True,
         ``|gamma|`` as the paper's broken line through ``S`` (2.5), or as the
         chord (``|gamma^T| = |v|``, ``|gamma^F| = |u|``).
     threads : int
-        Threads of the pass (:func:`ddfv.kernels.threaded`).
+        Threads of the pass (:func:`ddfv.threads.threaded`).
     vectors : bool
         Also keep ``u``, ``v``, ``e`` (otherwise None: the scheme needs
         them only for the vertex normals of (3.6)).
@@ -131,6 +131,7 @@ def diamond_geometry(mesh, F, T, dual_length="broken", threads=1, vectors=True,
         raise ValueError(f"unknown dual_length {dual_length!r}; choose one of "
                          f"{', '.join(DUAL_LENGTHS)}")
     from . import kernels as k
+    from .threads import for_threads
 
     F, T = _coordinates(F, mesh.n_f, "F"), _coordinates(T, mesh.n_t, "T")
     diamonds = _diamond_indices(mesh)
@@ -141,7 +142,7 @@ def diamond_geometry(mesh, F, T, dual_length="broken", threads=1, vectors=True,
     if scatter and (covolumes.shape != (mesh.n_unknowns,) or covolumes.dtype != np.float64):
         raise ValueError(f"covolumes must be a ({mesh.n_unknowns},) float64 array")
     chi = covolumes if scatter else np.empty(0)
-    k.for_threads(k.diamond_geometry_kernel, threads)(
+    for_threads(k.diamond_geometry_kernel, threads)(
         F, T, diamonds, *mesh.diamond_blocks(threads), broken, vectors, scatter,
         chi[:mesh.n_f], chi[mesh.n_f:], buf)
     rows = buf[:, :n_d]
@@ -178,7 +179,8 @@ def covolume_areas(mesh, geom, threads=1):
     chi_t : (n_t,) float array
         Views of one (n_f + n_t,) buffer, F-vertices first.
     """
-    from .kernels import covolume_kernel, for_threads
+    from .kernels import covolume_kernel
+    from .threads import for_threads
 
     diamonds = _diamond_indices(mesh)
     quarters = _diamond_array(geom.quarters, (4, diamonds.shape[1]), "quarters")
@@ -241,14 +243,15 @@ def t_barycentric(F, T, faces, return_min=False, threads=1):
         Also return the smallest coordinate (``out.min()``, computed in the
         same pass).
     threads : int
-        Threads of the pass (:func:`ddfv.kernels.threaded`).
+        Threads of the pass (:func:`ddfv.threads.threaded`).
 
     Returns
     -------
     (n_t, 3) float array
         With ``return_min``: ``(coordinates, smallest)``.
     """
-    from .kernels import for_threads, t_barycentric_kernel
+    from .kernels import t_barycentric_kernel
+    from .threads import for_threads
 
     faces = np.asarray(faces)
     if faces.ndim != 2 or faces.shape[1] != 3 or not np.issubdtype(faces.dtype, np.integer):

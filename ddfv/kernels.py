@@ -3,9 +3,11 @@
 One loop over the diamonds (or triangles, or CSR rows) per kernel; the
 formulas are those of :mod:`ddfv.geometry` and :mod:`ddfv.assembly`, whose
 public functions call these kernels and document the results. This is the
-only module of ``ddfv`` that imports numba; :mod:`ddfv.geometry` and
-:mod:`ddfv.assembly` import it on first use, so ``import ddfv`` does not
-pay for it.
+only module of ``ddfv`` that compiles with numba (loading its kernels from
+numba's cache takes about 0.1 s: a run that does not step DDFV never imports
+it); :mod:`ddfv.geometry` and :mod:`ddfv.assembly` import it on first use,
+so ``import ddfv`` does not pay for it. Their threaded copies are made by
+:mod:`ddfv.threads`.
 
 Conventions
 -----------
@@ -21,12 +23,9 @@ Conventions
 - ``cache=True``: compiled once into numba's cache (``NUMBA_CACHE_DIR``, by
   default ``__pycache__`` next to this file) and loaded from it afterwards.
 - Loops over independent elements are ``prange`` loops: plain loops in
-  these kernels, split over numba's threads in their :func:`threaded`
-  copies (``threads > 1``).
+  these kernels, split over numba's threads in their
+  :func:`ddfv.threads.threaded` copies (``threads > 1``).
 """
-
-import functools
-import types
 
 import numba
 import numpy as np
@@ -48,64 +47,6 @@ GEOMETRY_ROWS = 19
  SLOT_T1_A, SLOT_T1_B, SLOT_T2_A, SLOT_T2_B, SLOT_T1_T2, SLOT_T2_T1, SLOT_T1_T1,
  SLOT_T2_T2) = range(16)
 N_SLOTS = 16
-
-
-@functools.cache
-def threaded(kernel, **callees):
-    """``kernel`` compiled again with ``parallel=True``: its ``prange`` loops are
-    split into one block of iterations per thread, their sums and minima
-    reduced per block.
-
-    One source for both versions. The copy has its own name, hence its own
-    entry in numba's cache; it is built and compiled on first use, so a
-    one-thread run never compiles it. ``callees`` replace the compiled
-    functions the kernel calls, by name (their threaded copies); numba's
-    cache does not key on them, so each kernel has one set of callees (one
-    call site).
-
-    Parameters
-    ----------
-    kernel : numba dispatcher
-    **callees : numba dispatchers
-
-    Returns
-    -------
-    numba dispatcher
-        Compiled lazily for the argument types of each call.
-    """
-    py = kernel.py_func
-    clone = types.FunctionType(py.__code__, {**py.__globals__, **callees},
-                               f"{py.__name__}_threaded", py.__defaults__, py.__closure__)
-    clone.__qualname__, clone.__doc__ = clone.__name__, py.__doc__
-    options = {k: v for k, v in kernel.targetoptions.items() if k != "nopython"}
-    return numba.njit(parallel=True, cache=True, **options)(clone)
-
-
-def check_threads(threads):
-    """Refuse a thread count that is not a whole number in ``[1, NUMBA_NUM_THREADS]``."""
-    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) \
-            or threads < 1:
-        raise ValueError(f"threads must be a whole number >= 1, got {threads!r}")
-    if threads > numba.config.NUMBA_NUM_THREADS:
-        raise ValueError(f"threads={threads} exceeds the {numba.config.NUMBA_NUM_THREADS} "
-                         "thread(s) numba was started with (NUMBA_NUM_THREADS, by default "
-                         "the number of cores)")
-
-
-def for_threads(kernel, threads, **callees):
-    """``kernel`` for one thread; else its :func:`threaded` copy (calling the
-    threaded copies of ``callees``), with numba set to ``threads`` threads.
-
-    Raises
-    ------
-    ValueError
-        ``threads`` is not a whole number in ``[1, NUMBA_NUM_THREADS]``.
-    """
-    check_threads(threads)
-    if threads == 1:
-        return kernel
-    numba.set_num_threads(threads)
-    return threaded(kernel, **{name: threaded(c) for name, c in callees.items()})
 
 
 def padded_length(n):

@@ -57,6 +57,8 @@ height vector above the point of coordinates ``lam``, so its projection keeps
 angle for the height, ``height x sin`` for the projection).
 """
 
+from typing import NamedTuple
+
 import igl
 import numpy as np
 import scipy.sparse as sp
@@ -152,6 +154,7 @@ class TangentialMotion(KeptFactorSolver):
         self.faces, self.kind = faces, kind
         self.fixed = None if fixed is None else np.asarray(fixed, bool)
         self._t1 = None
+        self._layout = None
 
     def __call__(self, F_old, F_new, N):
         """The F-vertices of (TM1): ``F_new`` moved in the tangent planes of ``N``.
@@ -176,21 +179,35 @@ class TangentialMotion(KeptFactorSolver):
         A = p1_stiffness(F_old, self.faces)
         Y = F_new if self.kind == "bgn" else F_new - F_old
         AY = (A @ Y)[free]                                           # (A Y)_k, free k
-        A = A[free][:, free].tocoo()
         bases = [t[free] for t in self._bases(np.asarray(N, dtype=float))]
-        # (TM2), unknowns interleaved
-        rows, cols, values = zip(*((2 * A.row + a, 2 * A.col + b,
-                                    A.data * np.einsum("ij,ij->i", ta[A.row], tb[A.col]))
-                                   for a, ta in enumerate(bases)
-                                   for b, tb in enumerate(bases)))
-        m = 2 * A.shape[0]
-        S = sp.csc_matrix((np.concatenate(values),
-                           (np.concatenate(rows), np.concatenate(cols))), shape=(m, m))
+        S = self._system(A, free, bases)
         r = np.stack([np.einsum("ij,ij->i", ta, AY) for ta in bases], axis=1).ravel()
         s = self.solve(-r, S.dot, S)
         X = F_new.copy()
         X[free] += s[0::2, None] * bases[0] + s[1::2, None] * bases[1]
         return X
+
+    def _system(self, A, free, bases):
+        """The matrix ``S`` of (TM2), unknowns interleaved: ``S_{2k+a, 2j+b} = A_kj
+        (t_a[k] . t_b[j])`` over the free ``k, j``, (2 n_free, 2 n_free) CSC.
+
+        ``A`` has the pattern of the mesh at every step, so where its entries go
+        in ``S`` is found once (:func:`system_layout`, again if the pattern
+        changes): a step multiplies and gathers, without a COO to CSC
+        conversion (the same matrix, entry for entry, as assembling it anew).
+        """
+        if self._layout is None or not (np.array_equal(self._layout.indptr, A.indptr)
+                                        and np.array_equal(self._layout.indices, A.indices)):
+            self._layout = system_layout(A, free)
+        layout = self._layout
+        a = A.data[layout.pick]
+        # np.take: four times faster than indexing rows of an (n, 3) array
+        at_col = [np.take(t, layout.col, axis=0) for t in bases]
+        values = np.concatenate([a * np.einsum("ij,ij->i", np.take(t, layout.row, axis=0), tb)
+                                 for t in bases for tb in at_col])
+        m = 2 * layout.n_free
+        return sp.csc_matrix((values[layout.order], layout.system_indices,
+                              layout.system_indptr), shape=(m, m))
 
     def _bases(self, N):
         """``t1, t2`` (n, 3) at the normals ``N``, ``t1`` following the last one."""
@@ -203,6 +220,55 @@ class TangentialMotion(KeptFactorSolver):
             t1 = np.where(length > 0.5, t1 / np.where(length > 0.5, length, 1.0), fresh)
         self._t1 = t1
         return t1, np.cross(N, t1)
+
+
+class SystemLayout(NamedTuple):
+    """Where the entries of the stiffness ``A`` go in the matrix ``S`` of (TM2)
+    (:func:`system_layout`).
+
+    Attributes
+    ----------
+    indptr, indices : int arrays
+        ``A``'s CSR pattern (the layout holds for it only).
+    pick : (q,) int array
+        Positions in ``A.data`` of the free-free entries, in the order of ``A[free][:,
+        free]`` as COO.
+    row, col : (q,) int arrays
+        Their rows and columns among the free vertices.
+    n_free : int
+        Free vertices (``S`` is ``(2 n_free, 2 n_free)``).
+    order : (4 q,) int array
+        Positions, in the four blocks ``(a, b) = (0, 0), (0, 1), (1, 0), (1, 1)``
+        of the entries ``A_kj t_a[k] . t_b[j]`` laid end to end, of ``S``'s
+        entries in CSC order.
+    system_indices, system_indptr : int arrays
+        ``S``'s CSC pattern.
+    """
+
+    indptr: np.ndarray
+    indices: np.ndarray
+    pick: np.ndarray
+    row: np.ndarray
+    col: np.ndarray
+    n_free: int
+    order: np.ndarray
+    system_indices: np.ndarray
+    system_indptr: np.ndarray
+
+
+def system_layout(A, free):
+    """:class:`SystemLayout` of the CSR matrix ``A`` (n, n) on the vertices ``free`` (n,)
+    bool: the sparse conversions of an assembly done once, on entry numbers."""
+    numbered = sp.csr_matrix((np.arange(1.0, A.nnz + 1), A.indices, A.indptr), shape=A.shape)
+    sub = numbered[free][:, free]
+    coo = sub.tocoo()
+    rows = np.concatenate([2 * coo.row + a for a in (0, 1) for _ in (0, 1)])
+    cols = np.concatenate([2 * coo.col + b for _ in (0, 1) for b in (0, 1)])
+    m = 2 * sub.shape[0]
+    S = sp.csc_matrix((np.arange(1.0, len(rows) + 1), (rows, cols)), shape=(m, m))
+    return SystemLayout(A.indptr.copy(), A.indices.copy(), coo.data.astype(np.intp) - 1,
+                        coo.row.astype(np.intp), coo.col.astype(np.intp), sub.shape[0],
+                        S.data.astype(np.intp) - 1, S.indices, S.indptr)
 
 
 def tangential_motion(F_old, F_new, faces, N, kind, fixed=None):

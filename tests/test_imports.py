@@ -57,6 +57,17 @@ def test_importing_a_scheme_package_loads_nothing_of_the_others(package):
     assert out == ""
 
 
+def test_a_vertex_scheme_s_run_loads_no_ddfv_kernel():
+    """The shared solver checks threads with ddfv.threads, not ddfv.kernels, whose
+    import loads every DDFV kernel from numba's cache: a cotan job does not pay it."""
+    code = ("import sys\nfrom mcfbench.running.run import run\n"
+            "run('cotan', 'sphere', 1)\n"
+            "print('ddfv.kernels' in sys.modules, 'ddfv.threads' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         cwd=ROOT, check=True).stdout.split()
+    assert out == ["False", "True"]
+
+
 def test_import_ddfv_has_no_process_wide_side_effect():
     """The glibc malloc tuning is an explicit call of the entry points."""
     code = ("import sys, ddfv\n"

@@ -11,8 +11,9 @@ bottom of the axes, at its mesh size, in the colour of its scheme.
 :func:`beyond_figures`
     ``levels`` (as the convergence figure for every level, and ours over
     the published error below), ``t_monitor`` (the T monitor against time,
-    one panel per scheme with T-vertices), ``time_convergence`` and
-    ``space_convergence``.
+    one panel per scheme with T-vertices), ``time_convergence``,
+    ``space_convergence`` and ``scaling`` (CPU seconds per step and memory
+    against the unknowns, log-log, each scheme's fitted slope in the legend).
 """
 
 import matplotlib
@@ -23,6 +24,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import FixedFormatter, FixedLocator, NullFormatter  # noqa: E402
 
+from mcfbench.presentation.formats import fix  # noqa: E402
 from mcfbench.running.schemes import find_scheme  # noqa: E402
 
 SMALLEST_TEXT = 8
@@ -253,10 +255,47 @@ def space_figure(table):
     return fig
 
 
-def beyond_figures(levels, stability, series, time, space, beyond, t_final):
+def scaling_figure(levels, scaling, fit_levels):
+    """CPU seconds per step and peak memory above the coarsest run against the unknowns.
+
+    Parameters
+    ----------
+    levels : pandas.DataFrame
+        The rows of the levels table to show (columns ``scheme``, ``level``,
+        ``nV``, ``step_seconds``, ``memory_mb``, ``status``).
+    scaling : pandas.DataFrame
+        The scaling table (one row per scheme: ``step_slope``, ``memory_slope``).
+    fit_levels : sequence of int
+        The levels of the fits (named in the title).
+    """
+    fig, axes = plt.subplots(1, 2, figsize=(10.4, 4.2), layout="constrained")
+    slopes = scaling.set_index("scheme")
+    panels = (("step_seconds", "step_slope", "CPU seconds per time step"),
+              ("memory_mb", "memory_slope", "peak memory above the coarsest run (MB)"))
+    for ax, (y, slope, ylabel) in zip(axes, panels):
+        shown = levels.assign(**{y: levels[y].where(levels[y] > 0)})
+        scheme_lines(ax, shown, "nV", y)
+        ax.legend([f"{style(s)[0]}: {fix(slopes[slope].get(s), 2)}"
+                   for s in shown["scheme"].unique()],
+                  title="slope", fontsize=7, title_fontsize=8, loc="upper left",
+                  frameon=False)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_xlabel("unknowns $n$ (DDFV: F- and T-vertices)")
+        ax.set_ylabel(ylabel)
+        ax.grid(True, which="major", linewidth=0.5, alpha=0.5)
+    fig.suptitle(f"Cost against size, shrinking sphere (slopes of $c\\,n^p$ fitted on levels "
+                 f"{', '.join(str(lv) for lv in fit_levels)}; one core per job)", fontsize=10)
+    return fig
+
+
+def beyond_figures(levels, stability, series, time, space, scaling, beyond, t_final):
     """``name -> figure`` of the beyond study from its tables (DataFrames)."""
     monitored = list(dict.fromkeys([*beyond["schemes"], *beyond["long_time"]["schemes"]]))
+    shown = levels[levels["level"].isin(beyond["scaling"]["levels"])]
     return {"levels": levels_figure(levels, t_final),
             "t_monitor": t_monitor_figure(series, stability, monitored),
             "time_convergence": time_figure(time),
-            "space_convergence": space_figure(space)}
+            "space_convergence": space_figure(space),
+            "scaling": scaling_figure(shown, scaling, beyond["scaling"]["fit_levels"])}

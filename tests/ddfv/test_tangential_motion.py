@@ -10,6 +10,8 @@ import numpy as np
 import pytest
 
 from ddfv import Flow, variant_options
+import scipy.sparse as sp
+
 from ddfv.tangential_motion import (TangentialMotion, follow_triangles, p1_stiffness,
                                     tangent_bases, tangential_motion)
 from ddfv.geometry import t_barycentric, vertex_normals
@@ -84,6 +86,34 @@ def _boundary(F):
     edges = np.sort(F[:, [[0, 1], [1, 2], [2, 0]]].reshape(-1, 2), axis=1)
     unique, count = np.unique(edges, axis=0, return_counts=True)
     return np.unique(unique[count == 1])
+
+
+def test_system_of_the_kept_layout_is_the_assembled_one_entry_for_entry():
+    """(TM2)'s matrix from the layout found once (TangentialMotion._system) is the
+    COO assembly ``S_{2k+a, 2j+b} = A_kj t_a[k] . t_b[j]`` over the free vertices,
+    bitwise, at a second state of the same mesh (the layout kept) and with
+    fixed vertices; a mesh of another pattern gets its own layout."""
+    V, F = surfaces.flat_patch(level=1, jitter=0.3, seed=1)
+    V = V + 0.05 * np.random.default_rng(4).normal(size=V.shape)
+    free = np.ones(len(V), bool)
+    free[_boundary(F)] = False
+    motion = TangentialMotion(F, "bgn", fixed=~free)
+    for X in (V, V + 1e-3 * np.random.default_rng(5).normal(size=V.shape)):
+        A = p1_stiffness(X, F)
+        N = _unit(np.random.default_rng(6).normal(size=X.shape))     # any unit vectors
+        bases = [t[free] for t in tangent_bases(N)]
+        S = motion._system(A, free, bases)
+        sub = A[free][:, free].tocoo()
+        expected = sum(sp.coo_matrix(
+            (sub.data * np.einsum("ij,ij->i", ta[sub.row], tb[sub.col]),
+             (2 * sub.row + a, 2 * sub.col + b)), shape=S.shape)
+            for a, ta in enumerate(bases) for b, tb in enumerate(bases)).tocsc()
+        assert S.shape == (2 * free.sum(),) * 2 and S.nnz == 4 * sub.nnz
+        assert np.array_equal(S.toarray(), expected.toarray())
+    layout = motion._layout
+    W, G = icosphere(1)
+    motion._system(p1_stiffness(W, G), np.ones(len(W), bool), tangent_bases(_unit(W)))
+    assert motion._layout is not layout and motion._layout.n_free == len(W)
 
 
 def test_motion_does_not_depend_on_the_tangent_bases():

@@ -7,7 +7,7 @@
 #
 # Settings: the config key `beyond` (config/README.md), checked by
 # mcfbench.studies.beyond.plan when a rule of this file joins the job graph
-# (a bad value stops `snakemake beyond`, not the other targets). Four studies, all under results/beyond/
+# (a bad value stops `snakemake beyond`, not the other targets). Five studies, all under results/beyond/
 # (results/README.md), for any scheme of the registry mcfbench.running.schemes.SCHEMES:
 #
 # - levels: every scheme on every level with tau ~ h^2 as in Table 3.1, and
@@ -17,7 +17,9 @@
 # - long_time: one level continued past t_final (onset of the breakdown);
 # - space: refined meshes with one tiny time step (order 2 in space);
 # - time: one mesh, tau halved repeatedly (order 1 in time;
-#   mcfbench.running.run.time_convergence).
+#   mcfbench.running.run.time_convergence);
+# - scaling: CPU seconds per step and peak memory of the levels' runs against
+#   their unknowns, slopes fitted on beyond.scaling.fit_levels (no runs of its own).
 #
 # Runs that break down are records like any other (status, t_failed, the T
 # monitor of every time level reached); the tables show them as such.
@@ -163,12 +165,13 @@ rule beyond_tables:
 
 
 rule beyond_figures:
-    """L2 per level, the T monitor against time, time and space convergence."""
+    """L2 per level, the T monitor against time, time and space convergence, cost against size."""
     input:
         levels=BEYOND_TABLES["levels_csv"],
         stability=BEYOND_TABLES["stability_csv"],
         time=BEYOND_TABLES["time_convergence_csv"],
         space=BEYOND_TABLES["space_convergence_csv"],
+        scaling=BEYOND_TABLES["scaling_csv"],
         t_monitor=f"{_beyond_paths.TABLES}/t_monitor.csv",
     output:
         **{

@@ -9,9 +9,10 @@ from mcfbench.storage.logs import setup_logging
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])
 tables = {key: pd.read_csv(sm.input[key])
-          for key in ("levels", "stability", "t_monitor", "time", "space")}
+          for key in ("levels", "stability", "t_monitor", "time", "space", "scaling")}
 figures = beyond_figures(tables["levels"], tables["stability"], tables["t_monitor"],
-                         tables["time"], tables["space"], dict(sm.params.beyond),
+                         tables["time"], tables["space"], tables["scaling"],
+                         dict(sm.params.beyond),
                          float(sm.params.t_final))
 write_files({str(sm.output[f"{name}_{ext}"]): fig
              for name, fig in figures.items() for ext in ("png", "pdf")})

@@ -11,6 +11,8 @@ The study's modules:
   (:func:`mcfbench.studies.convergence.job.job`);
 * :mod:`.aggregate`: the records into the tables and the T-monitor series
   (:mod:`.tables`);
+* :mod:`.scaling`: cost against size, the CPU seconds per step and the peak
+  memory of the levels' runs against their unknowns with fitted slopes;
 * :mod:`.findings`: the verdicts from the tables only (stable schemes, the
   finest common level, the ranking), worded in ``findings.md``
   (:func:`~.findings.write_findings`).
@@ -30,11 +32,12 @@ TABLES = f"{ROOT}/tables"
 """``{name}.csv/.md/.tex`` of :data:`TABLE_NAMES`, ``t_monitor.csv``, ``beyond.json``
 (provenance), ``records.json`` (the check of the records)."""
 
-TABLE_NAMES = ("levels", "stability", "time_convergence", "space_convergence", "integrators")
+TABLE_NAMES = ("levels", "stability", "time_convergence", "space_convergence", "integrators",
+               "scaling")
 
 FIGURES = f"{ROOT}/figures"
 """``{name}.png/.pdf`` of :data:`FIGURE_NAMES`."""
 
-FIGURE_NAMES = ("levels", "t_monitor", "time_convergence", "space_convergence")
+FIGURE_NAMES = ("levels", "t_monitor", "time_convergence", "space_convergence", "scaling")
 
 FINDINGS = f"{ROOT}/findings.md"

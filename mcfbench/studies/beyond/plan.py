@@ -37,17 +37,18 @@ def plan(config, table):
         L2/EOC table go on to that level; none by default), ``long_time`` (``level``, ``t_final``,
         ``tau``, ``schemes``), ``time_study`` (``level``, ``taus``
         (descending), ``reference_factor``, ``t_final``, ``rtol`` of its runs
-        (default the top-level one), ``schemes``) and
-        ``space_study`` (``levels``, ``tau``, ``t_final``, ``schemes``); times
-        as floats.
+        (default the top-level one), ``schemes``),
+        ``space_study`` (``levels``, ``tau``, ``t_final``, ``schemes``) and
+        ``scaling`` (``levels``, ``fit_levels``: sorted ints); times as floats.
 
     Raises
     ------
     ConfigError
         An unknown scheme, a final time that is not a whole multiple of a
         time step, a scheme of ``beyond.finest`` that is not one of
-        ``beyond.schemes``, or a finest level that is not above
-        ``beyond.levels``; the message names the key.
+        ``beyond.schemes``, a finest level that is not above
+        ``beyond.levels``, levels of ``beyond.scaling`` that are not levels of
+        the table, or fewer than two levels to fit; the message names the key.
     """
     beyond = config["beyond"]
     problem = convergence.problem_of(table)
@@ -79,6 +80,7 @@ def plan(config, table):
     return {
         "levels": levels,
         "schemes": schemes,
+        "scaling": _scaling(beyond["scaling"], levels),
         "finest": finest,
         "long_time": {"level": long_level, "t_final": long_t, "tau": problem.tau(long_level),
                       "schemes": check_schemes("beyond.long_time.schemes", long["schemes"])},
@@ -109,6 +111,20 @@ def _check_finest(finest, levels, schemes, problem):
                           f"levels of 'beyond.levels' {levels}")
     checked_steps("'beyond.finest.level'", problem, problem.tau(level), problem.t_final,
                   f"the level-{level}")
+
+
+def _scaling(scaling, levels):
+    """``beyond.scaling`` checked: its ``levels`` some of the table's ``levels`` (the
+    study runs nothing of its own), its ``fit_levels`` at least two of them."""
+    points = sorted({int(level) for level in scaling["levels"]})
+    fit = sorted({int(level) for level in scaling["fit_levels"]})
+    if not set(points) <= set(levels):
+        raise ConfigError(f"config key 'beyond.scaling.levels': {points} are not all levels "
+                          f"of 'beyond.levels' {levels} (the scaling study reads their runs)")
+    if len(fit) < 2 or not set(fit) <= set(points):
+        raise ConfigError(f"config key 'beyond.scaling.fit_levels': {fit} must be at least two "
+                          f"of 'beyond.scaling.levels' {points} (a slope needs two points)")
+    return {"levels": points, "fit_levels": fit}
 
 
 def is_finest_run(config, scheme, level):

@@ -7,6 +7,7 @@ from mcfbench.geometry.exact import eoc
 from mcfbench.presentation.formats import MISSING, fix, int_or, sci, sig, tex_inline
 from mcfbench.presentation.tables import Table, csv, latex, markdown
 from mcfbench.running.schemes import split_name
+from mcfbench.studies.beyond.scaling import scaling_points, scaling_rows, scaling_table
 from mcfbench.studies.convergence.tables import (
     eoc_column,
     l2_cell,
@@ -21,7 +22,8 @@ from mcfbench.studies.convergence.tables import (
 MONITOR_COLUMNS = ["t_reached", "t_monitor_start", "t_monitor_end", "t_exit"]
 
 
-BEYOND_LEVEL_COLUMNS = LEVEL_COLUMNS[:-1] + ["peak_rss_mb"] + MONITOR_COLUMNS + ["message"]
+BEYOND_LEVEL_COLUMNS = LEVEL_COLUMNS[:-1] + ["peak_rss_mb", "step_seconds", "memory_mb"] + \
+    MONITOR_COLUMNS + ["message"]
 
 
 STABILITY_COLUMNS = ["study", "scheme", "label", "level", "nT", "tau", "t_final", "N",
@@ -89,13 +91,14 @@ def monitor_series(records, study):
 
 
 def beyond_level_table(records, levels, paper_schemes):
-    """:func:`level_table` of every scheme with the peak memory of each run and the
-    T monitor (:func:`monitor_summary`); ``levels``: scheme -> its levels."""
+    """:func:`level_table` of every scheme with the peak memory of each run, the
+    columns of the scaling study (:func:`~mcfbench.studies.beyond.scaling.scaling_points`)
+    and the T monitor (:func:`monitor_summary`); ``levels``: scheme -> its levels."""
     table = level_table(records, list(levels), levels, paper_schemes=set(paper_schemes))
     summary = pd.DataFrame([{"peak_rss_mb": records[s, lv]["peak_rss_mb"],
                              **monitor_summary(records[s, lv])}
                             for s, lv in zip(table["scheme"], table["level"])])
-    return pd.concat([table, summary], axis=1)[BEYOND_LEVEL_COLUMNS]
+    return scaling_points(pd.concat([table, summary], axis=1))[BEYOND_LEVEL_COLUMNS]
 
 
 def stability_table(level_records, long_records):
@@ -220,7 +223,9 @@ def beyond_tables(inputs, records, beyond, paper_schemes):
     -------
     tables : dict
         ``levels``, ``stability``, ``time_convergence``, ``space_convergence``,
-        ``integrators`` (:func:`integrator_table`).
+        ``integrators`` (:func:`integrator_table`), ``scaling``
+        (:func:`~mcfbench.studies.beyond.scaling.scaling_table` of the levels of
+        ``beyond["scaling"]``).
     series : pandas.DataFrame
         The T monitor of the levels and long runs (:func:`monitor_series`).
     """
@@ -239,6 +244,10 @@ def beyond_tables(inputs, records, beyond, paper_schemes):
                                          beyond["space_study"]["levels"]),
     }
     tables["integrators"] = integrator_table(tables["levels"])
+    scaling = beyond["scaling"]
+    tables["scaling"] = scaling_table(
+        tables["levels"][tables["levels"]["level"].isin(scaling["levels"])],
+        scaling["fit_levels"])
     series = pd.concat([monitor_series(levels, "levels"), monitor_series(long, "long_time")],
                        ignore_index=True)
     return tables, series
@@ -413,6 +422,21 @@ def _beyond_descriptions(beyond, settings):
             "the Euler error: what the integrator buys at equal cost. Both integrators on "
             "the same footing: same scheme, solver, rtol, machine and one core per job; "
             "CPU seconds of jobs that ran side by side on a shared machine."),
+        "scaling": (
+            f"Cost against size: the runs of the L2 table on levels "
+            f"{', '.join(str(lv) for lv in beyond['scaling']['levels'])}, one job each; "
+            "unknowns n: F- plus T-vertices for DDFV, the mesh vertices otherwise. CPU "
+            "s/step: the run's CPU seconds (flow construction, steps, error) over its steps; "
+            "peak MB: the job's peak resident memory (ru_maxrss), and above that of the "
+            "scheme's coarsest run (imports, compiled kernels, warm-up: what every job "
+            "takes on). Slopes: p of c n^p, least squares in log-log over the finished "
+            f"runs of levels {', '.join(str(lv) for lv in beyond['scaling']['fit_levels'])} "
+            "(`beyond.scaling.fit_levels`); a slope of 1 is cost linear in the unknowns. "
+            "The timings are on the same footing: same machine, one thread per job "
+            f"(`threads`), same problem (the shrinking sphere, tau ~ h^2, t_f = "
+            f"{settings['t_final']:g}), warm-up (compilation, cache loading, first calls) "
+            "done before the clock starts; CPU seconds of jobs that ran side by side on a "
+            "shared machine."),
         "space_convergence": (
             f"tau = {space['tau']:g} on every level, t_f = {space['t_final']:g}: the "
             "error (3.2) against the exact sphere with the time error made small; EOC "
@@ -477,6 +501,9 @@ def beyond_documents(tables, beyond, settings, paper_schemes):
         "integrators": _markdown("Second order in time: each integrator against Euler on "
                                  "the Table 3.1 setting", desc["integrators"],
                                  [("", integrator_rows(tables["integrators"]))]),
+        "scaling": _markdown("Cost against size: CPU time per step and peak memory against "
+                             "the unknowns, fitted slopes", desc["scaling"],
+                             [("", scaling_rows(tables["scaling"]))]),
     }
     tex = {
         "levels": _latex(desc["levels"], [
@@ -498,6 +525,9 @@ def beyond_documents(tables, beyond, settings, paper_schemes):
         "integrators": _latex(desc["integrators"], [
             ("Integrators against Euler on the Table 3.1 setting.", "tab:beyond-integrators",
              integrator_rows(tables["integrators"]))]),
+        "scaling": _latex(desc["scaling"], [
+            ("CPU time per step and peak memory against the unknowns.", "tab:beyond-scaling",
+             scaling_rows(tables["scaling"]))]),
     }
     return {name: {"csv": csv(table), "md": md[name], "tex": tex[name]}
             for name, table in tables.items()}

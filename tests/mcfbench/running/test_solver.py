@@ -321,6 +321,32 @@ def test_direct_singular_matrix_fails_clearly():
         Solver("ilu-bicgstab")(S, np.array([[1.0, 2.0, 3.0]]), None)
 
 
+def test_direct_tries_symmetric_mode_then_partial_pivoting(monkeypatch):
+    """``direct`` factorises with SuperLU's symmetric mode first and, when that
+    fails, with COLAMD and partial pivoting (:data:`LU_ORDERINGS`): the answer is
+    the second's; with every ordering failing, the last failure is named."""
+    import mcfbench.running.solver as solver
+
+    factorize, seen = solver._factorize, []
+
+    def first_fails(A, ilu, *args, ordering=None, **kwargs):
+        seen.append(ordering)
+        if ordering is solver.LU_ORDERINGS[0]:
+            return None, "LU factorization failed: the first ordering"
+        return factorize(A, ilu, *args, ordering=ordering, **kwargs)
+
+    monkeypatch.setattr(solver, "_factorize", first_fails)
+    P = sp.csr_matrix(np.array([[0.0, 2.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 3.0]]))
+    x, info = Solver("direct")(P, np.array([[4.0, 1.0, 6.0]]), None)
+    np.testing.assert_allclose(x, [[1.0, 2.0, 2.0]], rtol=1e-15)
+    assert info.converged and seen == list(solver.LU_ORDERINGS)
+    assert solver.LU_ORDERINGS[0]["options"] == {"SymmetricMode": True}
+    assert solver.LU_ORDERINGS[-1] == {"permc_spec": "COLAMD"}
+    monkeypatch.setattr(solver, "LU_ORDERINGS", solver.LU_ORDERINGS[:1])
+    with pytest.raises(SolverFailure, match="the first ordering"):
+        Solver("direct")(P, np.array([[4.0, 1.0, 6.0]]), None)
+
+
 def test_direct_ill_conditioned_matrix_fails_clearly():
     """Hilbert matrix of order 14 (condition ~1e17): LU plus refinement
     cannot reach 1e-9."""

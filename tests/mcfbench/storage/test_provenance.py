@@ -25,6 +25,17 @@ def test_provenance_names_code_dependencies_and_settings():
     assert p["packages"] == dependency_versions()
 
 
+def test_dependency_versions_agree_with_importlib_metadata():
+    """Read from the metadata headers only: the versions of importlib.metadata's full
+    parse, the project and its requirements (and theirs) included."""
+    from importlib import metadata
+
+    versions = dependency_versions()
+    assert {name: metadata.version(name) for name in versions} == versions
+    for name in ("ddfv-mcf", "numpy", "scipy", "numba", "meshio", "jinja2", "markupsafe"):
+        assert versions[name] == metadata.version(name), name
+
+
 def test_git_commit_is_found_from_outside_the_repository(tmp_path):
     commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True,
                             text=True)

@@ -202,7 +202,8 @@ def synthetic_inputs(finest=()):
               "time_study": {"level": 2, "taus": [0.01, 0.005, 0.0025], "reference_factor": 8,
                              "t_final": 0.08, "schemes": ["ddfv", "ddfv-chord", "cotan"]},
               "space_study": {"levels": [1, 2], "tau": 0.0025, "t_final": 0.08,
-                              "schemes": SCHEMES_USED}}
+                              "schemes": SCHEMES_USED},
+              "scaling": {"levels": [2, 3], "fit_levels": [2, 3]}}
     inputs = {"levels": [p for p in records if p.startswith("runs/")],
               "long_time": list(long), "space": list(space), "time": list(time)}
     return inputs, {**records, **long, **space, **time}, beyond
@@ -282,14 +283,14 @@ def test_finest_level_of_one_scheme_leaves_the_other_rows_alone(tables, tmp_path
     for name, doc in docs.items():
         (tmp_path / f"{name}.csv").write_text(doc["csv"])
     read = [pd.read_csv(tmp_path / f"{n}.csv") for n in (
-        "levels", "stability", "time_convergence", "space_convergence")]
-    text = findings(*read, SCHEMES_USED, PAPER, 0.08, 0.04)
+        "levels", "stability", "time_convergence", "space_convergence", "scaling")]
+    text = findings(*read[:4], SCHEMES_USED, PAPER, 0.08, 0.04)
     chord = SCHEMES["ddfv-chord"].label
     assert f"## Level 3 (finest level run by every scheme; level 4 by {chord} only)" in text
     assert (f"- **{chord}** on level 4: L2 2.1328e-04, EOC 2.000 against level 3; 640 "
             "BiCGStab iterations, 0 s wall, 200 MB peak memory.") in text
     assert f"- level 3: {SCHEMES['ddfv'].label} 0 CPU s until it broke down" in text
-    figures = beyond_figures(read[0], read[1], series, read[2], read[3], beyond, 0.08)
+    figures = beyond_figures(read[0], read[1], series, read[2], read[3], read[4], beyond, 0.08)
     write_files({tmp_path / f"{name}.png": fig for name, fig in figures.items()})
     assert (tmp_path / "levels.png").stat().st_size > 1000
 
@@ -357,8 +358,10 @@ def test_documents_and_findings_follow_the_numbers(tables, tmp_path):
 def test_plots_from_the_tables(tables, tmp_path):
     tabs, series, beyond = tables
     figures = beyond_figures(tabs["levels"], tabs["stability"], series,
-                             tabs["time_convergence"], tabs["space_convergence"], beyond, 0.08)
-    assert sorted(figures) == ["levels", "space_convergence", "t_monitor", "time_convergence"]
+                             tabs["time_convergence"], tabs["space_convergence"],
+                             tabs["scaling"], beyond, 0.08)
+    assert sorted(figures) == ["levels", "scaling", "space_convergence", "t_monitor",
+                               "time_convergence"]
     paths = {tmp_path / f"{name}.{ext}": fig for name, fig in figures.items()
              for ext in ("png", "pdf")}
     write_files(paths)
@@ -413,6 +416,7 @@ def test_default_config_passes_the_schema_and_the_checks():
     assert all(s.partition("@")[0] in SCHEMES for s in used_schemes(settings))
     # the level-7 run is off by default
     assert settings["finest"] == {"level": 7, "rtol": 1e-11, "schemes": []}
+    assert settings["scaling"] == {"levels": [2, 3, 4, 5, 6], "fit_levels": [4, 5, 6]}
     assert not [p for p in study_runs(Plans(config, SCHEMAS))["levels"] if "level7" in p]
 
 
@@ -503,6 +507,13 @@ def test_main_schema_refuses_an_old_key():
      "config key 'beyond.finest.level': 6 is not above the levels of 'beyond.levels'"),
     (("finest", "rtol"), float("nan"), "config key 'beyond.finest.rtol': must lie in (0, 1)"),
     (("time_study", "rtol"), 1.0, "config key 'beyond.time_study.rtol': must lie in (0, 1)"),
+    (("scaling", "levels"), [2, 7],
+     "config key 'beyond.scaling.levels': [2, 7] are not all levels of 'beyond.levels'"),
+    (("scaling", "fit_levels"), [6],
+     "config key 'beyond.scaling.fit_levels': [6] must be at least two"),
+    (("scaling", "fit_levels"), [1, 2],
+     "config key 'beyond.scaling.fit_levels': [1, 2] must be at least two of "
+     "'beyond.scaling.levels' [2, 3, 4, 5, 6]"),
 ])
 def test_checks_across_keys_name_the_key(path, value, message):
     config = json.loads(json.dumps(CONFIG))
@@ -659,3 +670,56 @@ def test_order_table_has_a_row_per_scheme_and_a_column_pair_per_integrator():
                       "bdf2 order (volume)"]
     assert body[0] == [SCHEMES["cotan"].label, "1.10", "1.10", "2.00", "2.00"]
     assert body[1] == [SCHEMES["bgn"].label, MISSING, MISSING, "0.30", "2.10"]
+
+
+# -- the scaling study ------------------------------------------------------------
+
+def test_scaling_fits_exact_power_laws_exactly():
+    """Records whose CPU seconds per step are 2e-6 n^1.25 (cotan) and 3e-7 n^0.9 (DDFV)
+    and whose jobs take 100 MB plus 1e-3 n^1.1 MB (the level-1 run: 100 MB): the fits
+    on levels 4-6 give those slopes and coefficients to round-off; a run that broke
+    down is left out of the fit, and level 1 is not a point of the study."""
+    laws = {"cotan": (2e-6, 1.25, 1e-3, 1.1), "ddfv": (3e-7, 0.9, 4e-3, 1.05)}
+    records = {}
+    for scheme, (b, q, a, p) in laws.items():
+        for level in range(1, 7):
+            r = record(scheme, level, status="solver_failed" if (scheme, level) == ("ddfv", 3)
+                       else "ok")
+            r["cpu_seconds"] = r["N"] * b * r["nV"] ** q
+            r["peak_rss_mb"] = 100.0 + (a * r["nV"] ** p if level > 1 else 0.0)
+            records[f"runs/{scheme}/level{level}.json"] = r
+    _, _, beyond = synthetic_inputs()
+    beyond = {**beyond, "levels": list(range(1, 7)), "schemes": list(laws),
+              "scaling": {"levels": [2, 3, 4, 5, 6], "fit_levels": [4, 5, 6]}}
+    by_level = {(r["scheme"], r["level"]): r for r in records.values()}
+    from mcfbench.studies.beyond.tables import beyond_level_table
+    from mcfbench.studies.beyond.scaling import power_fit, scaling_table
+
+    levels = beyond_level_table(by_level, {s: list(range(1, 7)) for s in laws}, ["ddfv"])
+    table = scaling_table(levels[levels["level"] >= 2], [4, 5, 6]).set_index("scheme")
+    for scheme, (b, q, a, p) in laws.items():
+        row = table.loc[scheme]
+        assert row["fit_levels"] == "4 5 6"
+        assert row["step_slope"] == pytest.approx(q, rel=1e-10)
+        assert row["step_coefficient"] == pytest.approx(b, rel=1e-8)
+        assert row["memory_slope"] == pytest.approx(p, rel=1e-10)
+        assert row["memory_coefficient"] == pytest.approx(a, rel=1e-8)
+        assert row["fixed_mb"] == 100.0
+        assert row["n_max"] == by_level[scheme, 6]["nV"]
+    points = levels.set_index(["scheme", "level"])
+    assert np.isnan(points.loc[("ddfv", 3), "step_seconds"])       # broke down: no point
+    # a scheme with one finished run among the fit levels has no slope
+    assert np.isnan(scaling_table(levels[levels["level"] <= 4], [3, 4])
+                    .set_index("scheme").loc["ddfv", "step_slope"])
+    assert np.isnan(power_fit([10.0, 20.0], [1.0, -1.0])[1])
+
+
+def test_scaling_table_and_figure_are_written(tables, tmp_path):
+    tabs, _, beyond = tables
+    docs = beyond_documents(tabs, beyond, SETTINGS, PAPER)
+    md = docs["scaling"]["md"]
+    assert "| scheme | levels fitted | unknowns | CPU s/step (finest) | slope CPU/step |" in md
+    assert "same machine, one thread per job" in md and "warm-up" in md
+    assert "levels 2, 3 (`beyond.scaling.fit_levels`)" in md
+    assert "tab:beyond-scaling" in docs["scaling"]["tex"]
+    assert len(pd.read_csv(io.StringIO(docs["scaling"]["csv"]))) == len(SCHEMES_USED)
