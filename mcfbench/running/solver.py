@@ -15,14 +15,12 @@ coordinate x, y, z) from an initial guess ``x0``:
   y, then all z; the BGN scheme couples the components);
 * ``A`` block upper triangular with an identity leading block (KLL's (KL6),
   ``baselines/README.md``): an object with ``A.shape == (k n, k n)``, an
-  (n, n) matrix ``A.shared`` of the last ``A.rows`` rows of ``b``, which are
-  decoupled, and ``A.substitute(y, b)``, the first rows from their solution
-  ``y``. The solver solves ``A.shared y = b[-A.rows:]`` as a shared system
-  (from ``x0[-A.rows:]``; ``direct`` factorises ``A.shared`` once for its
-  ``A.rows`` right-hand sides, BiCGStab iterates on the (A.rows, n) block)
-  and returns ``[A.substitute(y, b); y]``. Its iterations, residual and
-  stopping test are those of the shared system (the substituted rows have
-  residual zero up to round-off).
+  (n, n) matrix ``A.shared`` of the last ``A.rows`` (decoupled) rows of
+  ``b`` and ``A.substitute(y, b)``, the first rows from their solution ``y``:
+  ``A.shared y = b[-A.rows:]`` is solved as a shared system from
+  ``x0[-A.rows:]`` (``direct`` factorises ``A.shared`` once for its rows),
+  ``[A.substitute(y, b); y]`` returned; iterations, residual and stopping
+  test are the shared system's (the substituted rows' residual is round-off).
 
 Iteration count
 ---------------
