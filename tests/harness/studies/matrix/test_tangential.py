@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from mcfbench.studies.matrix import findings as matrix_findings
+from mcfbench.studies.matrix import page as matrix_page
 from mcfbench.studies.matrix import tables as matrix_tables
 from mcfbench.studies.matrix.tangential import strategy_frame, tangential_section
 
@@ -108,6 +109,10 @@ def test_every_sentence_of_the_section_comes_from_the_numbers(matrix):
     assert ("- Cost: none is the cheapest per step (2 x cotan, median), bgn the most "
             "expensive (5 x).") in section
     assert "bgn: BGN's equidistribution" in section      # the registry's description
+    # on the results page (the findings rendered): a table
+    html = matrix_page.findings_html(section, ".")
+    assert "<table>" in html and "<th>strategy</th>" in html
+    assert '<td style="text-align: right;">1 of 2</td>' in html
 
 
 def test_one_strategy_makes_no_section_and_no_cotan_no_cost(matrix):
