@@ -121,10 +121,9 @@ def _trend(row, monitor, spec):
     return " → ".join("–" if np.isnan(v) else format(v, spec) for v in values)
 
 
-def strategy_table(frame, labels=None):
+def strategy_table(frame):
     """The frame of :func:`strategy_frame` as a :class:`~mcfbench.presentation.tables.Table`."""
-    labels = labels or {}
-    rows = [(labels.get(r["strategy"], r["strategy"]), ", ".join(r["schemes"]),
+    rows = [(r["strategy"], ", ".join(r["schemes"]),
              _share(r["finished"], r["series"]), _share(r["real_finished"], r["real_series"]),
              r["accuracy"], _trend(r, "min_angle", ".1f"), _trend(r, "covolume_ratio", ".2f"),
              r["cost"]) for _, r in frame.iterrows()]
