@@ -36,7 +36,8 @@ class _Monitor:
     def __init__(self, every):
         self.every = max(1, int(every))
         self.t, self.t_monitor = [], []
-        self.quality = {"quality_t": [], "min_angle": [], "max_aspect": [], "flipped": []}
+        self.quality = {"quality_t": [], "min_angle": [], "max_aspect": [], "flipped": [],
+                        "covolume_ratio": []}
         self._neighbours = None
 
     def __call__(self, flow):
@@ -60,11 +61,18 @@ class _Monitor:
             return
         if self._neighbours is None:
             self._neighbours = metrics.edge_neighbours(flow.faces)
-        q = metrics.quality(flow.vertices, flow.faces, self._neighbours)
+        V = flow.vertices
+        q = metrics.quality(V, flow.faces, self._neighbours)
         self.quality["quality_t"].append(flow.n * flow.tau)
         self.quality["min_angle"].append(q["min_angle"])
         self.quality["max_aspect"].append(q["max_aspect_ratio"])
         self.quality["flipped"].append(q["flipped_triangles"])
+        # the scheme's own covolumes (DDFV: the F-vertices' come first); the module
+        # imports pandas, on first use (the warm-up's)
+        from mcfbench.geometry.quality import covolume_ratio
+
+        self.quality["covolume_ratio"].append(covolume_ratio(
+            np.asarray(flow.l2_weights)[:len(V)], flow.faces))
 
 
 class _Steady:

@@ -34,6 +34,24 @@ MATRICES = {
 """Kinds of linear system -> the solver that suits it (:attr:`Scheme.matrix`)."""
 
 
+TANGENTIAL = {
+    "none": "the normal velocity only (DDFV's T-vertices by the scheme or carried)",
+    "eliminate": "the paper's elimination of the tangential velocity (3.6)",
+    "redistribute": "area-oriented redistribution (Mikula, Remesikova, Sarkoci, Sevcovic "
+                    "2014; the journal version)",
+    "bgn": "BGN's equidistribution (Barrett, Garcke, Nuernberg 2008)",
+    "mdr": "minimal deformation rate (Hu, Li 2022)",
+    "deturck": "DeTurck (Elliott, Fritz 2017)",
+    "conformal": "conformalized MCF (Kazhdan, Solomon, Ben-Chen 2012)",
+    "intrinsic-delaunay": "intrinsic Delaunay operators (Sharp, Crane 2020)",
+    "kll": "KLL's velocity law (Kovacs, Li, Lubich 2019)",
+}
+"""Tangential strategies -> description (:attr:`Scheme.tangential`): how a scheme
+moves its vertices along the surface, the grouping of the findings' comparison
+(:mod:`mcfbench.studies.matrix.tangential`). DDFV's are the values of its
+``tangential`` option (:data:`ddfv.variants.VARIANTS`)."""
+
+
 @dataclass(frozen=True)
 class Scheme:
     """One scheme of the benchmark.
@@ -76,6 +94,9 @@ class Scheme:
         The time integrator its runs use unless told otherwise
         (:data:`mcfbench.running.integrators.INTEGRATORS`; ``"euler"`` for
         every registry entry, another for a name ``<name>@<integrator>``).
+    tangential : str
+        Its tangential strategy, a key of :data:`TANGENTIAL` (DDFV: its
+        ``tangential`` option, ``"none"`` without one).
     """
 
     name: str
@@ -89,11 +110,15 @@ class Scheme:
     matrix: str = "nonsymmetric"
     robust_solver: str = "direct"
     integrator: str = "euler"
+    tangential: str = "none"
 
     def __post_init__(self):
         if self.matrix not in MATRICES:
             raise ValueError(f"scheme {self.name!r}: unknown matrix kind {self.matrix!r}; "
                              f"choose one of {', '.join(MATRICES)}")
+        if self.tangential not in TANGENTIAL:
+            raise ValueError(f"scheme {self.name!r}: unknown tangential strategy "
+                             f"{self.tangential!r}; choose one of {', '.join(TANGENTIAL)}")
 
     @property
     def suited_solver(self):
@@ -125,11 +150,12 @@ def _ddfv(variant, label, color, marker, linestyle, description):
     name = "ddfv" if variant == "paper" else f"ddfv-{variant}"
     from ddfv.variants import variant_options
 
-    return Scheme(name, label, "ddfv.flow:Flow", variant_options(variant),
+    options = variant_options(variant)
+    return Scheme(name, label, "ddfv.flow:Flow", options,
                   {"color": color, "marker": marker, "linestyle": linestyle},
                   description, family="ddfv", extra_points=True,
                   matrix="scaled-spd" if "chord" in variant and "redistribute" not in variant
-                  else "nonsymmetric")
+                  else "nonsymmetric", tangential=options.get("tangential", "none"))
 
 
 SCHEMES = {s.name: s for s in (
@@ -172,7 +198,8 @@ SCHEMES = {s.name: s for s in (
            {"color": "tab:brown", "marker": "d", "linestyle": "-."},
            "the cotangent scheme (Dziuk 1991) with the stiffness and barycentric mass of the "
            "intrinsic Delaunay triangulation (Sharp, Crane 2020; robust-laplacian), rebuilt "
-           "every step", matrix="scaled-spd"),
+           "every step", matrix="scaled-spd",
+           tangential="intrinsic-delaunay"),
     Scheme("cotan-redistribute", "cotangent, area redistribution", "baselines.cotan:CotanFlow",
            {"mass": "barycentric", "redistribution": "area", "target": "triangle"},
            {"color": "tab:olive", "marker": "P", "linestyle": "--"},
@@ -180,30 +207,32 @@ SCHEMES = {s.name: s for s in (
            "of Mikula, Remesikova, Sarkoci, Sevcovic (2014), semi-implicit (the advection "
            "grad psi . grad X in the matrix, Scharfetter-Gummel weights, Peclet limit 0.1), "
            "omega = 10, toward the areas of equal-area triangles (half at a fixed boundary)",
-           matrix="nonsymmetric"),
+           matrix="nonsymmetric", tangential="redistribute"),
     Scheme("cmcf", "conformalized MCF", "baselines.cmcf:CMCFFlow", {"mass": "barycentric"},
            {"color": "C6", "marker": ">", "linestyle": "-."},
            "conformalized mean curvature flow (Kazhdan, Solomon, Ben-Chen 2012): initial "
-           "stiffness kept, mass rebuilt, no rescaling", matrix="scaled-spd"),
+           "stiffness kept, mass rebuilt, no rescaling", matrix="scaled-spd",
+           tangential="conformal"),
     Scheme("bgn", "BGN", "baselines.bgn:BGNFlow", {"scaling": "mass"},
            {"color": "C7", "marker": "P", "linestyle": ":"},
            "Barrett, Garcke, Nuernberg (2008): mass-lumped vertex normals, tangential "
-           "motion that equidistributes the mesh", matrix="scaled-spd"),
+           "motion that equidistributes the mesh", matrix="scaled-spd", tangential="bgn"),
     Scheme("mdr", "MDR", "baselines.mdr:MDRFlow", {"scaling": "mass"},
            {"color": "tab:cyan", "marker": "d", "linestyle": "-"},
            "minimal deformation rate (Hu, Li 2022): the velocity of least int |grad v|^2 with "
            "normal part -H, the multiplier eliminated into BGN's system with unit normals",
-           matrix="scaled-spd"),
+           matrix="scaled-spd", tangential="mdr"),
     Scheme("deturck", "DeTurck", "baselines.deturck:DeTurckFlow", {"alpha": 0.1},
            {"color": "tab:brown", "marker": "H", "linestyle": "--"},
            "the DeTurck trick (Elliott, Fritz 2017): reparametrised by the harmonic map heat "
            "flow onto the initial mesh with time scale 1/alpha, the advection implicit",
-           matrix="nonsymmetric"),
+           matrix="nonsymmetric", tangential="deturck"),
     Scheme("kll", "KLL", "baselines.kll:KLLFlow", {},
            {"color": "tab:purple", "marker": "*", "linestyle": "-"},
            "Kovacs, Li, Lubich (2019): normal and mean curvature evolved by Huisken's "
            "equations, velocity -H nu, P1 elements (the proof needs degree >= 2), the "
-           "velocity law linearised at the extrapolated state", matrix="nonsymmetric"),
+           "velocity law linearised at the extrapolated state", matrix="nonsymmetric",
+           tangential="kll"),
 )}
 """Scheme name -> :class:`Scheme`."""
 

@@ -71,7 +71,9 @@ class RunResult:
         finish.
     series : dict of lists
         ``t``, ``t_min_barycentric`` (every level), ``quality_t``,
-        ``min_angle``, ``max_aspect``, ``flipped`` (sampled levels).
+        ``min_angle``, ``max_aspect``, ``flipped``, ``covolume_ratio``
+        (sampled levels; :func:`mcfbench.geometry.quality.covolume_ratio` of the
+        scheme's own covolumes, absent from records written before it).
     timing_repeats : int
         How many executions of the run ``cpu_seconds`` and ``wall_seconds`` are
         the best of: 1, or more for a run too short to time once (below

@@ -14,6 +14,7 @@ import numpy as np
 
 from mcfbench.studies.matrix import mesh_problems
 from mcfbench.studies.matrix.tables import (
+    error_ratios,
     format_or_missing,
     levels_text,
     is_error,
@@ -314,6 +315,7 @@ def matrix_findings(table, summary=None, labels=None, mesh_problems=(),
     if work_precision:
         lines += work_precision_section(work_precision)
     lines += real_mesh_section(summary, verdict, problems, schemes)
+    lines += tangential_lines(table, summary, problems, schemes)
     lines += recommendation(summary, verdict, problems, schemes, mesh_problems)
     solver = summary[[bool(fixed) for fixed in summary["solver_only"]]]
     if len(solver):
@@ -349,10 +351,7 @@ def real_mesh_section(summary, verdict, problems, schemes):
     meshes it reached the final time on every level, and the median magnitude of its
     finest-level error against the references there (the real meshes also count as
     real-world-like meshes in the recommendation: a breakdown there disqualifies)."""
-    from mcfbench.running.problems import get_problem
-    from mcfbench.studies.matrix import is_real_mesh
-
-    real = [p for p in problems if is_real_mesh(get_problem(p))]
+    real = real_meshes(problems)
     if not real:
         return []
     lines = ["## On the real meshes", "",
@@ -374,6 +373,27 @@ def real_mesh_section(summary, verdict, problems, schemes):
             text += f"; broke down on {', '.join(broke)}"
         lines.append(text + ".")
     return lines + [""]
+
+
+def real_meshes(problems):
+    """The committed real meshes among ``problems`` (names of the registry)."""
+    from mcfbench.running.problems import get_problem
+    from mcfbench.studies.matrix import is_real_mesh
+
+    return [p for p in problems if is_real_mesh(get_problem(p))]
+
+
+def tangential_lines(table, summary, problems, schemes):
+    """The section "Tangential strategies" (:mod:`mcfbench.studies.matrix.tangential`)
+    of the registry's schemes among ``schemes``, grouped by their
+    :attr:`~mcfbench.running.schemes.Scheme.tangential`."""
+    from mcfbench.running.schemes import TANGENTIAL, find_scheme
+    from mcfbench.studies.matrix.tangential import strategy_frame, tangential_section
+
+    entries = {s: find_scheme(s) for s in schemes}
+    strategy_of = {s: e.tangential for s, e in entries.items() if e is not None}
+    frame = strategy_frame(table, summary, strategy_of, real_meshes(problems), ROUNDOFF)
+    return tangential_section(frame, TANGENTIAL)
 
 
 def recommendation(summary, verdict, problems, schemes, mesh_problems):
@@ -435,15 +455,8 @@ def recommendation(summary, verdict, problems, schemes, mesh_problems):
             why_not[s] = reasons
         else:
             candidates.append(s)
-    ratios = {}
-    for p in exact:
-        part = summary[(summary["problem"] == p) & np.isfinite(summary["finest_value"])
-                       & (summary["runs_ok"] == summary["runs"])]
-        best = np.abs(part["finest_value"]).min() if len(part) else np.nan
-        if not best > ROUNDOFF:  # exact to round-off somewhere: no ranking by this problem
-            continue
-        for _, r in part.iterrows():
-            ratios[(p, r["scheme"])] = abs(r["finest_value"]) / best
+    # exact to round-off somewhere: no ranking by that problem
+    ratios = error_ratios(summary, exact, floor=ROUNDOFF)
 
     def geometric_mean(s):
         logs = [np.log(ratios[(p, s)]) for p in exact if (p, s) in ratios]

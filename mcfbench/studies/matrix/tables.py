@@ -56,10 +56,14 @@ ZERO_METRICS = ("max_height", "l2_height", "max_displacement")
 LONG_COLUMNS = ["scheme", "problem", "level", "h", "tau", "steps", "steps_done", "metric",
                 "main", "value", "eoc", "status", "t_failed", "min_angle", "max_flipped",
                 "t_min_barycentric", "iterations", "cpu_seconds", "robust_status",
-                "robust_value", "robust_t_failed"]
+                "robust_value", "robust_t_failed", *(
+                    f"{monitor}_{when}" for monitor in ("min_angle", "covolume_ratio")
+                    for when in ("start", "middle", "end"))]
 """Columns of the long table. ``main``: the metric is its problem's main metric
 (:func:`main_metric`, decided here once: the summary, the problem tables, the
 plots, the page and the findings take these rows, :func:`main_runs`).
+``min_angle_*``, ``covolume_ratio_*``: the mesh quality of the run over time
+(:func:`quality_over_time`; ``min_angle`` is its worst over the run).
 ``robust_*``: the re-run of a run that ended with a ``solver_*`` status with
 the robust solver (:func:`mcfbench.studies.matrix.job`; ``robust_status`` empty
 without a re-run)."""
@@ -121,6 +125,7 @@ def long_table(records, schemes=None, problems=None):
         names = by_problem.setdefault(r["problem"], [])
         names.extend(m for m in _metric_names(r) if m not in names)
     main = {problem: main_metric(problem, names) for problem, names in by_problem.items()}
+    quality = {id(r): quality_over_time(r) for r in records}
     rows = []
     for r in records:
         for metric in by_problem[r["problem"]] or [""]:
@@ -133,15 +138,48 @@ def long_table(records, schemes=None, problems=None):
                 "status": r["status"], "t_failed": r["t_failed"], "min_angle": r["min_angle"],
                 "max_flipped": r["max_flipped"], "t_min_barycentric": r["t_min_barycentric"],
                 "iterations": int(r["iterations"]), "cpu_seconds": r["cpu_seconds"],
-                **_robust(r, metric)})
+                **_robust(r, metric), **quality[id(r)]})
     table = pd.DataFrame(rows, columns=LONG_COLUMNS)
     for column in ("h", "tau", "value", "eoc", "t_failed", "min_angle", "max_flipped",
-                   "t_min_barycentric", "cpu_seconds", "robust_value", "robust_t_failed"):
+                   "t_min_barycentric", "cpu_seconds", "robust_value", "robust_t_failed",
+                   *LONG_COLUMNS[LONG_COLUMNS.index("robust_t_failed") + 1:]):
         table[column] = table[column].astype(float)
     schemes = schemes or list(dict.fromkeys(table["scheme"]))
     problems = problems or list(dict.fromkeys(table["problem"]))
     table = _ordered(table, schemes, problems)
     return add_eoc(table)
+
+
+def quality_over_time(record):
+    """The mesh quality of a run at its start, its middle and its end, from the
+    monitor's samples in its record's ``series`` (:func:`mcfbench.running.run.run`).
+
+    ``start``: the first sample (``t = 0``); ``middle``: the last sample at or
+    before half the final time ``N tau``, NaN when the run ended before it;
+    ``end``: the last state reached (at a breakdown, the state it broke down
+    in). NaN where the record has no such series (``covolume_ratio`` before
+    it was recorded).
+
+    Returns
+    -------
+    dict
+        ``min_angle_start``, ..., ``covolume_ratio_end`` (:data:`LONG_COLUMNS`).
+    """
+    series = record.get("series") or {}
+    t = np.asarray(series.get("quality_t") or [], dtype=float)
+    half = 0.5 * float(record["N"]) * float(record["tau"])
+    reached = np.flatnonzero(t <= half * (1 + 1e-9))
+    ended = float(record.get("t_end", np.nan))
+    middle = reached[-1] if len(reached) and ended >= half * (1 - 1e-9) else None
+    out = {}
+    for monitor in ("min_angle", "covolume_ratio"):
+        values = np.asarray([np.nan if v is None else v for v in series.get(monitor) or []],
+                            dtype=float)
+        known = len(values) == len(t) and len(t) > 0
+        out[f"{monitor}_start"] = values[0] if known else np.nan
+        out[f"{monitor}_middle"] = values[middle] if known and middle is not None else np.nan
+        out[f"{monitor}_end"] = values[-1] if known else np.nan
+    return out
 
 
 def _robust(record, metric):
@@ -303,6 +341,39 @@ def _robust_summary(runs, metric):
         "robust_finest_level": int(levels[finite[-1]]) if len(finite) else np.nan,
         "robust_finest_value": values[finite[-1]] if len(finite) else np.nan,
     }
+
+
+def error_ratios(summary, problems, floor=0.0):
+    """Each scheme's finest-level error relative to the smallest of any scheme that
+    finished every level of the problem: the recommendation's score and the
+    tangential strategies' accuracy (its geometric mean).
+
+    Parameters
+    ----------
+    summary : pandas.DataFrame
+        :func:`summary_table` (or its scheme view: the robust re-runs in place).
+    problems : sequence of str
+        The problems with an exact error.
+    floor : float
+        A problem whose smallest error is at most this (exact to round-off) ranks
+        no scheme.
+
+    Returns
+    -------
+    dict
+        ``(problem, scheme) -> |finest error| / smallest``, over the schemes that
+        finished every level with a finite error.
+    """
+    ratios = {}
+    for p in problems:
+        part = summary[(summary["problem"] == p) & np.isfinite(summary["finest_value"])
+                       & (summary["runs_ok"] == summary["runs"])]
+        best = np.abs(part["finest_value"]).min() if len(part) else np.nan
+        if not best > floor:
+            continue
+        for _, r in part.iterrows():
+            ratios[(p, r["scheme"])] = abs(r["finest_value"]) / best
+    return ratios
 
 
 LEVEL_LISTS = ("values", "eocs", "failed", "solver_only", "robust_failed", "robust_values")

@@ -50,6 +50,17 @@ def test_run_records_quality_and_the_t_monitor():
     cotan, _ = run("cotan", "sphere", 1)
     assert cotan.nV == cotan.nF == 42 and cotan.nT == 0
     assert np.isnan(cotan.t_min_barycentric)
+    # the covolume ratio at every sample: at t = 0 that of the icosphere's lumped mass
+    # (cotan) and of the F-covolumes chi of the paper's T-vertices (DDFV, not the same)
+    from mcfbench.geometry.metrics import lumped_mass
+    from mcfbench.geometry.quality import covolume_ratio
+
+    V, F = icosphere(1)
+    for r in (result, cotan):
+        assert len(r.series["covolume_ratio"]) == len(r.series["quality_t"]) == 3
+    assert cotan.series["covolume_ratio"][0] == pytest.approx(
+        covolume_ratio(lumped_mass(V, F), F), rel=1e-12)
+    assert 1.0 < result.series["covolume_ratio"][0] < 2.0
 
 
 def test_breakdown_keeps_partial_results_and_names_the_time():

@@ -114,6 +114,24 @@ def test_unknown_matrix_kind_is_refused():
         Scheme("x", "x", "baselines.cotan:CotanFlow", matrix="spd")
 
 
+def test_tangential_strategy_is_declared_once_per_entry():
+    """DDFV's strategy is its ``tangential`` option (declared in ddfv.variants, not
+    again in the registry); another integrator keeps the entry's; an unknown one is
+    refused."""
+    from mcfbench.running.schemes import TANGENTIAL, Scheme
+
+    for name, scheme in SCHEMES.items():
+        assert scheme.tangential in TANGENTIAL
+        if scheme.family == "ddfv":
+            assert scheme.tangential == scheme.options.get("tangential", "none")
+    assert [SCHEMES[n].tangential for n in ("cotan", "cotan-redistribute", "bgn",
+                                            "ddfv-chord-bgn-carried", "mdr", "deturck")] \
+        == ["none", "redistribute", "bgn", "bgn", "mdr", "deturck"]
+    assert get_scheme("ddfv-chord-mdr-carried@bdf2").tangential == "mdr"
+    with pytest.raises(ValueError, match="unknown tangential strategy 'sideways'"):
+        Scheme("x", "x", "baselines.cotan:CotanFlow", tangential="sideways")
+
+
 @pytest.mark.parametrize("name, parts", [("cotan", ("cotan", "euler")),
                                          ("cotan@bdf2", ("cotan", "bdf2")),
                                          ("ddfv-chord@bdf3", ("ddfv-chord", "bdf3"))])

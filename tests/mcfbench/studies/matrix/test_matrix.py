@@ -180,6 +180,15 @@ def test_tiny_tables_and_findings(tiny):
     back = matrix_tables.read_long_table(out / "matrix.csv")
     assert len(back) == len(table)
     assert np.allclose(back["value"], table["value"], equal_nan=True, rtol=1e-9)
+    # the mesh quality at start, middle and end of every run, from its record's series
+    quality = back[[c for c in matrix_tables.LONG_COLUMNS if c.startswith(("min_angle_",
+                                                                             "covolume_ratio_"))]]
+    # (a run that broke down before half its final time has no middle)
+    reached = back["t_failed"].isna() | (back["t_failed"] >= 0.5 * back["steps"] * back["tau"])
+    assert quality.shape[1] == 6 and np.isfinite(quality[reached].to_numpy()).all()
+    assert np.isfinite(quality.drop(columns=["min_angle_middle", "covolume_ratio_middle"])
+                       .to_numpy()).all()
+    assert (back["covolume_ratio_start"] >= 1).all() and (back["min_angle_end"] > 0).all()
 
 
 def test_tiny_plots(tiny):
