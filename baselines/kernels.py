@@ -470,11 +470,13 @@ def gradient_norm_weights(V, faces, u, w, squared):
 
 
 @njit(cache=True)
-def drift_weights(indptr, indices, L_data, psi, peclet, out):
+def drift_weights(indptr, indices, L_data, psi, peclet, X, out, DX):
     """Values of the drift stiffness (R4) of :mod:`baselines.redistribution` in the
     pattern of ``L``: off-diagonal ``L_ij B(psi_i - psi_j)``, the difference clipped
     to ``[-peclet, peclet]``, ``B(x) = x / (e^x - 1)`` (``B(0) = 1``), and the
-    diagonal minus the sum of its row's off-diagonal values (zero row sums).
+    diagonal minus the sum of its row's off-diagonal values (zero row sums); in the
+    same pass ``(L_psi - L) X`` (the drift of (R5)), as ``sum_j (L_psi - L)_ij (X_j -
+    X_i)`` (both matrices have zero row sums).
 
     Parameters
     ----------
@@ -482,13 +484,18 @@ def drift_weights(indptr, indices, L_data, psi, peclet, out):
     indices : (nnz,) int array
         Each row's diagonal stored (it is overwritten).
     L_data : (nnz,) float64 array
+        Zero row sums.
     psi : (n,) float64 array
     peclet : float
+    X : (3, n) float64 array
     out : (nnz,) float64 array, output
+    DX : (3, n) float64 array, output
+        ``(L_psi - L) X``.
     """
     for i in range(len(indptr) - 1):
         total = 0.0
         diagonal = -1
+        d0 = d1 = d2 = 0.0
         for p in range(indptr[i], indptr[i + 1]):
             j = indices[p]
             if j == i:
@@ -498,5 +505,10 @@ def drift_weights(indptr, indices, L_data, psi, peclet, out):
             w = L_data[p] * (x / np.expm1(x) if x != 0.0 else 1.0)
             out[p] = w
             total += w
+            c = w - L_data[p]
+            d0 += c * (X[0, j] - X[0, i])
+            d1 += c * (X[1, j] - X[1, i])
+            d2 += c * (X[2, j] - X[2, i])
         if diagonal >= 0:
             out[diagonal] = -total
+        DX[0, i], DX[1, i], DX[2, i] = d0, d1, d2

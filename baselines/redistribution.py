@@ -303,7 +303,7 @@ def bernoulli(x):
     return np.where(x == 0.0, 1.0, b)
 
 
-def drift_laplacian(L, psi, peclet=np.inf):
+def drift_laplacian(L, psi, peclet=np.inf, X=None):
     """The stiffness of (R4): ``-e^{-psi} div(e^psi grad .)`` times the lumped mass.
 
     Parameters
@@ -316,22 +316,31 @@ def drift_laplacian(L, psi, peclet=np.inf):
     peclet : float
         Largest ``|psi_j - psi_i|`` an edge's weight sees (R6): the differences
         are clipped to ``[-peclet, peclet]``.
+    X : (3, n) float array, optional
+        Positions whose drift ``(L_psi - L) X`` (R5) is wanted too.
 
     Returns
     -------
-    (n, n) scipy.sparse.csr_matrix
+    L_psi : (n, n) scipy.sparse.csr_matrix
         Same pattern (its ``indices`` and ``indptr``, shared); off-diagonal
         ``-c_ij B(psi_i - psi_j)`` (:func:`bernoulli`), diagonal the negated sum
         of its row's off-diagonal entries (zero row sums): one compiled pass
         (:func:`baselines.kernels.drift_weights`). Not symmetric, but where no
         difference is clipped ``diag(e^psi) L_psi`` is (``psi`` constant: ``L``
         itself).
+    drift : (3, n) float array
+        ``(L_psi - L) X``, from the same pass; only when ``X`` is given.
     """
     L = sp.csr_matrix(L)
     data = np.empty(L.nnz)
+    n = L.shape[0]
+    DX = np.empty((3, n))
     drift_weights(L.indptr, L.indices, np.ascontiguousarray(L.data, dtype=np.float64),
-                  np.ascontiguousarray(psi, dtype=np.float64), float(peclet), data)
-    return sp.csr_matrix((data, L.indices, L.indptr), shape=L.shape)
+                  np.ascontiguousarray(psi, dtype=np.float64), float(peclet),
+                  np.zeros((3, n)) if X is None else np.ascontiguousarray(X, dtype=np.float64),
+                  data, DX)
+    L_psi = sp.csr_matrix((data, L.indices, L.indptr), shape=L.shape)
+    return L_psi if X is None else (L_psi, DX)
 
 
 def surface_components(faces, n_vertices):

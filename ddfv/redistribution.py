@@ -375,7 +375,7 @@ def bernoulli(x):
     return np.where(x == 0.0, 1.0, b)
 
 
-def drift_system(assembler, A, geom, chi, dt, psi, peclet=np.inf):
+def drift_system(assembler, A, geom, chi, dt, psi, peclet=np.inf, X=None):
     """The matrix of (R7) in row-scaled form: ``A + dt diag(1/chi) D``.
 
     Parameters
@@ -394,16 +394,20 @@ def drift_system(assembler, A, geom, chi, dt, psi, peclet=np.inf):
     peclet : float
         Largest ``|psi_b - psi_a|`` a weight sees: the differences are clipped
         to ``[-peclet, peclet]`` (R8).
+    X : (3, n) float array, optional
+        Positions (own numbering) whose drift ``dt diag(1/chi) D X`` is wanted too.
 
     Returns
     -------
-    (n, n) scipy.sparse.csr_matrix
+    A_psi : (n, n) scipy.sparse.csr_matrix
         In the pattern of ``A`` (same ``indices`` and ``indptr``). ``D``
         multiplies the F-row part of each inner diamond's fluxes by ``w - 1``,
         ``w_a = B(psi_a - psi_b)`` in the row of ``a`` and ``w_b = B(psi_b -
         psi_a)`` in the row of ``b`` (:func:`bernoulli`); T-rows, boundary
         diamonds and Dirichlet rows are those of ``A``. With ``psi`` constant,
         ``A`` itself.
+    drift : (3, n) float array
+        ``(A_psi - A) X``, from the same compiled pass; only when ``X`` is given.
     """
     from .geometry import _diamond_indices
     from .kernels import drift_kernel
@@ -418,9 +422,14 @@ def drift_system(assembler, A, geom, chi, dt, psi, peclet=np.inf):
     factors = (np.asarray(getattr(geom, name), dtype=np.float64)
                for name in ("gamma_t", "gamma_f", "J", "len_u", "len_v", "uv"))
     data = A.data.copy()
+    n = mesh.n_unknowns
+    DX = np.empty((3, n))
     drift_kernel(assembler._inner, *factors, assembler._slots, _diamond_indices(mesh),
-                 np.ascontiguousarray(psi, dtype=np.float64), scale, float(peclet), data)
-    return sp.csr_matrix((data, A.indices, A.indptr), shape=A.shape)
+                 np.ascontiguousarray(psi, dtype=np.float64), scale, float(peclet),
+                 np.zeros((3, n)) if X is None else np.ascontiguousarray(X, dtype=np.float64),
+                 mesh.n_f, data, DX)
+    A_psi = sp.csr_matrix((data, A.indices, A.indptr), shape=A.shape)
+    return A_psi if X is None else (A_psi, DX)
 
 
 def carry_t_vertices(F, T, faces, lam):
