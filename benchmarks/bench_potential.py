@@ -1,23 +1,26 @@
-"""Cost of a redistributing step against the same scheme's plain step, before and after
-the potential's kept Cholesky factor and CG (issue #32), in one process.
+"""Cost of a redistributing step against the same scheme's plain step (issues #30 and
+#32: at most 2 x at level 5 of the sphere), before and after a change, in one process.
 
 The redistributing schemes solve, at every step, the potential's Laplacian
 (``baselines.redistribution.PotentialSolver``, ``ddfv.redistribution.TangentialPotential``)
 and then the positions' system with the drift (R4) / (R7). "before" is the
-packages ``ddfv`` and ``baselines`` of commit ``BEFORE`` (a kept sparse LU
-refined at every step, the drift built as a COO matrix), extracted by ``git
-archive`` into a temporary directory as ``ddfv_before`` and ``baselines_before``
-and driven by this harness; "after" is this tree. Each pair (plain scheme,
-redistributing scheme) is stepped on the shrinking sphere at ``--level``
-(Table 3.1's time step, every step of the run, or the first ``--steps``) by
+packages ``ddfv``, ``baselines`` and ``kept_factor`` of commit ``--before``
+(default :data:`BEFORE`: the potential solved to 1e-7, the drift's normal part by
+a second sparse product), extracted by ``git archive`` into a temporary
+directory as ``ddfv_before``, ``baselines_before`` and ``kept_factor_before``
+(their imports of ``kept_factor`` rewritten) and driven by this harness;
+"after" is this tree. Each pair (plain scheme, redistributing scheme) is
+stepped on the shrinking sphere at ``--level`` (Table 3.1's time step, every
+step of the run, or the first ``--steps``) by
 :func:`mcfbench.running.driver.simulate`, both versions interleaved (the
 order reversed on odd repeats), after a level-1 run of every variant (no
 compilation or first call timed). Printed: the median CPU milliseconds per
 step, the potential's share of the step (its source, stiffness and solve:
-``flow.timings["potential"]``, the before-DDFV's timed by wrapping its
-``_potential_of``), the ratio of each redistributing step to the plain step
-of the same version (target of issue #32: at most 2 at level 5), and after /
-before. ``--solvers``: instead, the choice of the potential's solver: the
+``flow.timings["potential"]``), the positions' BiCGStab iterations per step
+(does the drift make them more?), the potential's CG iterations per step
+and its factorisations, the ratio of each redistributing step to the plain
+step of the same version (target: at most 2 at level 5), and after / before.
+``--solvers``: instead, the choice of the potential's solver: the
 systems (R2) of the first ``--steps`` (default 64) steps of ``cotan-redistribute``
 at ``--level`` are recorded, then solved in sequence by each candidate (a
 factorisation or preconditioner of the first system kept, each later system
@@ -29,6 +32,7 @@ the largest relative difference to a direct solve. Algebraic multigrid
 (it is not a dependency). Usage::
 
     python benchmarks/bench_potential.py [--level 5] [--repeats 3] [--steps N]
+        [--before COMMIT]
         [--pairs cotan:cotan-redistribute ddfv-chord-carried:ddfv-chord-redistribute-carried]
     python benchmarks/bench_potential.py --solvers [--level 5] [--steps 64]
 """
@@ -42,7 +46,6 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
 import dataclasses  # noqa: E402
-import importlib  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
@@ -59,34 +62,30 @@ from mcfbench.running.schemes import get_scheme  # noqa: E402
 from mcfbench.running.solver import Solver  # noqa: E402
 from mcfbench.storage.memory import tune_malloc  # noqa: E402
 
-BEFORE = "acf8b58"
+BEFORE = "660c097"
 TARGET = 2.0
 PAIRS = ["cotan:cotan-redistribute", "ddfv-chord-carried:ddfv-chord-redistribute-carried"]
+PACKAGES = ("ddfv", "baselines", "kept_factor")
 
 
-def before_packages(tree):
-    """``ddfv`` and ``baselines`` of :data:`BEFORE` as ``ddfv_before``, ``baselines_before``
-    (their imports are relative) under ``tree``, importable; the DDFV potential timed."""
-    archive = subprocess.run(["git", "archive", BEFORE, "ddfv", "baselines"], cwd=ROOT,
+def before_packages(tree, commit):
+    """:data:`PACKAGES` of ``commit`` as ``ddfv_before``, ``baselines_before``,
+    ``kept_factor_before`` under ``tree``, importable (``ddfv`` and ``baselines``
+    import each other's files relatively, ``kept_factor`` absolutely: rewritten)."""
+    archive = subprocess.run(["git", "archive", commit, *PACKAGES], cwd=ROOT,
                              capture_output=True, check=True).stdout
     subprocess.run(["tar", "-x", "-C", tree], input=archive, check=True)
-    for package in ("ddfv", "baselines"):
+    for package in PACKAGES:
         Path(tree, package).rename(Path(tree, f"{package}_before"))
+    for source in Path(tree).glob("*_before/*.py"):
+        text = source.read_text()
+        source.write_text(text.replace("from kept_factor import", "from kept_factor_before import"))
     sys.path.insert(0, tree)
-    flow = importlib.import_module("ddfv_before.flow").Flow
-    potential_of = flow._potential_of
-
-    def timed(self, *args):
-        clock = time.perf_counter()
-        psi = potential_of(self, *args)
-        self.timings["potential"] = (self.timings.get("potential", 0.0)
-                                     + time.perf_counter() - clock)
-        return psi
-    flow._potential_of = timed
 
 
 def variant(name, version):
-    """The registry scheme ``name``, its flow class from this tree or from :data:`BEFORE`."""
+    """The registry scheme ``name``, its flow class from this tree or from the packages
+    of the 'before' commit (:func:`before_packages`)."""
     scheme = get_scheme(name)
     if version == "after":
         return scheme
@@ -96,9 +95,10 @@ def variant(name, version):
 
 
 def step_cost(scheme, level, steps):
-    """``(CPU ms per step, the potential's share of the step)`` of one run of the sphere
-    at ``level`` (the share: the flow's wall-clock timing of the potential over the
-    run's wall-clock time, so that load on the machine cancels)."""
+    """``(CPU ms per step, the potential's share of the step, BiCGStab iterations per
+    step, the potential's CG iterations per step, its factorisations)`` of one run of
+    the sphere at ``level`` (the share: the flow's wall-clock timing of the potential
+    over the run's wall-clock time, so that load on the machine cancels)."""
     sphere = get_problem("sphere")
     V, F = icosphere(level)
     tau = sphere.tau(level)
@@ -109,9 +109,11 @@ def step_cost(scheme, level, steps):
     cpu, wall = time.process_time() - clock, time.perf_counter() - wall
     if not traj.ok:
         raise RuntimeError(f"{scheme.name} ({scheme.flow}): {traj.message}")
-    timings = flow.timings
-    potential = timings.get("potential", timings.get("redistribution", 0.0))
-    return 1e3 * cpu / steps, potential / wall
+    potential = getattr(flow, "_potential_solver", getattr(flow, "_potential", None))
+    cg, factorisations = ((potential.iterations / steps, potential.factorisations)
+                          if potential is not None else (float("nan"), 0))
+    return (1e3 * cpu / steps, flow.timings.get("potential", 0.0) / wall,
+            float(traj.iterations.mean()), cg, factorisations)
 
 
 def recorded_systems(level, steps):
@@ -215,6 +217,8 @@ def main(argv=None):
                         help="plain:redistributing registry names")
     parser.add_argument("--solvers", action="store_true",
                         help="compare the potential's solvers instead")
+    parser.add_argument("--before", default=BEFORE,
+                        help=f"the commit of the 'before' packages (default {BEFORE})")
     args = parser.parse_args(argv)
     tune_malloc()
     one_core()
@@ -225,8 +229,8 @@ def main(argv=None):
     pairs = [tuple(p.split(":")) for p in args.pairs]
     names = [name for pair in pairs for name in pair]
     versions = ("before", "after")
-    with tempfile.TemporaryDirectory(prefix=f"potential-{BEFORE}-") as tree:
-        before_packages(tree)
+    with tempfile.TemporaryDirectory(prefix=f"potential-{args.before}-") as tree:
+        before_packages(tree, args.before)
         schemes = {(n, v): variant(n, v) for n in names for v in versions}
         for scheme in schemes.values():                   # warm-up: compilation, caches
             step_cost(scheme, 1, None)
@@ -235,13 +239,13 @@ def main(argv=None):
             keys = list(schemes) if repeat % 2 == 0 else list(schemes)[::-1]
             for key in keys:
                 cost[key].append(step_cost(schemes[key], args.level, args.steps))
-    ms = {k: median([c[0] for c in v]) for k, v in cost.items()}
-    pot = {k: median([c[1] for c in v]) for k, v in cost.items()}
+    ms, pot, its, cg, fac = ({k: median([c[i] for c in v]) for k, v in cost.items()}
+                             for i in range(5))
     print(f"sphere level {args.level}, CPU ms per step (median of {args.repeats}, "
           f"{'every step' if args.steps is None else f'{args.steps} steps'}), "
-          f"before = {BEFORE}")
+          f"before = {args.before}")
     print(f"{'scheme':34s} {'version':>7s} {'ms/step':>9s} {'potential %':>12s} "
-          f"{'x plain':>8s} {'after/before':>13s}  verdict")
+          f"{'BiCGStab':>9s} {'CG':>6s} {'LLT':>4s} {'x plain':>8s} {'after/before':>13s}  verdict")
     for plain, redistributing in pairs:
         for name in (plain, redistributing):
             for version in versions:
@@ -251,11 +255,12 @@ def main(argv=None):
                 verdict = ("" if name == plain else
                            "ok" if ratio <= TARGET else f"above {TARGET:g}")
                 print(f"{name:34s} {version:>7s} {ms[key]:9.2f} {100 * pot[key]:12.1f} "
-                      f"{ratio:8.2f} {change if version == 'after' else float('nan'):13.2f}"
-                      f"  {verdict}")
+                      f"{its[key]:9.2f} {cg[key]:6.2f} {fac[key]:4.0f} {ratio:8.2f} "
+                      f"{change if version == 'after' else float('nan'):13.2f}  {verdict}")
     print("potential %: the share of the step spent in the potential (R2)/(R3) (its "
-          "source, stiffness and solve); x plain: CPU time per step over the plain "
-          "scheme's of the same version.")
+          "source, stiffness and solve); BiCGStab: the positions' iterations per step; "
+          "CG: the potential's iterations per step; LLT: its factorisations in the run; x "
+          "plain: CPU time per step over the plain scheme's of the same version.")
     print(footing())
 
 

