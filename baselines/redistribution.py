@@ -140,25 +140,6 @@ POTENTIAL_RTOL = 1e-4
 """Relative residual of the potential's solve (:class:`PotentialSolver`)."""
 
 
-def mean_curvature_vectors(L, mass, X):
-    """``h = -M^{-1} L X`` (the scheme's ``Delta_G X``), zero where ``m_i = 0``.
-
-    Parameters
-    ----------
-    L : (n, n) sparse matrix
-        Cotangent stiffness (positive semi-definite).
-    mass : (n,) float array
-    X : (3, n) float array
-
-    Returns
-    -------
-    (3, n) float array
-    """
-    LX = np.asarray(L @ np.asarray(X).T).T
-    safe = np.where(mass > 0.0, mass, 1.0)
-    return np.where(mass > 0.0, -LX / safe, 0.0)
-
-
 def target_shares(faces, n, target="vertex"):
     """Target share ``w_i`` of the total area for each covolume, ``sum w_i = 1``.
 
@@ -206,8 +187,10 @@ def redistribution_source(L, mass, X, fixed, omega, shares=None):
     -------
     (n,) float array
     """
-    h = mean_curvature_vectors(L, mass, X)
-    hV = np.where(fixed, 0.0, (h * h).sum(axis=0))
+    LX = np.asarray(L @ np.asarray(X).T)                # h_i = -(L X)_i / m_i, zero where
+    safe = np.where(mass > 0.0, mass, np.inf)           # m_i = 0
+    hV = np.einsum("ij,ij->i", LX, LX) / (safe * safe)  # |h_i|^2
+    hV[fixed] = 0.0
     area = mass.sum()
     f = hV - (mass * hV).sum() / area
     if omega:
