@@ -29,12 +29,17 @@ relative residual 1e-7; factorised again when the iteration fails): CPU ms
 per solve (the first, the factorisation, apart), iterations per solve and
 the largest relative difference to a direct solve. Algebraic multigrid
 (``pyamg``, smoothed aggregation) is measured when ``pyamg`` is importable
-(it is not a dependency). Usage::
+(it is not a dependency). ``--profile``: instead, this tree's step taken apart:
+CPU ms per step of each part (:data:`PARTS`: the potential's source,
+stiffness and solve, the drift and its normal part, the system matrix, the
+positions' BiCGStab, the rest) and the iterations per step, plain against
+redistributing, over the first ``--steps`` steps. Usage::
 
     python benchmarks/bench_potential.py [--level 5] [--repeats 3] [--steps N]
         [--before COMMIT]
         [--pairs cotan:cotan-redistribute ddfv-chord-carried:ddfv-chord-redistribute-carried]
     python benchmarks/bench_potential.py --solvers [--level 5] [--steps 64]
+    python benchmarks/bench_potential.py --profile [--level 5] [--steps 64] [--repeats 3]
 """
 
 import os
@@ -46,6 +51,7 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
 import dataclasses  # noqa: E402
+import importlib  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
@@ -114,6 +120,100 @@ def step_cost(scheme, level, steps):
                           if potential is not None else (float("nan"), 0))
     return (1e3 * cpu / steps, flow.timings.get("potential", 0.0) / wall,
             float(traj.iterations.mean()), cg, factorisations)
+
+
+#: the parts of a step timed by ``--profile``: (module, owner or None, attribute, label);
+#: the potential's solve includes its stiffness's pinning, the rest of a step (geometry,
+#: checks, bookkeeping) is the run's CPU time minus these
+PARTS = {
+    "baselines": [
+        ("baselines.cotan", None, "redistribution_source", "potential: source (R2)"),
+        ("baselines.redistribution", "PotentialSolver", "__call__", "potential: solve (R2)"),
+        ("baselines.cotan", None, "drift_laplacian", "drift (R4) + its D X"),
+        ("baselines.cotan", "CotanFlow", "_normal_drift", "normal part (R5)"),
+        ("baselines.cotan", "CotanAssembler", "row_scaled", "system matrix (C3)"),
+    ],
+    "ddfv": [
+        ("ddfv.flow", "Flow", "_geometry_at", "geometry"),
+        ("ddfv.assembly", "Assembler", "system", "system matrix (2.10)"),
+        ("ddfv.flow", None, "vertex_normals", "vertex normals"),
+        ("ddfv.flow", None, "redistribution_source", "potential: source (R3)"),
+        ("ddfv.flow", None, "neumann_stiffness", "potential: stiffness K"),
+        ("ddfv.redistribution", "TangentialPotential", "__call__", "potential: solve (R3)"),
+        ("ddfv.flow", None, "drift_system", "drift (R7) + its D X"),
+        ("ddfv.flow", None, "carry_t_vertices", "T-vertices carried"),
+    ],
+}
+
+
+class _Timed:
+    """The registry's solver, its CPU time kept (the positions' solve)."""
+
+    can_overwrite_x0 = Solver.can_overwrite_x0
+
+    def __init__(self):
+        self.solver, self.seconds = Solver(), 0.0
+
+    def __call__(self, *args, **kwargs):
+        clock = time.process_time()
+        result = self.solver(*args, **kwargs)
+        self.seconds += time.process_time() - clock
+        return result
+
+
+def profile(pairs, level, steps, repeats):
+    """CPU ms per step of each part of a step (:data:`PARTS`), plain and redistributing,
+    over the first ``steps`` steps of the sphere at ``level`` (medians of ``repeats``
+    runs, interleaved): the parts' functions wrapped by a CPU clock."""
+    sphere = get_problem("sphere")
+    V, F = icosphere(level)
+    tau = sphere.tau(level)
+    names = [name for pair in pairs for name in pair]
+    spent = {}
+    for package in {get_scheme(n).flow.partition(".")[0] for n in names}:
+        for module, owner, attribute, label in PARTS[package]:
+            target = importlib.import_module(module)
+            target = getattr(target, owner) if owner else target
+            setattr(target, attribute, _clocked(getattr(target, attribute), label, spent))
+    rows = {name: [] for name in names}
+    for repeat in range(repeats + 1):                     # the first: warm-up
+        for name in (names if repeat % 2 == 0 else names[::-1]):
+            flow, solver = get_scheme(name).make(V, F, tau), _Timed()
+            spent.clear()
+            clock = time.process_time()
+            traj = simulate(flow, steps, solver=solver, save_every=0)
+            total = time.process_time() - clock
+            potential = getattr(flow, "_potential_solver", getattr(flow, "_potential", None))
+            row = {label: spent.get(label, 0.0) for *_, label in
+                   PARTS[get_scheme(name).flow.partition(".")[0]]}
+            row["positions: BiCGStab"] = solver.seconds
+            row["rest of the step"] = total - sum(row.values())
+            row["step"] = total
+            row["BiCGStab iterations"] = float(traj.iterations.sum())
+            row["potential: CG iterations"] = (potential.iterations if potential is not None
+                                               else 0.0)
+            if repeat:
+                rows[name].append(row)
+    print(f"sphere level {level}, first {steps} steps, CPU ms per step (iterations per step), "
+          f"median of {repeats}; the potential's solve includes its first factorisation; "
+          f"rest of the step: geometry (cotan), checks, bookkeeping")
+    for plain, redistributing in pairs:
+        print(f"{'part':40s} {plain:>20s} {redistributing:>32s}")
+        for label in rows[redistributing][0]:
+            values = [median([r.get(label, 0.0) for r in rows[n]]) / steps
+                      for n in (plain, redistributing)]
+            scale = 1.0 if "iterations" in label else 1e3
+            print(f"{label:40s} {scale * values[0]:20.3f} {scale * values[1]:32.3f}")
+        print()
+
+
+def _clocked(function, label, spent):
+    def clocked(*args, **kwargs):
+        clock = time.process_time()
+        result = function(*args, **kwargs)
+        spent[label] = spent.get(label, 0.0) + time.process_time() - clock
+        return result
+    return clocked
 
 
 def recorded_systems(level, steps):
@@ -217,6 +317,8 @@ def main(argv=None):
                         help="plain:redistributing registry names")
     parser.add_argument("--solvers", action="store_true",
                         help="compare the potential's solvers instead")
+    parser.add_argument("--profile", action="store_true",
+                        help="time the parts of a step instead (this tree, --steps, default 64)")
     parser.add_argument("--before", default=BEFORE,
                         help=f"the commit of the 'before' packages (default {BEFORE})")
     args = parser.parse_args(argv)
@@ -227,6 +329,9 @@ def main(argv=None):
         choose_solver(args.level, 64 if args.steps is None else args.steps)
         return
     pairs = [tuple(p.split(":")) for p in args.pairs]
+    if args.profile:
+        profile(pairs, args.level, 64 if args.steps is None else args.steps, args.repeats)
+        return
     names = [name for pair in pairs for name in pair]
     versions = ("before", "after")
     with tempfile.TemporaryDirectory(prefix=f"potential-{args.before}-") as tree:
