@@ -64,7 +64,8 @@ import igl
 import numpy as np
 import scipy.sparse as sp
 
-from .kernels import cotan_geometry, neighbour_cosines, row_scaled_system, vertex_normals
+from .kernels import (cotan_geometry, neighbour_cosines, normal_parts, row_scaled_system,
+                      vertex_normals)
 from .mesh import edge_mesh, laplacian_pattern
 from .redistribution import (OMEGA, PECLET, REDISTRIBUTIONS, PotentialSolver, drift_laplacian,
                              redistribution_source, surface_components, tangential_velocity,
@@ -634,8 +635,6 @@ class CotanFlow(VertexFlow):
         normals = np.empty((self.mesh.n_vertices, 3))
         vertex_normals(self.faces, self.geometry_at(at).area_vectors, self.mesh.n_vertices,
                        normals)
-        N = normals.T                                   # unnormalised, zero if bare
-        squared = np.maximum(np.einsum("ij,ij->j", N, N), 1e-300)
-        scale = np.einsum("ij,ij->j", N, DX) / (squared * np.where(mass > 0.0, mass, np.inf))
-        scale[self.fixed] = 0.0
-        return scale * N
+        g = np.empty((3, self.mesh.n_vertices))
+        normal_parts(normals, np.ascontiguousarray(DX), mass, self.fixed, g)
+        return g

@@ -525,3 +525,27 @@ def drift_weights(indptr, indices, L_data, psi, peclet, X, out, DX):
         if diagonal >= 0:
             out[diagonal] = -total
         DX[0, i], DX[1, i], DX[2, i] = d0, d1, d2
+
+
+@njit(cache=True)
+def normal_parts(omega, D, mass, fixed, g):
+    """``g_i = N_i N_i . D_i / m_i`` (the normal part (R5) of the drift of
+    :mod:`baselines.redistribution`), ``N_i = omega_i / |omega_i|``; zero at fixed
+    vertices and where ``omega_i = 0`` or ``m_i <= 0``.
+
+    Parameters
+    ----------
+    omega : (n, 3) float64 array
+        Vertex normals, any length (:func:`vertex_normals`).
+    D : (3, n) float64 array
+    mass : (n,) float64 array
+    fixed : (n,) bool array
+    g : (3, n) float64 array, output
+    """
+    for i in range(mass.shape[0]):
+        nx, ny, nz = omega[i, 0], omega[i, 1], omega[i, 2]
+        squared = nx * nx + ny * ny + nz * nz
+        s = 0.0
+        if not fixed[i] and squared > 0.0 and mass[i] > 0.0:
+            s = (nx * D[0, i] + ny * D[1, i] + nz * D[2, i]) / (squared * mass[i])
+        g[0, i], g[1, i], g[2, i] = s * nx, s * ny, s * nz

@@ -6,7 +6,7 @@ import pytest
 from conftest import twin_sphere
 
 from baselines.cotan import CotanFlow
-from baselines.kernels import bernoulli_weight, vertex_gradients
+from baselines.kernels import bernoulli_weight, normal_parts, vertex_gradients
 from baselines.redistribution import (POTENTIAL_RTOL, PotentialSolver, bernoulli,
                                       drift_laplacian, redistribution_source, solve_potential,
                                       target_shares)
@@ -200,6 +200,28 @@ def test_drift_laplacian_is_a_symmetrisable_m_matrix():
     centred -= np.diag(centred.sum(axis=1))
     np.testing.assert_allclose((drift_laplacian(L, eps * psi) - L).toarray() / eps, centred,
                                rtol=0, atol=1e-5 * np.abs(centred).max())
+
+
+def test_normal_parts_of_the_drift():
+    """(R5) compiled: ``g_i = N_i N_i . D_i / m_i`` with the unit normal of any-length
+    ``omega_i``; zero at a fixed vertex, a bare vertex (``omega_i = 0``) and ``m_i = 0``."""
+    rng = np.random.default_rng(5)
+    omega, D = rng.standard_normal((6, 3)), rng.standard_normal((3, 6))
+    mass = rng.uniform(0.5, 2.0, 6)
+    omega[3] = 0.0
+    mass[4] = 0.0
+    fixed = np.zeros(6, dtype=bool)
+    fixed[5] = True
+    g = np.empty((3, 6))
+    normal_parts(omega, D, mass, fixed, g)
+    N = omega / np.linalg.norm(omega[:3], axis=1).max()          # any length
+    unit = omega[:3] / np.linalg.norm(omega[:3], axis=1, keepdims=True)
+    expected = (unit * (unit * D.T[:3]).sum(axis=1, keepdims=True) / mass[:3, None]).T
+    np.testing.assert_allclose(g[:, :3], expected, rtol=1e-14, atol=1e-15)
+    assert not g[:, 3:].any()
+    g_scaled = np.empty((3, 6))
+    normal_parts(N, D, mass, fixed, g_scaled)
+    np.testing.assert_allclose(g_scaled, g, rtol=1e-14, atol=1e-15)
 
 
 # -- invariances -----------------------------------------------------------------
