@@ -75,13 +75,17 @@ PACKAGES = ("ddfv", "baselines", "kept_factor")
 
 
 def before_packages(tree, commit):
-    """:data:`PACKAGES` of ``commit`` as ``ddfv_before``, ``baselines_before``,
-    ``kept_factor_before`` under ``tree``, importable (``ddfv`` and ``baselines``
-    import each other's files relatively, ``kept_factor`` absolutely: rewritten)."""
-    archive = subprocess.run(["git", "archive", commit, *PACKAGES], cwd=ROOT,
+    """:data:`PACKAGES` of ``commit`` (those it has) as ``ddfv_before``,
+    ``baselines_before``, ``kept_factor_before`` under ``tree``, importable (``ddfv``
+    and ``baselines`` import their own files relatively, ``kept_factor`` absolutely:
+    rewritten)."""
+    present = subprocess.run(["git", "ls-tree", "--name-only", commit], cwd=ROOT,
+                             capture_output=True, check=True, text=True).stdout.split()
+    packages = [p for p in PACKAGES if p in present]     # kept_factor: since 36cf514
+    archive = subprocess.run(["git", "archive", commit, *packages], cwd=ROOT,
                              capture_output=True, check=True).stdout
     subprocess.run(["tar", "-x", "-C", tree], input=archive, check=True)
-    for package in PACKAGES:
+    for package in packages:
         Path(tree, package).rename(Path(tree, f"{package}_before"))
     for source in Path(tree).glob("*_before/*.py"):
         text = source.read_text()

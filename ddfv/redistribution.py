@@ -244,9 +244,10 @@ class TangentialPotential(KeptFactorSolver):
     velocity (any leaves the shape alone), so its tolerance is
     :data:`POTENTIAL_RTOL` = 1e-4 (it was 1e-7): the extrapolated start meets
     it in most steps with no iteration (level 5 of the sphere: 0.42 CG
-    iterations per step against 1.02), and the Table 3.1 setting's errors,
-    orders, smallest angle and largest aspect ratio (levels 1-5) are unchanged
-    in their 7th, 4th, 4th and 4th digits (``ddfv/README.md``).
+    iterations per step against 1.02), and the Table 3.1 setting's errors
+    (levels 1-5) are unchanged to 7 digits, their orders, the smallest angle
+    and the largest aspect ratio to the 4th decimal (``ddfv/README.md``, item
+    22 of its deviations).
 
     Parameters
     ----------
