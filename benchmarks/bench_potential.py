@@ -16,7 +16,8 @@ step of the run, or the first ``--steps``) by
 order reversed on odd repeats), after a level-1 run of every variant (no
 compilation or first call timed). Printed: the median CPU milliseconds per
 step, the potential's share of the step (its source, stiffness and solve:
-``flow.timings["potential"]``), the positions' BiCGStab iterations per step
+``flow.timings["potential"]``; 0 for flows that did not time it, e.g. the
+DDFV of ``acf8b58``), the positions' BiCGStab iterations per step
 (does the drift make them more?), the potential's CG iterations per step
 and its factorisations, the ratio of each redistributing step to the plain
 step of the same version (target: at most 2 at level 5), and after / before.
@@ -120,8 +121,8 @@ def step_cost(scheme, level, steps):
     if not traj.ok:
         raise RuntimeError(f"{scheme.name} ({scheme.flow}): {traj.message}")
     potential = getattr(flow, "_potential_solver", getattr(flow, "_potential", None))
-    cg, factorisations = ((potential.iterations / steps, potential.factorisations)
-                          if potential is not None else (float("nan"), 0))
+    cg = getattr(potential, "iterations", float("nan")) / steps   # not counted before 36cf514
+    factorisations = getattr(potential, "factorisations", float("nan"))
     return (1e3 * cpu / steps, flow.timings.get("potential", 0.0) / wall,
             float(traj.iterations.mean()), cg, factorisations)
 
