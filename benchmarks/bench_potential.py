@@ -34,13 +34,16 @@ the largest relative difference to a direct solve. Algebraic multigrid
 CPU ms per step of each part (:data:`PARTS`: the potential's source,
 stiffness and solve, the drift and its normal part, the system matrix, the
 positions' BiCGStab, the rest) and the iterations per step, plain against
-redistributing, over the first ``--steps`` steps. Usage::
+redistributing, over the first ``--steps`` steps. ``--tolerances``: the
+potential's tolerance against the sphere's errors, orders, mesh quality and
+CG iterations (levels 1 to ``--level``). Usage::
 
     python benchmarks/bench_potential.py [--level 5] [--repeats 3] [--steps N]
         [--before COMMIT]
         [--pairs cotan:cotan-redistribute ddfv-chord-carried:ddfv-chord-redistribute-carried]
     python benchmarks/bench_potential.py --solvers [--level 5] [--steps 64]
     python benchmarks/bench_potential.py --profile [--level 5] [--steps 64] [--repeats 3]
+    python benchmarks/bench_potential.py --tolerances 1e-7 1e-4 1e-3 [--level 5]
 """
 
 import os
@@ -221,6 +224,34 @@ def _clocked(function, label, spent):
     return clocked
 
 
+def tolerances(names, levels, rtols):
+    """The potential's tolerance against the results: for each redistributing scheme and
+    ``rtol`` (``POTENTIAL_RTOL`` of both packages), the sphere's Table 3.1 runs at
+    ``levels`` (:func:`mcfbench.running.run.run`): L2 error, EOC, smallest angle, largest
+    aspect ratio and the potential's CG iterations per step."""
+    import baselines.redistribution
+    import ddfv.redistribution
+
+    from _harness import harness_run
+
+    print(f"sphere, Table 3.1 setting, levels {levels}: the potential's tolerance")
+    print(f"{'scheme':34s} {'rtol':>6s} {'level':>5s} {'L2 error':>13s} {'EOC':>6s} "
+          f"{'min angle':>10s} {'max aspect':>10s} {'CG/step':>8s}")
+    for name in names:
+        for rtol in rtols:
+            baselines.redistribution.POTENTIAL_RTOL = ddfv.redistribution.POTENTIAL_RTOL = rtol
+            last = None
+            for level in levels:
+                result, flow = harness_run(name, level)
+                error = result.metrics["l2_error"]
+                potential = getattr(flow, "_potential_solver", getattr(flow, "_potential", None))
+                eoc = np.log2(last / error) if last else float("nan")
+                print(f"{name:34s} {rtol:6.0e} {level:5d} {error:13.6e} {eoc:6.3f} "
+                      f"{result.min_angle:10.4f} {result.max_aspect:10.4f} "
+                      f"{potential.iterations / result.steps_done:8.2f}")
+                last = error
+
+
 def recorded_systems(level, steps):
     """``(A, b)`` of the pinned potential systems of the first ``steps`` steps of
     ``cotan-redistribute`` on the sphere at ``level`` (as ``PotentialSolver`` forms them)."""
@@ -322,6 +353,9 @@ def main(argv=None):
                         help="plain:redistributing registry names")
     parser.add_argument("--solvers", action="store_true",
                         help="compare the potential's solvers instead")
+    parser.add_argument("--tolerances", nargs="+", type=float, default=None,
+                        help="the potential's tolerances to compare on the sphere's levels "
+                             "1 to --level instead")
     parser.add_argument("--profile", action="store_true",
                         help="time the parts of a step instead (this tree, --steps, default 64)")
     parser.add_argument("--before", default=BEFORE,
@@ -334,6 +368,9 @@ def main(argv=None):
         choose_solver(args.level, 64 if args.steps is None else args.steps)
         return
     pairs = [tuple(p.split(":")) for p in args.pairs]
+    if args.tolerances:
+        tolerances([pair[1] for pair in pairs], list(range(1, args.level + 1)), args.tolerances)
+        return
     if args.profile:
         profile(pairs, args.level, 64 if args.steps is None else args.steps, args.repeats)
         return
