@@ -64,7 +64,8 @@ import igl
 import numpy as np
 import scipy.sparse as sp
 
-from .kernels import cotan_geometry, neighbour_cosines, row_scaled_system, vertex_normals
+from .kernels import (cotan_geometry, neighbour_cosines, normal_parts, row_scaled_system,
+                      vertex_normals)
 from .mesh import edge_mesh, laplacian_pattern
 from .redistribution import (OMEGA, PECLET, REDISTRIBUTIONS, PotentialSolver, drift_laplacian,
                              redistribution_source, surface_components, tangential_velocity,
@@ -621,21 +622,19 @@ class CotanFlow(VertexFlow):
                                              self.fixed), base
         L = sp.csr_matrix(self.laplacian(at))
         mass = self._system_mass(at)
-        drift = drift_laplacian(L, self._potential(at, L, mass), self.peclet)   # (R4)
-        D = sp.csr_matrix((drift.data - L.data, L.indices, L.indptr), shape=L.shape)
-        rhs = base + dt * self._normal_drift(at, D, mass)                     # (R5)
+        drift, DX = drift_laplacian(L, self._potential(at, L, mass), self.peclet, at)  # (R4)
+        rhs = base + dt * self._normal_drift(at, DX, mass)                          # (R5)
         if self.assembly == "igl":
             return row_scaled_matrix(drift, mass, dt, self.fixed), rhs
         return self.assembler.row_scaled(drift.data, mass, dt, self.fixed), rhs
 
-    def _normal_drift(self, at, D, mass):
+    def _normal_drift(self, at, DX, mass):
         """``g* = N N . (D X*) / m`` (3, n) (R5): the normal part of the drift's
-        ``-(L_psi - L) X* / m`` at ``at``, to be added back; zero at fixed vertices."""
+        ``-(L_psi - L) X* / m`` at ``at``, to be added back, from ``DX = (L_psi - L) X*``
+        (3, n); zero at fixed vertices."""
         normals = np.empty((self.mesh.n_vertices, 3))
         vertex_normals(self.faces, self.geometry_at(at).area_vectors, self.mesh.n_vertices,
                        normals)
-        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
-        DX = np.asarray(D @ at.T) / np.where(mass > 0.0, mass, np.inf)[:, None]
-        g = (DX * normals).sum(axis=1)[:, None] * normals
-        g[self.fixed] = 0.0
-        return g.T
+        g = np.empty((3, self.mesh.n_vertices))
+        normal_parts(normals, np.ascontiguousarray(DX), mass, self.fixed, g)
+        return g

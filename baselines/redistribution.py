@@ -136,25 +136,8 @@ PECLET = 0.1
 """Default limit of the edge Peclet number ``|psi_j - psi_i|`` of (R6)."""
 OMEGA = 10.0
 """Default relaxation rate of (R1): area ratios relax like ``exp(-omega t)``."""
-
-
-def mean_curvature_vectors(L, mass, X):
-    """``h = -M^{-1} L X`` (the scheme's ``Delta_G X``), zero where ``m_i = 0``.
-
-    Parameters
-    ----------
-    L : (n, n) sparse matrix
-        Cotangent stiffness (positive semi-definite).
-    mass : (n,) float array
-    X : (3, n) float array
-
-    Returns
-    -------
-    (3, n) float array
-    """
-    LX = np.asarray(L @ np.asarray(X).T).T
-    safe = np.where(mass > 0.0, mass, 1.0)
-    return np.where(mass > 0.0, -LX / safe, 0.0)
+POTENTIAL_RTOL = 1e-4
+"""Relative residual of the potential's solve (:class:`PotentialSolver`)."""
 
 
 def target_shares(faces, n, target="vertex"):
@@ -204,8 +187,10 @@ def redistribution_source(L, mass, X, fixed, omega, shares=None):
     -------
     (n,) float array
     """
-    h = mean_curvature_vectors(L, mass, X)
-    hV = np.where(fixed, 0.0, (h * h).sum(axis=0))
+    LX = np.asarray(L @ np.asarray(X).T)                # h_i = -(L X)_i / m_i, zero where
+    safe = np.where(mass > 0.0, mass, np.inf)           # m_i = 0
+    hV = np.einsum("ij,ij->i", LX, LX) / (safe * safe)  # |h_i|^2
+    hV[fixed] = 0.0
     area = mass.sum()
     f = hV - (mass * hV).sum() / area
     if omega:
@@ -237,15 +222,25 @@ class PotentialSolver(KeptFactorSolver):
     aggregation, hierarchy kept) + CG 4.2 ms (3.4 V-cycles); Jacobi-CG 12 ms
     (120 iterations; ~1200 on sliver-rich meshes). Where ``A`` is not
     numerically positive definite the factorisation is a sparse LU (SuperLU)
-    and the iteration a refinement. ``psi`` only sets a tangential velocity:
-    ``rtol = 1e-7`` moves the points by ``1e-7`` of the redistribution's own
-    displacement.
+    and the iteration a refinement.
+
+    ``psi`` only sets a tangential velocity, so its tolerance is
+    :data:`POTENTIAL_RTOL` = 1e-4 (it was 1e-7): an error of that size moves
+    the points tangentially by ``1e-4`` of the redistribution's own
+    displacement, and the extrapolated start meets it in most steps with no
+    iteration (no factor solve): at level 5 of the sphere 0.43 CG iterations
+    per step against 1.75; the Table 3.1 setting's errors (levels 1-5) change by
+    at most 6e-7 of themselves, their orders and the smallest angle and largest
+    aspect ratio not in the 4th decimal (``baselines/README.md``).
 
     Parameters
     ----------
     rtol : float
     max_iterations : int
     """
+
+    def __init__(self, rtol=None, max_iterations=4):
+        super().__init__(POTENTIAL_RTOL if rtol is None else rtol, max_iterations)
 
     def __call__(self, L, mass, f):
         """``psi`` (n,) for the stiffness ``L`` (n, n, symmetric positive
@@ -303,7 +298,7 @@ def bernoulli(x):
     return np.where(x == 0.0, 1.0, b)
 
 
-def drift_laplacian(L, psi, peclet=np.inf):
+def drift_laplacian(L, psi, peclet=np.inf, X=None):
     """The stiffness of (R4): ``-e^{-psi} div(e^psi grad .)`` times the lumped mass.
 
     Parameters
@@ -316,22 +311,31 @@ def drift_laplacian(L, psi, peclet=np.inf):
     peclet : float
         Largest ``|psi_j - psi_i|`` an edge's weight sees (R6): the differences
         are clipped to ``[-peclet, peclet]``.
+    X : (3, n) float array, optional
+        Positions whose drift ``(L_psi - L) X`` (R5) is wanted too.
 
     Returns
     -------
-    (n, n) scipy.sparse.csr_matrix
+    L_psi : (n, n) scipy.sparse.csr_matrix
         Same pattern (its ``indices`` and ``indptr``, shared); off-diagonal
         ``-c_ij B(psi_i - psi_j)`` (:func:`bernoulli`), diagonal the negated sum
         of its row's off-diagonal entries (zero row sums): one compiled pass
         (:func:`baselines.kernels.drift_weights`). Not symmetric, but where no
         difference is clipped ``diag(e^psi) L_psi`` is (``psi`` constant: ``L``
         itself).
+    drift : (3, n) float array
+        ``(L_psi - L) X``, from the same pass; only when ``X`` is given.
     """
     L = sp.csr_matrix(L)
     data = np.empty(L.nnz)
+    n = L.shape[0]
+    DX = np.empty((3, n))
     drift_weights(L.indptr, L.indices, np.ascontiguousarray(L.data, dtype=np.float64),
-                  np.ascontiguousarray(psi, dtype=np.float64), float(peclet), data)
-    return sp.csr_matrix((data, L.indices, L.indptr), shape=L.shape)
+                  np.ascontiguousarray(psi, dtype=np.float64), float(peclet),
+                  np.zeros((3, n)) if X is None else np.ascontiguousarray(X, dtype=np.float64),
+                  data, DX)
+    L_psi = sp.csr_matrix((data, L.indices, L.indptr), shape=L.shape)
+    return L_psi if X is None else (L_psi, DX)
 
 
 def surface_components(faces, n_vertices):

@@ -1,23 +1,27 @@
-"""Cost of a redistributing step against the same scheme's plain step, before and after
-the potential's kept Cholesky factor and CG (issue #32), in one process.
+"""Cost of a redistributing step against the same scheme's plain step (issues #30 and
+#32: at most 2 x at level 5 of the sphere), before and after a change, in one process.
 
 The redistributing schemes solve, at every step, the potential's Laplacian
 (``baselines.redistribution.PotentialSolver``, ``ddfv.redistribution.TangentialPotential``)
 and then the positions' system with the drift (R4) / (R7). "before" is the
-packages ``ddfv`` and ``baselines`` of commit ``BEFORE`` (a kept sparse LU
-refined at every step, the drift built as a COO matrix), extracted by ``git
-archive`` into a temporary directory as ``ddfv_before`` and ``baselines_before``
-and driven by this harness; "after" is this tree. Each pair (plain scheme,
-redistributing scheme) is stepped on the shrinking sphere at ``--level``
-(Table 3.1's time step, every step of the run, or the first ``--steps``) by
+packages ``ddfv``, ``baselines`` and ``kept_factor`` of commit ``--before``
+(default :data:`BEFORE`: the potential solved to 1e-7, the drift's normal part by
+a second sparse product), extracted by ``git archive`` into a temporary
+directory as ``ddfv_before``, ``baselines_before`` and ``kept_factor_before``
+(their imports of ``kept_factor`` rewritten) and driven by this harness;
+"after" is this tree. Each pair (plain scheme, redistributing scheme) is
+stepped on the shrinking sphere at ``--level`` (Table 3.1's time step, every
+step of the run, or the first ``--steps``) by
 :func:`mcfbench.running.driver.simulate`, both versions interleaved (the
 order reversed on odd repeats), after a level-1 run of every variant (no
 compilation or first call timed). Printed: the median CPU milliseconds per
 step, the potential's share of the step (its source, stiffness and solve:
-``flow.timings["potential"]``, the before-DDFV's timed by wrapping its
-``_potential_of``), the ratio of each redistributing step to the plain step
-of the same version (target of issue #32: at most 2 at level 5), and after /
-before. ``--solvers``: instead, the choice of the potential's solver: the
+``flow.timings["potential"]``; 0 for flows that did not time it, e.g. the
+DDFV of ``acf8b58``), the positions' BiCGStab iterations per step
+(does the drift make them more?), the potential's CG iterations per step
+and its factorisations, the ratio of each redistributing step to the plain
+step of the same version (target: at most 2 at level 5), and after / before.
+``--solvers``: instead, the choice of the potential's solver: the
 systems (R2) of the first ``--steps`` (default 64) steps of ``cotan-redistribute``
 at ``--level`` are recorded, then solved in sequence by each candidate (a
 factorisation or preconditioner of the first system kept, each later system
@@ -26,11 +30,20 @@ relative residual 1e-7; factorised again when the iteration fails): CPU ms
 per solve (the first, the factorisation, apart), iterations per solve and
 the largest relative difference to a direct solve. Algebraic multigrid
 (``pyamg``, smoothed aggregation) is measured when ``pyamg`` is importable
-(it is not a dependency). Usage::
+(it is not a dependency). ``--profile``: instead, this tree's step taken apart:
+CPU ms per step of each part (:data:`PARTS`: the potential's source,
+stiffness and solve, the drift and its normal part, the system matrix, the
+positions' BiCGStab, the rest) and the iterations per step, plain against
+redistributing, over the first ``--steps`` steps. ``--tolerances``: the
+potential's tolerance against the sphere's errors, orders, mesh quality and
+CG iterations (levels 1 to ``--level``). Usage::
 
     python benchmarks/bench_potential.py [--level 5] [--repeats 3] [--steps N]
+        [--before COMMIT]
         [--pairs cotan:cotan-redistribute ddfv-chord-carried:ddfv-chord-redistribute-carried]
     python benchmarks/bench_potential.py --solvers [--level 5] [--steps 64]
+    python benchmarks/bench_potential.py --profile [--level 5] [--steps 64] [--repeats 3]
+    python benchmarks/bench_potential.py --tolerances 1e-7 1e-4 1e-3 [--level 5]
 """
 
 import os
@@ -59,34 +72,34 @@ from mcfbench.running.schemes import get_scheme  # noqa: E402
 from mcfbench.running.solver import Solver  # noqa: E402
 from mcfbench.storage.memory import tune_malloc  # noqa: E402
 
-BEFORE = "acf8b58"
+BEFORE = "660c097"
 TARGET = 2.0
 PAIRS = ["cotan:cotan-redistribute", "ddfv-chord-carried:ddfv-chord-redistribute-carried"]
+PACKAGES = ("ddfv", "baselines", "kept_factor")
 
 
-def before_packages(tree):
-    """``ddfv`` and ``baselines`` of :data:`BEFORE` as ``ddfv_before``, ``baselines_before``
-    (their imports are relative) under ``tree``, importable; the DDFV potential timed."""
-    archive = subprocess.run(["git", "archive", BEFORE, "ddfv", "baselines"], cwd=ROOT,
+def before_packages(tree, commit):
+    """:data:`PACKAGES` of ``commit`` (those it has) as ``ddfv_before``,
+    ``baselines_before``, ``kept_factor_before`` under ``tree``, importable (``ddfv``
+    and ``baselines`` import their own files relatively, ``kept_factor`` absolutely:
+    rewritten)."""
+    present = subprocess.run(["git", "ls-tree", "--name-only", commit], cwd=ROOT,
+                             capture_output=True, check=True, text=True).stdout.split()
+    packages = [p for p in PACKAGES if p in present]     # kept_factor: since 36cf514
+    archive = subprocess.run(["git", "archive", commit, *packages], cwd=ROOT,
                              capture_output=True, check=True).stdout
     subprocess.run(["tar", "-x", "-C", tree], input=archive, check=True)
-    for package in ("ddfv", "baselines"):
+    for package in packages:
         Path(tree, package).rename(Path(tree, f"{package}_before"))
+    for source in Path(tree).glob("*_before/*.py"):
+        text = source.read_text()
+        source.write_text(text.replace("from kept_factor import", "from kept_factor_before import"))
     sys.path.insert(0, tree)
-    flow = importlib.import_module("ddfv_before.flow").Flow
-    potential_of = flow._potential_of
-
-    def timed(self, *args):
-        clock = time.perf_counter()
-        psi = potential_of(self, *args)
-        self.timings["potential"] = (self.timings.get("potential", 0.0)
-                                     + time.perf_counter() - clock)
-        return psi
-    flow._potential_of = timed
 
 
 def variant(name, version):
-    """The registry scheme ``name``, its flow class from this tree or from :data:`BEFORE`."""
+    """The registry scheme ``name``, its flow class from this tree or from the packages
+    of the 'before' commit (:func:`before_packages`)."""
     scheme = get_scheme(name)
     if version == "after":
         return scheme
@@ -96,9 +109,10 @@ def variant(name, version):
 
 
 def step_cost(scheme, level, steps):
-    """``(CPU ms per step, the potential's share of the step)`` of one run of the sphere
-    at ``level`` (the share: the flow's wall-clock timing of the potential over the
-    run's wall-clock time, so that load on the machine cancels)."""
+    """``(CPU ms per step, the potential's share of the step, BiCGStab iterations per
+    step, the potential's CG iterations per step, its factorisations)`` of one run of
+    the sphere at ``level`` (the share: the flow's wall-clock timing of the potential
+    over the run's wall-clock time, so that load on the machine cancels)."""
     sphere = get_problem("sphere")
     V, F = icosphere(level)
     tau = sphere.tau(level)
@@ -109,9 +123,133 @@ def step_cost(scheme, level, steps):
     cpu, wall = time.process_time() - clock, time.perf_counter() - wall
     if not traj.ok:
         raise RuntimeError(f"{scheme.name} ({scheme.flow}): {traj.message}")
-    timings = flow.timings
-    potential = timings.get("potential", timings.get("redistribution", 0.0))
-    return 1e3 * cpu / steps, potential / wall
+    potential = getattr(flow, "_potential_solver", getattr(flow, "_potential", None))
+    cg = getattr(potential, "iterations", float("nan")) / steps   # not counted before 36cf514
+    factorisations = getattr(potential, "factorisations", float("nan"))
+    return (1e3 * cpu / steps, flow.timings.get("potential", 0.0) / wall,
+            float(traj.iterations.mean()), cg, factorisations)
+
+
+#: the parts of a step timed by ``--profile``: (module, owner or None, attribute, label);
+#: the potential's solve includes its stiffness's pinning, the rest of a step (geometry,
+#: checks, bookkeeping) is the run's CPU time minus these
+PARTS = {
+    "baselines": [
+        ("baselines.cotan", None, "redistribution_source", "potential: source (R2)"),
+        ("baselines.redistribution", "PotentialSolver", "__call__", "potential: solve (R2)"),
+        ("baselines.cotan", None, "drift_laplacian", "drift (R4) + its D X"),
+        ("baselines.cotan", "CotanFlow", "_normal_drift", "normal part (R5)"),
+        ("baselines.cotan", "CotanAssembler", "row_scaled", "system matrix (C3)"),
+    ],
+    "ddfv": [
+        ("ddfv.flow", "Flow", "_geometry_at", "geometry"),
+        ("ddfv.assembly", "Assembler", "system", "system matrix (2.10)"),
+        ("ddfv.flow", None, "vertex_normals", "vertex normals"),
+        ("ddfv.flow", None, "redistribution_source", "potential: source (R3)"),
+        ("ddfv.flow", None, "neumann_stiffness", "potential: stiffness K"),
+        ("ddfv.redistribution", "TangentialPotential", "__call__", "potential: solve (R3)"),
+        ("ddfv.flow", None, "drift_system", "drift (R7) + its D X"),
+        ("ddfv.flow", None, "carry_t_vertices", "T-vertices carried"),
+    ],
+}
+
+
+class _Timed:
+    """The registry's solver, its CPU time kept (the positions' solve)."""
+
+    can_overwrite_x0 = Solver.can_overwrite_x0
+
+    def __init__(self):
+        self.solver, self.seconds = Solver(), 0.0
+
+    def __call__(self, *args, **kwargs):
+        clock = time.process_time()
+        result = self.solver(*args, **kwargs)
+        self.seconds += time.process_time() - clock
+        return result
+
+
+def profile(pairs, level, steps, repeats):
+    """CPU ms per step of each part of a step (:data:`PARTS`), plain and redistributing,
+    over the first ``steps`` steps of the sphere at ``level`` (medians of ``repeats``
+    runs, interleaved): the parts' functions wrapped by a CPU clock."""
+    sphere = get_problem("sphere")
+    V, F = icosphere(level)
+    tau = sphere.tau(level)
+    names = [name for pair in pairs for name in pair]
+    spent = {}
+    for package in {get_scheme(n).flow.partition(".")[0] for n in names}:
+        for module, owner, attribute, label in PARTS[package]:
+            target = importlib.import_module(module)
+            target = getattr(target, owner) if owner else target
+            setattr(target, attribute, _clocked(getattr(target, attribute), label, spent))
+    rows = {name: [] for name in names}
+    for repeat in range(repeats + 1):                     # the first: warm-up
+        for name in (names if repeat % 2 == 0 else names[::-1]):
+            flow, solver = get_scheme(name).make(V, F, tau), _Timed()
+            spent.clear()
+            clock = time.process_time()
+            traj = simulate(flow, steps, solver=solver, save_every=0)
+            total = time.process_time() - clock
+            potential = getattr(flow, "_potential_solver", getattr(flow, "_potential", None))
+            row = {label: spent.get(label, 0.0) for *_, label in
+                   PARTS[get_scheme(name).flow.partition(".")[0]]}
+            row["positions: BiCGStab"] = solver.seconds
+            row["rest of the step"] = total - sum(row.values())
+            row["step"] = total
+            row["BiCGStab iterations"] = float(traj.iterations.sum())
+            row["potential: CG iterations"] = (potential.iterations if potential is not None
+                                               else 0.0)
+            if repeat:
+                rows[name].append(row)
+    print(f"sphere level {level}, first {steps} steps, CPU ms per step (iterations per step), "
+          f"median of {repeats}; the potential's solve includes its first factorisation; "
+          f"rest of the step: geometry (cotan), checks, bookkeeping")
+    for plain, redistributing in pairs:
+        print(f"{'part':40s} {plain:>20s} {redistributing:>32s}")
+        for label in rows[redistributing][0]:
+            values = [median([r.get(label, 0.0) for r in rows[n]]) / steps
+                      for n in (plain, redistributing)]
+            scale = 1.0 if "iterations" in label else 1e3
+            print(f"{label:40s} {scale * values[0]:20.3f} {scale * values[1]:32.3f}")
+        print()
+
+
+def _clocked(function, label, spent):
+    def clocked(*args, **kwargs):
+        clock = time.process_time()
+        result = function(*args, **kwargs)
+        spent[label] = spent.get(label, 0.0) + time.process_time() - clock
+        return result
+    return clocked
+
+
+def tolerances(names, levels, rtols):
+    """The potential's tolerance against the results: for each redistributing scheme and
+    ``rtol`` (``POTENTIAL_RTOL`` of both packages), the sphere's Table 3.1 runs at
+    ``levels`` (:func:`mcfbench.running.run.run`): L2 error, EOC, smallest angle, largest
+    aspect ratio and the potential's CG iterations per step."""
+    import baselines.redistribution
+    import ddfv.redistribution
+
+    from _harness import harness_run
+
+    print(f"sphere, Table 3.1 setting, levels {levels}: the potential's tolerance")
+    print(f"{'scheme':34s} {'rtol':>6s} {'level':>5s} {'L2 error':>13s} {'EOC':>6s} "
+          f"{'min angle':>10s} {'max aspect':>10s} {'CG/step':>8s}")
+    for name in names:
+        for rtol in rtols:
+            baselines.redistribution.POTENTIAL_RTOL = ddfv.redistribution.POTENTIAL_RTOL = rtol
+            last = None
+            for level in levels:
+                result, flow = harness_run(name, level)
+                error = result.metrics["l2_error"]
+                potential = getattr(flow, "_potential_solver", getattr(flow, "_potential", None))
+                eoc = np.log2(last / error) if last else float("nan")
+                print(f"{name:34s} {rtol:6.0e} {level:5d} {error:13.6e} {eoc:6.3f} "
+                      f"{result.min_angle:10.4f} {result.max_aspect:10.4f} "
+                      f"{potential.iterations / result.steps_done:8.2f}")
+                last = error
 
 
 def recorded_systems(level, steps):
@@ -215,6 +353,13 @@ def main(argv=None):
                         help="plain:redistributing registry names")
     parser.add_argument("--solvers", action="store_true",
                         help="compare the potential's solvers instead")
+    parser.add_argument("--tolerances", nargs="+", type=float, default=None,
+                        help="the potential's tolerances to compare on the sphere's levels "
+                             "1 to --level instead")
+    parser.add_argument("--profile", action="store_true",
+                        help="time the parts of a step instead (this tree, --steps, default 64)")
+    parser.add_argument("--before", default=BEFORE,
+                        help=f"the commit of the 'before' packages (default {BEFORE})")
     args = parser.parse_args(argv)
     tune_malloc()
     one_core()
@@ -223,10 +368,16 @@ def main(argv=None):
         choose_solver(args.level, 64 if args.steps is None else args.steps)
         return
     pairs = [tuple(p.split(":")) for p in args.pairs]
+    if args.tolerances:
+        tolerances([pair[1] for pair in pairs], list(range(1, args.level + 1)), args.tolerances)
+        return
+    if args.profile:
+        profile(pairs, args.level, 64 if args.steps is None else args.steps, args.repeats)
+        return
     names = [name for pair in pairs for name in pair]
     versions = ("before", "after")
-    with tempfile.TemporaryDirectory(prefix=f"potential-{BEFORE}-") as tree:
-        before_packages(tree)
+    with tempfile.TemporaryDirectory(prefix=f"potential-{args.before}-") as tree:
+        before_packages(tree, args.before)
         schemes = {(n, v): variant(n, v) for n in names for v in versions}
         for scheme in schemes.values():                   # warm-up: compilation, caches
             step_cost(scheme, 1, None)
@@ -235,13 +386,13 @@ def main(argv=None):
             keys = list(schemes) if repeat % 2 == 0 else list(schemes)[::-1]
             for key in keys:
                 cost[key].append(step_cost(schemes[key], args.level, args.steps))
-    ms = {k: median([c[0] for c in v]) for k, v in cost.items()}
-    pot = {k: median([c[1] for c in v]) for k, v in cost.items()}
+    ms, pot, its, cg, fac = ({k: median([c[i] for c in v]) for k, v in cost.items()}
+                             for i in range(5))
     print(f"sphere level {args.level}, CPU ms per step (median of {args.repeats}, "
           f"{'every step' if args.steps is None else f'{args.steps} steps'}), "
-          f"before = {BEFORE}")
+          f"before = {args.before}")
     print(f"{'scheme':34s} {'version':>7s} {'ms/step':>9s} {'potential %':>12s} "
-          f"{'x plain':>8s} {'after/before':>13s}  verdict")
+          f"{'BiCGStab':>9s} {'CG':>6s} {'LLT':>4s} {'x plain':>8s} {'after/before':>13s}  verdict")
     for plain, redistributing in pairs:
         for name in (plain, redistributing):
             for version in versions:
@@ -251,11 +402,12 @@ def main(argv=None):
                 verdict = ("" if name == plain else
                            "ok" if ratio <= TARGET else f"above {TARGET:g}")
                 print(f"{name:34s} {version:>7s} {ms[key]:9.2f} {100 * pot[key]:12.1f} "
-                      f"{ratio:8.2f} {change if version == 'after' else float('nan'):13.2f}"
-                      f"  {verdict}")
+                      f"{its[key]:9.2f} {cg[key]:6.2f} {fac[key]:4.0f} {ratio:8.2f} "
+                      f"{change if version == 'after' else float('nan'):13.2f}  {verdict}")
     print("potential %: the share of the step spent in the potential (R2)/(R3) (its "
-          "source, stiffness and solve); x plain: CPU time per step over the plain "
-          "scheme's of the same version.")
+          "source, stiffness and solve); BiCGStab: the positions' iterations per step; "
+          "CG: the potential's iterations per step; LLT: its factorisations in the run; x "
+          "plain: CPU time per step over the plain scheme's of the same version.")
     print(footing())
 
 

@@ -35,7 +35,6 @@ import time
 from functools import cached_property
 
 import numpy as np
-import scipy.sparse as sp
 
 from .assembly import Assembler
 from .geometry import diamond_geometry, t_barycentric, vertex_normals
@@ -339,13 +338,11 @@ class Flow:
             N = vertex_normals(self._mesh, geometry)                  # N*
             rhs = base - dt * (h - (h * N).sum(axis=0) * N)           # (3.6)
         elif self.tangential == "redistribute":                       # (R6)-(R7)
-            psi = self._potential_of(at, A, dt, geometry, covolumes)
-            drift = drift_system(self._assembler, A, geometry, covolumes, dt, psi, self.peclet)
             N = vertex_normals(self._mesh, geometry)
-            D = sp.csr_matrix((drift.data - A.data, A.indices, A.indptr), shape=A.shape)
-            drifted = (D @ at.T).T                                    # -dt x drift of X*
-            rhs = base + (drifted * N).sum(axis=0) * N                # + dt g*: normal part back
-            A = drift
+            psi = self._potential_of(at, A, dt, geometry, covolumes, N)
+            A, drifted = drift_system(self._assembler, A, geometry, covolumes, dt, psi,
+                                      self.peclet, at)                # drifted: -dt x drift of X*
+            rhs = base + np.einsum("ij,ij->j", drifted, N) * N        # + dt g*: normal part back
         self._tick("assembly", clock)
         return A, rhs
 
@@ -386,14 +383,15 @@ class Flow:
         self._tick("tangential", clock)
         return np.ascontiguousarray(np.concatenate([F, T]).T)
 
-    def _potential_of(self, at, A, dt, geometry, covolumes):
+    def _potential_of(self, at, A, dt, geometry, covolumes, N=None):
         """(n,) ``psi`` of (R3) at the state ``at``; ``A`` the scheme's step matrix at
-        ``at`` with step ``dt`` (its discrete Laplacian gives ``h``, as in (3.6))."""
+        ``at`` with step ``dt`` (its discrete Laplacian gives ``h``, as in (3.6)), ``N``
+        the vertex normals of ``geometry`` (3, n) when the caller has them."""
         clock = time.perf_counter()
         mesh = self._mesh
-        N = vertex_normals(mesh, geometry)
+        N = vertex_normals(mesh, geometry) if N is None else N
         h = (at - (A @ at.T).T) / dt                             # h*, zero at fixed F
-        hV = (h * N).sum(axis=0) ** 2                            # h.V = H^2 (V = H N)
+        hV = np.einsum("ij,ij->j", h, N) ** 2                    # h.V = H^2 (V = H N)
         if self._area_0 is None:                                 # the first step's state
             self._area_0 = float(covolumes[:mesh.n_f].sum())
         rate = self.omega * 4.0 * np.pi / self._area_0           # scale-covariant omega

@@ -6,10 +6,11 @@ the factorisation ``P`` of an earlier ``A`` is a preconditioner for which
 a few iterations reach the tolerance at the cost of a few triangular solves,
 against a new factorisation (tens of solves' worth). The factorisation is
 sparse Cholesky (CHOLMOD, through ``cholespy``) where ``A`` is symmetric
-positive definite, with conjugate gradients (``scipy.sparse.linalg.cg``,
-``M`` the kept factor's solve); else sparse LU (SuperLU, ordering of ``A +
-A^T``) with iterative refinement ``x <- x + P^{-1} (b - A x)``. The iteration
-stops at ``|b - A x| <= rtol |b|``; when it takes more than
+positive definite, with conjugate gradients preconditioned by the kept
+factor's solve (:func:`_preconditioned_cg`: scipy's loop without its set-up);
+else sparse LU (SuperLU, ordering of ``A + A^T``) with iterative refinement
+``x <- x + P^{-1} (b - A x)``. The iteration stops at ``|b - A x| <= rtol
+|b|`` (CG: its recurrence residual, as scipy's); when it takes more than
 ``max_iterations``, ``A`` is factorised anew.
 
 GMRES (``scipy.sparse.linalg.gmres``) instead of the refinement was not taken:
@@ -198,17 +199,9 @@ class KeptFactorSolver:
         x = solve(b) if start is None else np.array(start, dtype=float)
         tol = self.rtol * np.linalg.norm(b)
         if self.method == "cg":
-            count = [0]
-
-            def counted(_):
-                count[0] += 1
-            x, info = spla.cg(spla.LinearOperator((n, n), matvec=apply, dtype=float), b, x,
-                              rtol=0.0, atol=tol, maxiter=self.max_iterations,
-                              M=spla.LinearOperator((n, n), matvec=solve, dtype=float),
-                              callback=counted)
-            self.iterations += count[0]
-            # cg checks the residual before each iteration: after the last one, here
-            return x, info == 0 or np.linalg.norm(b - apply(x)) <= tol
+            x, k, converged = _preconditioned_cg(apply, solve, b, x, tol, self.max_iterations)
+            self.iterations += k
+            return x, converged
         for k in range(self.max_iterations + 1):         # refinement
             r = b - apply(x)
             if np.linalg.norm(r) <= tol:
@@ -218,3 +211,43 @@ class KeptFactorSolver:
                 x = x + solve(r)
         self.iterations += self.max_iterations
         return x, False
+
+
+def _preconditioned_cg(apply, precondition, b, x, tol, max_iterations):
+    """Conjugate gradients preconditioned by ``precondition`` (Hestenes-Stiefel), from
+    ``x`` until the recurrence residual ``|r| <= tol`` or ``max_iterations``.
+
+    The loop of ``scipy.sparse.linalg.cg`` without its set-up, which at one
+    iteration (the usual count with a kept factor) cost about a third of the
+    solve: here one product for the start's residual, then one product and one
+    preconditioner solve per iteration (scipy: 0.81 ms per solve of the cotangent
+    potential at level 5 of the sphere, this loop 0.64 ms, a factor solve 0.44 ms).
+    A start that meets the tolerance costs one product. Stops, not converged, where
+    ``p . A p <= 0`` (a matrix or preconditioner not positive definite).
+
+    Returns
+    -------
+    x : (n,) float array
+    iterations : int
+    converged : bool
+    """
+    r = b - apply(x)
+    if np.linalg.norm(r) <= tol:
+        return x, 0, True
+    z = precondition(r)
+    p, rz = z, np.dot(r, z)
+    for k in range(1, max_iterations + 1):
+        q = apply(p)
+        pq = np.dot(p, q)
+        if not pq > 0.0:
+            return x, k, False
+        alpha = rz / pq
+        x = x + alpha * p
+        r = r - alpha * q
+        if np.linalg.norm(r) <= tol:
+            return x, k, True
+        if k < max_iterations:
+            z = precondition(r)
+            rz, rz_old = np.dot(r, z), rz
+            p = z + (rz / rz_old) * p
+    return x, max_iterations, False

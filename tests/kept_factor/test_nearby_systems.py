@@ -12,6 +12,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from kept_factor import KeptFactorSolver, cholesky_solve, factorise, pinned
+from kept_factor.nearby_systems import _preconditioned_cg
 from mcfbench.geometry.spheres import icosphere
 
 V, F = icosphere(2)
@@ -116,3 +117,22 @@ def test_pinned_system():
     assert A[3, 3] == 1.0 and A[3].nnz == 1 and A[:, 3].nnz == 1
     assert factorise(A)[0] == "cg"
 
+
+def test_preconditioned_cg_exact_in_n_steps_and_stops_where_not_positive_definite():
+    """Unpreconditioned CG on a 3 x 3 SPD matrix with distinct eigenvalues: the
+    solution in exactly 3 iterations (not 2); a start that meets the tolerance: 0
+    iterations; an indefinite matrix (``p . A p < 0`` at the first direction):
+    stopped, not converged, ``x`` untouched."""
+    A = np.array([[4.0, 1.0, 0.0], [1.0, 3.0, 1.0], [0.0, 1.0, 2.0]])
+    b = np.array([1.0, 2.0, 3.0])
+    exact = np.linalg.solve(A, b)
+    x, k, ok = _preconditioned_cg(A.dot, lambda r: r, b, np.zeros(3), 1e-12, 2)
+    assert (k, ok) == (2, False) and np.linalg.norm(x - exact) > 1e-6
+    x, k, ok = _preconditioned_cg(A.dot, lambda r: r, b, np.zeros(3), 1e-12, 10)
+    assert (k, ok) == (3, True)
+    np.testing.assert_allclose(x, exact, rtol=1e-12)
+    assert _preconditioned_cg(A.dot, lambda r: r, b, exact, 1e-12, 10)[1:] == (0, True)
+    D = np.diag([1.0, -1.0])
+    x, k, ok = _preconditioned_cg(D.dot, lambda r: r, np.array([0.0, 1.0]), np.zeros(2),
+                                  1e-12, 10)
+    assert (k, ok) == (1, False) and not x.any()
