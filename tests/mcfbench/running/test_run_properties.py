@@ -8,7 +8,8 @@
 * The same run agrees with itself under a rigid motion (a rotation by up to about 160
   degrees about any axis and a shift of up to 10 diameters), a relabelling of the vertices, of the triangles and of the corners of
   each triangle, and a scaling: the same status at the same step, and final vertex
-  positions equal to :data:`RELATIVE` times the surface's diameter.
+  positions equal to :data:`RELATIVE` times the surface's diameter (the redistributing
+  schemes: plus :data:`POTENTIAL_RTOL` times the run's largest displacement).
 * Random invalid meshes (a valid one with a repeated vertex, a duplicate, a zero-area, a
   non-manifold or a flipped triangle, a vertex index out of range, a NaN coordinate) are
   refused by ``run`` with a :class:`mcfbench.geometry.mesh.MeshError` of the right kind.
@@ -19,6 +20,8 @@ on every run) with few examples per test, so this file runs in a few seconds;
 fresh examples, 25 times as many per test.
 """
 
+import baselines.redistribution
+import ddfv.redistribution
 import numpy as np
 import pytest
 from hypothesis import assume, given, note
@@ -37,6 +40,12 @@ STEPS = 3
 
 RELATIVE = 1e-8
 """Transformed runs agree to this times the surface's diameter (measured: below 1e-11)."""
+
+POTENTIAL_RTOL = max(baselines.redistribution.POTENTIAL_RTOL, ddfv.redistribution.POTENTIAL_RTOL)
+"""The redistribution's potential is solved to this relative residual: whether its CG
+iterates once or not at all can turn on round-off, so a redistributing run agrees with
+its transformed self only to this fraction of its displacement (measured: 1.9e-7 of the
+diameter on a hull of 8 points after 3 steps)."""
 
 
 def hull_mesh(seed, n, axes):
@@ -104,10 +113,10 @@ def named(result):
         assert result.message == "" and result.steps_done == STEPS
 
 
-def agree(result, X, ref, ref_X, diameter):
+def agree(result, X, ref, ref_X, atol):
     assert (result.status, result.steps_done) == (ref.status, ref.steps_done), \
         (result.message, ref.message)
-    np.testing.assert_allclose(X, ref_X, rtol=0, atol=RELATIVE * diameter)
+    np.testing.assert_allclose(X, ref_X, rtol=0, atol=atol)
 
 
 @pytest.mark.parametrize("scheme", list(SCHEMES))
@@ -120,11 +129,14 @@ def test_runs_end_named_and_agree_under_rigid_motion_relabelling_and_scale(
     diameter = np.linalg.norm(V.max(axis=0) - V.min(axis=0))
     ref, ref_X = run_mesh(scheme, V, F, tau_edge)
     named(ref)
+    atol = RELATIVE * diameter
+    if SCHEMES[scheme].tangential == "redistribute":
+        atol += POTENTIAL_RTOL * np.abs(ref_X - V).max()
     # a rigid motion: rotation and a shift of up to 10 diameters
     Q = rotation(q)
     moved, X = run_mesh(scheme, V @ Q.T + np.asarray(shift) * diameter, F, tau_edge)
     named(moved)
-    agree(moved, (X - np.asarray(shift) * diameter) @ Q, ref, ref_X, diameter)
+    agree(moved, (X - np.asarray(shift) * diameter) @ Q, ref, ref_X, atol)
     # relabelled: vertices, triangles and the corners of each triangle (orientation kept)
     rng = np.random.default_rng(seed)
     perm = rng.permutation(len(V))
@@ -135,11 +147,11 @@ def test_runs_end_named_and_agree_under_rigid_motion_relabelling_and_scale(
     F2 = np.take_along_axis(F2, (np.arange(3)[None, :] + roll[:, None]) % 3, axis=1)
     relabelled, X = run_mesh(scheme, V[perm], F2, tau_edge)
     named(relabelled)
-    agree(relabelled, X[new], ref, ref_X, diameter)
+    agree(relabelled, X[new], ref, ref_X, atol)
     # scaled by 1e-6 .. 1e6 (tau = c h^2 scales as the square)
     scaled, X = run_mesh(scheme, scale * V, F, tau_edge)
     named(scaled)
-    agree(scaled, X / scale, ref, ref_X, diameter)
+    agree(scaled, X / scale, ref, ref_X, atol)
 
 
 CORRUPTIONS = {
