@@ -35,6 +35,24 @@ def bumpy():
     return bumpy_sphere()
 
 
+@pytest.fixture
+def split_cube_file(tmp_path):
+    """A cube split twice (192 triangles) written to ``tmp_path / "cube.obj"``: the
+    paper's DDFV loses a T-vertex on it within 60 steps of tau = 0.01."""
+    import igl
+
+    from mcfbench.geometry.spheres import subdivide
+
+    V = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
+    F = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+    for _ in range(2):
+        V, F = subdivide(V, F)
+    mesh = tmp_path / "cube.obj"
+    igl.write_triangle_mesh(str(mesh), V, F)
+    return mesh
+
+
 @pytest.fixture(scope="module")
 def noisy_sphere():
     """A level-2 icosphere with radial noise: no symmetry hides index errors."""

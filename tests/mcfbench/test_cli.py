@@ -138,17 +138,9 @@ def test_run_reports_a_breakdown_and_keeps_frames(tmp_path, capsys):
     assert str(run["status"]) == "solver_failed" and run["steps"].tolist() == [0]
 
 
-def test_run_names_the_escape_of_a_t_vertex(tmp_path, capsys):
+def test_run_names_the_escape_of_a_t_vertex(tmp_path, capsys, split_cube_file):
     """A cube split twice (192 triangles): the T-vertices leave their triangles."""
-    from mcfbench.geometry.spheres import subdivide
-
-    V = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
-    F = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
-                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
-    for _ in range(2):
-        V, F = subdivide(V, F)
-    mesh = tmp_path / "cube.obj"
-    igl.write_triangle_mesh(str(mesh), V, F)
+    mesh = split_cube_file
     out = tmp_path / "run.npz"
     code = main(["run", str(mesh), "--tau", "0.01", "--steps", "60", "--save-every", "0",
                  "--out", str(out)])

@@ -56,20 +56,12 @@ def test_exported_run_reads_back_with_meshio(tmp_path, capsys):
     assert "meshio" in meta["export"]["packages"]
 
 
-def test_ddfv_run_writes_t_vertices_and_the_t_monitor(tmp_path, capsys):
+def test_ddfv_run_writes_t_vertices_and_the_t_monitor(tmp_path, capsys, split_cube_file):
     """The paper's DDFV on a cube split twice: a T-vertex leaves its triangle. The
     collection written by ``run`` holds the T-vertices as their own point set, the
     covolumes of both families (each tiles the surface once) and the T monitor, whose
     value in the last frame is the run's own (negative)."""
-    from mcfbench.geometry.spheres import subdivide
-
-    V = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
-    F = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
-                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
-    for _ in range(2):
-        V, F = subdivide(V, F)
-    mesh = tmp_path / "cube.obj"
-    igl.write_triangle_mesh(str(mesh), V, F)
+    mesh = split_cube_file
     npz, pvd = tmp_path / "run.npz", tmp_path / "run.pvd"
     common = [str(mesh), "--tau", "0.01", "--steps", "60", "--save-every", "0"]
     assert main(["run", *common, "--out", str(npz)]) == 1
@@ -83,7 +75,7 @@ def test_ddfv_run_writes_t_vertices_and_the_t_monitor(tmp_path, capsys):
     surface, points = collection.read("surface", last), collection.read("t_vertices", last)
     np.testing.assert_array_equal(surface.points, run["vertices"][last])
     np.testing.assert_array_equal(points.points, run["extra_points"][last])
-    np.testing.assert_array_equal(points.cells_dict["vertex"].ravel(), np.arange(len(F)))
+    np.testing.assert_array_equal(points.cells_dict["vertex"].ravel(), np.arange(len(run["faces"])))
     monitor = surface.cell_data["t_monitor"][0]
     np.testing.assert_array_equal(points.point_data["t_monitor"], monitor)
     assert monitor.min() < 0
