@@ -261,8 +261,9 @@ def scaling_figure(levels, scaling, fit_levels):
     Parameters
     ----------
     levels : pandas.DataFrame
-        The rows of the levels table to show (columns ``scheme``, ``level``,
-        ``nV``, ``step_seconds``, ``memory_mb``, ``status``).
+        One row per run (columns ``scheme``, ``level``, ``nV``, ``step_seconds``,
+        ``memory_mb``, ``status``: the points of
+        :func:`mcfbench.studies.beyond.tables.scaling_tables`).
     scaling : pandas.DataFrame
         The scaling table (one row per scheme: ``step_slope``, ``memory_slope``).
     fit_levels : sequence of int
@@ -290,12 +291,11 @@ def scaling_figure(levels, scaling, fit_levels):
     return fig
 
 
-def beyond_figures(levels, stability, series, time, space, scaling, beyond, t_final):
-    """``name -> figure`` of the beyond study from its tables (DataFrames)."""
+def beyond_figures(levels, stability, series, time, space, beyond, t_final):
+    """``name -> figure`` of the beyond study from its tables (DataFrames); the
+    scaling study's figure is :func:`scaling_figure` (rule ``beyond_scaling``)."""
     monitored = list(dict.fromkeys([*beyond["schemes"], *beyond["long_time"]["schemes"]]))
-    shown = levels[levels["level"].isin(beyond["scaling"]["levels"])]
     return {"levels": levels_figure(levels, t_final),
             "t_monitor": t_monitor_figure(series, stability, monitored),
             "time_convergence": time_figure(time),
-            "space_convergence": space_figure(space),
-            "scaling": scaling_figure(shown, scaling, beyond["scaling"]["fit_levels"])}
+            "space_convergence": space_figure(space)}
