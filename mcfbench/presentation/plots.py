@@ -267,16 +267,20 @@ def scaling_figure(levels, scaling, fit_levels):
     scaling : pandas.DataFrame
         The scaling table (one row per scheme: ``step_slope``, ``memory_slope``).
     fit_levels : sequence of int
-        The levels of the fits (named in the title).
+        The levels of the fits (named in the title; a scheme fitted on others,
+        ``beyond.scaling.up_to``, has its own in the legend).
     """
     fig, axes = plt.subplots(1, 2, figsize=(10.4, 4.2), layout="constrained")
     slopes = scaling.set_index("scheme")
+    default = " ".join(str(lv) for lv in fit_levels)
+    own = {s: f" (levels {fit})" for s, fit in slopes["fit_levels"].items()
+           if isinstance(fit, str) and fit != default}
     panels = (("step_seconds", "step_slope", "CPU seconds per time step"),
               ("memory_mb", "memory_slope", "peak memory above the coarsest run (MB)"))
     for ax, (y, slope, ylabel) in zip(axes, panels):
         shown = levels.assign(**{y: levels[y].where(levels[y] > 0)})
         scheme_lines(ax, shown, "nV", y)
-        ax.legend([f"{style(s)[0]}: {fix(slopes[slope].get(s), 2)}"
+        ax.legend([f"{style(s)[0]}: {fix(slopes[slope].get(s), 2)}" + own.get(s, "")
                    for s in shown["scheme"].unique()],
                   title="slope", fontsize=7, title_fontsize=8, loc="upper left",
                   frameon=False)

@@ -41,7 +41,8 @@ def plan(config, table):
         ``space_study`` (``levels``, ``tau``, ``t_final``, ``schemes``) and
         ``scaling`` (``schemes``: every Euler scheme of the registry unless
         ``beyond.scaling.schemes`` lists them, ``levels``, ``fit_levels``: sorted
-        ints); times as floats.
+        ints, ``up_to``: scheme -> its finest level where it stops below
+        ``levels``); times as floats.
 
     Raises
     ------
@@ -50,7 +51,9 @@ def plan(config, table):
         time step, a scheme of ``beyond.finest`` that is not one of
         ``beyond.schemes``, a finest level that is not above
         ``beyond.levels``, fit levels of ``beyond.scaling`` that are not among
-        its levels, or fewer than two of them; the message names the key.
+        its levels, or fewer than two of them, a scheme of ``beyond.scaling.up_to``
+        not in its schemes or with fewer levels than the fit takes; the message
+        names the key.
     """
     beyond = config["beyond"]
     problem = convergence.problem_of(table)
@@ -133,7 +136,33 @@ def _scaling(scaling, problem):
     if len(fit) < 2 or not set(fit) <= set(points):
         raise ConfigError(f"config key 'beyond.scaling.fit_levels': {fit} must be at least two "
                           f"of 'beyond.scaling.levels' {points} (a slope needs two points)")
-    return {"schemes": schemes, "levels": points, "fit_levels": fit}
+    up_to = {str(s): int(level) for s, level in scaling.get("up_to", {}).items()}
+    others = [s for s in up_to if s not in schemes]
+    if others:
+        raise ConfigError(f"config key 'beyond.scaling.up_to': {others} not in "
+                          f"'beyond.scaling.schemes'")
+    short = {s: level for s, level in up_to.items()
+             if len([lv for lv in points if lv <= level]) < len(fit)}
+    if short:
+        raise ConfigError(f"config key 'beyond.scaling.up_to': {short} leaves fewer than "
+                          f"{len(fit)} levels of 'beyond.scaling.levels' {points} (the fit "
+                          "takes as many as 'beyond.scaling.fit_levels')")
+    return {"schemes": schemes, "levels": points, "fit_levels": fit, "up_to": up_to}
+
+
+def scaling_levels(scaling, scheme):
+    """Levels of ``scheme`` in the scaling study (``plan["scaling"]``): its ``levels``,
+    up to the scheme's level of ``up_to`` (a scheme whose finest run costs too much)."""
+    top = scaling["up_to"].get(scheme, scaling["levels"][-1])
+    return [level for level in scaling["levels"] if level <= top]
+
+
+def scaling_fit_levels(scaling, scheme):
+    """Levels of the fits of ``scheme``: ``fit_levels``, or for a scheme of ``up_to``
+    as many of its own finest levels (``fit_levels`` 4, 5, 6, up to 5: 3, 4, 5)."""
+    if scheme not in scaling["up_to"]:
+        return scaling["fit_levels"]
+    return scaling_levels(scaling, scheme)[-len(scaling["fit_levels"]):]
 
 
 def is_finest_run(config, scheme, level):
@@ -221,7 +250,8 @@ def beyond_runs(plan, table, code):
         "time": {TIME_RUN.format(scheme=s): time_settings(plan, table, s, code)
                  for s in plan["time_study"]["schemes"]},
         "scaling": {convergence.run_record(s, lv): level_settings(plan, table, s, lv, code)
-                    for s in plan["scaling"]["schemes"] for lv in plan["scaling"]["levels"]},
+                    for s in plan["scaling"]["schemes"]
+                    for lv in scaling_levels(plan["scaling"], s)},
     }
 
 

@@ -7,6 +7,7 @@ from mcfbench.geometry.exact import eoc
 from mcfbench.presentation.formats import MISSING, fix, int_or, sci, sig, tex_inline
 from mcfbench.presentation.tables import Table, csv, latex, markdown
 from mcfbench.running.schemes import split_name
+from mcfbench.studies.beyond.plan import scaling_fit_levels, scaling_levels
 from mcfbench.studies.beyond.scaling import scaling_points, scaling_rows, scaling_table
 from mcfbench.studies.convergence.tables import (
     eoc_column,
@@ -527,10 +528,11 @@ def scaling_tables(records, beyond):
     """
     scaling = beyond["scaling"]
     by_level = {(r["scheme"], r["level"]): r for r in records.values()}
-    runs = {s: [lv for lv in scaling["levels"] if (s, lv) in by_level]
+    runs = {s: [lv for lv in scaling_levels(scaling, s) if (s, lv) in by_level]
             for s in scaling["schemes"]}
     points = beyond_level_table(by_level, runs, paper_schemes=())
-    return points, scaling_table(points, scaling["fit_levels"])
+    return points, scaling_table(points, {s: scaling_fit_levels(scaling, s)
+                                          for s in scaling["schemes"]})
 
 
 def scaling_documents(table, beyond, settings):
@@ -547,7 +549,12 @@ def scaling_documents(table, beyond, settings):
         "scheme's coarsest run (imports, compiled kernels, warm-up: what every job "
         "takes on). Slopes: p of c n^p, least squares in log-log over the finished "
         f"runs of levels {', '.join(str(lv) for lv in scaling['fit_levels'])} "
-        "(`beyond.scaling.fit_levels`); a slope of 1 is cost linear in the unknowns. "
+        "(`beyond.scaling.fit_levels`)"
+        + "".join(f"; {label(s)} up to level {lv}, fitted on its "
+                  f"{len(scaling['fit_levels'])} finest levels"
+                  for s, lv in scaling["up_to"].items())
+        + (" (`beyond.scaling.up_to`: a finer run costs too much)" if scaling["up_to"] else "")
+        + "; a slope of 1 is cost linear in the unknowns. "
         "The timings are on the same footing: same machine, one thread per job "
         f"(`threads`), same problem (the shrinking sphere, tau ~ h^2, t_f = "
         f"{settings['t_final']:g}), warm-up (compilation, cache loading, first calls) "

@@ -36,6 +36,8 @@ from mcfbench.studies.beyond.job import time_job
 from mcfbench.studies.beyond.plan import (
     levels_of,
     record_fields,
+    scaling_fit_levels,
+    scaling_levels,
     study_records,
     study_runs,
     used_schemes,
@@ -424,8 +426,8 @@ def test_default_config_passes_the_schema_and_the_checks():
     # the level-7 run is off by default
     assert settings["finest"] == {"level": 7, "rtol": 1e-11, "schemes": []}
     # the scaling study: every scheme of the registry with the Euler step
-    assert settings["scaling"] == {"schemes": list(SCHEMES), "levels": [2, 3, 4, 5, 6],
-                                   "fit_levels": [4, 5, 6]}
+    assert {k: v for k, v in settings["scaling"].items() if k != "up_to"} == {
+        "schemes": list(SCHEMES), "levels": [2, 3, 4, 5, 6], "fit_levels": [4, 5, 6]}
     assert not [p for p in study_runs(Plans(config, SCHEMAS))["levels"] if "level7" in p]
 
 
@@ -519,6 +521,10 @@ def test_main_schema_refuses_an_old_key():
     (("time_study", "rtol"), 1.0, "config key 'beyond.time_study.rtol': must lie in (0, 1)"),
     (("scaling", "schemes"), ["cotan", "fem"],
      "config key 'beyond.scaling.schemes': unknown scheme(s) ['fem']; known schemes"),
+    (("scaling", "up_to"), {"fem": 5},
+     "config key 'beyond.scaling.up_to': ['fem'] not in 'beyond.scaling.schemes'"),
+    (("scaling", "up_to"), {"cotan": 3},
+     "config key 'beyond.scaling.up_to': {'cotan': 3} leaves fewer than 3 levels"),
     (("scaling", "fit_levels"), [6],
      "config key 'beyond.scaling.fit_levels': [6] must be at least two"),
     (("scaling", "fit_levels"), [1, 2],
@@ -751,7 +757,7 @@ def test_scaling_study_runs_every_scheme_of_the_registry_unless_narrowed():
                                    "fit_levels": [2, 3]}
     narrowed = Plans(config, SCHEMAS)
     assert narrowed.plan("beyond")["scaling"] == {
-        "schemes": ["kll", "cotan@bdf2"], "levels": [2, 3], "fit_levels": [2, 3]}
+        "schemes": ["kll", "cotan@bdf2"], "levels": [2, 3], "fit_levels": [2, 3], "up_to": {}}
     assert sorted(study_runs(narrowed)["scaling"]) == [
         "results/runs/cotan@bdf2/level2.json", "results/runs/cotan@bdf2/level3.json",
         "results/runs/kll/level2.json", "results/runs/kll/level3.json"]
@@ -760,6 +766,17 @@ def test_scaling_study_runs_every_scheme_of_the_registry_unless_narrowed():
     assert "results/runs/kll/level6.json" not in study_records(default)
     del config["beyond"]["scaling"]["schemes"]                     # absent: "all"
     assert Plans(config, SCHEMAS).plan("beyond")["scaling"]["schemes"] == list(SCHEMES)
+    # beyond.scaling.up_to: a scheme stops below the finest level, fitted on as many
+    # of its own finest levels
+    config = json.loads(json.dumps(CONFIG))
+    config["beyond"]["scaling"]["up_to"] = {"cotan-intrinsic": 5}
+    capped = Plans(config, SCHEMAS)
+    scaling = capped.plan("beyond")["scaling"]
+    assert scaling_levels(scaling, "cotan-intrinsic") == [2, 3, 4, 5]
+    assert scaling_fit_levels(scaling, "cotan-intrinsic") == [3, 4, 5]
+    assert scaling_fit_levels(scaling, "cotan") == [4, 5, 6]
+    assert set(runs["scaling"]) - set(study_runs(capped)["scaling"]) == {
+        "results/runs/cotan-intrinsic/level6.json"}
 
 
 def test_scaling_table_and_figure_are_written(tmp_path):
@@ -776,7 +793,7 @@ def test_scaling_table_and_figure_are_written(tmp_path):
             records[f"runs/{scheme}/level{level}.json"] = r
     _, _, beyond = synthetic_inputs()
     beyond = {**beyond, "scaling": {"schemes": ["cotan", "bgn"], "levels": [2, 3, 4],
-                                    "fit_levels": [3, 4]}}
+                                    "fit_levels": [3, 4], "up_to": {}}}
     points, table = scaling_tables(records, beyond)
     assert points[["scheme", "level"]].values.tolist() == [
         [s, lv] for s in ("cotan", "bgn") for lv in (2, 3, 4)]
@@ -784,6 +801,17 @@ def test_scaling_table_and_figure_are_written(tmp_path):
     np.testing.assert_allclose(rows["step_slope"], 1.2, rtol=1e-10)
     np.testing.assert_allclose(rows["memory_slope"], 1.1, rtol=1e-10)
     np.testing.assert_allclose(rows["fixed_mb"], 100.0)
+    # up_to: bgn stops at level 3 (its level-4 record, were it there, is not read),
+    # fitted on levels 2-3 (its memory there: level 2 is the baseline, no slope)
+    capped = {**beyond, "scaling": {**beyond["scaling"], "up_to": {"bgn": 3}}}
+    capped_points, capped_table = scaling_tables(records, capped)
+    assert ["bgn", 4] not in capped_points[["scheme", "level"]].values.tolist()
+    bgn = capped_table.set_index("scheme").loc["bgn"]
+    assert bgn["fit_levels"] == "2 3" and bgn["step_slope"] == pytest.approx(1.2, rel=1e-10)
+    assert np.isnan(bgn["memory_slope"])
+    assert "BGN up to level 3, fitted on its 2 finest levels (`beyond.scaling.up_to`" in \
+        scaling_documents(capped_table, capped, SETTINGS)["md"].replace(SCHEMES["bgn"].label,
+                                                                        "BGN")
     doc = scaling_documents(table, beyond, SETTINGS)
     md = doc["md"]
     assert "| scheme | levels fitted | unknowns | CPU s/step (finest) | slope CPU/step |" in md
