@@ -1,7 +1,8 @@
 # Beyond Table 3.1: level 6, the scheme variants and the T-vertex stability
 # study (issue #5). Not part of `rule all`:
 #
-#   snakemake --cores 2 beyond      # about 8 minutes on 2 cores
+#   snakemake --cores 2 beyond      # about 8 minutes on 2 cores before the scaling
+#   # study ran every scheme; its runs alone 7.4 minutes (config/config.yaml)
 #   # and level 7 of the chord variant in the L2/EOC table (config key beyond.finest):
 #   snakemake --cores 2 beyond --config 'beyond={finest: {schemes: [ddfv-chord]}}'
 #

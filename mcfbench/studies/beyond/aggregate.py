@@ -1,7 +1,7 @@
 """The records of the beyond study into its tables and the T-monitor series
 (:mod:`mcfbench.studies.beyond.tables`), written together."""
 
-from mcfbench.studies.beyond.plan import record_fields
+from mcfbench.studies.beyond.plan import record_fields, scaling_fit_levels, scaling_levels
 
 
 def aggregate(expected, inputs, plan, settings, paper, outputs, log):
@@ -73,7 +73,10 @@ def aggregate_scaling(expected, plan, settings, outputs, log):
     from mcfbench.studies.beyond.tables import scaling_documents, scaling_tables
 
     records = read_records(expected, log, required=record_fields)
-    points, table = scaling_tables(records, plan)
+    scaling = plan["scaling"]
+    points, table = scaling_tables(records,
+                                   {s: scaling_levels(scaling, s) for s in scaling["schemes"]},
+                                   {s: scaling_fit_levels(scaling, s) for s in scaling["schemes"]})
     doc = scaling_documents(table, plan, settings)
     texts = {str(outputs[f"scaling_{ext}"]): text for ext, text in doc.items()}
     texts[str(outputs["points"])] = csv(points)

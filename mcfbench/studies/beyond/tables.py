@@ -7,7 +7,6 @@ from mcfbench.geometry.exact import eoc
 from mcfbench.presentation.formats import MISSING, fix, int_or, sci, sig, tex_inline
 from mcfbench.presentation.tables import Table, csv, latex, markdown
 from mcfbench.running.schemes import split_name
-from mcfbench.studies.beyond.plan import scaling_fit_levels, scaling_levels
 from mcfbench.studies.beyond.scaling import scaling_points, scaling_rows, scaling_table
 from mcfbench.studies.convergence.tables import (
     eoc_column,
@@ -507,16 +506,16 @@ def beyond_documents(tables, beyond, settings, paper_schemes):
             for name, table in tables.items()}
 
 
-def scaling_tables(records, beyond):
+def scaling_tables(records, levels, fit_levels):
     """The scaling study from its checked records (its own runs, rule ``run_scheme``).
 
     Parameters
     ----------
     records : dict
-        Path -> record of the runs of ``beyond["scaling"]`` (every scheme on
-        every level).
-    beyond : dict
-        The normalised config key ``beyond`` (:func:`mcfbench.studies.beyond.plan`).
+        Path -> record of the runs of the study.
+    levels, fit_levels : dict
+        Scheme -> its levels, its levels of the fits, in row order
+        (:func:`mcfbench.studies.beyond.plan.scaling_levels`, ``scaling_fit_levels``).
 
     Returns
     -------
@@ -526,13 +525,11 @@ def scaling_tables(records, beyond):
     table : pandas.DataFrame
         :func:`~mcfbench.studies.beyond.scaling.scaling_table` of ``points``.
     """
-    scaling = beyond["scaling"]
     by_level = {(r["scheme"], r["level"]): r for r in records.values()}
-    runs = {s: [lv for lv in scaling_levels(scaling, s) if (s, lv) in by_level]
-            for s in scaling["schemes"]}
+    runs = {s: [lv for lv in scheme_levels if (s, lv) in by_level]
+            for s, scheme_levels in levels.items()}
     points = beyond_level_table(by_level, runs, paper_schemes=())
-    return points, scaling_table(points, {s: scaling_fit_levels(scaling, s)
-                                          for s in scaling["schemes"]})
+    return points, scaling_table(points, fit_levels)
 
 
 def scaling_documents(table, beyond, settings):
