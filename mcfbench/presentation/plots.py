@@ -261,21 +261,26 @@ def scaling_figure(levels, scaling, fit_levels):
     Parameters
     ----------
     levels : pandas.DataFrame
-        The rows of the levels table to show (columns ``scheme``, ``level``,
-        ``nV``, ``step_seconds``, ``memory_mb``, ``status``).
+        One row per run (columns ``scheme``, ``level``, ``nV``, ``step_seconds``,
+        ``memory_mb``, ``status``: the points of
+        :func:`mcfbench.studies.beyond.tables.scaling_tables`).
     scaling : pandas.DataFrame
         The scaling table (one row per scheme: ``step_slope``, ``memory_slope``).
     fit_levels : sequence of int
-        The levels of the fits (named in the title).
+        The levels of the fits (named in the title; a scheme fitted on others,
+        ``beyond.scaling.up_to``, has its own in the legend).
     """
     fig, axes = plt.subplots(1, 2, figsize=(10.4, 4.2), layout="constrained")
     slopes = scaling.set_index("scheme")
+    default = " ".join(str(lv) for lv in fit_levels)
+    own = {s: f" (levels {fit})" for s, fit in slopes["fit_levels"].items()
+           if isinstance(fit, str) and fit != default}
     panels = (("step_seconds", "step_slope", "CPU seconds per time step"),
               ("memory_mb", "memory_slope", "peak memory above the coarsest run (MB)"))
     for ax, (y, slope, ylabel) in zip(axes, panels):
         shown = levels.assign(**{y: levels[y].where(levels[y] > 0)})
         scheme_lines(ax, shown, "nV", y)
-        ax.legend([f"{style(s)[0]}: {fix(slopes[slope].get(s), 2)}"
+        ax.legend([f"{style(s)[0]}: {fix(slopes[slope].get(s), 2)}" + own.get(s, "")
                    for s in shown["scheme"].unique()],
                   title="slope", fontsize=7, title_fontsize=8, loc="upper left",
                   frameon=False)
@@ -290,12 +295,11 @@ def scaling_figure(levels, scaling, fit_levels):
     return fig
 
 
-def beyond_figures(levels, stability, series, time, space, scaling, beyond, t_final):
-    """``name -> figure`` of the beyond study from its tables (DataFrames)."""
+def beyond_figures(levels, stability, series, time, space, beyond, t_final):
+    """``name -> figure`` of the beyond study from its tables (DataFrames); the
+    scaling study's figure is :func:`scaling_figure` (rule ``beyond_scaling``)."""
     monitored = list(dict.fromkeys([*beyond["schemes"], *beyond["long_time"]["schemes"]]))
-    shown = levels[levels["level"].isin(beyond["scaling"]["levels"])]
     return {"levels": levels_figure(levels, t_final),
             "t_monitor": t_monitor_figure(series, stability, monitored),
             "time_convergence": time_figure(time),
-            "space_convergence": space_figure(space),
-            "scaling": scaling_figure(shown, scaling, beyond["scaling"]["fit_levels"])}
+            "space_convergence": space_figure(space)}

@@ -407,7 +407,8 @@ def test_a_code_change_compiles_and_reruns_in_one_invocation(tmp_path, env):
 SCRIPTS = REPO / "workflow" / "scripts"
 OWN_SCRIPTS = ["compile_kernels", "run_scheme", "beyond_run", "figure", "convergence_table",
                "plot_convergence",
-               "beyond_tables", "beyond_plots", "beyond_findings", "report", "report_pdf",
+               "beyond_tables", "beyond_plots", "beyond_findings", "beyond_scaling", "report",
+               "report_pdf",
                "check_records"]
 
 

@@ -1,7 +1,8 @@
 # Beyond Table 3.1: level 6, the scheme variants and the T-vertex stability
 # study (issue #5). Not part of `rule all`:
 #
-#   snakemake --cores 2 beyond      # about 8 minutes on 2 cores
+#   snakemake --cores 2 beyond      # about 8 minutes on 2 cores before the scaling
+#   # study ran every scheme; its runs alone 7.4 minutes (config/config.yaml)
 #   # and level 7 of the chord variant in the L2/EOC table (config key beyond.finest):
 #   snakemake --cores 2 beyond --config 'beyond={finest: {schemes: [ddfv-chord]}}'
 #
@@ -18,8 +19,12 @@
 # - space: refined meshes with one tiny time step (order 2 in space);
 # - time: one mesh, tau halved repeatedly (order 1 in time;
 #   mcfbench.running.run.time_convergence);
-# - scaling: CPU seconds per step and peak memory of the levels' runs against
-#   their unknowns, slopes fitted on beyond.scaling.fit_levels (no runs of its own).
+# - scaling: CPU seconds per step and peak memory against the unknowns, slopes
+#   fitted on beyond.scaling.fit_levels, of every scheme of the registry (unless
+#   beyond.scaling.schemes narrows it) on beyond.scaling.levels: runs of rule
+#   run_scheme (one job for a run the levels study also makes); its own rule
+#   beyond_scaling, so that its table needs those runs only:
+#     snakemake --cores 2 results/beyond/tables/scaling.md
 #
 # Runs that break down are records like any other (status, t_failed, the T
 # monitor of every time level reached); the tables show them as such.
@@ -38,8 +43,21 @@ BEYOND_FIGURES = {
     for name in _beyond_paths.FIGURE_NAMES
     for ext in ("png", "pdf")
 }
+SCALING_OUTPUTS = {
+    **{
+        f"scaling_{ext}": f"{_beyond_paths.SCALING}.{ext}"
+        for ext in ("csv", "md", "tex")
+    },
+    "points": f"{_beyond_paths.SCALING}_points.csv",
+    "provenance": f"{_beyond_paths.SCALING}.json",
+    **{
+        f"figure_{ext}": f"{_beyond_paths.SCALING_FIGURE}.{ext}"
+        for ext in ("png", "pdf")
+    },
+}
 BEYOND_TARGETS = [
     *BEYOND_TABLES.values(),
+    *SCALING_OUTPUTS.values(),
     f"{_beyond_paths.TABLES}/t_monitor.csv",
     f"{_beyond_paths.TABLES}/beyond.json",
     *BEYOND_FIGURES.values(),
@@ -121,7 +139,7 @@ rule beyond_records:
 
 
 rule beyond_tables:
-    """The tables of the beyond study and the T monitor series."""
+    """The tables of the beyond study (but the scaling study's) and the T monitor series."""
     input:
         checked=f"{_beyond_paths.TABLES}/records.json",
         levels=lambda wildcards: list(_beyond.study_runs(PLANS)["levels"]),
@@ -165,13 +183,12 @@ rule beyond_tables:
 
 
 rule beyond_figures:
-    """L2 per level, the T monitor against time, time and space convergence, cost against size."""
+    """L2 per level, the T monitor against time, time and space convergence."""
     input:
         levels=BEYOND_TABLES["levels_csv"],
         stability=BEYOND_TABLES["stability_csv"],
         time=BEYOND_TABLES["time_convergence_csv"],
         space=BEYOND_TABLES["space_convergence_csv"],
-        scaling=BEYOND_TABLES["scaling_csv"],
         t_monitor=f"{_beyond_paths.TABLES}/t_monitor.csv",
     output:
         **{
@@ -238,3 +255,48 @@ rule beyond_findings:
         tau_level_1=config["tau_level_1"],
     script:
         "../scripts/beyond_findings.py"
+
+
+rule beyond_scaling:
+    """Cost against size: the scaling table, its points and figure from its own runs."""
+    input:
+        lambda wildcards: list(_beyond.study_runs(PLANS)["scaling"]),
+    output:
+        **{
+            key: (
+                report(
+                    path,
+                    caption=(
+                        "../report/beyond_scaling.rst"
+                        if key == "scaling_csv"
+                        else "../report/beyond_figure_scaling.rst"
+                    ),
+                    category="Beyond Table 3.1",
+                    labels=(
+                        {"table": "scaling"}
+                        if key == "scaling_csv"
+                        else {"figure": "scaling"}
+                    ),
+                )
+                if key in ("scaling_csv", "figure_png")
+                else path
+            )
+            for key, path in SCALING_OUTPUTS.items()
+        },
+    log:
+        "results/logs/beyond/scaling.log",
+    benchmark:
+        "results/benchmarks/beyond/scaling.tsv"
+    localrule: True
+    conda:
+        "../envs/ddfv.yaml"
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    params:
+        expected=lambda wildcards: _beyond.study_runs(PLANS)["scaling"],
+        beyond=lambda wildcards: PLANS.plan("beyond"),
+        settings={"t_final": config["t_final"]},
+    script:
+        "../scripts/beyond_scaling.py"

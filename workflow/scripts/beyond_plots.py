@@ -9,9 +9,9 @@ from mcfbench.storage.logs import setup_logging
 sm = snakemake  # noqa: F821
 log = setup_logging(sm.log[0])
 tables = {key: pd.read_csv(sm.input[key])
-          for key in ("levels", "stability", "t_monitor", "time", "space", "scaling")}
+          for key in ("levels", "stability", "t_monitor", "time", "space")}
 figures = beyond_figures(tables["levels"], tables["stability"], tables["t_monitor"],
-                         tables["time"], tables["space"], tables["scaling"],
+                         tables["time"], tables["space"],
                          dict(sm.params.beyond),
                          float(sm.params.t_final))
 write_files({str(sm.output[f"{name}_{ext}"]): fig

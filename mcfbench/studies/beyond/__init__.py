@@ -12,7 +12,8 @@ The study's modules:
 * :mod:`.aggregate`: the records into the tables and the T-monitor series
   (:mod:`.tables`);
 * :mod:`.scaling`: cost against size, the CPU seconds per step and the peak
-  memory of the levels' runs against their unknowns with fitted slopes;
+  memory of its runs (every scheme of the registry unless ``beyond.scaling.schemes``
+  narrows it) against their unknowns with fitted slopes;
 * :mod:`.findings`: the verdicts from the tables only (stable schemes, the
   finest common level, the ranking), worded in ``findings.md``
   (:func:`~.findings.write_findings`).
@@ -32,12 +33,19 @@ TABLES = f"{ROOT}/tables"
 """``{name}.csv/.md/.tex`` of :data:`TABLE_NAMES`, ``t_monitor.csv``, ``beyond.json``
 (provenance), ``records.json`` (the check of the records)."""
 
-TABLE_NAMES = ("levels", "stability", "time_convergence", "space_convergence", "integrators",
-               "scaling")
+TABLE_NAMES = ("levels", "stability", "time_convergence", "space_convergence", "integrators")
+
+SCALING = f"{TABLES}/scaling"
+"""The scaling study's own outputs (rule ``beyond_scaling``, its runs only):
+``scaling.csv/.md/.tex`` (one row per scheme), ``scaling_points.csv`` (one row
+per run), ``scaling.json`` (provenance); its figure :data:`SCALING_FIGURE`."""
+
+SCALING_FIGURE = f"{ROOT}/figures/scaling"
+"""``scaling.png/.pdf``: cost against size."""
 
 FIGURES = f"{ROOT}/figures"
 """``{name}.png/.pdf`` of :data:`FIGURE_NAMES`."""
 
-FIGURE_NAMES = ("levels", "t_monitor", "time_convergence", "space_convergence", "scaling")
+FIGURE_NAMES = ("levels", "t_monitor", "time_convergence", "space_convergence")
 
 FINDINGS = f"{ROOT}/findings.md"

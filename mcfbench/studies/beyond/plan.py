@@ -39,7 +39,10 @@ def plan(config, table):
         (descending), ``reference_factor``, ``t_final``, ``rtol`` of its runs
         (default the top-level one), ``schemes``),
         ``space_study`` (``levels``, ``tau``, ``t_final``, ``schemes``) and
-        ``scaling`` (``levels``, ``fit_levels``: sorted ints); times as floats.
+        ``scaling`` (``schemes``: every Euler scheme of the registry unless
+        ``beyond.scaling.schemes`` lists them, ``levels``, ``fit_levels``: sorted
+        ints, ``up_to``: scheme -> its finest level where it stops below
+        ``levels``); times as floats.
 
     Raises
     ------
@@ -47,8 +50,10 @@ def plan(config, table):
         An unknown scheme, a final time that is not a whole multiple of a
         time step, a scheme of ``beyond.finest`` that is not one of
         ``beyond.schemes``, a finest level that is not above
-        ``beyond.levels``, levels of ``beyond.scaling`` that are not levels of
-        the table, or fewer than two levels to fit; the message names the key.
+        ``beyond.levels``, fit levels of ``beyond.scaling`` that are not among
+        its levels, or fewer than two of them, a scheme of ``beyond.scaling.up_to``
+        not in its schemes or with fewer levels than the fit takes; the message
+        names the key.
     """
     beyond = config["beyond"]
     problem = convergence.problem_of(table)
@@ -80,7 +85,7 @@ def plan(config, table):
     return {
         "levels": levels,
         "schemes": schemes,
-        "scaling": _scaling(beyond["scaling"], levels),
+        "scaling": _scaling(beyond["scaling"], problem),
         "finest": finest,
         "long_time": {"level": long_level, "t_final": long_t, "tau": problem.tau(long_level),
                       "schemes": check_schemes("beyond.long_time.schemes", long["schemes"])},
@@ -113,18 +118,51 @@ def _check_finest(finest, levels, schemes, problem):
                   f"the level-{level}")
 
 
-def _scaling(scaling, levels):
-    """``beyond.scaling`` checked: its ``levels`` some of the table's ``levels`` (the
-    study runs nothing of its own), its ``fit_levels`` at least two of them."""
+def _scaling(scaling, problem):
+    """``beyond.scaling`` checked: its ``schemes`` (``"all"`` or absent: every scheme of
+    the registry with the paper's Euler step, :data:`mcfbench.running.schemes.SCHEMES`),
+    its ``levels`` (each a whole number of steps to t_final), its ``fit_levels`` at
+    least two of them."""
+    from mcfbench.running.schemes import SCHEMES
+
+    chosen = scaling.get("schemes", "all")
+    schemes = list(SCHEMES) if chosen == "all" else \
+        check_schemes("beyond.scaling.schemes", chosen)
     points = sorted({int(level) for level in scaling["levels"]})
+    for level in points:
+        checked_steps("'beyond.scaling.levels'", problem, problem.tau(level), problem.t_final,
+                      f"the level-{level}")
     fit = sorted({int(level) for level in scaling["fit_levels"]})
-    if not set(points) <= set(levels):
-        raise ConfigError(f"config key 'beyond.scaling.levels': {points} are not all levels "
-                          f"of 'beyond.levels' {levels} (the scaling study reads their runs)")
     if len(fit) < 2 or not set(fit) <= set(points):
         raise ConfigError(f"config key 'beyond.scaling.fit_levels': {fit} must be at least two "
                           f"of 'beyond.scaling.levels' {points} (a slope needs two points)")
-    return {"levels": points, "fit_levels": fit}
+    up_to = {str(s): int(level) for s, level in scaling.get("up_to", {}).items()}
+    others = [s for s in up_to if s not in schemes]
+    if others:
+        raise ConfigError(f"config key 'beyond.scaling.up_to': {others} not in "
+                          f"'beyond.scaling.schemes'")
+    short = {s: level for s, level in up_to.items()
+             if len([lv for lv in points if lv <= level]) < len(fit)}
+    if short:
+        raise ConfigError(f"config key 'beyond.scaling.up_to': {short} leaves fewer than "
+                          f"{len(fit)} levels of 'beyond.scaling.levels' {points} (the fit "
+                          "takes as many as 'beyond.scaling.fit_levels')")
+    return {"schemes": schemes, "levels": points, "fit_levels": fit, "up_to": up_to}
+
+
+def scaling_levels(scaling, scheme):
+    """Levels of ``scheme`` in the scaling study (``plan["scaling"]``): its ``levels``,
+    up to the scheme's level of ``up_to`` (a scheme whose finest run costs too much)."""
+    top = scaling["up_to"].get(scheme, scaling["levels"][-1])
+    return [level for level in scaling["levels"] if level <= top]
+
+
+def scaling_fit_levels(scaling, scheme):
+    """Levels of the fits of ``scheme``: ``fit_levels``, or for a scheme of ``up_to``
+    as many of its own finest levels (``fit_levels`` 4, 5, 6, up to 5: 3, 4, 5)."""
+    if scheme not in scaling["up_to"]:
+        return scaling["fit_levels"]
+    return scaling_levels(scaling, scheme)[-len(scaling["fit_levels"]):]
 
 
 def is_finest_run(config, scheme, level):
@@ -138,7 +176,7 @@ def is_finest_run(config, scheme, level):
 def used_schemes(plan):
     """Every scheme the beyond study runs, in order of first appearance."""
     names = list(plan["schemes"])
-    for key in ("long_time", "time_study", "space_study"):
+    for key in ("long_time", "time_study", "space_study", "scaling"):
         names += [s for s in plan[key]["schemes"] if s not in names]
     return names
 
@@ -196,7 +234,8 @@ def time_steps_total(plan):
 
 def beyond_runs(plan, table, code):
     """``{study: {record path: settings}}`` of the beyond study (``levels``,
-    ``long_time``, ``space``, ``time``)."""
+    ``long_time``, ``space``, ``time``, ``scaling``: a run of both ``levels`` and
+    ``scaling``, the same record, is one job)."""
     long_level = plan["long_time"]["level"]
     return {
         "levels": {convergence.run_record(s, lv): level_settings(plan, table, s, lv, code)
@@ -210,6 +249,9 @@ def beyond_runs(plan, table, code):
                   for lv in plan["space_study"]["levels"]},
         "time": {TIME_RUN.format(scheme=s): time_settings(plan, table, s, code)
                  for s in plan["time_study"]["schemes"]},
+        "scaling": {convergence.run_record(s, lv): level_settings(plan, table, s, lv, code)
+                    for s in plan["scaling"]["schemes"]
+                    for lv in scaling_levels(plan["scaling"], s)},
     }
 
 
@@ -230,9 +272,15 @@ def study_runs(plans):
     return beyond_runs(plans.plan("beyond"), plans.plan("convergence"), plans.code)
 
 
-def study_records(plans):
-    """``{record path: settings}`` of every run of the beyond study."""
-    return {path: s for runs in study_runs(plans).values() for path, s in runs.items()}
+TABLE_STUDIES = ("levels", "long_time", "space", "time")
+"""The studies of rule ``beyond_tables``; the scaling study has its own rule
+(``beyond_scaling``), so that its table needs its runs only."""
+
+
+def study_records(plans, studies=TABLE_STUDIES):
+    """``{record path: settings}`` of every run of ``studies`` of the beyond study."""
+    runs = study_runs(plans)
+    return {path: s for study in studies for path, s in runs[study].items()}
 
 
 def study_run_settings(plans, study, scheme, level):

@@ -74,20 +74,21 @@ def scaling_points(levels):
 
 def scaling_table(levels, fit_levels):
     """One row per scheme (:data:`SCALING_COLUMNS`): the power laws fitted on the
-    finished runs of ``fit_levels``.
+    finished runs of its ``fit_levels``.
 
     Parameters
     ----------
     levels : pandas.DataFrame
         :func:`scaling_points` of the levels table.
-    fit_levels : sequence of int
-        The levels of the fits (a scheme with fewer than two finished runs among
-        them has NaN fits).
+    fit_levels : sequence of int, or dict
+        The levels of the fits, or scheme -> its levels of the fits (a scheme
+        with fewer than two finished runs among them has NaN fits).
     """
     rows = []
     for scheme in dict.fromkeys(levels["scheme"]):
         runs = levels[levels["scheme"] == scheme].sort_values("level")
-        fitted = runs[runs["level"].isin(fit_levels) & np.isfinite(runs["step_seconds"])]
+        fit = fit_levels[scheme] if isinstance(fit_levels, dict) else fit_levels
+        fitted = runs[runs["level"].isin(fit) & np.isfinite(runs["step_seconds"])]
         step = power_fit(fitted["nV"], fitted["step_seconds"])
         memory = power_fit(fitted["nV"], fitted["memory_mb"])
         finest = fitted.iloc[-1] if len(fitted) else pd.Series(dtype=float)

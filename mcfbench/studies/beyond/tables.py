@@ -223,9 +223,7 @@ def beyond_tables(inputs, records, beyond, paper_schemes):
     -------
     tables : dict
         ``levels``, ``stability``, ``time_convergence``, ``space_convergence``,
-        ``integrators`` (:func:`integrator_table`), ``scaling``
-        (:func:`~mcfbench.studies.beyond.scaling.scaling_table` of the levels of
-        ``beyond["scaling"]``).
+        ``integrators`` (:func:`integrator_table`).
     series : pandas.DataFrame
         The T monitor of the levels and long runs (:func:`monitor_series`).
     """
@@ -244,10 +242,6 @@ def beyond_tables(inputs, records, beyond, paper_schemes):
                                          beyond["space_study"]["levels"]),
     }
     tables["integrators"] = integrator_table(tables["levels"])
-    scaling = beyond["scaling"]
-    tables["scaling"] = scaling_table(
-        tables["levels"][tables["levels"]["level"].isin(scaling["levels"])],
-        scaling["fit_levels"])
     series = pd.concat([monitor_series(levels, "levels"), monitor_series(long, "long_time")],
                        ignore_index=True)
     return tables, series
@@ -422,21 +416,6 @@ def _beyond_descriptions(beyond, settings):
             "the Euler error: what the integrator buys at equal cost. Both integrators on "
             "the same footing: same scheme, solver, rtol, machine and one core per job; "
             "CPU seconds of jobs that ran side by side on a shared machine."),
-        "scaling": (
-            f"Cost against size: the runs of the L2 table on levels "
-            f"{', '.join(str(lv) for lv in beyond['scaling']['levels'])}, one job each; "
-            "unknowns n: F- plus T-vertices for DDFV, the mesh vertices otherwise. CPU "
-            "s/step: the run's CPU seconds (flow construction, steps, error) over its steps; "
-            "peak MB: the job's peak resident memory (ru_maxrss), and above that of the "
-            "scheme's coarsest run (imports, compiled kernels, warm-up: what every job "
-            "takes on). Slopes: p of c n^p, least squares in log-log over the finished "
-            f"runs of levels {', '.join(str(lv) for lv in beyond['scaling']['fit_levels'])} "
-            "(`beyond.scaling.fit_levels`); a slope of 1 is cost linear in the unknowns. "
-            "The timings are on the same footing: same machine, one thread per job "
-            f"(`threads`), same problem (the shrinking sphere, tau ~ h^2, t_f = "
-            f"{settings['t_final']:g}), warm-up (compilation, cache loading, first calls) "
-            "done before the clock starts; CPU seconds of jobs that ran side by side on a "
-            "shared machine."),
         "space_convergence": (
             f"tau = {space['tau']:g} on every level, t_f = {space['t_final']:g}: the "
             "error (3.2) against the exact sphere with the time error made small; EOC "
@@ -501,9 +480,6 @@ def beyond_documents(tables, beyond, settings, paper_schemes):
         "integrators": _markdown("Second order in time: each integrator against Euler on "
                                  "the Table 3.1 setting", desc["integrators"],
                                  [("", integrator_rows(tables["integrators"]))]),
-        "scaling": _markdown("Cost against size: CPU time per step and peak memory against "
-                             "the unknowns, fitted slopes", desc["scaling"],
-                             [("", scaling_rows(tables["scaling"]))]),
     }
     tex = {
         "levels": _latex(desc["levels"], [
@@ -525,9 +501,65 @@ def beyond_documents(tables, beyond, settings, paper_schemes):
         "integrators": _latex(desc["integrators"], [
             ("Integrators against Euler on the Table 3.1 setting.", "tab:beyond-integrators",
              integrator_rows(tables["integrators"]))]),
-        "scaling": _latex(desc["scaling"], [
-            ("CPU time per step and peak memory against the unknowns.", "tab:beyond-scaling",
-             scaling_rows(tables["scaling"]))]),
     }
     return {name: {"csv": csv(table), "md": md[name], "tex": tex[name]}
             for name, table in tables.items()}
+
+
+def scaling_tables(records, levels, fit_levels):
+    """The scaling study from its checked records (its own runs, rule ``run_scheme``).
+
+    Parameters
+    ----------
+    records : dict
+        Path -> record of the runs of the study.
+    levels, fit_levels : dict
+        Scheme -> its levels, its levels of the fits, in row order
+        (:func:`mcfbench.studies.beyond.plan.scaling_levels`, ``scaling_fit_levels``).
+
+    Returns
+    -------
+    points : pandas.DataFrame
+        One row per run (:func:`beyond_level_table`: unknowns ``nV``,
+        ``step_seconds``, ``peak_rss_mb``, ``memory_mb``, ...).
+    table : pandas.DataFrame
+        :func:`~mcfbench.studies.beyond.scaling.scaling_table` of ``points``.
+    """
+    by_level = {(r["scheme"], r["level"]): r for r in records.values()}
+    runs = {s: [lv for lv in scheme_levels if (s, lv) in by_level]
+            for s, scheme_levels in levels.items()}
+    points = beyond_level_table(by_level, runs, paper_schemes=())
+    return points, scaling_table(points, fit_levels)
+
+
+def scaling_documents(table, beyond, settings):
+    """``{"csv": text, "md": text, "tex": text}`` of the scaling table
+    (:func:`scaling_tables`); ``settings`` holds ``t_final``."""
+    scaling = beyond["scaling"]
+    description = (
+        f"Cost against size: {len(scaling['schemes'])} schemes (`beyond.scaling.schemes`) "
+        f"on levels {', '.join(str(lv) for lv in scaling['levels'])}, one job (one fresh "
+        "process) each, shared with the L2 table where both run it; "
+        "unknowns n: F- plus T-vertices for DDFV, the mesh vertices otherwise. CPU "
+        "s/step: the run's CPU seconds (flow construction, steps, error) over its steps; "
+        "peak MB: the job's peak resident memory (ru_maxrss), and above that of the "
+        "scheme's coarsest run (imports, compiled kernels, warm-up: what every job "
+        "takes on). Slopes: p of c n^p, least squares in log-log over the finished "
+        f"runs of levels {', '.join(str(lv) for lv in scaling['fit_levels'])} "
+        "(`beyond.scaling.fit_levels`)"
+        + "".join(f"; {label(s)} up to level {lv}, fitted on its "
+                  f"{len(scaling['fit_levels'])} finest levels"
+                  for s, lv in scaling["up_to"].items())
+        + (" (`beyond.scaling.up_to`: a finer run costs too much)" if scaling["up_to"] else "")
+        + "; a slope of 1 is cost linear in the unknowns. "
+        "The timings are on the same footing: same machine, one thread per job "
+        f"(`threads`), same problem (the shrinking sphere, tau ~ h^2, t_f = "
+        f"{settings['t_final']:g}), warm-up (compilation, cache loading, first calls) "
+        "done before the clock starts; CPU seconds of jobs that ran side by side on a "
+        "shared machine.")
+    rows = scaling_rows(table)
+    return {"csv": csv(table),
+            "md": _markdown("Cost against size: CPU time per step and peak memory against "
+                            "the unknowns, fitted slopes", description, [("", rows)]),
+            "tex": _latex(description, [("CPU time per step and peak memory against the "
+                                         "unknowns.", "tab:beyond-scaling", rows)])}

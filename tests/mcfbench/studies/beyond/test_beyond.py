@@ -22,7 +22,7 @@ import pytest
 import yaml
 
 from mcfbench.pipeline import Plans, mem_mb, runtime_minutes
-from mcfbench.presentation.plots import beyond_figures
+from mcfbench.presentation.plots import beyond_figures, scaling_figure
 from mcfbench.running.integrators import INTEGRATORS
 from mcfbench.running.run import space_convergence
 from mcfbench.running.schemes import SCHEMES
@@ -33,11 +33,21 @@ from mcfbench.storage.records import RecordError, read_record, read_records
 from mcfbench.studies.beyond.findings import beyond_findings
 from mcfbench.studies.beyond.findings import findings as verdicts
 from mcfbench.studies.beyond.job import time_job
-from mcfbench.studies.beyond.plan import levels_of, record_fields, study_runs, used_schemes
+from mcfbench.studies.beyond.plan import (
+    levels_of,
+    record_fields,
+    scaling_fit_levels,
+    scaling_levels,
+    study_records,
+    study_runs,
+    used_schemes,
+)
 from mcfbench.studies.beyond.tables import (
     beyond_documents,
     beyond_tables,
     monitor_summary,
+    scaling_documents,
+    scaling_tables,
     space_table,
     time_order,
 )
@@ -203,7 +213,7 @@ def synthetic_inputs(finest=()):
                              "t_final": 0.08, "schemes": ["ddfv", "ddfv-chord", "cotan"]},
               "space_study": {"levels": [1, 2], "tau": 0.0025, "t_final": 0.08,
                               "schemes": SCHEMES_USED},
-              "scaling": {"levels": [2, 3], "fit_levels": [2, 3]}}
+              "scaling": {"schemes": SCHEMES_USED, "levels": [2, 3], "fit_levels": [2, 3]}}
     inputs = {"levels": [p for p in records if p.startswith("runs/")],
               "long_time": list(long), "space": list(space), "time": list(time)}
     return inputs, {**records, **long, **space, **time}, beyond
@@ -283,14 +293,14 @@ def test_finest_level_of_one_scheme_leaves_the_other_rows_alone(tables, tmp_path
     for name, doc in docs.items():
         (tmp_path / f"{name}.csv").write_text(doc["csv"])
     read = [pd.read_csv(tmp_path / f"{n}.csv") for n in (
-        "levels", "stability", "time_convergence", "space_convergence", "scaling")]
+        "levels", "stability", "time_convergence", "space_convergence")]
     text = findings(*read[:4], SCHEMES_USED, PAPER, 0.08, 0.04)
     chord = SCHEMES["ddfv-chord"].label
     assert f"## Level 3 (finest level run by every scheme; level 4 by {chord} only)" in text
     assert (f"- **{chord}** on level 4: L2 2.1328e-04, EOC 2.000 against level 3; 640 "
             "BiCGStab iterations, 0 s wall, 200 MB peak memory.") in text
     assert f"- level 3: {SCHEMES['ddfv'].label} 0 CPU s until it broke down" in text
-    figures = beyond_figures(read[0], read[1], series, read[2], read[3], read[4], beyond, 0.08)
+    figures = beyond_figures(read[0], read[1], series, read[2], read[3], beyond, 0.08)
     write_files({tmp_path / f"{name}.png": fig for name, fig in figures.items()})
     assert (tmp_path / "levels.png").stat().st_size > 1000
 
@@ -358,10 +368,9 @@ def test_documents_and_findings_follow_the_numbers(tables, tmp_path):
 def test_plots_from_the_tables(tables, tmp_path):
     tabs, series, beyond = tables
     figures = beyond_figures(tabs["levels"], tabs["stability"], series,
-                             tabs["time_convergence"], tabs["space_convergence"],
-                             tabs["scaling"], beyond, 0.08)
-    assert sorted(figures) == ["levels", "scaling", "space_convergence", "t_monitor",
-                               "time_convergence"]
+                             tabs["time_convergence"], tabs["space_convergence"], beyond,
+                             0.08)
+    assert sorted(figures) == ["levels", "space_convergence", "t_monitor", "time_convergence"]
     paths = {tmp_path / f"{name}.{ext}": fig for name, fig in figures.items()
              for ext in ("png", "pdf")}
     write_files(paths)
@@ -416,7 +425,9 @@ def test_default_config_passes_the_schema_and_the_checks():
     assert all(s.partition("@")[0] in SCHEMES for s in used_schemes(settings))
     # the level-7 run is off by default
     assert settings["finest"] == {"level": 7, "rtol": 1e-11, "schemes": []}
-    assert settings["scaling"] == {"levels": [2, 3, 4, 5, 6], "fit_levels": [4, 5, 6]}
+    # the scaling study: every scheme of the registry with the Euler step
+    assert {k: v for k, v in settings["scaling"].items() if k != "up_to"} == {
+        "schemes": list(SCHEMES), "levels": [2, 3, 4, 5, 6], "fit_levels": [4, 5, 6]}
     assert not [p for p in study_runs(Plans(config, SCHEMAS))["levels"] if "level7" in p]
 
 
@@ -455,6 +466,7 @@ def test_finest_level_adds_its_runs_only():
      "config key 'beyond.finest.schemes': 'ddfv-chord' is not of type 'array'"),
     (("finest", "extra"), 1, "config key 'beyond.finest': Additional properties"),
     (("schemes",), ["DDFV"], "config key 'beyond.schemes.0': 'DDFV' does not match"),
+    (("scaling", "schemes"), "every", "config key 'beyond.scaling.schemes': 'every' is not"),
     (("long_time", "t_final"), 0.3,
      "config key 'beyond.long_time.t_final': 0.3 is greater than or equal to"),
     (("time_study", "taus"), [0.3], "config key 'beyond.time_study.taus': [0.3] is too short"),
@@ -507,8 +519,12 @@ def test_main_schema_refuses_an_old_key():
      "config key 'beyond.finest.level': 6 is not above the levels of 'beyond.levels'"),
     (("finest", "rtol"), float("nan"), "config key 'beyond.finest.rtol': must lie in (0, 1)"),
     (("time_study", "rtol"), 1.0, "config key 'beyond.time_study.rtol': must lie in (0, 1)"),
-    (("scaling", "levels"), [2, 7],
-     "config key 'beyond.scaling.levels': [2, 7] are not all levels of 'beyond.levels'"),
+    (("scaling", "schemes"), ["cotan", "fem"],
+     "config key 'beyond.scaling.schemes': unknown scheme(s) ['fem']; known schemes"),
+    (("scaling", "up_to"), {"fem": 5},
+     "config key 'beyond.scaling.up_to': ['fem'] not in 'beyond.scaling.schemes'"),
+    (("scaling", "up_to"), {"cotan": 3},
+     "config key 'beyond.scaling.up_to': {'cotan': 3} leaves fewer than 3 levels"),
     (("scaling", "fit_levels"), [6],
      "config key 'beyond.scaling.fit_levels': [6] must be at least two"),
     (("scaling", "fit_levels"), [1, 2],
@@ -558,7 +574,7 @@ def test_dry_run_of_beyond_and_a_bad_value(tmp_path):
     env = {k: v for k, v in os.environ.items() if not k.startswith("SLURM_")}
     env["PATH"] = os.pathsep.join([str(stub), env.get("PATH", "")])
     # the study's own outputs (`beyond` also rebuilds the report)
-    targets = ["beyond_tables", "beyond_figures", "beyond_findings"]
+    targets = ["beyond_tables", "beyond_figures", "beyond_findings", "beyond_scaling"]
     runs = {"good": ["-n", *targets], "bad": ["-n", *targets, "--configfile", "bad.yaml"],
             # --config merges into the config file's `beyond`: the level stays 7
             "finest": ["-n", *targets, "--config", FINEST],
@@ -570,7 +586,8 @@ def test_dry_run_of_beyond_and_a_bad_value(tmp_path):
     out = {k: p.communicate(timeout=300)[0] for k, p in procs.items()}
     assert procs["good"].returncode == 0, out["good"][-3000:]
     for job in ("beyond_run", "beyond_time", "beyond_tables", "beyond_figures",
-                "beyond_findings", "results/runs/ddfv-chord/level6.json",
+                "beyond_findings", "beyond_scaling", "results/runs/ddfv-chord/level6.json",
+                "results/runs/kll/level6.json",             # the scaling study: every scheme
                 "results/beyond/runs/long_time/ddfv/level5.json",
                 "results/beyond/runs/time/cotan.json"):   # the time study: every scheme
         assert job in out["good"], job
@@ -586,6 +603,10 @@ def test_dry_run_of_beyond_and_a_bad_value(tmp_path):
     runtime = runtime_minutes(7, level_steps(pipeline.plan("convergence"), 7))
     assert f"runtime={runtime}, mem_mb={mem_mb(7)}," in job, job
     assert jobs(out["finest"], "run_scheme") == jobs(out["good"], "run_scheme") + 1
+    # a run of both the L2/EOC table and the scaling study is one job
+    runs = study_runs(pipeline)
+    assert jobs(out["good"], "run_scheme") == len(set(runs["levels"]) | set(runs["scaling"])) \
+        < len(runs["levels"]) + len(runs["scaling"])
     assert procs["bad_finest"].returncode != 0
     assert "config key 'beyond.finest.level': 6 is not above" in out["bad_finest"]
     assert not (work / "results").exists()
@@ -714,12 +735,99 @@ def test_scaling_fits_exact_power_laws_exactly():
     assert np.isnan(power_fit([10.0, 20.0], [1.0, -1.0])[1])
 
 
-def test_scaling_table_and_figure_are_written(tables, tmp_path):
-    tabs, _, beyond = tables
-    docs = beyond_documents(tabs, beyond, SETTINGS, PAPER)
-    md = docs["scaling"]["md"]
+def test_scaling_study_runs_every_scheme_of_the_registry_unless_narrowed():
+    """beyond.scaling.schemes: "all" (the default) is every Euler scheme of the registry
+    on every level of beyond.scaling.levels, as records of rule run_scheme whose
+    settings are those of the L2/EOC table where both run (one job); a list narrows
+    it (an integrator's rows only when listed). The records the other tables read
+    do not change."""
+    default = Plans(json.loads(json.dumps(CONFIG)), SCHEMAS)
+    runs = study_runs(default)
+    slow = {"cotan-intrinsic", "ddfv-chord-bgn-carried", "ddfv-chord-mdr-carried"}
+    assert default.plan("beyond")["scaling"]["up_to"] == {s: 5 for s in slow}
+    assert set(runs["scaling"]) == {f"results/runs/{s}/level{lv}.json" for s in SCHEMES
+                                    for lv in (2, 3, 4, 5, 6) if not (s in slow and lv == 6)}
+    shared = set(runs["scaling"]) & set(runs["levels"])
+    assert shared == {f"results/runs/{s}/level{lv}.json"
+                      for s in ("ddfv", "ddfv-chord", "ddfv-eliminate", "cotan")
+                      for lv in (2, 3, 4, 5, 6)}
+    assert all(runs["scaling"][p] == runs["levels"][p] for p in shared)
+    assert all(runs["scaling"][f"results/runs/{s}/level{lv}.json"] ==
+               sphere_run_settings(default, s, lv) for s in ("bgn", "kll") for lv in (2, 6))
+    config = json.loads(json.dumps(CONFIG))
+    config["beyond"]["scaling"] = {"schemes": ["kll", "cotan@bdf2"], "levels": [3, 2],
+                                   "fit_levels": [2, 3]}
+    narrowed = Plans(config, SCHEMAS)
+    assert narrowed.plan("beyond")["scaling"] == {
+        "schemes": ["kll", "cotan@bdf2"], "levels": [2, 3], "fit_levels": [2, 3], "up_to": {}}
+    assert sorted(study_runs(narrowed)["scaling"]) == [
+        "results/runs/cotan@bdf2/level2.json", "results/runs/cotan@bdf2/level3.json",
+        "results/runs/kll/level2.json", "results/runs/kll/level3.json"]
+    # the tables' records (rule beyond_tables) are those of the other studies only
+    assert study_records(narrowed) == study_records(default)
+    assert "results/runs/kll/level6.json" not in study_records(default)
+    del config["beyond"]["scaling"]["schemes"]                     # absent: "all"
+    assert Plans(config, SCHEMAS).plan("beyond")["scaling"]["schemes"] == list(SCHEMES)
+    # beyond.scaling.up_to: a scheme stops below the finest level, fitted on as many
+    # of its own finest levels
+    config = json.loads(json.dumps(CONFIG))
+    config["beyond"]["scaling"]["up_to"] = {"cotan-intrinsic": 5}
+    capped = Plans(config, SCHEMAS)
+    scaling = capped.plan("beyond")["scaling"]
+    assert scaling_levels(scaling, "cotan-intrinsic") == [2, 3, 4, 5]
+    assert scaling_fit_levels(scaling, "cotan-intrinsic") == [3, 4, 5]
+    assert scaling_fit_levels(scaling, "cotan") == [4, 5, 6]
+    assert set(study_runs(capped)["scaling"]) - set(runs["scaling"]) == {
+        f"results/runs/{s}/level6.json" for s in slow - {"cotan-intrinsic"}}
+
+
+def plan_levels(scaling):
+    """The levels and fit levels of each scheme of ``scaling`` (as aggregate_scaling)."""
+    return ({s: scaling_levels(scaling, s) for s in scaling["schemes"]},
+            {s: scaling_fit_levels(scaling, s) for s in scaling["schemes"]})
+
+
+def test_scaling_table_and_figure_are_written(tmp_path):
+    """Rule beyond_scaling from its own records: one row per scheme of
+    beyond.scaling.schemes (here one the levels study does not run) and one point
+    per run, the memory above the scheme's coarsest run (level 2: 100 MB), CPU
+    seconds per step 1e-6 n^1.2 and memory 1e-3 n^1.1 above it on levels 3-4."""
+    records = {}
+    for scheme in ("cotan", "bgn"):
+        for level in (2, 3, 4):
+            r = record(scheme, level)
+            r["cpu_seconds"] = r["N"] * 1e-6 * r["nV"] ** 1.2
+            r["peak_rss_mb"] = 100.0 + (1e-3 * r["nV"] ** 1.1 if level > 2 else 0.0)
+            records[f"runs/{scheme}/level{level}.json"] = r
+    _, _, beyond = synthetic_inputs()
+    beyond = {**beyond, "scaling": {"schemes": ["cotan", "bgn"], "levels": [2, 3, 4],
+                                    "fit_levels": [3, 4], "up_to": {}}}
+    points, table = scaling_tables(records, *plan_levels(beyond["scaling"]))
+    assert points[["scheme", "level"]].values.tolist() == [
+        [s, lv] for s in ("cotan", "bgn") for lv in (2, 3, 4)]
+    rows = table.set_index("scheme")
+    np.testing.assert_allclose(rows["step_slope"], 1.2, rtol=1e-10)
+    np.testing.assert_allclose(rows["memory_slope"], 1.1, rtol=1e-10)
+    np.testing.assert_allclose(rows["fixed_mb"], 100.0)
+    # up_to: bgn stops at level 3 (its level-4 record, were it there, is not read),
+    # fitted on levels 2-3 (its memory there: level 2 is the baseline, no slope)
+    capped = {**beyond, "scaling": {**beyond["scaling"], "up_to": {"bgn": 3}}}
+    capped_points, capped_table = scaling_tables(records, *plan_levels(capped["scaling"]))
+    assert ["bgn", 4] not in capped_points[["scheme", "level"]].values.tolist()
+    bgn = capped_table.set_index("scheme").loc["bgn"]
+    assert bgn["fit_levels"] == "2 3" and bgn["step_slope"] == pytest.approx(1.2, rel=1e-10)
+    assert np.isnan(bgn["memory_slope"])
+    assert "BGN up to level 3, fitted on its 2 finest levels (`beyond.scaling.up_to`" in \
+        scaling_documents(capped_table, capped, SETTINGS)["md"].replace(SCHEMES["bgn"].label,
+                                                                        "BGN")
+    doc = scaling_documents(table, beyond, SETTINGS)
+    md = doc["md"]
     assert "| scheme | levels fitted | unknowns | CPU s/step (finest) | slope CPU/step |" in md
+    assert "2 schemes (`beyond.scaling.schemes`) on levels 2, 3, 4" in md
     assert "same machine, one thread per job" in md and "warm-up" in md
-    assert "levels 2, 3 (`beyond.scaling.fit_levels`)" in md
-    assert "tab:beyond-scaling" in docs["scaling"]["tex"]
-    assert len(pd.read_csv(io.StringIO(docs["scaling"]["csv"]))) == len(SCHEMES_USED)
+    assert "levels 3, 4 (`beyond.scaling.fit_levels`)" in md
+    assert "tab:beyond-scaling" in doc["tex"]
+    assert len(pd.read_csv(io.StringIO(doc["csv"]))) == 2
+    figure = scaling_figure(points, table, [3, 4])
+    write_files({tmp_path / "scaling.png": figure})
+    assert (tmp_path / "scaling.png").stat().st_size > 1000
