@@ -29,7 +29,7 @@ import numpy as np  # noqa: E402
 
 from mcfbench.geometry import metrics  # noqa: E402
 from mcfbench.geometry.committed_meshes import read_committed_mesh  # noqa: E402
-from mcfbench.running.problems import PROBLEMS, Problem  # noqa: E402
+from mcfbench.running.problems import Problem  # noqa: E402
 from mcfbench.running.run import run  # noqa: E402
 from mcfbench.running.solver import Solver  # noqa: E402
 

@@ -195,7 +195,7 @@ class KeptFactorSolver:
         """``(x, converged)`` from ``start`` (None: ``P^{-1} b``) with the kept factor
         ``P``: CG preconditioned by ``P`` or iterative refinement, at most
         ``max_iterations``."""
-        solve, n = self._factor
+        solve, _ = self._factor
         x = solve(b) if start is None else np.array(start, dtype=float)
         tol = self.rtol * np.linalg.norm(b)
         if self.method == "cg":
