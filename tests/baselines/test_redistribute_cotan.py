@@ -4,10 +4,11 @@
 import numpy as np
 import pytest
 from conftest import twin_sphere
+from reference import bernoulli
 
 from baselines.cotan import CotanFlow
 from baselines.kernels import bernoulli_weight, normal_parts, vertex_gradients
-from baselines.redistribution import (POTENTIAL_RTOL, PotentialSolver, bernoulli,
+from baselines.redistribution import (POTENTIAL_RTOL, PotentialSolver,
                                       drift_laplacian, redistribution_source, solve_potential,
                                       target_shares)
 from mcfbench.running.driver import simulate
@@ -162,16 +163,19 @@ def test_step_moves_no_point_tangentially_where_symmetry_forbids_it(level):
 
 
 def test_bernoulli_weight():
+    def weight(x):
+        return np.array([bernoulli_weight(v) for v in x])
+
     x = np.array([-800.0, -30.0, -1e-9, 0.0, 1e-9, 2.0, 30.0, 800.0])
-    b = bernoulli(x)
+    b = weight(x)
     assert np.all(np.isfinite(b)) and np.all(b >= 0.0)
-    np.testing.assert_allclose(bernoulli(-x), b + x, rtol=1e-13, atol=1e-15)  # B(-x) = B(x) + x
+    np.testing.assert_allclose(weight(-x), b + x, rtol=1e-13, atol=1e-15)  # B(-x) = B(x) + x
     np.testing.assert_allclose(b[2:5], 1.0, rtol=0, atol=1e-9)
     assert b[5] == pytest.approx(2.0 / np.expm1(2.0), rel=1e-15)
     assert b[0] == pytest.approx(800.0) and b[-1] == 0.0            # upwind limits
+    np.testing.assert_array_equal(b[[0, 1, 6, 7]], bernoulli(x[[0, 1, 6, 7]]))   # expm1
     x = np.r_[np.linspace(-0.2, 0.2, 4001), 0.1 - 1e-17, -0.1 + 1e-17]   # the kernel's
-    series = np.array([bernoulli_weight(v) for v in x])                # series, |x| < 0.1
-    np.testing.assert_allclose(series, bernoulli(x), rtol=4e-16, atol=0)
+    np.testing.assert_allclose(weight(x), bernoulli(x), rtol=4e-16, atol=0)  # series, |x| < 0.1
 
 
 def test_drift_laplacian_is_a_symmetrisable_m_matrix():
