@@ -3,7 +3,7 @@
 
 import numpy as np
 import pytest
-from conftest import twin_sphere
+from conftest import table_3_1_error, twin_sphere
 from reference import bernoulli
 
 from baselines.cotan import CotanFlow
@@ -13,7 +13,7 @@ from baselines.redistribution import (POTENTIAL_RTOL, PotentialSolver,
                                       target_shares)
 from mcfbench.running.driver import simulate
 from mcfbench.running.integrators import Euler
-from mcfbench.geometry.exact import SphereL2Error, eoc
+from mcfbench.geometry.exact import eoc
 from mcfbench.running.solver import Solver
 from mcfbench.geometry.shapes import cylinder, flat_lattice
 from mcfbench.geometry.spheres import icosphere
@@ -264,15 +264,7 @@ def test_sphere_errors_close_to_cotan_and_order_two():
     # 8.28996e-4 (EOC 2.08, 2.05; the explicit one gave 1.4464e-2, 3.4256e-3, 8.2927e-4;
     # the Peclet limit 0.1 acts at level 1 only: without it 1.45646e-2)
     cotan = [1.4463591e-2, 3.3984786e-3, 8.2795681e-4]
-    errors = []
-    for level in (1, 2, 3):
-        V, F = icosphere(level)
-        tau = 0.04 / 4 ** (level - 1)
-        error = SphereL2Error(1.0)
-        traj = simulate(redistributing(V, F, tau), round(0.08 / tau), solver=Solver(),
-                        save_every=0, observers=[error])
-        assert traj.status == "ok", traj.message
-        errors.append(error.value)
+    errors = [table_3_1_error(redistributing, level)[0] for level in (1, 2, 3)]
     np.testing.assert_allclose(errors, [1.45164e-2, 3.43049e-3, 8.28996e-4], rtol=2e-4)
     assert np.all(np.abs(np.array(errors) / cotan - 1.0) < 0.01)
     orders = eoc(errors)[1:]
