@@ -288,16 +288,6 @@ def tangential_velocity(vertices, faces, psi):
     return alpha.T, degenerate
 
 
-def bernoulli(x):
-    """``B(x) = x / (e^x - 1)``, ``B(0) = 1``, elementwise (the Scharfetter-Gummel
-    weight of (R4)): positive, ``B(x) -> -x`` for ``x -> -inf`` and ``-> 0`` for
-    ``x -> +inf`` (no overflow), ``B(-x) = B(x) + x``."""
-    x = np.asarray(x, dtype=float)
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        b = x / np.expm1(x)
-    return np.where(x == 0.0, 1.0, b)
-
-
 def drift_laplacian(L, psi, peclet=np.inf, X=None):
     """The stiffness of (R4): ``-e^{-psi} div(e^psi grad .)`` times the lumped mass.
 
@@ -318,7 +308,8 @@ def drift_laplacian(L, psi, peclet=np.inf, X=None):
     -------
     L_psi : (n, n) scipy.sparse.csr_matrix
         Same pattern (its ``indices`` and ``indptr``, shared); off-diagonal
-        ``-c_ij B(psi_i - psi_j)`` (:func:`bernoulli`), diagonal the negated sum
+        ``-c_ij B(psi_i - psi_j)`` (``B`` the Bernoulli function
+        :func:`baselines.kernels.bernoulli_weight`), diagonal the negated sum
         of its row's off-diagonal entries (zero row sums): one compiled pass
         (:func:`baselines.kernels.drift_weights`). Not symmetric, but where no
         difference is clipped ``diag(e^psi) L_psi`` is (``psi`` constant: ``L``

@@ -370,17 +370,6 @@ def vertex_gradients(mesh, geom, psi, normals):
     return mean - (mean * normals).sum(axis=0) * normals
 
 
-def bernoulli(x):
-    """``B(x) = x / (e^x - 1)``, ``B(0) = 1``, elementwise: the Scharfetter-Gummel
-    weight of (R7), positive, ``-> -x`` for ``x -> -inf``, ``-> 0`` for ``x -> +inf``
-    (no overflow). (``baselines.redistribution.bernoulli`` is the same function; the
-    two packages do not import each other.)"""
-    x = np.asarray(x, dtype=float)
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        b = x / np.expm1(x)
-    return np.where(x == 0.0, 1.0, b)
-
-
 def drift_system(assembler, A, geom, chi, dt, psi, peclet=np.inf, X=None):
     """The matrix of (R7) in row-scaled form: ``A + dt diag(1/chi) D``.
 
@@ -409,9 +398,10 @@ def drift_system(assembler, A, geom, chi, dt, psi, peclet=np.inf, X=None):
         In the pattern of ``A`` (same ``indices`` and ``indptr``). ``D``
         multiplies the F-row part of each inner diamond's fluxes by ``w - 1``,
         ``w_a = B(psi_a - psi_b)`` in the row of ``a`` and ``w_b = B(psi_b -
-        psi_a)`` in the row of ``b`` (:func:`bernoulli`); T-rows, boundary
-        diamonds and Dirichlet rows are those of ``A``. With ``psi`` constant,
-        ``A`` itself.
+        psi_a)`` in the row of ``b``, ``B(x) = x / (e^x - 1)``, ``B(0) = 1``
+        (the compiled ``ddfv.kernels._bernoulli``); T-rows, boundary diamonds
+        and Dirichlet rows are those of ``A``. With ``psi`` constant, ``A``
+        itself.
     drift : (3, n) float array
         ``(A_psi - A) X``, from the same compiled pass; only when ``X`` is given.
     """

@@ -18,7 +18,8 @@ from mcfbench.geometry.spheres import random_bumpy_sphere as bumpy_sphere
 # half_height = 0.5) are those of mcfbench.geometry.shapes.cylinder.
 cylinder = functools.partial(surfaces.cylinder, diagonals="parallel")
 
-__all__ = ["approaches_the_catenoid", "bumpy_sphere", "cylinder", "flat_lattice", "twin_sphere"]
+__all__ = ["approaches_the_catenoid", "bumpy_sphere", "cylinder", "flat_lattice",
+           "table_3_1_error", "twin_sphere"]
 
 # hypothesis (tests/mcfbench/running/test_run_properties.py): "ci", the default, draws the same few
 # examples on every run (derandomized, no example database); HYPOTHESIS_PROFILE=nightly
@@ -73,6 +74,29 @@ def approaches_the_catenoid(X, tol=0.004):
     assert np.all(np.diff(neck) < 0), neck
     assert neck[-1] == pytest.approx(a, rel=0.01)
     np.testing.assert_allclose(r[-1], a * np.cosh(z[-1] / a), atol=tol)
+
+
+def table_3_1_error(flow, level, solver=None):
+    """The setting of the paper's Table 3.1: ``flow(V, F, tau)`` from the icosphere of
+    ``level``, ``tau = 0.04 / 4**(level - 1)``, to ``t = 0.08``; the run must finish.
+
+    Returns
+    -------
+    error : float
+        The L2 error (3.2) against the exact radius ``sqrt(1 - 4t)``.
+    trajectory : mcfbench.running.driver.Trajectory
+    """
+    from mcfbench.geometry.exact import SphereL2Error
+    from mcfbench.running.driver import simulate
+    from mcfbench.running.solver import Solver
+
+    V, F = icosphere(level)
+    tau = 0.04 / 4 ** (level - 1)
+    error = SphereL2Error(1.0)
+    traj = simulate(flow(V, F, tau), round(0.08 / tau), solver=solver or Solver(),
+                    save_every=0, observers=[error])
+    assert traj.status == "ok", traj.message
+    return error.value, traj
 
 
 def twin_sphere(n=162, eps=0.1, seed=0):

@@ -1,8 +1,13 @@
-"""Slow, literal transcription of the paper's equations (2.10)-(2.15).
+"""Slow, literal transcriptions for the tests to check the compiled and vectorized code against.
 
-Loops over vertices and their ordered one-rings, with the paper's own
-indexing, as an independent check of the vectorized assembly. Only the
-typo in (2.11) is corrected (chi(V_i^F) in b and c).
+:func:`literal_system`: the paper's equations (2.10)-(2.15), by loops over
+vertices and their ordered one-rings with the paper's own indexing, an
+independent check of the vectorized assembly. Only the typo in (2.11) is
+corrected (chi(V_i^F) in b and c).
+
+:func:`bernoulli`: the Bernoulli function of the drift weights, by ``expm1``,
+against which the compiled weights (``ddfv.kernels._bernoulli``,
+``baselines.kernels.bernoulli_weight``: a Taylor series near 0) are checked.
 """
 
 import numpy as np
@@ -79,3 +84,14 @@ def literal_system(F, T, faces, tau):
             A[nf + i, nf + Tn] += -tau / (2 * chi) * qT[p]
             A[nf + i, f[p]] += tau / chi * (qF[p] - qF[p - 1])
     return A
+
+
+def bernoulli(x):
+    """``B(x) = x / (e^x - 1)``, ``B(0) = 1``, elementwise: the Scharfetter-Gummel
+    weight of (R4) (``baselines.redistribution``) and (R7) (``ddfv.redistribution``),
+    positive, ``-> -x`` for ``x -> -inf``, ``-> 0`` for ``x -> +inf`` (no overflow),
+    ``B(-x) = B(x) + x``."""
+    x = np.asarray(x, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        b = x / np.expm1(x)
+    return np.where(x == 0.0, 1.0, b)

@@ -103,11 +103,13 @@ class CollapseCheck:
         """Area and bounding-box diagonal of every component, two ``(count,)`` arrays
         (one compiled pass: about 1.5 ms per 100 000 triangles, 4-5 ms a step at
         level 7 of the sphere, whose steps take about 85 ms each: 696 s / 8192)."""
+        from mcfbench.geometry.kernels import component_extents  # numba on first use
+
         V = np.asarray(vertices, dtype=np.float64)
         area = np.zeros(self.count)
         box = np.empty((2, self.count, 3))
         box[0], box[1] = np.inf, -np.inf
-        _kernel()(V, self.faces, self._face_label, self.labels, area, box)
+        component_extents(V, self.faces, self._face_label, self.labels, area, box)
         return area, np.sqrt(((box[1] - box[0]) ** 2).sum(axis=1))
 
     def __call__(self, vertices):
@@ -134,40 +136,3 @@ class CollapseCheck:
                 f"({a_ratio[c]:.3g} x its initial {self.area0[c]:.3g}), diameter "
                 f"{diameter[c]:.3g} ({d_ratio[c]:.3g} x its initial {self.diameter0[c]:.3g})"
                 + more)
-
-
-_KERNEL = None
-
-
-def _kernel():
-    """The compiled pass of :meth:`CollapseCheck.extents` (numba imported and the
-    kernel loaded from its cache on first use)."""
-    global _KERNEL
-    if _KERNEL is not None:
-        return _KERNEL
-    import numba
-
-    @numba.njit(cache=True, nogil=True, error_model="numpy")
-    def extents_kernel(V, F, face_label, labels, area, box):
-        """``area[c] +=`` the areas of the triangles of component ``c``; ``box[0, c]``,
-        ``box[1, c]``: the smallest and largest coordinates of its vertices (NaN
-        propagates to the area)."""
-        for t in range(F.shape[0]):
-            i0, i1, i2 = F[t, 0], F[t, 1], F[t, 2]
-            a0, a1, a2 = V[i1, 0] - V[i0, 0], V[i1, 1] - V[i0, 1], V[i1, 2] - V[i0, 2]
-            b0, b1, b2 = V[i2, 0] - V[i0, 0], V[i2, 1] - V[i0, 1], V[i2, 2] - V[i0, 2]
-            n0 = a1 * b2 - a2 * b1
-            n1 = a2 * b0 - a0 * b2
-            n2 = a0 * b1 - a1 * b0
-            area[face_label[t]] += 0.5 * np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
-        for i in range(V.shape[0]):
-            c = labels[i]
-            for k in range(3):
-                x = V[i, k]
-                if x < box[0, c, k]:
-                    box[0, c, k] = x
-                if x > box[1, c, k]:
-                    box[1, c, k] = x
-
-    _KERNEL = extents_kernel
-    return _KERNEL

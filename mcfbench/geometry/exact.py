@@ -6,30 +6,6 @@ import numpy as np
 
 from mcfbench.geometry.metrics import catenoid_parameter
 
-_KERNEL = None
-
-
-def _error_kernel():
-    """The compiled pass of :meth:`SphereL2Error.__call__` (numba imported on first use)."""
-    global _KERNEL
-    if _KERNEL is None:
-        import numba
-
-        @numba.njit(cache=True, nogil=True, error_model="numpy")
-        def sphere_error_sum(X, c0, c1, c2, r, w):
-            """``sum_i w_i (|X_i - c| - r)^2`` in one pass (no temporaries)."""
-            total = 0.0
-            for i in range(X.shape[1]):
-                x0 = X[0, i] - c0
-                x1 = X[1, i] - c1
-                x2 = X[2, i] - c2
-                dist = np.sqrt(x0 * x0 + x1 * x1 + x2 * x2) - r
-                total += dist * dist * w[i]
-            return total
-
-        _KERNEL = sphere_error_sum
-    return _KERNEL
-
 
 def sphere_radius(t, radius=1.0):
     """Exact radius ``r(t) = sqrt(R^2 - 4 t)`` of a sphere under MCF (Section 3.1)."""
@@ -113,7 +89,9 @@ class SphereL2Error:
                              f"{w.shape}")
         c0, c1, c2 = (float(c) for c in self.centre)
         # (3.2): one compiled pass over the points, no copy of flow.X
-        self.total += flow.tau * float(_error_kernel()(X, c0, c1, c2, r, w))
+        from mcfbench.geometry.kernels import sphere_error_sum  # numba on first use
+
+        self.total += flow.tau * float(sphere_error_sum(X, c0, c1, c2, r, w))
         self.levels += 1
 
     @property

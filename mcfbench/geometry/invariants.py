@@ -137,10 +137,12 @@ class FlowInvariants:
         """Area, smallest angle (degrees) and the number of triangles folded that
         were not at step 0, of the state ``vertices`` (n, 3): one compiled pass over
         the triangles and one over the pairs of edge-neighbours."""
+        from mcfbench.geometry.kernels import count_folds, invariants_pass  # numba on first use
+
         V = np.ascontiguousarray(vertices, dtype=np.float64)
         N, R, S = self._work
-        area, tangent = _kernel()(V, self.faces, N)
-        folded = folds_kernel()(N, *self.neighbours, self._skip, R, S)
+        area, tangent = invariants_pass(V, self.faces, N)
+        folded = count_folds(N, *self.neighbours, self._skip, R, S)
         return float(area), float(np.degrees(np.arctan(tangent))), int(folded)
 
     def _folded(self, V):
@@ -164,98 +166,3 @@ class FlowInvariants:
         return (f"the mesh degenerated: smallest angle {self.angle:.3g} degrees at step "
                 f"{self.angle_step} ({self.angle0:.3g} at step 0), below "
                 f"{self.angle_threshold:.3g} since step {self.collapsed_since}")
-
-
-_KERNEL = None
-
-
-def _kernel():
-    """The compiled pass of :meth:`FlowInvariants.measure` over the triangles (numba
-    imported and the kernel loaded from its cache on first use); the fold count is
-    :func:`folds_kernel`, shared with the quality monitor."""
-    global _KERNEL
-    if _KERNEL is not None:
-        return _KERNEL
-    import numba
-
-    @numba.njit(cache=True, nogil=True, error_model="numpy")
-    def invariants_kernel(V, F, N):
-        """Total area and the smallest tangent of the smallest angles of the
-        triangles (the smallest angle of a triangle, opposite its shortest side, is
-        at most 60 degrees, so its tangent ``|u x v| / (u . v)`` is increasing in
-        it); ``N[t]``: the normal ``(b - a) x (c - a)`` of triangle ``t``. NaN
-        propagates to the area and the tangent."""
-        m = F.shape[0]
-        area = 0.0
-        tangent = np.inf
-        for t in range(m):
-            i0, i1, i2 = F[t, 0], F[t, 1], F[t, 2]
-            a0, a1, a2 = V[i1, 0] - V[i0, 0], V[i1, 1] - V[i0, 1], V[i1, 2] - V[i0, 2]
-            b0, b1, b2 = V[i2, 0] - V[i1, 0], V[i2, 1] - V[i1, 1], V[i2, 2] - V[i1, 2]
-            c0, c1, c2 = V[i0, 0] - V[i2, 0], V[i0, 1] - V[i2, 1], V[i0, 2] - V[i2, 2]
-            # n = (x1 - x0) x (x2 - x0) = a x (-c)
-            n0 = c1 * a2 - c2 * a1
-            n1 = c2 * a0 - c0 * a2
-            n2 = c0 * a1 - c1 * a0
-            N[t, 0] = n0
-            N[t, 1] = n1
-            N[t, 2] = n2
-            twice = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
-            area += 0.5 * twice
-            la = a0 * a0 + a1 * a1 + a2 * a2
-            lb = b0 * b0 + b1 * b1 + b2 * b2
-            lc = c0 * c0 + c1 * c1 + c2 * c2
-            # the two sides at the smallest angle: the two longest
-            if lb <= la and lb <= lc:
-                dot = -(a0 * c0 + a1 * c1 + a2 * c2)     # corner 0: a and -c
-            elif lc <= la:
-                dot = -(a0 * b0 + a1 * b1 + a2 * b2)     # corner 1: -a and b
-            else:
-                dot = -(b0 * c0 + b1 * c1 + b2 * c2)     # corner 2: -b and c
-            tan = twice / dot if dot > 0 else (0.0 if twice == twice else twice)
-            if tangent == tangent and (tan < tangent or tan != tan):
-                tangent = tan
-        return area, tangent
-
-    _KERNEL = invariants_kernel
-    return _KERNEL
-
-
-_FOLDS = None
-
-
-def folds_kernel():
-    """The compiled fold count of :class:`FlowInvariants` and of the quality monitor
-    :func:`mcfbench.geometry.metrics.quality` (numba imported and the kernel loaded from
-    its cache on first use)."""
-    global _FOLDS
-    if _FOLDS is not None:
-        return _FOLDS
-    import numba
-
-    @numba.njit(cache=True, nogil=True, error_model="numpy")
-    def count_folds(N, t1, t2, skip, R, S):
-        """Number of triangles ``t`` with ``skip[t] == 0`` whose normal ``N[t]`` has
-        ``N_t . sum_s N_s < 0`` over its edge-neighbours ``s`` (the pairs ``t1, t2``);
-        the sums accumulated like ``np.bincount(t1, N[t2]) + np.bincount(t2, N[t1])``
-        into the scratch ``R``, ``S`` (m, 3)."""
-        R[:, :] = 0.0
-        S[:, :] = 0.0
-        for k in range(t1.shape[0]):
-            p, q = t1[k], t2[k]
-            R[p, 0] += N[q, 0]
-            R[p, 1] += N[q, 1]
-            R[p, 2] += N[q, 2]
-            S[q, 0] += N[p, 0]
-            S[q, 1] += N[p, 1]
-            S[q, 2] += N[p, 2]
-        folded = 0
-        for t in range(N.shape[0]):
-            d = (N[t, 0] * (R[t, 0] + S[t, 0]) + N[t, 2] * (R[t, 2] + S[t, 2])) \
-                + N[t, 1] * (R[t, 1] + S[t, 1])
-            if d < 0 and skip[t] == 0:
-                folded += 1
-        return folded
-
-    _FOLDS = count_folds
-    return _FOLDS

@@ -434,86 +434,15 @@ def quality(vertices, faces, neighbours=None):
     # against plain numpy evaluations of the same formulas in tests/mcfbench/geometry/test_metrics.py);
     # the arctan2 of the smallest angles is numpy's
     work = np.empty((4, len(F), 3))
-    aspect, a_min, a_max = _quality_kernel()(V, F.astype(np.int64, copy=False), work)
-    from mcfbench.geometry.invariants import folds_kernel   # (invariants imports metrics)
+    from mcfbench.geometry.kernels import count_folds, quality_pass  # numba on first use
 
-    flipped = folds_kernel()(work[1], t1, t2, np.zeros(len(F), np.uint8), work[2], work[3])
+    aspect, a_min, a_max = quality_pass(V, F.astype(np.int64, copy=False), work)
+    flipped = count_folds(work[1], t1, t2, np.zeros(len(F), np.uint8), work[2], work[3])
     angle = np.arctan2(work[0, :, 0], work[0, :, 1]).min()
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = float(np.float64(a_max) / np.float64(a_min))
     return {"min_angle": float(np.degrees(angle)), "max_aspect_ratio": float(aspect),
             "area_ratio": ratio, "flipped_triangles": int(flipped)}
-
-
-_QUALITY = None
-
-
-def _quality_kernel():
-    """The compiled kernel of :func:`quality` (numba imported and the kernel loaded
-    from its cache on first use)."""
-    global _QUALITY
-    if _QUALITY is not None:
-        return _QUALITY
-    import numba
-
-    @numba.njit(cache=True, nogil=True, error_model="numpy")
-    def quality_kernel(V, F, work):
-        """Largest aspect ratio, smallest and largest area;
-        ``work[0, t, :2]``: ``|u x v|`` and ``u . v`` of the smallest angle of
-        triangle ``t``, ``work[1, t]`` its normal ``(b - a) x (c - a)``. NaN
-        propagates as in numpy's min/max."""
-        m = F.shape[0]
-        out = work[0]
-        N = work[1]
-        asp = -np.inf
-        a_min = np.inf
-        a_max = -np.inf
-        for t in range(m):
-            i0, i1, i2 = F[t, 0], F[t, 1], F[t, 2]
-            # e_k: corner k -> corner k + 1
-            a0, a1, a2 = V[i1, 0] - V[i0, 0], V[i1, 1] - V[i0, 1], V[i1, 2] - V[i0, 2]
-            b0, b1, b2 = V[i2, 0] - V[i1, 0], V[i2, 1] - V[i1, 1], V[i2, 2] - V[i1, 2]
-            c0, c1, c2 = V[i0, 0] - V[i2, 0], V[i0, 1] - V[i2, 1], V[i0, 2] - V[i2, 2]
-            la = (a0 * a0 + a2 * a2) + a1 * a1
-            lb = (b0 * b0 + b2 * b2) + b1 * b1
-            lc = (c0 * c0 + c2 * c2) + c1 * c1
-            # the smallest angle is opposite the shortest side (the first one on ties):
-            # u = e_{s+2}, v = -e_{s+1}
-            if lb < la and lb <= lc:
-                u0, u1, u2, v0, v1, v2 = a0, a1, a2, -c0, -c1, -c2
-            elif lc < la and lc < lb:
-                u0, u1, u2, v0, v1, v2 = b0, b1, b2, -a0, -a1, -a2
-            else:
-                u0, u1, u2, v0, v1, v2 = c0, c1, c2, -b0, -b1, -b2
-            x0 = u1 * v2 - u2 * v1
-            x1 = u2 * v0 - u0 * v2
-            x2 = u0 * v1 - u1 * v0
-            out[t, 0] = np.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
-            out[t, 1] = (u0 * v0 + u2 * v2) + u1 * v1
-            # normal (b - a) x (c - a), area, aspect ratio
-            y0, y1, y2 = V[i2, 0] - V[i0, 0], V[i2, 1] - V[i0, 1], V[i2, 2] - V[i0, 2]
-            n0 = a1 * y2 - a2 * y1
-            n1 = a2 * y0 - a0 * y2
-            n2 = a0 * y1 - a1 * y0
-            N[t, 0] = n0
-            N[t, 1] = n1
-            N[t, 2] = n2
-            area = 0.5 * np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
-            sa = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
-            sb = np.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
-            sc = np.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
-            r = sa * sb * sc * (0.5 * (sa + sb + sc)) / (8.0 * (area * area))
-            if asp == asp and (r > asp or r != r):
-                asp = r
-            if a_min == a_min and (area < a_min or area != area):
-                a_min = area
-            if a_max == a_max and (area > a_max or area != area):
-                a_max = area
-        return asp, a_min, a_max
-
-    _QUALITY = quality_kernel
-    return _QUALITY
-
 
 
 # -------------------------------------------------------- steady state

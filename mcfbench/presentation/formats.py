@@ -18,37 +18,47 @@ def finite_value(x):
     return value if math.isfinite(value) else None
 
 
+def formatted(x, spec, scale=1, unit="", missing=MISSING):
+    """``scale * x`` formatted with ``spec``, then ``unit``; ``missing`` for None or a
+    value that is not a finite number (:func:`finite_value`).
+
+    Examples
+    --------
+    >>> formatted(0.5, ".2f", 100, " %"), formatted(float("nan"), ".3g")
+    ('50.00 %', '–')
+    """
+    v = finite_value(x)
+    return missing if v is None else f"{scale * v:{spec}}{unit}"
+
+
 def sci(x, digits=3):
     """``1.311e-02``; :data:`MISSING` for None or NaN."""
-    v = finite_value(x)
-    return MISSING if v is None else f"{v:.{digits}e}"
+    return formatted(x, f".{digits}e")
 
 
 def fix(x, digits=3):
-    v = finite_value(x)
-    return MISSING if v is None else f"{v:.{digits}f}"
+    """``0.013``: ``digits`` after the point."""
+    return formatted(x, f".{digits}f")
 
 
 def sig(x, digits=3):
-    v = finite_value(x)
-    return MISSING if v is None else f"{v:.{digits}g}"
+    """``0.0131``: ``digits`` significant digits (``%g``)."""
+    return formatted(x, f".{digits}g")
 
 
 def signed(x, digits=3):
-    v = finite_value(x)
-    return MISSING if v is None else f"{v:+.{digits}f}"
+    """``+0.013``: with its sign."""
+    return formatted(x, f"+.{digits}f")
 
 
 def pct(x, digits=2):
     """A relative deviation as a signed percentage: 0.0123 -> '+1.23 %'."""
-    v = finite_value(x)
-    return MISSING if v is None else f"{100 * v:+.{digits}f} %"
+    return formatted(x, f"+.{digits}f", 100, " %")
 
 
 def pct0(x):
     """A tolerance as a percentage: 0.01 -> '1 %'."""
-    v = finite_value(x)
-    return MISSING if v is None else f"{100 * v:g} %"
+    return formatted(x, "g", 100, " %")
 
 
 def num(x):

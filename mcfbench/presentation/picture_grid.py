@@ -30,6 +30,49 @@ def frame_surface(frames, which=-1):
             extra[which] if extra is not None and len(extra) else None, faces)
 
 
+def last_frames(entries, subjects, schemes, note, first_note):
+    """Per subject (a problem, a mesh) its initial surface and each scheme's last
+    frame, the cells of :func:`draw_grid`.
+
+    Parameters
+    ----------
+    entries : dict
+        ``(subject, scheme) -> (record, frames)``, ``frames`` a mapping of the
+        saved arrays (``np.load`` of the npz).
+    subjects, schemes : sequences of str
+    note : callable
+        ``note(record)``, the text under a scheme's last frame.
+    first_note : callable
+        ``note(record, faces)``, the text under the initial surface, taken from
+        the first scheme with frames.
+
+    Returns
+    -------
+    list of lists
+        ``cells[k]`` for ``subjects[k]``: the initial surface, then one cell
+        per scheme, ``(vertices, extra, faces, note)``, None without a run, or
+        ``(None, None, None, status)`` for a run without a mesh (refused).
+    """
+    cells = []
+    for subject in subjects:
+        row = [None] * (len(schemes) + 1)
+        for j, scheme in enumerate(schemes):
+            entry = entries.get((subject, scheme))
+            if entry is None:
+                continue
+            record, frames = entry
+            if "faces" not in frames or not len(frames["faces"]):
+                row[j + 1] = (None, None, None, record["status"])
+                continue
+            vertices, extra, faces = frame_surface(frames, -1)
+            row[j + 1] = (vertices, extra, faces, note(record))
+            if row[0] is None:
+                initial, _, _ = frame_surface(frames, 0)
+                row[0] = (initial, None, faces, first_note(record, faces))
+        cells.append(row)
+    return cells
+
+
 def draw_grid(cells, row_labels, col_labels, paths, title, views=None, share="column",
                size=1.9):
     """Draw ``cells[i][j] = (vertices, extra, faces, note)`` (:func:`frame_surface`)

@@ -84,22 +84,22 @@ def plot_levels(frames, title=""):
             ax.text(0 if np.isnan(v) else v, yi, " n/a" if np.isnan(v) else f" {v:{fmt}}",
                     va="center", ha="left", fontsize=8)
 
+    def diamond_and_primal(ax, diamond, primal, fmt, label):
+        """The diamond mesh's bars (column ``diamond``) above the primal triangles'."""
+        bars(ax, y + h / 2, [r[diamond] for r in rows], diamond_c, fmt, label)
+        bars(ax, y - h / 2, [r[primal] for r in rows], primal_c, fmt, "primal triangles")
+
     bars(ax_b, y, [r["t_bary_min"] for r in rows], diamond_c, ".4f", "smallest")
     ax_b.plot([r["t_bary_median"] for r in rows], y, "k|", ms=14, label="median")
     ax_b.axvline(1 / 3, color="0.5", lw=0.8, ls="--")
     known = [float(r["t_bary_min"]) for r in rows if not pd.isna(r["t_bary_min"])]
     ax_b.set_xlim(min([0.0, *known]), 0.5)
     ax_b.set_xlabel("T-vertex barycentric coordinate\n(1/3: barycentre, < 0: outside)")
-    bars(ax_g, y + h / 2, [r["angle_min_deg"] for r in rows], diamond_c, ".1f",
-         "diamond mesh (F, F, T)")
-    bars(ax_g, y - h / 2, [r["min_angle"] for r in rows], primal_c, ".1f",
-         "primal triangles")
+    diamond_and_primal(ax_g, "angle_min_deg", "min_angle", ".1f", "diamond mesh (F, F, T)")
     ax_g.set_xlim(0, 75)
     ax_g.set_xlabel("smallest angle [deg]")
-    bars(ax_a, y + h / 2, [r["diamond_area_min_rel"] for r in rows], diamond_c, ".3f",
-         "diamond cells")
-    bars(ax_a, y - h / 2, [r["primal_area_min_rel"] for r in rows], primal_c, ".3f",
-         "primal triangles")
+    diamond_and_primal(ax_a, "diamond_area_min_rel", "primal_area_min_rel", ".3f",
+                       "diamond cells")
     ax_a.set_xlim(0, 1.3)
     ax_a.set_xlabel("smallest area / mean area")
     ax_b.set_yticks(y, names)

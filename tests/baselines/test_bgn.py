@@ -1,15 +1,17 @@
 """The BGN scheme (baselines/bgn.py)."""
 
+from functools import partial
+
 import igl
 import numpy as np
 import pytest
 import scipy.sparse as sp
-from conftest import approaches_the_catenoid, cylinder
+from conftest import approaches_the_catenoid, cylinder, table_3_1_error
 from scipy.sparse.linalg import spsolve
 
 from baselines.bgn import BGNFlow
 from baselines.cotan import cotangent_laplacian
-from mcfbench.geometry.exact import SphereL2Error, eoc
+from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate
 from mcfbench.running.integrators import Euler
@@ -28,16 +30,6 @@ def lumped_normals(V, F):
         np.add.at(num, F[:, k], N)
         np.add.at(den, F[:, k], dbl)
     return num / den[:, None], den / 6.0
-
-
-def sphere_error(level, flow_class=BGNFlow, **options):
-    V, F = icosphere(level)
-    tau = 0.04 / 4 ** (level - 1)
-    error = SphereL2Error(1.0)
-    traj = simulate(flow_class(V, F, tau, **options), round(0.08 / tau), solver=Solver(),
-                    save_every=0, observers=[error])
-    assert traj.status == "ok", traj.message
-    return error.value
 
 
 def test_matrix_is_b4_and_symmetric(noisy_sphere):
@@ -103,12 +95,13 @@ def test_one_step_is_invariant_under_rigid_motions(noisy_sphere):
 def test_sphere_errors_reproduce_the_reference_values():
     # Table 3.1 setting; reference (CEO): 3.2624e-3, 8.4696e-4, 2.0236e-4.
     # Measured 3.26243e-3, 8.46964e-4, 2.02360e-4 (iterations 4, 48, 205)
-    errors = [sphere_error(level) for level in (1, 2, 3)]
+    errors = [table_3_1_error(BGNFlow, level)[0] for level in (1, 2, 3)]
     np.testing.assert_allclose(errors, [3.2624e-3, 8.4696e-4, 2.0236e-4], rtol=1e-4)
     orders = eoc(errors)[1:]
     assert np.all((orders > 1.9) & (orders < 2.1)), orders       # 1.95, 2.07
     # the unscaled symmetric system gives the same errors
-    assert sphere_error(2, scaling="none") == pytest.approx(errors[1], rel=1e-6)
+    unscaled, _ = table_3_1_error(partial(BGNFlow, scaling="none"), 2)
+    assert unscaled == pytest.approx(errors[1], rel=1e-6)
 
 
 def test_normalised_normals_are_another_scheme():
@@ -118,7 +111,7 @@ def test_normalised_normals_are_another_scheme():
             omega = super()._normals(geometry)
             return omega / np.linalg.norm(omega, axis=1)[:, None]
 
-    assert sphere_error(1, Normalised) == pytest.approx(1.4464e-2, rel=1e-4)
+    assert table_3_1_error(Normalised, 1)[0] == pytest.approx(1.4464e-2, rel=1e-4)
 
 
 def test_open_cylinder_keeps_its_boundary_and_approaches_the_catenoid():

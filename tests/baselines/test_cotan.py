@@ -1,31 +1,22 @@
 """The cotangent baseline (baselines/cotan.py) and its shared assembly."""
 
+from functools import partial
+
 import igl
 import numpy as np
 import pytest
-from conftest import approaches_the_catenoid, cylinder, flat_lattice
+from conftest import approaches_the_catenoid, cylinder, flat_lattice, table_3_1_error
 
 from baselines import cotan
 from baselines.cotan import CotanAssembler, CotanFlow, cotangent_laplacian, lumped_mass
 from baselines.mesh import edge_mesh
-from mcfbench.geometry.exact import SphereL2Error, eoc
+from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate
 from mcfbench.running.integrators import Euler
 from mcfbench.running.solver import Solver
 
 EXACT = Solver(method="direct", rtol=1e-12)
-
-
-def sphere_error(flow_class, level, **options):
-    """Table 3.1 setting: tau = 0.04 / 4**(level - 1), t_final = 0.08, error (3.2)."""
-    V, F = icosphere(level)
-    tau = 0.04 / 4 ** (level - 1)
-    error = SphereL2Error(1.0)
-    traj = simulate(flow_class(V, F, tau, **options), round(0.08 / tau), solver=Solver(),
-                    save_every=0, observers=[error])
-    assert traj.status == "ok", traj.message
-    return error.value, int(traj.iterations.sum())
 
 
 def rigid_motion():
@@ -167,9 +158,9 @@ def test_sphere_errors_and_eoc_levels_1_to_3():
     expected = {"barycentric": ([1.4463591e-2, 3.3984786e-3, 8.2795681e-4], [4, 26, 96]),
                 "voronoi": ([1.4196975e-2, 3.2972176e-3, 8.0382723e-4], [2, 23, 65])}
     for mass, (errors, iterations) in expected.items():
-        runs = [sphere_error(CotanFlow, level, mass=mass) for level in (1, 2, 3)]
+        runs = [table_3_1_error(partial(CotanFlow, mass=mass), level) for level in (1, 2, 3)]
         np.testing.assert_allclose([e for e, _ in runs], errors, rtol=1e-6)
-        assert [i for _, i in runs] == pytest.approx(iterations, abs=2)
+        assert [int(t.iterations.sum()) for _, t in runs] == pytest.approx(iterations, abs=2)
         orders = eoc([e for e, _ in runs])[1:]
         assert np.all((orders > 2.0) & (orders < 2.15)), orders   # 2.09, 2.04 / 2.11, 2.04
 

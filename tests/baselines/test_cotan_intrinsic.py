@@ -2,11 +2,11 @@
 
 import numpy as np
 import pytest
-from conftest import cylinder, twin_sphere
+from conftest import cylinder, table_3_1_error, twin_sphere
 
 from baselines.cotan import CotanFlow, cotangent_laplacian, lumped_mass
 from baselines.cotan_intrinsic import IntrinsicCotanFlow, intrinsic_operators
-from mcfbench.geometry.exact import SphereL2Error, eoc
+from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate
 from mcfbench.running.solver import Solver
@@ -67,15 +67,7 @@ def test_on_a_non_delaunay_mesh_every_edge_weight_is_nonnegative():
 def test_order_2_on_the_sphere():
     """Table 3.1 setting, levels 1-3: L2 1.4464e-2, 3.3985e-3, 8.2796e-4 (EOC 2.09,
     2.04), cotan's values."""
-    errors = []
-    for level in (1, 2, 3):
-        V, F = icosphere(level)
-        tau = 0.04 / 4 ** (level - 1)
-        error = SphereL2Error(1.0)
-        traj = simulate(IntrinsicCotanFlow(V, F, tau), round(0.08 / tau), solver=EXACT,
-                        save_every=0, observers=[error])
-        assert traj.status == "ok", traj.message
-        errors.append(error.value)
+    errors = [table_3_1_error(IntrinsicCotanFlow, level, EXACT)[0] for level in (1, 2, 3)]
     np.testing.assert_allclose(errors, [1.4464e-2, 3.3985e-3, 8.2796e-4], rtol=1e-4)
     orders = eoc(np.array(errors))[1:]
     assert np.all((orders > 2.0) & (orders < 2.15)), orders

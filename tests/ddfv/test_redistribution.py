@@ -5,13 +5,17 @@ the icosahedron, invariance of the flow, order 2 on the sphere, and a sliver
 mesh the paper's scheme cannot run.
 """
 
+from functools import partial
+
 import numpy as np
 import pytest
+from conftest import table_3_1_error
+from reference import bernoulli
 
 from ddfv import Flow, variant_options
 from ddfv.assembly import Assembler, flux_coefficients
 from ddfv.geometry import covolume_areas, diamond_geometry, vertex_normals
-from ddfv.redistribution import (TangentialPotential, bernoulli, carry_t_vertices,
+from ddfv.redistribution import (TangentialPotential, carry_t_vertices,
                                  diamond_gradients, drift_system, neumann_stiffness,
                                  redistribution_source, tangential_potential,
                                  vertex_gradients)
@@ -21,7 +25,6 @@ from mcfbench.geometry import surfaces
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate
 from mcfbench.running.integrators import Euler
-from mcfbench.geometry.exact import SphereL2Error
 from mcfbench.running.solver import Solver
 
 CARRIED = variant_options("chord-redistribute-carried")
@@ -390,22 +393,13 @@ def test_carried_t_vertices_keep_their_barycentric_coordinates_and_height():
     np.testing.assert_allclose(height(out), height(Tm), atol=1e-13)
 
 
-def _sphere_error(level, options):
-    V, F = icosphere(level)
-    tau = 0.04 / 4 ** (level - 1)
-    err = SphereL2Error(1.0)
-    traj = simulate(Flow(V, F, tau, **options), round(0.08 / tau), save_every=0,
-                    observers=[err], solver=Solver(rtol=1e-9))
-    assert traj.status == "ok"
-    return err.value
-
-
 @pytest.mark.parametrize("variant", ["chord-redistribute-carried", "redistribute"])
 def test_order_two_on_the_sphere(variant):
     """Table 3.1 setting, levels 1-3 (measured: chord-redistribute-carried
     1.3370e-2, 3.3508e-3, 8.3388e-4, EOC 1.996, 2.007; redistribute 1.3098e-2,
     3.2535e-3, 7.9997e-4, EOC 2.009, 2.024)."""
-    e = [_sphere_error(level, variant_options(variant)) for level in (1, 2, 3)]
+    e = [table_3_1_error(partial(Flow, **variant_options(variant)), level, Solver(rtol=1e-9))[0]
+         for level in (1, 2, 3)]
     eoc = np.log2(np.array(e[:-1]) / np.array(e[1:]))
     assert np.all((eoc > 1.9) & (eoc < 2.1)), (e, eoc)
 

@@ -113,29 +113,29 @@ def test_every_study_is_one_folder_of_role_modules():
                                                                           "config.py"]
 
 
+def _loaded(modules, matches):
+    """The modules, sorted and joined by commas, that a fresh interpreter holds after
+    importing ``modules`` and whose name ``m`` makes the expression ``matches`` true."""
+    code = (f"import sys\nfor m in {modules!r}: __import__(m)\n"
+            f"print(','.join(sorted(m for m in sys.modules if {matches})))")
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=ROOT, check=True).stdout.strip()
+
+
 def test_importing_presentation_loads_no_solver_driver_or_numba():
     modules = sorted(f"mcfbench.presentation.{p.stem}" for p in (HARNESS / "presentation").glob("*.py")
                      if p.stem != "__init__")
     modules += [name for _, name in _study_modules(("aggregate",)) + _study_modules("presentation")]
-    code = (f"import sys\nfor m in {modules!r}: __import__(m)\n"
-            "bad = sorted(m for m in sys.modules if m == 'numba' or m.startswith(("
-            "'mcfbench.running.solver', 'mcfbench.running.driver', 'mcfbench.running.run', "
-            "'ddfv.kernels', 'ddfv.flow', 'baselines')) or m.endswith('.job'))\n"
-            "print(','.join(bad))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
-                         check=True).stdout.strip()
-    assert out == ""
+    assert _loaded(modules, "m == 'numba' or m.startswith(('mcfbench.running.solver', "
+                            "'mcfbench.running.driver', 'mcfbench.running.run', 'ddfv.kernels', "
+                            "'ddfv.flow', 'baselines')) or m.endswith('.job')") == ""
 
 
 def test_storage_loads_nothing_of_the_other_layers():
-    code = ("import sys, mcfbench.storage.records, mcfbench.storage.atomic, "
-            "mcfbench.storage.provenance\n"
-            "print(','.join(sorted(m for m in sys.modules if m.startswith(('mcfbench.running', "
-            "'mcfbench.geometry', 'mcfbench.presentation', 'mcfbench.studies', 'numba', 'ddfv', "
-            "'baselines')))))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
-                         check=True).stdout.strip()
-    assert out == ""
+    modules = ["mcfbench.storage.records", "mcfbench.storage.atomic", "mcfbench.storage.provenance"]
+    assert _loaded(modules, "m.startswith(('mcfbench.running', 'mcfbench.geometry', "
+                            "'mcfbench.presentation', 'mcfbench.studies', 'numba', 'ddfv', "
+                            "'baselines'))") == ""
 
 
 def test_no_harness_module_is_over_600_lines():

@@ -3,7 +3,7 @@
 
 from pathlib import Path
 
-from mcfbench.presentation.picture_grid import draw_grid, frame_surface, run_note
+from mcfbench.presentation.picture_grid import draw_grid, last_frames, run_note
 from mcfbench.presentation.plots import style as scheme_style
 from mcfbench.storage.logs import setup_logging
 
@@ -40,21 +40,8 @@ def gallery_grid(entries, paths, meshes, schemes):
 
     ``entries``: ``(mesh, scheme) -> (record, frames)``.
     """
-    cells = [[None] * (len(schemes) + 1) for _ in meshes]
-    for i, mesh in enumerate(meshes):
-        for j, scheme in enumerate(schemes):
-            entry = entries.get((mesh, scheme))
-            if entry is None:
-                continue
-            record, frames = entry
-            if "faces" not in frames or not len(frames["faces"]):
-                cells[i][j + 1] = (None, None, None, record["status"])
-                continue
-            vertices, extra, faces = frame_surface(frames, -1)
-            cells[i][j + 1] = (vertices, extra, faces, run_note(record))
-            if cells[i][0] is None:
-                initial, _, _ = frame_surface(frames, 0)
-                cells[i][0] = (initial, None, faces, f"{len(faces)} triangles")
+    cells = last_frames(entries, meshes, schemes, run_note,
+                        lambda record, faces: f"{len(faces)} triangles")
     labels = ["initial"] + [scheme_style(s)[0] for s in schemes]
     draw_grid(cells, list(meshes), labels, paths, "Gallery: first and last frame per scheme",
                share="row")

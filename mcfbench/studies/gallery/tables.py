@@ -2,8 +2,9 @@
 
 import numpy as np
 
+from mcfbench.presentation.formats import formatted
 from mcfbench.presentation.tables import Table, markdown
-from mcfbench.studies.matrix.tables import TIMING_BASE, format_or_missing
+from mcfbench.studies.matrix.tables import TIMING_BASE
 
 
 GALLERY_COLUMNS = ["mesh", "scheme", "status", "steps_done", "steps", "t_failed", "min_angle",
@@ -32,11 +33,11 @@ def gallery_markdown(table, plan):
     view = pd.DataFrame({
         "mesh": table["mesh"], "scheme": table["scheme"], "status": table["status"],
         "steps": [f"{a}/{b}" for a, b in zip(table["steps_done"], table["steps"])],
-        "breakdown t": [format_or_missing(v, ".4g") for v in table["t_failed"]],
-        "min angle": [format_or_missing(v, ".3g") for v in table["min_angle"]],
-        "flipped": [format_or_missing(v, ".0f") for v in table["max_flipped"]],
-        "T monitor": [format_or_missing(v, ".3g") for v in table["t_min_barycentric"]],
-        "CPU s": [format_or_missing(v, ".3g") for v in table["cpu_seconds"]]})
+        "breakdown t": [formatted(v, ".4g") for v in table["t_failed"]],
+        "min angle": [formatted(v, ".3g") for v in table["min_angle"]],
+        "flipped": [formatted(v, ".0f") for v in table["max_flipped"]],
+        "T monitor": [formatted(v, ".3g") for v in table["t_min_barycentric"]],
+        "CPU s": [formatted(v, ".3g") for v in table["cpu_seconds"]]})
     notes = [f"Every scheme on every mesh: tau = C (mean edge length)^2 with C = {plan['C']:g}, "
              f"{plan['steps']} steps, solver {plan['solver']} (rtol {plan['rtol']:g}). "
              "Min angle and flipped triangles: worst over the sampled time levels; "

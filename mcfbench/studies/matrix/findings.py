@@ -12,10 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
+from mcfbench.presentation.formats import formatted
 from mcfbench.studies.matrix import mesh_problems
 from mcfbench.studies.matrix.tables import (
     error_ratios,
-    format_or_missing,
     levels_text,
     is_error,
     main_runs,
@@ -269,7 +269,7 @@ def matrix_findings(table, summary=None, labels=None, mesh_problems=(),
             name = f"**{r['scheme']}**"
             values = list(r["values"])
             shown = ", ".join(_number(v) if np.isfinite(v) else "–" for v in values)
-            eocs = ", ".join(format_or_missing(v, ".2f", "") for v in r["eocs"])
+            eocs = ", ".join(formatted(v, ".2f", missing="") for v in r["eocs"])
             if r["class"] == "order2":
                 two = " from two levels only" if sum(np.isfinite(values)) == 2 else ""
                 text = (f"{name} converges at order ~2{two}: EOC {r['eoc']:.2f} (levels "

@@ -1,4 +1,4 @@
-"""Plots of the benchmark matrix and the gallery (PNG and PDF, written atomically).
+"""Plots of the benchmark matrix (PNG and PDF, written atomically).
 
 * :func:`error_figure`: the main metric against ``h`` per problem, every
   scheme, with slope-2 guides; a problem without an exact error shows the
@@ -7,9 +7,8 @@
   time per problem (finest level of each scheme, from the records'
   ``series``);
 * :func:`picture_grid`: the final surfaces, scheme x problem, from the
-  saved frames (:mod:`mcfbench.presentation.render`);
-* :func:`gallery_grid`: per mesh the initial surface and every scheme's
-  last frame.
+  saved frames (:mod:`mcfbench.presentation.picture_grid`; the gallery's grid
+  is :func:`mcfbench.studies.gallery.plots.gallery_grid`).
 """
 
 import matplotlib
@@ -18,7 +17,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from mcfbench.presentation.picture_grid import draw_grid, frame_surface, run_note  # noqa: E402
+from mcfbench.presentation.picture_grid import draw_grid, last_frames, run_note  # noqa: E402
 from mcfbench.presentation.plots import SMALLEST_TEXT  # noqa: E402
 from mcfbench.presentation.plots import style as scheme_style  # noqa: E402
 from mcfbench.storage.atomic import save_figure  # noqa: E402
@@ -255,19 +254,10 @@ def picture_grid(entries, paths, problems, schemes):
         ``(problem, scheme) -> (record, frames)``, ``frames`` a mapping of
         the saved arrays (``np.load`` of the npz).
     """
-    cells = [[None] * len(problems) for _ in range(len(schemes) + 1)]
-    for j, problem in enumerate(problems):
-        for i, scheme in enumerate(schemes):
-            entry = entries.get((problem, scheme))
-            if entry is None:
-                continue
-            record, frames = entry
-            vertices, extra, faces = frame_surface(frames, -1)
-            note = f"L{record['level']}: {run_note(record)}"
-            cells[i + 1][j] = (vertices, extra, faces, note)
-            if cells[0][j] is None:
-                initial, _, _ = frame_surface(frames, 0)
-                cells[0][j] = (initial, None, faces, f"level {record['level']}, t = 0")
+    columns = last_frames(entries, problems, schemes,
+                          lambda record: f"L{record['level']}: {run_note(record)}",
+                          lambda record, _: f"level {record['level']}, t = 0")
+    cells = [list(row) for row in zip(*columns)]
     labels = ["initial"] + [scheme_style(s)[0] for s in schemes]
     draw_grid(cells, labels, problems, paths, "Final surfaces (coarsest level of each problem)",
                views=[VIEWS.get(p, (20.0, -60.0)) for p in problems])

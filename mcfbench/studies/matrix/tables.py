@@ -16,6 +16,7 @@ findings.
 import numpy as np
 
 from mcfbench.geometry.exact import eoc
+from mcfbench.presentation.formats import formatted
 
 TIMING_BASE = (
     "Timings compare schemes fairly only on the same footing: the same solver and "
@@ -227,12 +228,6 @@ def add_eoc(table):
         group = group.sort_values("level")
         table.loc[group.index, "eoc"] = eoc(group["value"], levels=group["level"])
     return table
-
-
-def format_or_missing(x, spec=".3e", none="–"):
-    if x is None or (isinstance(x, float) and not np.isfinite(x)):
-        return none
-    return format(x, spec)
 
 
 def levels_text(levels):
@@ -470,19 +465,19 @@ def problem_table(table, problem, schemes=None, labels=None):
                 row[f"L{level}"] = "–"
                 continue
             r = runs.loc[level]
-            row[f"L{level}"] = format_or_missing(r["value"]) if r["status"] == "ok" else r["status"]
-        row["EOC"] = ", ".join(format_or_missing(v, ".2f") for v in runs["eoc"].iloc[1:]) \
+            row[f"L{level}"] = formatted(r["value"], ".3e") if r["status"] == "ok" else r["status"]
+        row["EOC"] = ", ".join(formatted(v, ".2f") for v in runs["eoc"].iloc[1:]) \
             if is_error(metric) and len(runs) > 1 else "–"
         failed = runs[runs["status"] != "ok"]
         row["status"] = "ok" if not len(failed) else "; ".join(
             breakdown_text(r.status, r.t_failed, lv) for lv, r in failed.iterrows())
         finest = runs.iloc[-1]
         row["steps (finest)"] = f"{int(finest['steps_done'])}/{int(finest['steps'])}"
-        row["min angle"] = format_or_missing(runs["min_angle"].min(), ".3g")
-        row["flipped"] = format_or_missing(runs["max_flipped"].max(), ".0f")
-        row["T monitor"] = format_or_missing(runs["t_min_barycentric"].min(), ".3g")
+        row["min angle"] = formatted(runs["min_angle"].min(), ".3g")
+        row["flipped"] = formatted(runs["max_flipped"].max(), ".0f")
+        row["T monitor"] = formatted(runs["t_min_barycentric"].min(), ".3g")
         row["iterations (finest)"] = str(int(finest["iterations"]))
-        row["CPU s (finest)"] = format_or_missing(finest["cpu_seconds"], ".3g")
+        row["CPU s (finest)"] = formatted(finest["cpu_seconds"], ".3g")
         rows.append(row)
     return pd.DataFrame(rows), metric
 

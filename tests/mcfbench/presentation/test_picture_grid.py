@@ -1,10 +1,11 @@
-"""One panel of a picture grid (mcfbench.presentation.picture_grid.panel_image): the
+"""A picture grid (mcfbench.presentation.picture_grid): one panel (panel_image) is the
 mesh drawn alone into an image of the panel's size that covers the given extent,
-so that a grid of hundreds of panels holds images, not every panel's polygons."""
+so that a grid of hundreds of panels holds images, not every panel's polygons; the
+cells (last_frames) are each subject's initial surface and every scheme's last frame."""
 
 import numpy as np
 
-from mcfbench.presentation.picture_grid import PANEL_DPI, panel_image
+from mcfbench.presentation.picture_grid import PANEL_DPI, last_frames, panel_image
 from mcfbench.presentation.render import project
 
 
@@ -28,3 +29,23 @@ def test_panel_is_an_image_of_the_panel_size_with_the_mesh_where_its_projection_
     assert abs(cols.min() - n / 4) <= 4 and abs(cols.max() - 3 * n / 4) <= 4
     assert drawn[n // 4 + 6: 3 * n // 4 - 6, n // 4 + 6: 3 * n // 4 - 6].mean() > 0.99
     assert not drawn[: n // 4 - 6].any() and not drawn[:, 3 * n // 4 + 6:].any()
+
+
+def test_cells_are_the_initial_surface_and_each_schemes_last_frame():
+    V = np.eye(3)
+    faces = np.array([[0, 1, 2]])
+    frames = {"vertices": np.stack([V, 2 * V, 3 * V]), "faces": faces}
+    ok, refused = {"status": "ok"}, {"status": "invalid_mesh"}
+    entries = {("a", "s1"): (refused, {"t": np.zeros(0)}), ("a", "s2"): (ok, frames),
+               ("b", "s1"): (ok, {**frames, "extra_points": np.stack([V[:1]] * 3)})}
+    cells = last_frames(entries, ["a", "b", "c"], ["s1", "s2"], lambda r: r["status"],
+                        lambda r, f: f"{len(f)} triangle")
+    (initial, none, f0, text0), refused_cell, (last, extra, f2, text2) = cells[0]
+    # the initial surface from the first scheme with frames (s2): its frame 0
+    np.testing.assert_array_equal(initial, V)
+    assert none is None and text0 == "1 triangle" and (f0 == faces).all()
+    assert refused_cell == (None, None, None, "invalid_mesh")
+    np.testing.assert_array_equal(last, 3 * V)
+    assert extra is None and text2 == "ok" and (f2 == faces).all()
+    np.testing.assert_array_equal(cells[1][1][1], V[:1])       # DDFV's T-vertices
+    assert cells[1][2] is None and cells[2] == [None, None, None]

@@ -1,0 +1,170 @@
+"""Compiled (numba) passes of the geometry layer over a mesh's triangles or points.
+
+Imported on first use by the functions they serve (numba is not imported
+before, so a command that measures nothing does not pay for it), each kernel
+loaded from numba's cache: :func:`quality_pass` (:func:`mcfbench.geometry.metrics.quality`),
+:func:`invariants_pass` and :func:`count_folds` (:class:`mcfbench.geometry.invariants.FlowInvariants`;
+the fold count also the quality monitor's), :func:`component_extents`
+(:class:`mcfbench.geometry.collapse.CollapseCheck`) and :func:`sphere_error_sum`
+(:class:`mcfbench.geometry.exact.SphereL2Error`), tested through them (the quality
+monitor's and the sphere error's against numpy evaluations of their formulas).
+
+A triangle ``(x_0, x_1, x_2)`` is read by :func:`_triangle`: its edges ``a = x_1 -
+x_0``, ``b = x_2 - x_1``, ``c = x_0 - x_2`` and its normal ``n = (x_1 - x_0) x (x_2 -
+x_0) = c x a`` (length twice the area).
+"""
+
+import numba
+import numpy as np
+
+_OPTIONS = {"cache": True, "nogil": True, "error_model": "numpy"}
+
+
+@numba.njit(inline="always", **_OPTIONS)
+def _triangle(V, F, t):
+    """Edges ``a``, ``b``, ``c`` and normal ``n`` of triangle ``t``, twelve floats:
+    ``a0, a1, a2, b0, b1, b2, c0, c1, c2, n0, n1, n2``."""
+    i0, i1, i2 = F[t, 0], F[t, 1], F[t, 2]
+    a0, a1, a2 = V[i1, 0] - V[i0, 0], V[i1, 1] - V[i0, 1], V[i1, 2] - V[i0, 2]
+    b0, b1, b2 = V[i2, 0] - V[i1, 0], V[i2, 1] - V[i1, 1], V[i2, 2] - V[i1, 2]
+    c0, c1, c2 = V[i0, 0] - V[i2, 0], V[i0, 1] - V[i2, 1], V[i0, 2] - V[i2, 2]
+    return (a0, a1, a2, b0, b1, b2, c0, c1, c2,
+            c1 * a2 - c2 * a1, c2 * a0 - c0 * a2, c0 * a1 - c1 * a0)
+
+
+@numba.njit(**_OPTIONS)
+def quality_pass(V, F, work):
+    """Largest aspect ratio, smallest and largest area;
+    ``work[0, t, :2]``: ``|u x v|`` and ``u . v`` of the smallest angle of
+    triangle ``t``, ``work[1, t]`` its normal ``n``. NaN
+    propagates as in numpy's min/max."""
+    m = F.shape[0]
+    out = work[0]
+    N = work[1]
+    asp = -np.inf
+    a_min = np.inf
+    a_max = -np.inf
+    for t in range(m):
+        # e_k: corner k -> corner k + 1
+        a0, a1, a2, b0, b1, b2, c0, c1, c2, n0, n1, n2 = _triangle(V, F, t)
+        la = (a0 * a0 + a2 * a2) + a1 * a1
+        lb = (b0 * b0 + b2 * b2) + b1 * b1
+        lc = (c0 * c0 + c2 * c2) + c1 * c1
+        # the smallest angle is opposite the shortest side (the first one on ties):
+        # u = e_{s+2}, v = -e_{s+1}
+        if lb < la and lb <= lc:
+            u0, u1, u2, v0, v1, v2 = a0, a1, a2, -c0, -c1, -c2
+        elif lc < la and lc < lb:
+            u0, u1, u2, v0, v1, v2 = b0, b1, b2, -a0, -a1, -a2
+        else:
+            u0, u1, u2, v0, v1, v2 = c0, c1, c2, -b0, -b1, -b2
+        x0 = u1 * v2 - u2 * v1
+        x1 = u2 * v0 - u0 * v2
+        x2 = u0 * v1 - u1 * v0
+        out[t, 0] = np.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
+        out[t, 1] = (u0 * v0 + u2 * v2) + u1 * v1
+        # normal, area, aspect ratio
+        N[t, 0] = n0
+        N[t, 1] = n1
+        N[t, 2] = n2
+        area = 0.5 * np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+        sa = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
+        sb = np.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
+        sc = np.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+        r = sa * sb * sc * (0.5 * (sa + sb + sc)) / (8.0 * (area * area))
+        if asp == asp and (r > asp or r != r):
+            asp = r
+        if a_min == a_min and (area < a_min or area != area):
+            a_min = area
+        if a_max == a_max and (area > a_max or area != area):
+            a_max = area
+    return asp, a_min, a_max
+
+
+@numba.njit(**_OPTIONS)
+def invariants_pass(V, F, N):
+    """Total area and the smallest tangent of the smallest angles of the
+    triangles (the smallest angle of a triangle, opposite its shortest side, is
+    at most 60 degrees, so its tangent ``|u x v| / (u . v)`` is increasing in
+    it); ``N[t]``: the normal ``n`` of triangle ``t``. NaN
+    propagates to the area and the tangent."""
+    m = F.shape[0]
+    area = 0.0
+    tangent = np.inf
+    for t in range(m):
+        a0, a1, a2, b0, b1, b2, c0, c1, c2, n0, n1, n2 = _triangle(V, F, t)
+        N[t, 0] = n0
+        N[t, 1] = n1
+        N[t, 2] = n2
+        twice = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+        area += 0.5 * twice
+        la = a0 * a0 + a1 * a1 + a2 * a2
+        lb = b0 * b0 + b1 * b1 + b2 * b2
+        lc = c0 * c0 + c1 * c1 + c2 * c2
+        # the two sides at the smallest angle: the two longest
+        if lb <= la and lb <= lc:
+            dot = -(a0 * c0 + a1 * c1 + a2 * c2)     # corner 0: a and -c
+        elif lc <= la:
+            dot = -(a0 * b0 + a1 * b1 + a2 * b2)     # corner 1: -a and b
+        else:
+            dot = -(b0 * c0 + b1 * c1 + b2 * c2)     # corner 2: -b and c
+        tan = twice / dot if dot > 0 else (0.0 if twice == twice else twice)
+        if tangent == tangent and (tan < tangent or tan != tan):
+            tangent = tan
+    return area, tangent
+
+
+@numba.njit(**_OPTIONS)
+def count_folds(N, t1, t2, skip, R, S):
+    """Number of triangles ``t`` with ``skip[t] == 0`` whose normal ``N[t]`` has
+    ``N_t . sum_s N_s < 0`` over its edge-neighbours ``s`` (the pairs ``t1, t2``);
+    the sums accumulated like ``np.bincount(t1, N[t2]) + np.bincount(t2, N[t1])``
+    into the scratch ``R``, ``S`` (m, 3)."""
+    R[:, :] = 0.0
+    S[:, :] = 0.0
+    for k in range(t1.shape[0]):
+        p, q = t1[k], t2[k]
+        R[p, 0] += N[q, 0]
+        R[p, 1] += N[q, 1]
+        R[p, 2] += N[q, 2]
+        S[q, 0] += N[p, 0]
+        S[q, 1] += N[p, 1]
+        S[q, 2] += N[p, 2]
+    folded = 0
+    for t in range(N.shape[0]):
+        d = (N[t, 0] * (R[t, 0] + S[t, 0]) + N[t, 2] * (R[t, 2] + S[t, 2])) \
+            + N[t, 1] * (R[t, 1] + S[t, 1])
+        if d < 0 and skip[t] == 0:
+            folded += 1
+    return folded
+
+
+@numba.njit(**_OPTIONS)
+def component_extents(V, F, face_label, labels, area, box):
+    """``area[c] +=`` the areas of the triangles of component ``c``; ``box[0, c]``,
+    ``box[1, c]``: the smallest and largest coordinates of its vertices (NaN
+    propagates to the area)."""
+    for t in range(F.shape[0]):
+        n0, n1, n2 = _triangle(V, F, t)[9:]
+        area[face_label[t]] += 0.5 * np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+    for i in range(V.shape[0]):
+        c = labels[i]
+        for k in range(3):
+            x = V[i, k]
+            if x < box[0, c, k]:
+                box[0, c, k] = x
+            if x > box[1, c, k]:
+                box[1, c, k] = x
+
+
+@numba.njit(**_OPTIONS)
+def sphere_error_sum(X, c0, c1, c2, r, w):
+    """``sum_i w_i (|X_i - c| - r)^2`` in one pass (no temporaries)."""
+    total = 0.0
+    for i in range(X.shape[1]):
+        x0 = X[0, i] - c0
+        x1 = X[1, i] - c1
+        x2 = X[2, i] - c2
+        dist = np.sqrt(x0 * x0 + x1 * x1 + x2 * x2) - r
+        total += dist * dist * w[i]
+    return total
