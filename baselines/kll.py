@@ -157,9 +157,8 @@ def two_rings(edges, n, vertices):
     """
     one = sp.csr_matrix((np.ones(2 * len(edges)), (edges.ravel(), edges[:, ::-1].ravel())),
                         shape=(n, n))
-    reach = one[vertices] + one[vertices] @ one
-    reach = sp.csr_matrix(reach - sp.csr_matrix((np.ones(len(vertices)), (
-        np.arange(len(vertices)), vertices)), shape=reach.shape).multiply(reach))
+    reach = sp.csr_matrix(one[vertices] + one[vertices] @ one)
+    reach[np.arange(len(vertices)), vertices] = 0.0          # a stored entry: no new one
     reach.eliminate_zeros()
     reach.sort_indices()
     counts = np.diff(reach.indptr)
@@ -197,6 +196,11 @@ def boundary_normals(vertices, centres, ring, member, rough):
     -------
     (b, 3) float array
 
+    Raises
+    ------
+    ValueError
+        A two-ring of fewer than five vertices (five coefficients to fit).
+
     Examples
     --------
     >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0], [1, 1, 0]])
@@ -206,6 +210,11 @@ def boundary_normals(vertices, centres, ring, member, rough):
     >>> ((n * np.sqrt(1.25)).round(12) + 0.0).tolist()               # (-0.5, 0, 1)
     [[-0.5, 0.0, 1.0]]
     """
+    small = np.flatnonzero(member.sum(axis=1) < 5)
+    if len(small):
+        raise ValueError(f"kll's boundary normals (KL8) fit a quadric to the vertices within "
+                         f"two edges of each boundary vertex and need five; boundary vertex "
+                         f"{int(centres[small[0]])} has {int(member[small[0]].sum())}")
     offsets = vertices[ring] - vertices[centres][:, None]                   # (b, k, 3)
     seed = offsets[np.arange(len(ring)), np.argmax(member * np.linalg.norm(
         np.cross(offsets, rough[:, None]), axis=2), axis=1)]
@@ -219,7 +228,8 @@ def boundary_normals(vertices, centres, ring, member, rough):
     # in units of the ring's size, the slopes a, b unchanged
     design = np.stack([u, v, u * u, u * v, v * v], axis=2)
     gram = np.einsum("bki,bk,bkj->bij", design, weight, design)
-    a, b = np.linalg.solve(gram, np.einsum("bki,bk,bk->bi", design, weight, w)[..., None])[:, :2, 0].T
+    moments = np.einsum("bki,bk,bk->bi", design, weight, w)
+    a, b = np.linalg.solve(gram, moments[..., None])[:, :2, 0].T
     normal = rough - a[:, None] * u1 - b[:, None] * u2
     return normal / np.linalg.norm(normal, axis=1, keepdims=True)
 

@@ -6,7 +6,8 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from conftest import cylinder
-from test_mdr import agrees_under_rigid_motion_and_relabelling
+from test_mdr import (agrees_under_rigid_motion_and_relabelling,
+                      reaches_the_catenoid_keeping_its_boundary)
 
 from baselines.cotan import cotangent_laplacian
 from baselines.kll import KLLFlow, curvature_weights
@@ -182,8 +183,8 @@ def test_invariant_under_rigid_motion_and_relabelling(noisy_sphere):
 
 def catenoid(level):
     """The catenoid ``r = a cosh(z / a)`` on the registry's cylinder of ``level`` (24 x 8
-    times ``2^(level-1)``, alternating diagonals, boundary circles of radius 1 at ``z = +-0.5``), its faces and
-    exact unit normals (away from the axis)."""
+    times ``2^(level-1)``, alternating diagonals, boundary circles of radius 1 at
+    ``z = +-0.5``), its faces and exact unit normals (away from the axis)."""
     V, F = shapes.cylinder(24 * 2 ** (level - 1), 8 * 2 ** (level - 1))
     a = catenoid_parameter()
     V[:, :2] *= a * np.cosh(V[:, 2:] / a)
@@ -230,6 +231,12 @@ def test_catenoid_stays_put_at_order_2():
     assert np.linalg.norm(flow.nu[flow.fixed] - normal[flow.fixed], axis=1).max() < 0.07
 
 
+def test_registry_catenoid_is_second_order_with_its_boundary_kept():
+    """The matrix's ``catenoid`` (from the cylinder to ``t = 1.5``), levels 1-2: largest
+    radial error 1.1846e-3, 2.8417e-4 (``cotan`` 3.437e-3, 8.42e-4), EOC 2.06."""
+    reaches_the_catenoid_keeping_its_boundary("kll", KLLFlow, [1.1846e-3, 2.8417e-4])
+
+
 def test_boundary_normals_are_second_order_where_the_vertex_normals_are_first():
     """(KL8) on the catenoid's boundary circles, levels 1-4: the quadric's normal is off by
     at most 0.031, 0.0056, 0.00094, 0.00022 (EOC 2.45, 2.57, 2.13), the one-sided unit
@@ -265,6 +272,13 @@ def test_open_surface_invariant_under_rigid_motion_and_relabelling():
     """The open 12 x 4 cylinder (``H = 1`` inside, ``0`` on its boundary circles): the
     boundary's fitted normals and the steps agree under rotation, shift and relabelling."""
     agrees_under_rigid_motion_and_relabelling(KLLFlow, *cylinder(12, 4))
+
+
+def test_boundary_too_small_for_the_quadric_is_named():
+    """Two triangles: every boundary vertex sees three others, the quadric needs five."""
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.2]])
+    with pytest.raises(ValueError, match="need five; boundary vertex 0 has 3"):
+        KLLFlow(V, np.array([[0, 1, 2], [1, 3, 2]]), 0.01)
 
 
 def test_non_finite_curvature_is_a_defect():
