@@ -68,8 +68,23 @@ BiCGStab iteration, for four right-hand sides), then::
 Initial values (any mesh): ``nu^0`` the unit area-weighted vertex normals
 (:func:`baselines.mdr.unit_vertex_normals`), ``H^0_i = nu^0_i . (L X^0)_i / m_i`` the
 normal part of the cotangent mean curvature vector (``-Delta X = H nu``), as
-MDR's ``H``. Closed surfaces only (the paper's setting): a mesh with a boundary
-is refused (``ValueError``; the harness records ``unsupported``).
+MDR's ``H``.
+
+Open surfaces (the paper's are closed; ours, ``baselines/README.md``, kll item 5):
+the boundary curve is held fixed as in the other schemes, and every block of
+(KL6) gets Dirichlet rows at the boundary vertices (``S``'s rows of the
+identity, the coupling ``dt H*``, ``dt nu*`` and the source zero there)::
+
+    X = B_X,    nu = n_b(X*),    H = 0        at a boundary vertex         (KL8)
+
+``H = 0`` because the boundary does not move: ``v = -H nu = 0`` there for
+``t > 0`` (at ``t = 0`` too, replacing the cotangent value, which a boundary
+vertex's half one-ring does not define); ``n_b(X*)`` is the normal of the
+extrapolated discrete surface at the vertex, from a quadric fitted to its
+two-ring (:func:`boundary_normals`, O(h^2); the one-sided vertex normal is
+O(h) off and costs ``nu`` an order on the catenoid). Both come from the
+discrete surface, not from a problem's exact solution; a closed mesh is
+stepped as before, bit for bit.
 """
 
 import numpy as np
@@ -113,6 +128,110 @@ def curvature_weights(vertices, faces, nu):
                           np.ascontiguousarray(faces, dtype=np.int64),
                           np.ascontiguousarray(nu, dtype=np.float64), w, squared)
     return w, squared
+
+
+def two_rings(edges, n, vertices):
+    """The vertices within two edges of each of ``vertices``, padded: what
+    :func:`boundary_normals` fits a quadric to.
+
+    Parameters
+    ----------
+    edges : (E, 2) int array
+    n : int
+        Number of vertices of the mesh.
+    vertices : (b,) int array
+
+    Returns
+    -------
+    ring : (b, k) int array
+        Row ``i``: the two-ring of ``vertices[i]`` (itself left out), padded with
+        ``vertices[i]``; ``k`` the largest two-ring.
+    member : (b, k) bool array
+        False at the padding.
+
+    Examples
+    --------
+    >>> ring, member = two_rings(np.array([[0, 1], [1, 2], [2, 3]]), 4, np.array([0, 3]))
+    >>> ring.tolist(), member.tolist()
+    ([[1, 2], [1, 2]], [[True, True], [True, True]])
+    """
+    one = sp.csr_matrix((np.ones(2 * len(edges)), (edges.ravel(), edges[:, ::-1].ravel())),
+                        shape=(n, n))
+    reach = sp.csr_matrix(one[vertices] + one[vertices] @ one)
+    reach[np.arange(len(vertices)), vertices] = 0.0          # a stored entry: no new one
+    reach.eliminate_zeros()
+    reach.sort_indices()
+    counts = np.diff(reach.indptr)
+    k = counts.max()
+    member = np.arange(k) < counts[:, None]
+    ring = np.repeat(np.asarray(vertices)[:, None], k, axis=1)
+    ring[member] = reach.indices
+    return ring, member
+
+
+def boundary_normals(vertices, centres, ring, member, rough):
+    """Unit normals at boundary vertices from a quadric fitted to their two-rings: the
+    Dirichlet values of ``nu`` (``baselines/README.md``, kll item 5).
+
+    In the frame ``(u_1, u_2, n_0)`` of a vertex ``p`` (``n_0`` its unit area-weighted
+    normal ``rough``), least squares of ``w = a u + b v + c u^2 + d u v + e v^2`` over the
+    offsets ``(u, v, w)`` of its two-ring from ``p``, weighted by ``1 / |offset|^2``
+    (the nearer points count more: the error is 2-4 x smaller on the catenoid); the
+    normal is that of the graph at ``p``, ``(n_0 - a u_1 - b u_2) / |...|``. The fit is
+    exact on quadrics, so its slope is O(h^2) off on a smooth surface (the cubic terms,
+    O(h^3), over a distance h), one-sided as the ring of a boundary vertex is, where
+    ``n_0`` is O(h) off.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    centres : (b,) int array
+        The boundary vertices.
+    ring, member : (b, k) arrays
+        Their :func:`two_rings`.
+    rough : (b, 3) float array
+        Their unit area-weighted vertex normals.
+
+    Returns
+    -------
+    (b, 3) float array
+
+    Raises
+    ------
+    ValueError
+        A two-ring of fewer than five vertices (five coefficients to fit).
+
+    Examples
+    --------
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0], [1, 1, 0]])
+    >>> V[:, 2] = 0.5 * V[:, 0] + V[:, 0] ** 2 - V[:, 1] ** 2      # a saddle's graph
+    >>> n = boundary_normals(V, np.array([0]), np.array([[1, 2, 3, 4, 5]]),
+    ...                      np.ones((1, 5), bool), np.array([[0.0, 0, 1]]))
+    >>> ((n * np.sqrt(1.25)).round(12) + 0.0).tolist()               # (-0.5, 0, 1)
+    [[-0.5, 0.0, 1.0]]
+    """
+    small = np.flatnonzero(member.sum(axis=1) < 5)
+    if len(small):
+        raise ValueError(f"kll's boundary normals (KL8) fit a quadric to the vertices within "
+                         f"two edges of each boundary vertex and need five; boundary vertex "
+                         f"{int(centres[small[0]])} has {int(member[small[0]].sum())}")
+    offsets = vertices[ring] - vertices[centres][:, None]                   # (b, k, 3)
+    seed = offsets[np.arange(len(ring)), np.argmax(member * np.linalg.norm(
+        np.cross(offsets, rough[:, None]), axis=2), axis=1)]
+    u1 = np.cross(np.cross(rough, seed), rough)
+    u1 /= np.linalg.norm(u1, axis=1, keepdims=True)
+    u2 = np.cross(rough, u1)
+    squared = (offsets ** 2).sum(axis=2)
+    weight = np.divide(1.0, squared, out=np.zeros_like(squared), where=member)
+    scale = np.sqrt((member * squared).sum(axis=1) / member.sum(axis=1))
+    u, v, w = (np.einsum("bkc,bc->bk", offsets, e) / scale[:, None] for e in (u1, u2, rough))
+    # in units of the ring's size, the slopes a, b unchanged
+    design = np.stack([u, v, u * u, u * v, v * v], axis=2)
+    gram = np.einsum("bki,bk,bkj->bij", design, weight, design)
+    moments = np.einsum("bki,bk,bk->bi", design, weight, w)
+    a, b = np.linalg.solve(gram, moments[..., None])[:, :2, 0].T
+    normal = rough - a[:, None] * u1 - b[:, None] * u2
+    return normal / np.linalg.norm(normal, axis=1, keepdims=True)
 
 
 class BlockSystem:
@@ -170,20 +289,16 @@ class BlockSystem:
 
 class KLLFlow(VertexFlow):
     """Mean curvature flow by the algorithm of Kovacs, Li and Lubich, (KL6), of one
-    closed surface; state ``(X, nu, H)``.
+    surface, closed or with its boundary held fixed (KL8); state ``(X, nu, H)``.
 
     Parameters
     ----------
     vertices : (n, 3) float array
         Initial surface ``X^0``.
     faces : (m, 3) int array
-        Consistently oriented triangles of a closed manifold surface.
+        Consistently oriented triangles of a manifold surface, closed or with
+        boundary (whose vertices keep their place, (KL8)).
     tau : float
-
-    Raises
-    ------
-    ValueError
-        The mesh has a boundary.
 
     Examples
     --------
@@ -197,13 +312,21 @@ class KLLFlow(VertexFlow):
 
     def __init__(self, vertices, faces, tau):
         super().__init__(vertices, faces, tau, mass="barycentric")
-        if self.fixed.any():
-            raise ValueError(f"kll evolves closed surfaces (Kovacs, Li, Lubich 2019); this "
-                             f"mesh has {int(self.fixed.sum())} boundary vertices")
         g, n = self.geometry, self.mesh.n_vertices
         nu = unit_vertex_normals(self.faces, g.area_vectors, n)
         H = np.einsum("ic,ic->i", nu, self.assembler.laplacian(g.L_data) @ self.vertices) / g.mass
+        if self.fixed.any():                       # (KL8): the Dirichlet values at X^0
+            self._boundary = np.flatnonzero(self.fixed)
+            self._rings = two_rings(self.mesh.edges, n, self._boundary)
+            nu[self._boundary] = self.boundary_values(self._X, g.area_vectors)
+            H[self._boundary] = 0.0
         self._adopt(np.vstack([self._X, nu.T, H[None]]))
+
+    def boundary_values(self, X, area_vectors):
+        """``nu`` at the boundary vertices of the surface ``X`` (3, n) with the triangle
+        ``area_vectors`` (m, 3), (KL8): :func:`boundary_normals`, (b, 3)."""
+        rough = unit_vertex_normals(self.faces, area_vectors, self.mesh.n_vertices)
+        return boundary_normals(X.T, self._boundary, *self._rings, rough[self._boundary])
 
     def _adopt(self, U):
         """Make ``U`` (7, n) the state; ``X`` is a view of its first rows."""
@@ -254,9 +377,15 @@ class KLLFlow(VertexFlow):
         w = curvature_weights(X.T, self.faces, nu.T)[0]
         source = dt * np.divide(w, g.mass, out=np.zeros(n), where=g.mass > 0)
         b = np.array(base, dtype=np.float64)
-        b[:3] += dt * H * nu
+        dtH, dtnu = dt * H, dt * nu
+        if self.fixed.any():                       # (KL8): Dirichlet rows of every block
+            dtH, dtnu = np.where(self.fixed, 0.0, dtH), np.where(self.fixed, 0.0, dtnu)
+            source[self._boundary] = 0.0
+            b[3:6, self._boundary] = self.boundary_values(X, g.area_vectors).T
+            b[6, self._boundary] = 0.0
+        b[:3] += dtH * nu
         b[3:] += source * at[3:]
-        return BlockSystem(S, dt * H, dt * nu), b
+        return BlockSystem(S, dtH, dtnu), b
 
     def advance(self, U):
         """Accept ``U`` (7, n) as the state ``n + 1``."""

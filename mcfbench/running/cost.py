@@ -11,10 +11,12 @@ scheme (:data:`COSTS`: vertex, DDFV, BGN, the redistributing ones apart, whose
 potential is a sparse LU at every step: level 5, 29.9 MB and 78 ms a step for
 ``cotan-redistribute`` against 14.1 MB and 3 ms for ``cotan``; 85.7 MB and
 38 ms for ``ddfv-chord-redistribute-carried`` against 27.1 MB and 6 ms for
-``ddfv``; ``bgn`` 16.4 MB and 4 ms; ``kll``, its 7n x 7n system, measured
-2026-11-26 beside ``cotan`` and ``bgn`` at load average 7: 25.4 MB and 6.7 ms
-against 14.0 MB and 2.1 ms for ``cotan``, 16.2 MB and 4.2 ms for ``bgn``; that
-was before its system was solved by blocks, not refitted since):
+``ddfv``; ``bgn`` 16.4 MB and 4 ms; ``kll``, its 7n x 7n system solved by
+blocks (one n x n matrix for four right-hand sides), refitted 2026-11-26 beside
+``cotan`` and ``bgn`` at load average 13-15: 17.0 MB and 4.4 ms against 13.8 MB
+and 3.5 ms for ``cotan``, 16.3 MB and 6.3 ms for ``bgn``; a second run beside
+``cotan``, 17.0 MB and 6.0 ms against 14.1 MB and 2.6 ms; before the block
+solve it took 25.4 MB and 6.7 ms):
 
 * the peak resident memory that grows with the mesh (mesh, flow, solver), above
   a process that made a level-1 run first, ``a n^p`` (slopes 1.06-1.12), plus
@@ -52,7 +54,7 @@ COSTS = {
     "ddfv": ((4.547e-4, 1.064), (1.143e-6, 0.825)),
     "ddfv, redistributing": ((7.923e-4, 1.122), (2.134e-6, 0.947)),
     "bgn": ((9.613e-4, 1.055), (9.14e-6, 0.661)),
-    "kll": ((1.322e-3, 1.068), (3.061e-6, 0.833)),
+    "kll": ((5.815e-4, 1.113), (3.848e-6, 0.763)),
 }
 """Kind of scheme (:func:`cost_class`) -> ``((a, p), (b, q))``: memory ``a n^p`` MB above
 a warmed-up process and ``b n^q`` CPU seconds per step (module docstring;

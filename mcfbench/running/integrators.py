@@ -85,7 +85,12 @@ operators at the extrapolated state, Kovacs, Li, Lubich, Numer. Math. 143 (2019)
     ``X^1`` error falls by 3.9, 3.9, 4.6, 5.6 per halving, not yet 8: stiff
     modes, ``tau`` not small against ``h^2``), and ``kll``'s EOCs become
     2.67, 2.72, 2.69, 2.81: its non-monotone EOCs are the start-up error
-    cancelling the bulk error near tau 0.00125, not a lower order.
+    cancelling the bulk error near tau 0.00125, not a lower order. That start-up
+    error is large because ``kll``'s ``nu^0``, ``H^0`` from the mesh are rough (stiff
+    modes, where the extrapolated Euler step is not yet asymptotic) and its ``X``
+    keeps what they leave; from smooth ``nu^0``, ``H^0`` the start-up is O(tau^3)
+    (errors / 7-8 per halving) and the EOCs are 2.91, 2.95, 2.98, 2.99
+    (``baselines/README.md``, kll, "Order in time").
     **BGN with BDF3 inverts** once tau is small: level-3 sphere to ``t = 0.08``
     ok at tau 0.01 and 0.0025 (smallest angle 54 -> 6.3 degrees), inverted at
     step 46 with tau 0.000625; Table 3.1's level 4 inverted at step 39 of 128
