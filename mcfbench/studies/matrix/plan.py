@@ -233,8 +233,10 @@ def planned_runs(plan, code="", root=ROOT):
 RUN_SECONDS = 0.3
 """Estimated CPU seconds of a run besides its time steps (:func:`series_seconds`):
 its mesh, its share of the scheme's warm-up, the metrics, the record and frames
-written (the matrix's cheapest runs, 2026-11-26: a series of one run took 1.2-1.5 s
-of CPU in its own process, about 1 s of it the process's start-up)."""
+written (measured 2026-11-26: a cut-down matrix of 198 runs in 8 batch jobs took
+64 CPU s besides the kernels' compilation and the tables and figures: 18 s the
+runs' timed flows, the other 46 s (the processes' start-up and Snakemake's work
+included) 0.23 s a run)."""
 
 BATCH_SECONDS = 10.0
 """Estimated CPU seconds of work a Snakemake job of the matrix gathers at least

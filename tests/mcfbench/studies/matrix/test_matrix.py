@@ -602,9 +602,21 @@ def test_series_job_writes_every_level_and_logs_to_one_file(tmp_path):
     assert "sphere level 1" in text and "sphere level 2" in text
 
 
-def test_batch_job_runs_each_series_with_its_own_log(tmp_path):
+def test_batch_job_runs_each_series_with_its_own_log(tmp_path, monkeypatch):
     """One Snakemake job, several series: every run's record as the series job's,
-    with the scheme and the level of its path, one log per series."""
+    with the scheme and the level of its path, one log per series; each series'
+    first run warmed up before it is timed, in a process that ran another scheme
+    first too."""
+    from mcfbench.running import run as run_module
+
+    timed, timed_run = [], run_module._timed_run
+
+    def spy(scheme, problem, mesh, tau, steps, **kwargs):
+        timed.append((scheme.name, steps))
+        return timed_run(scheme, problem, mesh, tau, steps, **kwargs)
+
+    monkeypatch.setattr(run_module, "_warmed", set())       # as a fresh process
+    monkeypatch.setattr(run_module, "_timed_run", spy)
     plan = matrix_plan.plan({"select": {"schemes": ["cotan", "bgn"],
                                         "problems": {"sphere": [1]}}})
     runs = matrix_plan.planned_runs(plan, code="test", root=str(tmp_path))
@@ -622,6 +634,10 @@ def test_batch_job_runs_each_series_with_its_own_log(tmp_path):
     for log, other in (logs, logs[::-1]):
         assert f"{log.stem} on sphere level 1" in log.read_text()
         assert f"{other.stem} on sphere" not in log.read_text()
+    # the warm-up's steps, then level 1's (2 steps; timed again while under 10 ms)
+    assert [call for k, call in enumerate(timed) if k == 0 or timed[k - 1] != call] == \
+        [("cotan", run_module.WARM_UP_STEPS), ("cotan", 2),
+         ("bgn", run_module.WARM_UP_STEPS), ("bgn", 2)]
 
 
 def test_the_main_metric_is_decided_once_in_the_long_table():
