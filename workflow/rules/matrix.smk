@@ -49,7 +49,8 @@ MATRIX_TARGETS = [
 # 10 CPU s, a heavy series alone (mcfbench.studies.matrix.job.batch_job); one
 # rule per batch since the outputs differ. Saves the start-up of a process and
 # Snakemake's work per job of every series but one per batch (about 1 s each);
-# a killed job redoes its own series.
+# a killed job redoes its own series. (Snakemake's `group:` would not do it: in
+# local execution group definitions are ignored, docs "Job Grouping".)
 for _batch in _matrix.batches(MATRIX):
     _levels = MATRIX["problems"][_batch.problem]
 
