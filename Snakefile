@@ -69,8 +69,8 @@ rule beyond:
 
 
 rule matrix:
-    """Target: every scheme x every problem x its levels (config key `matrix`;
-    about 20 minutes on 2 cores), tables, figures and findings in results/matrix/."""
+    """Target: every scheme x every problem x its levels (config key `matrix`; its
+    cost: config/config.yaml), tables, figures and findings in results/matrix/."""
     input:
         # the plan first: a bad value under `matrix` is named here
         lambda wildcards: PLANS.checked("matrix", MATRIX_TARGETS),

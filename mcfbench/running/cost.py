@@ -183,11 +183,21 @@ _first_levels = {}
 
 def _first_level(problem):
     """``(vertices, triangles, tau)`` of the problem's first level, built once per
-    process."""
+    process; for a committed real mesh whose time step follows the level, the counts
+    of its manifest (:func:`mcfbench.geometry.committed_meshes.mesh_manifest`, level
+    0 is the mesh itself) and ``tau`` None, unneeded: no file is read (the matrix's
+    batches estimate every series while Snakemake reads the workflow)."""
+    from mcfbench.geometry.committed_meshes import mesh_manifest
+
     first = min(problem.levels)
     params = problem.params(first)
     key = (problem.surface, tuple(sorted((k, repr(v)) for k, v in params.items())))
-    if key not in _first_levels:
+    if key in _first_levels:
+        return _first_levels[key]
+    if problem.surface == "real_mesh" and problem.tau_rule == "level" and first == 0:
+        entry = mesh_manifest()[params["mesh"]]
+        _first_levels[key] = (entry["vertices"], entry["faces"], None)
+    else:
         mesh = problem.mesh(first)
         _first_levels[key] = (len(mesh[0]), len(mesh[1]), problem.tau(first, mesh))
     return _first_levels[key]

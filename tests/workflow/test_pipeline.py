@@ -313,7 +313,7 @@ def test_a_one_line_selection_plans_only_the_named_runs(tmp_path, env):
     assert code == 0, out[-3000:]
     jobs = planned_jobs(out)
     assert {r: n for r, n in jobs.items() if r.startswith("matrix_run")} == \
-        {"matrix_run_sphere": 2}                 # one series job per scheme
+        {"matrix_run_sphere_batch1": 1}          # two cheap series: one job
     records = set(re.findall(r"results/matrix/runs/\S+?\.json", out))
     assert records == {f"results/matrix/runs/sphere/{s}/level{k}.json"
                        for s in ("cotan", "bgn") for k in (1, 2)}
@@ -321,16 +321,18 @@ def test_a_one_line_selection_plans_only_the_named_runs(tmp_path, env):
 
 
 def test_trimming_the_levels_reruns_no_run(tmp_path, env):
-    """A series' job params do not depend on its set of levels: after sphere 1-2,
-    asking for level 1 alone (or 1-2 again) plans no run, only the tables, and
-    names why in a few short lines."""
+    """A batch job's params depend neither on its series nor on their levels: after
+    cotan and bgn on sphere 1-2 (one job), asking for level 1 alone, one scheme
+    alone (other batches, other rules) or the same again plans no run, only the
+    tables, and names why in a few short lines."""
     work = copy_workflow(tmp_path / "work")
-    one = "matrix={select: {schemes: [cotan], problems: {sphere: [1, 2]}}}"
-    code, out = snakemake(work, env, "--cores", "2", "matrix", "--config", one)
+    both = "matrix={select: {schemes: [cotan, bgn], problems: {sphere: [1, 2]}}}"
+    code, out = snakemake(work, env, "--cores", "2", "matrix", "--config", both)
     assert code == 0, out[-3000:]
-    for levels in ("[1]", "[1, 2]"):
+    for schemes, levels in (("[cotan, bgn]", "[1]"), ("[bgn]", "[1, 2]"),
+                            ("[cotan]", "[2]"), ("[cotan, bgn]", "[1, 2]")):
         code, out = snakemake(work, env, "-n", "--cores", "2", "matrix", "--config",
-                              one.replace("[1, 2]", levels))
+                              both.replace("[1, 2]", levels).replace("[cotan, bgn]", schemes))
         assert code == 0, out[-3000:]
         assert "matrix_run" not in out, out[-3000:]
         assert max(map(len, out.splitlines())) < 1000

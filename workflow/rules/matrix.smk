@@ -1,7 +1,7 @@
 # The benchmark matrix: every scheme x every problem x its refinement series
 # (issue "The benchmark matrix"). Not part of `rule all`:
 #
-#   snakemake --cores 2 matrix      # the default matrix: about 20 minutes on 2 cores
+#   snakemake --cores 2 matrix      # the default matrix
 #
 # Settings: the config key `matrix` (config/config.yaml), checked against the
 # registries mcfbench.running.schemes.SCHEMES and mcfbench.running.problems.PROBLEMS by
@@ -44,42 +44,52 @@ MATRIX_TARGETS = [
 ]
 
 
-# One job per (problem, scheme): the problem's whole refinement series in one
-# process (mcfbench.studies.matrix.series_job), one rule per problem since the
-# levels, hence the outputs, differ. Saves the start-up of every run but one
-# (about 1 s each); a killed job redoes its series.
-for _problem, _levels in MATRIX["problems"].items():
-    if not _levels:
-        continue
+# One job per batch (mcfbench.studies.matrix.plan.batches): the cheap series of a
+# problem gathered in one process until their estimated cost reaches about
+# 10 CPU s, a heavy series alone (mcfbench.studies.matrix.job.batch_job); one
+# rule per batch since the outputs differ. Saves the start-up of a process and
+# Snakemake's work per job of every series but one per batch (about 1 s each);
+# a killed job redoes its own series. (Snakemake's `group:` would not do it: in
+# local execution group definitions are ignored, docs "Job Grouping".)
+for _batch in _matrix.batches(MATRIX):
+    _levels = MATRIX["problems"][_batch.problem]
 
     rule:
         name:
-            f"matrix_run_{_problem}"
+            f"matrix_run_{_batch.name}"
         input:
             kernels=ancient(KERNELS),
         output:
-            records=[_matrix.record_path(_problem, "{scheme}", k) for k in _levels],
-            frames=[_matrix.frames_path(_problem, "{scheme}", k) for k in _levels],
+            records=[
+                _matrix.record_path(_batch.problem, s, k)
+                for s in _batch.schemes
+                for k in _levels
+            ],
+            frames=[
+                _matrix.frames_path(_batch.problem, s, k)
+                for s in _batch.schemes
+                for k in _levels
+            ],
         log:
-            f"results/logs/matrix/{_problem}/{{scheme}}.log",
+            [f"results/logs/matrix/{_batch.problem}/{s}.log" for s in _batch.schemes],
         benchmark:
-            f"results/benchmarks/matrix/{_problem}/{{scheme}}.tsv"
-        wildcard_constraints:
-            scheme=_alternatives(MATRIX["schemes"]),
-        # the longest series first: long jobs start early and the two cores stay busy
-        priority: len(_levels)
+            f"results/benchmarks/matrix/{_batch.problem}/batch{_batch.index}.tsv"
+        # the costliest batches first (estimated CPU s): long jobs start early and
+        # the two cores stay busy
+        priority: round(_batch.seconds)
         conda:
             "../envs/ddfv.yaml"
         threads: 1
+        # one heavy series at most per batch, the others' estimate under 10 s:
+        # the bounds of a series job hold for a batch
         resources:
             mem_mb=1500,
             runtime=120,
-        # independent of the levels (each run's level is its record's): trimming
-        # or adding levels reruns no level already computed
+        # the settings of the problem's runs, not of the batch's series (each
+        # run's scheme and level are its record path's): regrouping the batches
+        # (other schemes or levels) or trimming levels reruns no run already computed
         params:
-            series=lambda wildcards, problem=_problem: _matrix.series_settings(
-                MATRIX, wildcards.scheme, problem, MATRIX_CODE
-            ),
+            settings=_matrix.problem_settings(MATRIX, _batch.problem, MATRIX_CODE),
         script:
             "../scripts/matrix_run.py"
 

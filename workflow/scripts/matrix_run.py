@@ -1,11 +1,12 @@
-"""One scheme on one problem's refinement series in the benchmark matrix: a
-record and first/last frame per level.
+"""The series of one batch of the benchmark matrix (several schemes on one
+problem, or one heavy series alone): a record and first/last frame per run, a
+log per series.
 
-Called by the rules ``matrix_run_{problem}`` (workflow/rules/matrix.smk); the
-settings of the series come from ``params.series``
-(:func:`mcfbench.studies.matrix.plan.series_settings`), each run's level from
-its record path. The work is
-:func:`mcfbench.studies.matrix.series_job`.
+Called by the rules ``matrix_run_{problem}_batch{k}`` (workflow/rules/matrix.smk);
+the settings shared by the problem's runs come from ``params.settings``
+(:func:`mcfbench.studies.matrix.plan.problem_settings`), each run's scheme and
+level from its record path. The work is
+:func:`mcfbench.studies.matrix.job.batch_job`.
 """
 
 import os
@@ -17,5 +18,5 @@ os.environ.update(dict.fromkeys((*BLAS_THREAD_VARIABLES, "NUMBA_NUM_THREADS"), "
 
 from mcfbench.studies.matrix import job as matrix_job  # noqa: E402
 
-matrix_job.series_job(snakemake.params.series, snakemake.output.records,  # noqa: F821
-                      snakemake.output.frames, snakemake.log[0])  # noqa: F821
+matrix_job.batch_job(snakemake.params.settings, snakemake.output.records,  # noqa: F821
+                     snakemake.output.frames, list(snakemake.log))  # noqa: F821

@@ -1,12 +1,13 @@
 """One run of the benchmark matrix (:func:`job`), the series of one scheme on one
-problem (:func:`series_job`, the Snakemake job) and the robust re-run of a run
-that its solver failed (:func:`robust_rerun`)."""
+problem (:func:`series_job`), several of them in one process (:func:`batch_job`,
+the Snakemake job) and the robust re-run of a run that its solver failed
+(:func:`robust_rerun`)."""
 
 import logging
 
 from mcfbench.running.run import framed_run
 from mcfbench.storage.logs import setup_logging
-from mcfbench.studies.matrix.plan import level_of
+from mcfbench.studies.matrix.plan import level_of, scheme_of
 
 
 def job(settings, record, frames, log_path=None):
@@ -45,12 +46,48 @@ def job(settings, record, frames, log_path=None):
     return result
 
 
+def batch_job(settings, records, frames, logs):
+    """The series of one batch (:func:`~mcfbench.studies.matrix.plan.batches`): the
+    matrix's Snakemake job. Several cheap series in one process save the start-up
+    of every one but the first (importing the harness and loading the compiled
+    kernels, about 1 s each) and Snakemake's work per job; a heavy series has its
+    job to itself. A killed job redoes its own series only. Each series' first
+    run is warmed up as every run is (:func:`mcfbench.running.run.warm_up`, once
+    per scheme in the process, before the clock starts).
+
+    Parameters
+    ----------
+    settings : dict
+        :func:`~mcfbench.studies.matrix.plan.problem_settings`: the scheme and
+        the level of each run are those of its record path, so
+        that the job's params depend neither on the batch's series nor on their
+        levels.
+    records, frames : list of str
+        The paths of every run, series after series
+        (:func:`~mcfbench.studies.matrix.plan.record_path`).
+    logs : list of str
+        One log file per series, in the order of their records.
+
+    Returns
+    -------
+    list of list of RunResult
+        Per series, per level.
+    """
+    series = {}
+    for record, frame in zip(records, frames, strict=True):
+        series.setdefault(scheme_of(record), []).append((record, frame))
+    if len(series) != len(logs):
+        raise ValueError(f"{len(logs)} log files for the {len(series)} series "
+                         f"{list(series)}: give one per series")
+    return [series_job({**settings, "scheme": scheme}, [r for r, _ in runs],
+                       [f for _, f in runs], log)
+            for (scheme, runs), log in zip(series.items(), logs, strict=True)]
+
+
 def series_job(series, records, frames, log_path=None):
     """The runs of one scheme on one problem's refinement series, coarsest first,
-    each :func:`job` (its record and frames written as soon as it is done): the
-    matrix's Snakemake job. One process per series instead of per run saves the
-    start-up of every run but one (importing the harness and loading the compiled
-    kernels, about 1 s each); a killed job redoes the whole series.
+    each :func:`job` (its record and frames written as soon as it is done), logged
+    to ``log_path``.
 
     ``series`` is :func:`~mcfbench.studies.matrix.plan.series_settings`; the level of
     each run is that of its record path, so that the job's params do not depend

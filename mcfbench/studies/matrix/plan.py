@@ -1,8 +1,11 @@
 """The plan of the benchmark matrix: the config key ``matrix`` checked against the
-registries (:func:`plan`), the settings of one run (:func:`run_settings`) and the
-paths of its record and frames (:data:`mcfbench.studies.matrix.RECORD`)."""
+registries (:func:`plan`), the settings of one run (:func:`run_settings`), the
+paths of its record and frames (:data:`mcfbench.studies.matrix.RECORD`) and the
+Snakemake jobs that run the series, several cheap ones in one process
+(:func:`batches`)."""
 
 import re
+from dataclasses import dataclass
 
 from mcfbench.studies.config import ConfigError
 from mcfbench.studies.matrix import FRAMES, RECORD, ROOT, is_mesh_problem
@@ -181,14 +184,21 @@ def frames_path(problem, scheme, level, root=ROOT):
     return FRAMES.format(root=root, problem=problem, scheme=scheme, level=level)
 
 
-def series_settings(plan, scheme, problem, code=""):
-    """What determines every record of one scheme's series on ``problem`` but the
-    level: the params of its Snakemake job, so that adding or removing levels does
-    not rerun the levels already computed."""
-    return {"study": "matrix", "scheme": scheme, "problem": problem,
+def problem_settings(plan, problem, code=""):
+    """What determines every record on ``problem`` but the scheme and the level: the
+    params of its Snakemake jobs (:func:`batches`; each run's scheme and level are
+    those of its record path), so that adding or removing levels or schemes, which
+    regroups the batches, does not rerun the runs already computed."""
+    return {"study": "matrix", "problem": problem,
             "solver": {"method": solver_method(plan, problem), "rtol": plan["rtol"],
                        "maxiter": plan["maxiter"]},
             "code": code}
+
+
+def series_settings(plan, scheme, problem, code=""):
+    """What determines every record of one scheme's series on ``problem`` but the
+    level (:func:`problem_settings` and the scheme)."""
+    return {**problem_settings(plan, problem, code), "scheme": scheme}
 
 
 def run_settings(plan, scheme, problem, level, code=""):
@@ -204,11 +214,122 @@ def level_of(record):
     return int(match.group(1))
 
 
+def scheme_of(record):
+    """The scheme of a run from its record path (:func:`record_path`)."""
+    match = re.search(r"/runs/[^/]+/([^/]+)/level\d+\.json$", str(record))
+    if match is None:
+        raise ValueError(f"{record}: not a matrix record path "
+                         f"(.../runs/<problem>/<scheme>/level<k>.json)")
+    return match.group(1)
+
+
 def planned_runs(plan, code="", root=ROOT):
     """``{record path: settings}`` of every run, problems then schemes then levels."""
     return {record_path(p, s, level, root): run_settings(plan, s, p, level, code)
             for p, levels in plan["problems"].items() for s in plan["schemes"]
             for level in levels}
+
+
+RUN_SECONDS = 0.3
+"""Estimated CPU seconds of a run besides its time steps (:func:`series_seconds`):
+its mesh, its share of the scheme's warm-up, the metrics, the record and frames
+written (measured 2026-11-26: a cut-down matrix of 198 runs in 8 batch jobs took
+64 CPU s besides the kernels' compilation and the tables and figures: 18 s the
+runs' timed flows, the other 46 s (the processes' start-up and Snakemake's work
+included) 0.23 s a run)."""
+
+BATCH_SECONDS = 10.0
+"""Estimated CPU seconds of work a Snakemake job of the matrix gathers at least
+(:func:`batches`): a process's start-up and Snakemake's work per job (about 1 s
+each on the 2-core machine) are then a tenth of it or less."""
+
+
+def series_seconds(plan, scheme, problem):
+    """Estimated CPU seconds of one scheme's series on ``problem``: per level,
+    :data:`RUN_SECONDS` and the time steps' CPU seconds of the cost model
+    (:func:`mcfbench.running.cost.estimate`; the problem's first level is built
+    once per process to know its size). The model gives the order of magnitude
+    only: it tells the heavy series from the cheap ones."""
+    from mcfbench.running.cost import estimate, size
+    from mcfbench.running.problems import get_problem
+    from mcfbench.running.schemes import get_scheme
+
+    entry, problem = get_scheme(scheme), get_problem(problem)
+    return sum(RUN_SECONDS + estimate(entry, *size(entry, problem, level)).seconds
+               for level in plan["problems"][problem.name])
+
+
+@dataclass(frozen=True)
+class Batch:
+    """The series that one Snakemake job of the matrix runs in one process.
+
+    Attributes
+    ----------
+    problem : str
+    index : int
+        Its place among the problem's batches, from 1 (the rule's name:
+        :attr:`name`).
+    schemes : tuple of str
+        Plan order.
+    seconds : float
+        Their estimated CPU seconds (:func:`series_seconds`).
+    """
+
+    problem: str
+    index: int
+    schemes: tuple
+    seconds: float
+
+    @property
+    def name(self):
+        return f"{self.problem}_batch{self.index}"
+
+
+def batches(plan):
+    """The series of the plan gathered into Snakemake jobs: each problem's schemes
+    in plan order (:func:`pack` of their :func:`series_seconds` by
+    :data:`BATCH_SECONDS`), problems in plan order. Deterministic; every series in
+    exactly one batch, a heavy one alone.
+
+    Returns
+    -------
+    list of Batch
+    """
+    gathered = []
+    for problem in plan["problems"]:
+        seconds = {s: series_seconds(plan, s, problem) for s in plan["schemes"]}
+        gathered += [Batch(problem, k, tuple(group), sum(seconds[s] for s in group))
+                     for k, group in enumerate(pack(seconds, BATCH_SECONDS), start=1)]
+    return gathered
+
+
+def pack(costs, budget):
+    """Consecutive groups of the keys of ``costs`` (in its order), each closed when its
+    costs reach ``budget``; a key costing ``budget`` or more is alone.
+
+    Parameters
+    ----------
+    costs : dict
+        Name -> estimated cost.
+    budget : float
+
+    Returns
+    -------
+    list of list
+        Every key in exactly one group, in order but for the heavy ones, each alone
+        where it comes.
+    """
+    groups, group, total = [], [], 0.0
+    for name, cost in costs.items():
+        if cost >= budget:
+            groups.append([name])
+            continue
+        group.append(name)
+        total += cost
+        if total >= budget:
+            groups.append(group)
+            group, total = [], 0.0
+    return groups + [group] if group else groups
 
 
 def picture_runs(plan, root=ROOT):

@@ -27,6 +27,17 @@ def test_size_of_a_level_without_building_its_mesh(scheme, level, points, first)
     assert big == first * 4 ** 11
 
 
+@pytest.mark.parametrize("problem, level", [("real_nut", 0), ("real_bob", 1)])
+def test_size_of_a_committed_mesh_from_its_manifest(problem, level):
+    """The real meshes' counts come from the manifest, without reading the file: the
+    same as the mesh's own."""
+    problem = get_problem(problem)
+    V, F = problem.mesh(level)
+    assert cost.size(get_scheme("ddfv"), problem, level) == \
+        cost.size(get_scheme("ddfv"), problem, level, mesh=(V, F))
+    assert cost.size(get_scheme("cotan"), problem, level)[0] == len(V)
+
+
 MEASURE = """
 import json
 from pathlib import Path

@@ -90,8 +90,56 @@ def test_run_settings_do_not_depend_on_the_other_levels():
     path = matrix_plan.record_path("sphere", "cotan", 1)
     assert matrix_plan.planned_runs(wide)[path] == matrix_plan.planned_runs(narrow)[path]
     assert matrix_plan.level_of(path) == 1
+    assert matrix_plan.scheme_of(path) == "cotan"
+    assert matrix_plan.scheme_of(matrix_plan.record_path("torus", "cotan@bdf2", 2)) == \
+        "cotan@bdf2"
+    with pytest.raises(ValueError, match="not a matrix record path"):
+        matrix_plan.scheme_of("results/matrix/frames/sphere/cotan/level1.npz")
     assert matrix_plan.run_settings(wide, "cotan", "sphere", 3) == \
         {**matrix_plan.series_settings(narrow, "cotan", "sphere"), "level": 3}
+    # a batch job's params: the same whatever the schemes and levels (its batch's)
+    fewer = matrix_plan.plan({"select": {"schemes": ["bgn"], "problems": {"sphere": [2]}}})
+    assert matrix_plan.problem_settings(fewer, "sphere") == \
+        matrix_plan.problem_settings(wide, "sphere")
+    assert matrix_plan.series_settings(wide, "cotan", "sphere") == \
+        {**matrix_plan.problem_settings(wide, "sphere"), "scheme": "cotan"}
+
+
+def test_pack_closes_a_group_at_the_budget_and_leaves_a_heavy_one_alone():
+    costs = {"a": 3.0, "b": 12.0, "c": 4.0, "d": 5.0, "e": 10.0, "f": 1.0}
+    assert matrix_plan.pack(costs, 10.0) == [["b"], ["a", "c", "d"], ["e"], ["f"]]
+    assert matrix_plan.pack({"a": 1.0, "b": 2.0}, 10.0) == [["a", "b"]]
+    assert matrix_plan.pack({}, 10.0) == []
+
+
+def test_batches_hold_every_series_once_the_heavy_ones_alone():
+    """The matrix's Snakemake jobs (plan.batches): deterministic, every planned run in
+    exactly one, a series estimated at BATCH_SECONDS or more alone, the others
+    gathered until their estimate reaches it (the last of a problem may hold less)."""
+    plan = matrix_plan.plan({"select": {
+        "schemes": ["cotan", "bgn", "ddfv", "ddfv-chord-redistribute-carried"],
+        "problems": {"catenoid": [1, 2, 3], "sphere": [1, 2], "real_nut": [0]}}})
+    batches = matrix_plan.batches(plan)
+    assert batches == matrix_plan.batches(plan)
+    assert [b.problem for b in batches] == sorted(
+        (b.problem for b in batches), key=list(plan["problems"]).index)
+    series = [(b.problem, s) for b in batches for s in b.schemes]
+    assert sorted(series) == sorted((p, s) for p in plan["problems"] for s in plan["schemes"])
+    records = [matrix_plan.record_path(b.problem, s, k) for b in batches for s in b.schemes
+               for k in plan["problems"][b.problem]]
+    assert sorted(records) == sorted(matrix_plan.planned_runs(plan))
+    seconds = {(p, s): matrix_plan.series_seconds(plan, s, p) for p, s in series}
+    heavy = {key for key, t in seconds.items() if t >= matrix_plan.BATCH_SECONDS}
+    # catenoid levels 1-3 of the redistributing DDFV: tens of seconds (measured 43 s of CPU)
+    assert ("catenoid", "ddfv-chord-redistribute-carried") in heavy
+    assert ("sphere", "cotan") not in heavy
+    for b in batches:
+        assert b.seconds == pytest.approx(sum(seconds[b.problem, s] for s in b.schemes))
+        assert len(b.schemes) == 1 or not heavy & {(b.problem, s) for s in b.schemes}
+        last = b is [c for c in batches if c.problem == b.problem][-1]
+        assert last or b.seconds >= matrix_plan.BATCH_SECONDS
+    assert {b.name for b in batches if b.problem == "sphere"} == {"sphere_batch1"}
+    assert len({b.name for b in batches}) == len(batches)
 
 
 @pytest.mark.parametrize("section, key", [
@@ -390,8 +438,10 @@ def test_snakemake_dry_run(tmp_path):
         __import__("yaml").safe_load((REPO / "config" / "config.yaml").read_text())["matrix"])
     counts = dict(line.split()[:2] for line in out.stdout.splitlines()
                   if len(line.split()) == 2 and line.split()[1].isdigit())
-    for problem, levels in plan["problems"].items():   # one job per series
-        assert int(counts.get(f"matrix_run_{problem}", 0)) == (len(plan["schemes"]) if levels else 0)
+    batches = matrix_plan.batches(plan)                 # one job per batch
+    assert {f"matrix_run_{b.name}" for b in batches} == \
+        {rule for rule in counts if rule.startswith("matrix_run_")}
+    assert all(int(counts[f"matrix_run_{b.name}"]) == 1 for b in batches)
     assert int(counts["matrix_page"]) == 1  # results/matrix/index.html
     assert int(counts["gallery_run"]) == len(SCHEMES)  # one mesh file, every scheme
     assert "gallery_mesh" not in counts  # a folder given: no generated meshes
@@ -550,6 +600,44 @@ def test_series_job_writes_every_level_and_logs_to_one_file(tmp_path):
     assert read_record(records[1])["l2_error"] == read_record(one)["l2_error"]
     text = log.read_text()
     assert "sphere level 1" in text and "sphere level 2" in text
+
+
+def test_batch_job_runs_each_series_with_its_own_log(tmp_path, monkeypatch):
+    """One Snakemake job, several series: every run's record as the series job's,
+    with the scheme and the level of its path, one log per series; each series'
+    first run warmed up before it is timed, in a process that ran another scheme
+    first too."""
+    from mcfbench.running import run as run_module
+
+    timed, timed_run = [], run_module._timed_run
+
+    def spy(scheme, problem, mesh, tau, steps, **kwargs):
+        timed.append((scheme.name, steps))
+        return timed_run(scheme, problem, mesh, tau, steps, **kwargs)
+
+    monkeypatch.setattr(run_module, "_warmed", set())       # as a fresh process
+    monkeypatch.setattr(run_module, "_timed_run", spy)
+    plan = matrix_plan.plan({"select": {"schemes": ["cotan", "bgn"],
+                                        "problems": {"sphere": [1]}}})
+    runs = matrix_plan.planned_runs(plan, code="test", root=str(tmp_path))
+    records = list(runs)
+    frames = [r.replace("/runs/", "/frames/").removesuffix(".json") + ".npz" for r in records]
+    logs = [tmp_path / "cotan.log", tmp_path / "bgn.log"]
+    settings = matrix_plan.problem_settings(plan, "sphere", code="test")
+    with pytest.raises(ValueError, match=r"1 log files for the 2 series \['cotan', 'bgn'\]"):
+        matrix_job.batch_job(settings, records, frames, logs[:1])
+    results = matrix_job.batch_job(settings, records, frames, logs)
+    assert [[(r.scheme, r.level) for r in series] for series in results] == \
+        [[("cotan", 1)], [("bgn", 1)]]
+    assert [read_record(r)["settings"] for r in records] == list(runs.values())
+    assert all(Path(f).stat().st_size > 0 for f in frames)
+    for log, other in (logs, logs[::-1]):
+        assert f"{log.stem} on sphere level 1" in log.read_text()
+        assert f"{other.stem} on sphere" not in log.read_text()
+    # the warm-up's steps, then level 1's (2 steps; timed again while under 10 ms)
+    assert [call for k, call in enumerate(timed) if k == 0 or timed[k - 1] != call] == \
+        [("cotan", run_module.WARM_UP_STEPS), ("cotan", 2),
+         ("bgn", run_module.WARM_UP_STEPS), ("bgn", 2)]
 
 
 def test_the_main_metric_is_decided_once_in_the_long_table():
