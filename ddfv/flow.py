@@ -192,30 +192,22 @@ class Flow:
         if tangential == "redistribute":
             self.timings["potential"] = 0.0
 
-    @cached_property
-    def _caller(self):
-        """``(X, F)``: the current state in the caller's numbering, (3, n_f + n_t), and
-        its F-vertices (n_f, 3) C-contiguous, gathered once per state (the driver's
-        checks, the monitors and the error (3.2) each ask for them every step)."""
-        X = np.take(self._X, self._external, axis=1)
-        return X, np.ascontiguousarray(X[:, :self._mesh.n_f].T)
-
     @property
     def X(self):
         """(3, n_f + n_t) ``[F^n; T^n]`` by components, caller's numbering (read-only copy)."""
-        X = self._caller[0].copy()
+        X = np.take(self._X, self._external, axis=1)
         X.flags.writeable = False
         return X
 
     @property
     def F(self):
-        """(n_f, 3) the F-vertices ``F^n`` (a C-contiguous copy)."""
-        return self._caller[1].copy()
+        """(n_f, 3) the F-vertices ``F^n`` (a copy)."""
+        return np.take(self._X, self._external[:self._mesh.n_f], axis=1).T
 
     @property
     def T(self):
         """(n_t, 3) the T-vertices ``T^n`` (a copy)."""
-        return self._caller[0][:, self._mesh.n_f:].T.copy()
+        return np.take(self._X, self._external[self._mesh.n_f:], axis=1).T
 
     @property
     def t(self):
@@ -373,7 +365,7 @@ class Flow:
                                           self._lambda0).T
         self._X = X
         self.n += 1
-        for name in ("_state", "_barycentric", "_caller"):
+        for name in ("_state", "_barycentric"):
             self.__dict__.pop(name, None)
 
     def _moved_tangentially(self, X):
