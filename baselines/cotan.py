@@ -474,14 +474,16 @@ class VertexFlow:
             return [("degenerated", f"{g.degenerate} triangle(s) of zero area (no cotangent "
                      f"weights), e.g. triangle {g.first_degenerate}")]
         area = self._triangle_checks[1]
-        collapsed = np.flatnonzero(~(area > max(COLLAPSED * area.mean(),
-                                                1e-2 * COLLAPSED * self._area0)))
+        threshold = max(COLLAPSED * area.mean(), 1e-2 * COLLAPSED * self._area0)
+        # the minimum first (one pass; NaN fails it): the indices only for a message
+        collapsed = np.flatnonzero(~(area > threshold)) if not area.min() > threshold else ()
         if len(collapsed):
             return [("degenerated", f"{len(collapsed)} triangle(s) collapsed (area below "
                      f"{COLLAPSED:g} x the mean or 1e-12 x the initial mean), e.g. triangle "
                      f"{int(collapsed[0])}")]
         cosine = self._normal_agreement()
-        flipped = np.flatnonzero(~(cosine >= 0.0) & ~self._flipped0)
+        flipped = np.flatnonzero(~(cosine >= 0.0) & ~self._flipped0) \
+            if not cosine.min() >= 0.0 else ()
         if len(flipped):
             worst = flipped[np.argmin(cosine[flipped])]
             return [("inverted", f"triangle {int(worst)} flipped against its neighbours "

@@ -302,53 +302,58 @@ def flux_coefficients_kernel(gamma_t, gamma_f, J, len_u, len_v, uv):
 
 
 @numba.njit(**_OPTIONS, inline="always")
-def _scatter_entries(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, order, lo, hi, data):
+def _scatter_entries(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, rows, scale, order,
+                     lo, hi, data):
     """The diamonds ``order[lo:hi]`` of :func:`system_kernel`."""
     for j in range(lo, hi):
         d = order[j]
         alpha, beta, alpha_hat, beta_hat = flux_coefficients_kernel(
             gamma_t[d], gamma_f[d], J[d], len_u[d], len_v[d], uv[d])
         s = slots[d]
+        r = rows[d]
+        s_a, s_b, s_t1 = scale[r[0]], scale[r[1]], scale[r[2]]
         # F-rows: flux_a = alpha (f_b - f_a) - beta (f_t2 - f_t1) = -flux_b
-        data[s[SLOT_AB]] = -alpha
-        data[s[SLOT_BA]] = -alpha
-        data[s[SLOT_AA]] += alpha
-        data[s[SLOT_BB]] += alpha
-        data[s[SLOT_A_T1]] -= beta
-        data[s[SLOT_B_T1]] += beta
+        data[s[SLOT_AB]] = -(alpha * s_a)
+        data[s[SLOT_BA]] = -(alpha * s_b)
+        data[s[SLOT_AA]] += alpha * s_a
+        data[s[SLOT_BB]] += alpha * s_b
+        data[s[SLOT_A_T1]] -= beta * s_a
+        data[s[SLOT_B_T1]] += beta * s_b
         if inner[d]:
-            data[s[SLOT_A_T2]] += beta
-            data[s[SLOT_B_T2]] -= beta
+            s_t2 = scale[r[3]]
+            data[s[SLOT_A_T2]] += beta * s_a
+            data[s[SLOT_B_T2]] -= beta * s_b
             # T-rows: flux_t1 = alpha_hat (f_t2 - f_t1) - beta_hat (f_b - f_a) = -flux_t2
-            data[s[SLOT_T1_A]] -= beta_hat
-            data[s[SLOT_T1_B]] += beta_hat
-            data[s[SLOT_T2_A]] += beta_hat
-            data[s[SLOT_T2_B]] -= beta_hat
-            data[s[SLOT_T1_T2]] = -alpha_hat
-            data[s[SLOT_T2_T1]] = -alpha_hat
-            data[s[SLOT_T1_T1]] += alpha_hat
-            data[s[SLOT_T2_T2]] += alpha_hat
+            data[s[SLOT_T1_A]] -= beta_hat * s_t1
+            data[s[SLOT_T1_B]] += beta_hat * s_t1
+            data[s[SLOT_T2_A]] += beta_hat * s_t2
+            data[s[SLOT_T2_B]] -= beta_hat * s_t2
+            data[s[SLOT_T1_T2]] = -(alpha_hat * s_t1)
+            data[s[SLOT_T2_T1]] = -(alpha_hat * s_t2)
+            data[s[SLOT_T1_T1]] += alpha_hat * s_t1
+            data[s[SLOT_T2_T2]] += alpha_hat * s_t2
         else:
             # f_t2 = f_a + f_b - f_t1 in the T-equation (Section 2.2.5)
-            data[s[SLOT_T1_A]] -= beta_hat + alpha_hat
-            data[s[SLOT_T1_B]] += beta_hat - alpha_hat
-            data[s[SLOT_T1_T1]] += 2.0 * alpha_hat
+            data[s[SLOT_T1_A]] -= (beta_hat + alpha_hat) * s_t1
+            data[s[SLOT_T1_B]] += (beta_hat - alpha_hat) * s_t1
+            data[s[SLOT_T1_T1]] += (2.0 * alpha_hat) * s_t1
 
 
 @numba.njit("void(boolean[::1], float64[:], float64[:], float64[:], float64[:], float64[:], "
-            "float64[:], uint32[:, ::1], uint64[::1], uint64[::1], uint32[::1], uint32[::1], "
-            "float64[::1], float64, float64[::1])", **_OPTIONS)
-def system_kernel(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, order, starts, indptr,
-                  diag, scale, shift, data):
+            "float64[:], uint32[:, ::1], uint32[:, ::1], uint64[::1], uint64[::1], "
+            "uint32[::1], uint32[::1], float64[::1], float64, float64[::1])", **_OPTIONS)
+def system_kernel(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, rows, order, starts,
+                  indptr, diag, scale, shift, data):
     """Values of ``diag(scale) K + shift I`` in a fixed CSR pattern (2.10)-(2.15).
 
-    Each diamond scatters its entries of ``K`` (minus its fluxes, see
-    :mod:`ddfv.assembly`) into their CSR slots, the blocks of
+    One pass over the rows sets the values to ``shift I``; then each diamond
+    adds its entries of ``K`` (minus its fluxes, see :mod:`ddfv.assembly`),
+    each times the ``scale`` of its row, into their CSR slots, the blocks of
     :meth:`ddfv.topology.DiamondMesh.diamond_blocks` one per thread, then
-    the diamonds across blocks; one pass over the rows then scales them and
-    adds ``shift`` on the diagonal. The slots, ``indptr`` and ``diag`` come
-    from :class:`ddfv.assembly.Assembler` (positions in its CSR pattern, all
-    below ``nnz`` by construction) and are not checked here.
+    the diamonds across blocks. The slots, ``rows``, ``indptr`` and ``diag``
+    come from :class:`ddfv.assembly.Assembler` (positions in its CSR
+    pattern and rows, all in range by construction) and are not checked
+    here.
 
     Parameters
     ----------
@@ -359,6 +364,9 @@ def system_kernel(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, order, st
     slots : (n_d, N_SLOTS) uint32 array
         CSR position of each entry of the diamond (``SLOT_*``); the ``t2``
         slots of boundary diamonds are unused.
+    rows : (n_d, 4) uint32 array
+        The rows ``a, b, n_f + t1, n_f + t2`` of each diamond (the last unused
+        on boundary diamonds).
     order, starts : uint64 arrays
         The diamond blocks.
     indptr : (n + 1,) uint32 array
@@ -372,17 +380,13 @@ def system_kernel(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, order, st
     for i in numba.prange(n):
         for j in range(indptr[i], indptr[i + 1]):
             data[j] = 0.0
+        data[diag[i]] = shift
     parts = starts.shape[0] - 2
     for k in numba.prange(parts):
-        _scatter_entries(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, order,
-                         starts[k], starts[k + 1], data)
-    _scatter_entries(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, order,
+        _scatter_entries(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, rows, scale,
+                         order, starts[k], starts[k + 1], data)
+    _scatter_entries(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, rows, scale, order,
                      starts[parts], starts[parts + 1], data)
-    for i in numba.prange(n):
-        s_i = scale[i]
-        for j in range(indptr[i], indptr[i + 1]):
-            data[j] *= s_i
-        data[diag[i]] += shift
 
 
 @numba.njit("float64(float64)", **_OPTIONS, inline="always")

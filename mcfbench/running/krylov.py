@@ -36,6 +36,28 @@ BREAKDOWN_DETAILS = {
 _JIT = dict(cache=True, error_model="numpy", nogil=True)
 
 
+@njit(**_JIT, inline="always")
+def _row3(indptr, indices, data, X, i):
+    """Row ``i`` of ``A`` times the three rows of ``X``, summed in CSR order, with the
+    row's sum and absolute sum: ``(A X_0)_i, (A X_1)_i, (A X_2)_i, sum_j a_ij,
+    sum_j |a_ij|`` (:func:`spmv` and :func:`residual`; inlined, the sums a caller
+    does not use are not computed)."""
+    y0 = 0.0
+    y1 = 0.0
+    y2 = 0.0
+    rs = 0.0
+    ra = 0.0
+    for jj in range(indptr[i], indptr[i + 1]):
+        a = data[jj]
+        j = indices[jj]
+        y0 += a * X[0, j]
+        y1 += a * X[1, j]
+        y2 += a * X[2, j]
+        rs += a
+        ra += abs(a)
+    return y0, y1, y2, rs, ra
+
+
 @njit(**_JIT)
 def spmv(indptr, indices, data, X, Y, R):
     """``Y = A X`` row by row of ``X``; returns ``(R, Y)`` and ``(Y, Y)`` (Frobenius).
@@ -48,15 +70,7 @@ def spmv(indptr, indices, data, X, Y, R):
     yy = 0.0
     if k == 3:
         for i in prange(m):
-            y0 = 0.0
-            y1 = 0.0
-            y2 = 0.0
-            for jj in range(indptr[i], indptr[i + 1]):
-                a = data[jj]
-                j = indices[jj]
-                y0 += a * X[0, j]
-                y1 += a * X[1, j]
-                y2 += a * X[2, j]
+            y0, y1, y2, _, _ = _row3(indptr, indices, data, X, i)
             Y[0, i] = y0
             Y[1, i] = y1
             Y[2, i] = y2
@@ -112,19 +126,7 @@ def residual(indptr, indices, data, b, x, cmean, cfull, r):
         c1 = cmean[1]
         c2 = cmean[2]
         for i in prange(m):
-            a0 = 0.0
-            a1 = 0.0
-            a2 = 0.0
-            rs = 0.0
-            ra = 0.0
-            for jj in range(indptr[i], indptr[i + 1]):
-                a = data[jj]
-                j = indices[jj]
-                a0 += a * x[0, j]
-                a1 += a * x[1, j]
-                a2 += a * x[2, j]
-                rs += a
-                ra += abs(a)
+            a0, a1, a2, rs, ra = _row3(indptr, indices, data, x, i)
             nan_a += ra * 0.0
             norm_a = max(norm_a, ra)
             width = max(width, np.int64(indptr[i + 1] - indptr[i]))

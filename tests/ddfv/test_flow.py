@@ -68,6 +68,24 @@ def test_public_arrays_are_in_the_callers_numbering(bumpy):
     np.testing.assert_allclose(flow.covolumes, np.r_[chi_f, chi_t], rtol=1e-13)
 
 
+def test_public_arrays_are_copies_of_the_current_state(bumpy):
+    """Writing into the arrays that F and T return leaves the flow's state alone; after
+    a step F, T and X are those of the new state."""
+    V, F = bumpy
+    flow = Flow(V, F, 0.01)
+    T0 = flow.T.copy()
+    F1, T1 = flow.F, flow.T
+    F1[:] = 0.0
+    T1[:] = 0.0
+    np.testing.assert_array_equal(flow.F, V)
+    np.testing.assert_array_equal(flow.T, T0)
+    flow.advance(2.0 * flow.state)
+    X = flow.X
+    np.testing.assert_array_equal(flow.F, 2.0 * V)
+    np.testing.assert_array_equal(X[:, :len(V)].T, flow.F)
+    np.testing.assert_array_equal(X[:, len(V):].T, flow.T)
+
+
 def test_trajectory_invariant_under_relabelling(bumpy):
     V, F = bumpy
     rng = np.random.default_rng(5)

@@ -1,0 +1,116 @@
+"""The sphere of Table 3.1 at one level: the tree of a git revision against the working tree.
+
+Paired A/B for a change whose gain is smaller than the noise of a shared
+machine: two persistent child processes pinned to the same core, one
+importing the tree at ``--rev`` (``git archive`` into a temporary
+directory), one this working tree, each warmed up on levels 1 and 4 of
+every scheme, then ``_harness.harness_run(scheme, "sphere", level)``
+(:func:`mcfbench.running.run.run` as the command line runs it) in each
+alternately, the order reversed every other pair. Prints per scheme the
+medians of the wall and CPU seconds, the median of the paired ratios
+(working tree / revision), iterations and L2 error (3.2) of both.
+
+    python benchmarks/bench_ab.py --rev 951fb48 [--level 5] [--repeats 5]
+        [--schemes ddfv cotan]
+"""
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    os.environ[_var] = "1"          # before numpy is imported; the children inherit them
+
+import argparse  # noqa: E402
+import json  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import tempfile  # noqa: E402
+
+from _harness import ROOT, machine_line, median, one_core  # noqa: E402
+
+_CHILD = r'''
+import json, os, sys
+sys.path[:0] = [os.getcwd(), os.path.join(os.getcwd(), "benchmarks")]
+from _harness import harness_run
+from mcfbench.storage.memory import tune_malloc
+tune_malloc()
+import ddfv
+for scheme in sys.argv[1:]:
+    harness_run(scheme, 1)
+    harness_run(scheme, 4)
+print(json.dumps({"ready": ddfv.__file__}), flush=True)
+for line in sys.stdin:
+    scheme, level = line.split()
+    r, _ = harness_run(scheme, int(level))
+    print(json.dumps({"wall": r.wall_seconds, "cpu": r.cpu_seconds, "status": r.status,
+                      "iterations": r.iterations, "l2": r.metrics.get("l2_error")}),
+          flush=True)
+'''
+
+
+class Tree:
+    """A persistent child process running the sphere in the tree ``path``."""
+
+    def __init__(self, path, schemes):
+        self.path = str(path)
+        self.proc = subprocess.Popen([sys.executable, "-c", _CHILD, *schemes], cwd=self.path,
+                                     env={**os.environ, "PYTHONPATH": self.path},
+                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        ready = json.loads(self.proc.stdout.readline())["ready"]
+        if not ready.startswith(self.path):
+            raise RuntimeError(f"the child in {self.path} imported {ready}")
+
+    def run(self, scheme, level):
+        self.proc.stdin.write(f"{scheme} {int(level)}\n")
+        self.proc.stdin.flush()
+        line = self.proc.stdout.readline()
+        if not line:
+            raise RuntimeError(f"the child in {self.path} died ({scheme}, level {level})")
+        result = json.loads(line)
+        if result["status"] != "ok":
+            raise RuntimeError(f"{scheme} level {level} in {self.path}: {result['status']}")
+        return result
+
+    def close(self):
+        self.proc.stdin.close()
+        self.proc.wait(timeout=60)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rev", required=True, help="the tree to compare against (git revision)")
+    parser.add_argument("--level", type=int, default=5)
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--schemes", nargs="+", default=["ddfv", "cotan"])
+    args = parser.parse_args(argv)
+    one_core()
+    print(f"bench_ab: {machine_line()}")
+    with tempfile.TemporaryDirectory(prefix=f"ab-{args.rev}-") as tree:
+        archive = subprocess.run(["git", "archive", args.rev], cwd=ROOT, capture_output=True,
+                                 check=True).stdout
+        subprocess.run(["tar", "-x", "-C", tree], input=archive, check=True)
+        trees = {"rev": Tree(tree, args.schemes), "work": Tree(ROOT, args.schemes)}
+        runs = {(k, s): [] for k in trees for s in args.schemes}
+        try:
+            for rep in range(args.repeats):
+                for scheme in args.schemes:
+                    for k in (("rev", "work") if rep % 2 == 0 else ("work", "rev")):
+                        runs[k, scheme].append(trees[k].run(scheme, args.level))
+        finally:
+            for t in trees.values():
+                t.close()
+    print(f"sphere level {args.level}, {args.repeats} pairs, interleaved; {args.rev} = rev, "
+          "the working tree = work; ratios: medians of the paired work / rev")
+    for scheme in args.schemes:
+        a, b = runs["rev", scheme], runs["work", scheme]
+        print(f"{scheme:>8}: rev wall {median(r['wall'] for r in a):.3f} s, CPU "
+              f"{median(r['cpu'] for r in a):.3f} s | work wall "
+              f"{median(r['wall'] for r in b):.3f} s, CPU {median(r['cpu'] for r in b):.3f} s | "
+              f"work / rev wall {median(y['wall'] / x['wall'] for x, y in zip(a, b)):.3f}, CPU "
+              f"{median(y['cpu'] / x['cpu'] for x, y in zip(a, b)):.3f} | iterations "
+              f"{a[0]['iterations']} / {b[0]['iterations']}, L2 {a[0]['l2']:.6e} / "
+              f"{b[0]['l2']:.6e}")
+    print(f"load average at the end: {machine_line()}")
+
+
+if __name__ == "__main__":
+    main()
