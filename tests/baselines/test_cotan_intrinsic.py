@@ -5,7 +5,8 @@ import pytest
 from conftest import cylinder, twin_sphere
 
 from baselines.cotan import CotanFlow, cotangent_laplacian, lumped_mass
-from baselines.cotan_intrinsic import IntrinsicCotanFlow, intrinsic_operators
+from baselines.cotan_intrinsic import (FLIP_BELOW, IntrinsicCotanFlow, intrinsic_operators,
+                                      is_intrinsic_delaunay)
 from mcfbench.geometry.exact import SphereL2Error, eoc
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate
@@ -112,3 +113,60 @@ def test_twin_point_sphere_completes_where_cotan_inverts():
 def test_bad_mollify_is_named(mollify):
     with pytest.raises(ValueError, match="mollify must be a finite number >= 0"):
         IntrinsicCotanFlow(*icosphere(1), 0.01, mollify=mollify)
+
+
+def planar_quad(weight):
+    """Two triangles on the edge (0, 1) from (-1, 0) to (1, 0), apexes (0, +-c): the edge's
+    weight ``(cot alpha + cot beta) / 2 = (c^2 - 1) / (2 c)`` set to ``weight``."""
+    c = weight + np.sqrt(weight ** 2 + 1.0)
+    V = np.array([[-1.0, 0, 0], [1, 0, 0], [0, c, 0], [0, -c, 0]])
+    return V, np.array([[0, 1, 2], [1, 0, 3]])
+
+
+@pytest.mark.parametrize("weight, delaunay", [(0.3, True), (-2e-7, True), (-8e-7, False),
+                                              (-3e-6, False), (-0.3, False)])
+def test_the_mesh_operators_are_taken_exactly_where_the_package_would_not_flip(weight, delaunay):
+    """The package keeps an edge of weight above ``FLIP_BELOW`` = -1e-6 (-8e-7: kept) and
+    flips one below (-3e-6: the other diagonal gets the weight ``3e-6``); the mesh's operators are
+    taken above ``FLIP_BELOW / 4`` only, and there they are the package's to round-off."""
+    V, F = planar_quad(weight)
+    flow = IntrinsicCotanFlow(V, F, 0.01)
+    L, mass = intrinsic_operators(V, F)
+    kept = L[0, 1] == pytest.approx(-weight, rel=1e-6)         # L_ab = -weight
+    assert kept == (weight > FLIP_BELOW)
+    assert kept or L[2, 3] == pytest.approx(weight, rel=1e-6)
+    assert is_intrinsic_delaunay(V, flow.mesh, flow.geometry.L_data,
+                                 flow.assembler.pattern.edge_slots) == delaunay
+    L_flow, mass_flow = flow.operators()
+    np.testing.assert_allclose(L_flow.toarray(), L.toarray(), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(mass_flow, mass, rtol=1e-15)
+
+
+def test_a_sliver_within_the_mollification_margin_takes_the_package():
+    """A triangle whose longest side is within 2 x 1e-5 x the mean edge length of the
+    sum of the other two is left to the package (it mollifies there), with every edge
+    weight passing; 10 x further it is not."""
+    for height, expected in [(1e-3, False), (1e-2, True)]:
+        # la + lb - lc = 2 sqrt(1 + h^2) - 2 ~ h^2, the mean edge length ~ 1.3
+        V = np.array([[-1.0, 0, 0], [1, 0, 0], [0, height, 0]])
+        F = np.array([[0, 1, 2]])
+        flow = IntrinsicCotanFlow(V, F, 0.01)
+        zero = np.zeros_like(flow.geometry.L_data)
+        assert is_intrinsic_delaunay(V, flow.mesh, zero,
+                                     flow.assembler.pattern.edge_slots) == expected
+
+
+def test_along_the_catenoid_flow_every_step_takes_the_mesh_operators():
+    """The open 24 x 8 cylinder stays Delaunay along its flow to the catenoid: all 200
+    systems from the mesh, the trajectory the package's to round-off (a run that calls
+    the package at every step: its test of the mesh made to refuse)."""
+    V, F = cylinder(24, 8)
+    fast = IntrinsicCotanFlow(V, F, 0.005)
+    traj = simulate(fast, 200, solver=EXACT, save_every=50)
+    assert fast.delaunay_steps == 200
+    slow = IntrinsicCotanFlow(V, F, 0.005)
+    slow._delaunay_geometry = lambda at: None
+    reference = simulate(slow, 200, solver=EXACT, save_every=50)
+    assert slow.delaunay_steps == 0
+    np.testing.assert_allclose(traj.frames["vertices"], reference.frames["vertices"], rtol=0,
+                               atol=1e-13)
