@@ -200,10 +200,9 @@ def flipped_operators(vertices, mesh, L, mass, flip):
     rows, cols, values, mass = [], [], [], mass.copy()
     for corners, opposite, sign in triangles:
         l2 = [side ** 2 for side in opposite]
-        area = 0.25 * np.sqrt(np.maximum(
-            (opposite[0] + opposite[1] + opposite[2]) * (-opposite[0] + opposite[1] + opposite[2])
-            * (opposite[0] - opposite[1] + opposite[2]) * (opposite[0] + opposite[1] - opposite[2]),
-            0.0))
+        x, y, z = opposite
+        area = 0.25 * np.sqrt(np.maximum((x + y + z) * (-x + y + z) * (x - y + z) * (x + y - z),
+                                         0.0))                                   # Heron
         for k in range(3):
             p, q = corners[(k + 1) % 3], corners[(k + 2) % 3]
             w = sign * (l2[(k + 1) % 3] + l2[(k + 2) % 3] - l2[k]) / (8.0 * area)   # cot / 2
