@@ -110,9 +110,9 @@ def edges_to_flip(vertices, mesh, L_data, edge_slots, mollify=MOLLIFY):
     when: a triangle is within twice the mollification's margin of degenerate
     (``la + lb - lc < 2 delta``, ``delta = mollify`` x the mean edge length: the
     package's ``epsilon`` would not be 0); a weight is within :data:`MARGIN` of the
-    threshold; a boundary edge would flip; two edges to flip share a triangle, or
-    a triangle of one has a boundary edge. :func:`flipped_operators` checks the rest
-    (no edge below the threshold after the round).
+    threshold; a boundary edge would flip; two edges to flip share a triangle.
+    :func:`flipped_operators` checks the rest (no edge below the threshold after
+    the round).
 
     Parameters
     ----------
@@ -141,7 +141,7 @@ def edges_to_flip(vertices, mesh, L_data, edge_slots, mollify=MOLLIFY):
         return None
     flip = np.flatnonzero(cover < FLIP_BELOW)
     faces = mesh.edge_faces[flip].ravel()
-    if (len(faces) and np.bincount(faces).max() > 1) or boundary[mesh.face_edges[faces]].any():
+    if len(faces) and np.bincount(faces).max() > 1:
         return None
     return flip
 
@@ -149,7 +149,8 @@ def edges_to_flip(vertices, mesh, L_data, edge_slots, mollify=MOLLIFY):
 def flipped_operators(vertices, mesh, L, mass, flip):
     """``(L, mass)`` of the triangulation of ``mesh`` with the edges ``flip`` flipped
     (:func:`edges_to_flip`), or None when an edge of it is still below :data:`FLIP_BELOW`
-    (or within :data:`MARGIN` of it) or a new edge is already one.
+    (or within :data:`MARGIN` of it; a boundary edge with twice its weight, as in the
+    tufted cover) or a new edge is already one.
 
     Each edge ``(a, b)`` between the triangles ``(a, b, c)`` and ``(b, a, d)``
     becomes ``(c, d)``, of the length of the planar unfolding of the two
@@ -214,7 +215,10 @@ def flipped_operators(vertices, mesh, L, mass, flip):
                                                     np.concatenate(cols))), shape=(n, n))
     L = (L + delta).tocsr()
     off = L.tocoo()
-    if np.any(-off.data[off.row != off.col] < FLIP_BELOW + MARGIN):
+    rim = mesh.edges[mesh.edge_faces[:, 1] < 0]            # boundary: twice in the cover
+    boundary = np.asarray(L[rim[:, 0], rim[:, 1]]).ravel() if len(rim) else np.zeros(0)
+    if np.any(-off.data[off.row != off.col] < FLIP_BELOW + MARGIN) or np.any(
+            -2.0 * boundary < FLIP_BELOW + MARGIN):
         return None
     return L, mass
 
