@@ -6,8 +6,9 @@ Per level, the shrinking sphere (Table 3.1's time step, to ``t = 0.08`` or
 interleaved (``cotan`` first on even repeats, last on odd ones), after a
 warm-up on level 1 so that no compilation is timed. Prints the median
 milliseconds per step and per assembly (``flow.timings["assembly"]``: for
-``cotan-intrinsic`` the intrinsic Delaunay triangulation, its Laplacian and
-mass built by ``robust_laplacian.mesh_laplacian``, and the row scaling) of
+``cotan-intrinsic`` the intrinsic Delaunay triangulation's Laplacian and mass,
+from the mesh where it is that triangulation or one round of flips away, else
+from ``robust_laplacian.mesh_laplacian``, and the row scaling) of
 each, and their ratios, measured in this run. Usage::
 
     python benchmarks/bench_intrinsic.py [--levels 3 4 5] [--repeats 5] [--steps 32]

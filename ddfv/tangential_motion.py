@@ -71,7 +71,8 @@ KINDS = ("bgn", "mdr")
 
 
 def p1_stiffness(F, faces):
-    """The P1 (cotangent) stiffness ``A = -igl.cotmatrix`` of the F-mesh.
+    """The P1 (cotangent) stiffness ``A = -igl.cotmatrix`` of the F-mesh (the libigl
+    reference of :class:`P1Stiffness`, which a flow uses).
 
     Parameters
     ----------
@@ -84,6 +85,45 @@ def p1_stiffness(F, faces):
         ``A_kj = int grad phi_k . grad phi_j``, symmetric positive semi-definite.
     """
     return sp.csr_matrix(-igl.cotmatrix(np.asarray(F, dtype=float), faces))
+
+
+class P1Stiffness:
+    """:func:`p1_stiffness` of the states of one F-mesh, in a CSR pattern found once.
+
+    ``igl.cotmatrix_entries`` gives the half cotangents ``w_{t,k} = cot(angle_k) / 2``
+    of every corner (the weight of the edge ``(a, b)`` opposite corner ``k`` of
+    triangle ``t``); ``A_ab = -sum w``, ``A_aa = A_bb = +sum w`` over the corners
+    facing the edge, summed with ``np.bincount`` into the slots of a pattern (the
+    edges and the diagonal, rows and columns sorted) built on the first call:
+    ``-igl.cotmatrix`` to round-off (its triplet assembly sums in another order)
+    at a tenth of its cost (3.2 -> 0.3 ms on the catenoid's level 3, 6 144
+    triangles). The pattern keeps every edge, also one whose weight vanishes.
+
+    Parameters
+    ----------
+    faces : (m, 3) int array
+    n : int
+        Vertices.
+    """
+
+    def __init__(self, faces, n):
+        self.faces = np.ascontiguousarray(faces, dtype=np.int64)
+        a = self.faces[:, [1, 2, 0]].T                     # (3, m): corner k's edge (a, b)
+        b = self.faces[:, [2, 0, 1]].T
+        rows = np.concatenate([a, b, a, b]).ravel()
+        cols = np.concatenate([b, a, a, b]).ravel()
+        keys, self._slots = np.unique(rows * n + cols, return_inverse=True)
+        self._sign = np.repeat([-1.0, -1.0, 1.0, 1.0], a.size)
+        self.indices = (keys % n).astype(np.int32)
+        self.indptr = np.searchsorted(keys // n, np.arange(n + 1)).astype(np.int32)
+        self.shape = (n, n)
+
+    def __call__(self, F):
+        """``A`` (n, n) CSR at the F-vertices ``F`` (n, 3)."""
+        w = igl.cotmatrix_entries(np.asarray(F, dtype=np.float64), self.faces).T.ravel()
+        data = np.bincount(self._slots, weights=np.tile(w, 4) * self._sign,
+                           minlength=len(self.indices))
+        return sp.csr_matrix((data, self.indices, self.indptr), shape=self.shape)
 
 
 def tangent_bases(N):
@@ -155,6 +195,7 @@ class TangentialMotion(KeptFactorSolver):
         self.fixed = None if fixed is None else np.asarray(fixed, bool)
         self._t1 = None
         self._layout = None
+        self._stiffness = None
 
     def __call__(self, F_old, F_new, N):
         """The F-vertices of (TM1): ``F_new`` moved in the tangent planes of ``N``.
@@ -176,7 +217,9 @@ class TangentialMotion(KeptFactorSolver):
         """
         F_old, F_new = np.asarray(F_old, dtype=float), np.asarray(F_new, dtype=float)
         free = np.ones(len(F_new), bool) if self.fixed is None else ~self.fixed
-        A = p1_stiffness(F_old, self.faces)
+        if self._stiffness is None or self._stiffness.shape[0] != len(F_old):
+            self._stiffness = P1Stiffness(self.faces, len(F_old))
+        A = self._stiffness(F_old)
         Y = F_new if self.kind == "bgn" else F_new - F_old
         AY = (A @ Y)[free]                                           # (A Y)_k, free k
         bases = [t[free] for t in self._bases(np.asarray(N, dtype=float))]

@@ -5,7 +5,8 @@ import pytest
 from conftest import cylinder, table_3_1_error, twin_sphere
 
 from baselines.cotan import CotanFlow, cotangent_laplacian, lumped_mass
-from baselines.cotan_intrinsic import IntrinsicCotanFlow, intrinsic_operators
+from baselines.cotan_intrinsic import (FLIP_BELOW, IntrinsicCotanFlow, edges_to_flip,
+                                      intrinsic_operators)
 from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate
@@ -104,3 +105,83 @@ def test_twin_point_sphere_completes_where_cotan_inverts():
 def test_bad_mollify_is_named(mollify):
     with pytest.raises(ValueError, match="mollify must be a finite number >= 0"):
         IntrinsicCotanFlow(*icosphere(1), 0.01, mollify=mollify)
+
+
+def planar_quad(weight):
+    """Two triangles on the edge (0, 1) from (-1, 0) to (1, 0), apexes (0, +-c): the edge's
+    weight ``(cot alpha + cot beta) / 2 = (c^2 - 1) / (2 c)`` set to ``weight``."""
+    c = weight + np.sqrt(weight ** 2 + 1.0)
+    V = np.array([[-1.0, 0, 0], [1, 0, 0], [0, c, 0], [0, -c, 0]])
+    return V, np.array([[0, 1, 2], [1, 0, 3]])
+
+
+@pytest.mark.parametrize("weight, flips", [(0.3, 0), (-2e-7, 0), (-8e-7, 0), (-3e-6, 1),
+                                           (-0.3, 1)])
+def test_the_mesh_operators_flip_exactly_where_the_package_does(weight, flips):
+    """The package keeps an edge of weight above ``FLIP_BELOW`` = -1e-6 (-8e-7: kept) and
+    flips one below (-3e-6: the other diagonal gets the weight ``3e-6``); so do the
+    mesh's operators (:func:`edges_to_flip`, a flip next to the boundary, whose edges
+    count twice in the tufted cover), and they are the package's to round-off."""
+    V, F = planar_quad(weight)
+    flow = IntrinsicCotanFlow(V, F, 0.01)
+    L, mass = intrinsic_operators(V, F)
+    kept = L[0, 1] == pytest.approx(-weight, rel=1e-6)         # L_ab = -weight
+    assert kept == (weight > FLIP_BELOW)
+    assert kept or L[2, 3] == pytest.approx(weight, rel=1e-6)
+    flip = edges_to_flip(V, flow.mesh, flow.geometry.L_data, flow.assembler.pattern.edge_slots)
+    assert len(flip) == flips
+    L_flow, mass_flow = flow.operators()
+    np.testing.assert_allclose(L_flow.toarray(), L.toarray(), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(mass_flow, mass, rtol=1e-15)
+
+
+def test_a_sliver_within_the_mollification_margin_takes_the_package():
+    """A triangle whose longest side is within 2 x 1e-5 x the mean edge length of the
+    sum of the other two is left to the package (it mollifies there), with every edge
+    weight passing; 10 x further it is not."""
+    for height, from_mesh in [(1e-3, False), (1e-2, True)]:
+        # la + lb - lc = 2 sqrt(1 + h^2) - 2 ~ h^2, the mean edge length ~ 1.3
+        V = np.array([[-1.0, 0, 0], [1, 0, 0], [0, height, 0]])
+        F = np.array([[0, 1, 2]])
+        flow = IntrinsicCotanFlow(V, F, 0.01)
+        zero = np.zeros_like(flow.geometry.L_data)
+        flip = edges_to_flip(V, flow.mesh, zero, flow.assembler.pattern.edge_slots)
+        assert (flip is not None) == from_mesh
+
+
+def test_one_flip_back_to_the_icosphere_is_the_packages_triangulation():
+    """The icosphere with one edge flipped (weight about -0.6): that edge is the one to
+    flip, and the operators of the flipped mesh (the edge's new length that of the
+    two triangles unfolded, not the chord of the icosphere) are the package's to
+    round-off; so are the flow's states, step by step."""
+    V, F = flipped_icosphere()
+    flow = IntrinsicCotanFlow(V, F, 0.001)
+    flip = edges_to_flip(V, flow.mesh, flow.geometry.L_data, flow.assembler.pattern.edge_slots)
+    assert len(flip) == 1 and set(flow.mesh.edges[flip[0]]) == set(F[0][:2])
+    L, mass = flow.operators()
+    L_package, mass_package = intrinsic_operators(V, F)
+    np.testing.assert_allclose(L.toarray(), L_package.toarray(), rtol=0, atol=1e-14)
+    np.testing.assert_allclose(mass, mass_package, rtol=1e-14)
+    traj = simulate(flow, 10, solver=EXACT, save_every=1)
+    assert flow.flipped_steps == 10
+    package = IntrinsicCotanFlow(V, F, 0.001)
+    package._mesh_operators = lambda at: None
+    reference = simulate(package, 10, solver=EXACT, save_every=1)
+    np.testing.assert_allclose(traj.frames["vertices"], reference.frames["vertices"], rtol=0,
+                               atol=1e-14)
+
+
+def test_along_the_catenoid_flow_every_step_takes_the_mesh_operators():
+    """The open 24 x 8 cylinder stays Delaunay along its flow to the catenoid: all 200
+    systems from the mesh, the trajectory the package's to round-off (a run that calls
+    the package at every step: its test of the mesh made to refuse)."""
+    V, F = cylinder(24, 8)
+    fast = IntrinsicCotanFlow(V, F, 0.005)
+    traj = simulate(fast, 200, solver=EXACT, save_every=50)
+    assert fast.delaunay_steps == 200
+    slow = IntrinsicCotanFlow(V, F, 0.005)
+    slow._mesh_operators = lambda at: None
+    reference = simulate(slow, 200, solver=EXACT, save_every=50)
+    assert slow.delaunay_steps == 0
+    np.testing.assert_allclose(traj.frames["vertices"], reference.frames["vertices"], rtol=0,
+                               atol=1e-13)

@@ -12,8 +12,8 @@ import pytest
 from ddfv import Flow, variant_options
 import scipy.sparse as sp
 
-from ddfv.tangential_motion import (TangentialMotion, follow_triangles, p1_stiffness,
-                                    tangent_bases, tangential_motion)
+from ddfv.tangential_motion import (P1Stiffness, TangentialMotion, follow_triangles,
+                                    p1_stiffness, tangent_bases, tangential_motion)
 from ddfv.geometry import t_barycentric, vertex_normals
 from mcfbench.geometry import surfaces
 from mcfbench.geometry.exact import SphereL2Error
@@ -86,6 +86,24 @@ def _boundary(F):
     edges = np.sort(F[:, [[0, 1], [1, 2], [2, 0]]].reshape(-1, 2), axis=1)
     unique, count = np.unique(edges, axis=0, return_counts=True)
     return np.unique(unique[count == 1])
+
+
+def test_stiffness_of_the_kept_pattern_is_libigls():
+    """:class:`P1Stiffness` is ``-igl.cotmatrix`` to round-off at two states of a closed
+    and of an open mesh, in one CSR pattern (every edge and the diagonal) kept."""
+    rng = np.random.default_rng(7)
+    for V, F in (icosphere(2), surfaces.flat_patch(level=1, jitter=0.3, seed=1)):
+        stiffness = P1Stiffness(F, len(V))
+        for X in (V, V + 0.05 * rng.normal(size=V.shape)):
+            A, expected = stiffness(X), p1_stiffness(X, F)
+            assert A.nnz == len(V) + 2 * len(_edges(F)) and A.has_sorted_indices
+            np.testing.assert_allclose(A.toarray(), expected.toarray(), rtol=0,
+                                       atol=1e-14 * abs(expected).max())
+            assert np.array_equal(A.indices, stiffness.indices)
+
+
+def _edges(F):
+    return np.unique(np.sort(F[:, [[0, 1], [1, 2], [2, 0]]].reshape(-1, 2), axis=1), axis=0)
 
 
 def test_system_of_the_kept_layout_is_the_assembled_one_entry_for_entry():
