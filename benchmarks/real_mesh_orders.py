@@ -4,9 +4,14 @@ is an EOC below 1.5 the pre-asymptotic level 0, or the reference's accuracy?).
     nice python benchmarks/real_mesh_orders.py --meshes bob nut --levels 0 1 2
     nice python benchmarks/real_mesh_orders.py --meshes bob --levels 3 --schemes cotan \\
         --rows out.jsonl                       # more levels later: rows appended
+    nice python benchmarks/real_mesh_orders.py --method direct  # the sparse LU instead
 
-Each run is the matrix's (:func:`mcfbench.running.run.run` on ``real_<mesh>``, the
-robust solver, :data:`mcfbench.running.solver.ROBUST`), with the problem's observer
+Each run is the matrix's (:func:`mcfbench.running.run.run` on ``real_<mesh>``, by
+default with the matrix's solver for these problems, BiCGStab at ``rtol = 1e-9``,
+``maxiter = 1000``: config ``matrix.solver``, as the real-mesh problems follow the
+level rule ``tau_k = tau_0 / 4^k``, not the ``"mesh"`` rule that ``matrix.mesh_solver``
+serves; ``--method`` another of :data:`mcfbench.running.solver.METHODS`, e.g.
+``direct``, the robust solver), with the problem's observer
 (:class:`mcfbench.running.real_mesh_problems.RealMeshShape`) kept to read the area at
 every checkpoint. Per scheme and mesh, the table gives:
 
@@ -36,18 +41,20 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 from mcfbench.running.problems import get_problem  # noqa: E402
 from mcfbench.running.real_mesh_problems import RealMeshShape  # noqa: E402
 from mcfbench.running.run import run  # noqa: E402
-from mcfbench.running.solver import ROBUST, Solver  # noqa: E402
+from mcfbench.running.solver import METHODS, Solver  # noqa: E402
 
 REFERENCES = Path(__file__).resolve().parents[1] / "mcfbench/data/meshes/references"
 
 
-def measure(scheme, mesh, level):
+def measure(scheme, mesh, level, method="bicgstab"):
     """One run's row: status, vertices, steps, CPU seconds, the metrics and the area and
-    volume at every checkpoint."""
+    volume at every checkpoint (``method``: the solver's, rtol 1e-9, 1000 iterations)."""
     problem = get_problem(f"real_{mesh}")
     shape = RealMeshShape(problem)
-    result, _ = run(scheme, problem, level, solver=Solver(method=ROBUST), observers=[shape])
-    return {"mesh": mesh, "scheme": scheme, "level": level, "status": result.status,
+    result, _ = run(scheme, problem, level, solver=Solver(method=method, rtol=1e-9,
+                                                          maxiter=1000), observers=[shape])
+    return {"mesh": mesh, "scheme": scheme, "level": level, "method": method,
+            "status": result.status,
             "vertices": result.nF, "steps": result.steps_done, "cpu": result.cpu_seconds,
             **result.metrics, **shape.values()}
 
@@ -89,11 +96,13 @@ def main():
     parser.add_argument("--schemes", nargs="+", default=["ddfv-chord-bgn-carried", "cotan"])
     parser.add_argument("--levels", nargs="+", type=int, default=[0, 1, 2])
     parser.add_argument("--rows", type=Path, default=Path("real_mesh_orders.jsonl"))
+    parser.add_argument("--method", choices=METHODS, default="bicgstab",
+                        help="the linear solver (default the matrix's for these problems)")
     args = parser.parse_args()
     for mesh in args.meshes:
         for scheme in args.schemes:
             for level in args.levels:
-                row = measure(scheme, mesh, level)
+                row = measure(scheme, mesh, level, args.method)
                 with args.rows.open("a") as out:
                     out.write(json.dumps(row) + "\n")
                 print(f"{mesh} {scheme} level {level}: {row['status']}, "
