@@ -24,7 +24,13 @@ every checkpoint. Per scheme and mesh, the table gives:
 * the reference-free order ``log2(|A_{k-2} - A_{k-1}| / |A_{k-1} - A_k|)`` of the area at
   the final time from the three finest levels run (the scheme's own convergence,
   whatever the reference);
-* the CPU seconds of each level.
+* the CPU seconds of each level;
+* when the rows hold the cotangent scheme on a level finer than the reference's
+  (``cotan`` in ``--schemes``, e.g. ``--levels 3``): each level's error and EOC
+  against a finer reference, the cotangent scheme's three finest levels run,
+  Richardson-extrapolated at every checkpoint as the reference files' own values are
+  (``mcfbench.running.two_scheme_references._scheme_estimate``), with its
+  largest relative accuracy: is the order the stored reference shows its own?
 
 One JSON row per run goes to ``--rows`` (appended; the table is made from every row
 there, so levels run at different times combine).
@@ -42,6 +48,7 @@ from mcfbench.running.problems import get_problem  # noqa: E402
 from mcfbench.running.real_mesh_problems import RealMeshShape  # noqa: E402
 from mcfbench.running.run import run  # noqa: E402
 from mcfbench.running.solver import METHODS, Solver  # noqa: E402
+from mcfbench.running.two_scheme_references import _scheme_estimate  # noqa: E402
 
 REFERENCES = Path(__file__).resolve().parents[1] / "mcfbench/data/meshes/references"
 
@@ -57,6 +64,18 @@ def measure(scheme, mesh, level, method="bicgstab"):
             "status": result.status,
             "vertices": result.nF, "steps": result.steps_done, "cpu": result.cpu_seconds,
             **result.metrics, **shape.values()}
+
+
+def finer_reference(by_level, stored_levels):
+    """The area at every checkpoint Richardson-extrapolated from the cotangent scheme's
+    three finest levels run (``by_level``: level -> row), and its largest relative
+    accuracy; ``None`` unless those reach beyond ``stored_levels`` (the reference's)."""
+    levels = sorted(k for k in by_level if by_level[k]["status"] == "ok")[-3:]
+    if len(levels) < 3 or levels[-1] <= max(stored_levels):
+        return None
+    estimates = [_scheme_estimate(values) for values in
+                 zip(*(by_level[k]["area"] for k in levels))]
+    return [v for v, _, _ in estimates], max(e / abs(v) for v, e, _ in estimates), levels
 
 
 def table(rows):
@@ -86,6 +105,17 @@ def table(rows):
             + " | " + ", ".join(f"{levels[i]}-{levels[i + 1]} {e:.2f}" for i, e in enumerate(eocs))
             + f" | {max(accuracy):.1e} | {worst[j] / accuracy[j]:.1f} | {order:.2f} | "
             + ", ".join(f"{by_level[k]['cpu']:.3g}" for k in levels))
+        finer = finer_reference(runs.get((mesh, "cotan"), {}), reference["levels"])
+        if finer is not None:
+            values, finer_accuracy, cotan_levels = finer
+            errors = [max(abs(a / r - 1) for a, r in zip(by_level[k]["area"], values))
+                      for k in levels]
+            lines.append(
+                f"    against cotan levels {cotan_levels} extrapolated (largest relative "
+                f"accuracy {finer_accuracy:.1e}): "
+                + ", ".join(f"L{k} {e:.3e}" for k, e in zip(levels, errors)) + " | EOC "
+                + ", ".join(f"{levels[i]}-{levels[i + 1]} {math.log2(a / b):.2f}"
+                            for i, (a, b) in enumerate(zip(errors, errors[1:]))))
     return lines
 
 
