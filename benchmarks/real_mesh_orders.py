@@ -4,9 +4,14 @@ is an EOC below 1.5 the pre-asymptotic level 0, or the reference's accuracy?).
     nice python benchmarks/real_mesh_orders.py --meshes bob nut --levels 0 1 2
     nice python benchmarks/real_mesh_orders.py --meshes bob --levels 3 --schemes cotan \\
         --rows out.jsonl                       # more levels later: rows appended
+    nice python benchmarks/real_mesh_orders.py --method direct  # the sparse LU instead
 
-Each run is the matrix's (:func:`mcfbench.running.run.run` on ``real_<mesh>``, the
-robust solver, :data:`mcfbench.running.solver.ROBUST`), with the problem's observer
+Each run is the matrix's (:func:`mcfbench.running.run.run` on ``real_<mesh>``, by
+default with the matrix's solver for these problems, BiCGStab at ``rtol = 1e-9``,
+``maxiter = 1000``: config ``matrix.solver``, as the real-mesh problems follow the
+level rule ``tau_k = tau_0 / 4^k``, not the ``"mesh"`` rule that ``matrix.mesh_solver``
+serves; ``--method`` another of :data:`mcfbench.running.solver.METHODS`, e.g.
+``direct``, the robust solver), with the problem's observer
 (:class:`mcfbench.running.real_mesh_problems.RealMeshShape`) kept to read the area at
 every checkpoint. Per scheme and mesh, the table gives:
 
@@ -19,7 +24,13 @@ every checkpoint. Per scheme and mesh, the table gives:
 * the reference-free order ``log2(|A_{k-2} - A_{k-1}| / |A_{k-1} - A_k|)`` of the area at
   the final time from the three finest levels run (the scheme's own convergence,
   whatever the reference);
-* the CPU seconds of each level.
+* the CPU seconds of each level;
+* when the rows hold the cotangent scheme on a level finer than the reference's
+  (``cotan`` in ``--schemes``, e.g. ``--levels 3``): each level's error and EOC
+  against a finer reference, the cotangent scheme's three finest levels run,
+  Richardson-extrapolated at every checkpoint as the reference files' own values are
+  (``mcfbench.running.two_scheme_references._scheme_estimate``), with its
+  largest relative accuracy: is the order the stored reference shows its own?
 
 One JSON row per run goes to ``--rows`` (appended; the table is made from every row
 there, so levels run at different times combine).
@@ -36,20 +47,35 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 from mcfbench.running.problems import get_problem  # noqa: E402
 from mcfbench.running.real_mesh_problems import RealMeshShape  # noqa: E402
 from mcfbench.running.run import run  # noqa: E402
-from mcfbench.running.solver import ROBUST, Solver  # noqa: E402
+from mcfbench.running.solver import METHODS, Solver  # noqa: E402
+from mcfbench.running.two_scheme_references import _scheme_estimate  # noqa: E402
 
 REFERENCES = Path(__file__).resolve().parents[1] / "mcfbench/data/meshes/references"
 
 
-def measure(scheme, mesh, level):
+def measure(scheme, mesh, level, method="bicgstab"):
     """One run's row: status, vertices, steps, CPU seconds, the metrics and the area and
-    volume at every checkpoint."""
+    volume at every checkpoint (``method``: the solver's, rtol 1e-9, 1000 iterations)."""
     problem = get_problem(f"real_{mesh}")
     shape = RealMeshShape(problem)
-    result, _ = run(scheme, problem, level, solver=Solver(method=ROBUST), observers=[shape])
-    return {"mesh": mesh, "scheme": scheme, "level": level, "status": result.status,
+    result, _ = run(scheme, problem, level, solver=Solver(method=method, rtol=1e-9,
+                                                          maxiter=1000), observers=[shape])
+    return {"mesh": mesh, "scheme": scheme, "level": level, "method": method,
+            "status": result.status,
             "vertices": result.nF, "steps": result.steps_done, "cpu": result.cpu_seconds,
             **result.metrics, **shape.values()}
+
+
+def finer_reference(by_level, stored_levels):
+    """The area at every checkpoint Richardson-extrapolated from the cotangent scheme's
+    three finest levels run (``by_level``: level -> row), and its largest relative
+    accuracy; ``None`` unless those reach beyond ``stored_levels`` (the reference's)."""
+    levels = sorted(k for k in by_level if by_level[k]["status"] == "ok")[-3:]
+    if len(levels) < 3 or levels[-1] <= max(stored_levels):
+        return None
+    estimates = [_scheme_estimate(values) for values in
+                 zip(*(by_level[k]["area"] for k in levels))]
+    return [v for v, _, _ in estimates], max(e / abs(v) for v, e, _ in estimates), levels
 
 
 def table(rows):
@@ -79,6 +105,17 @@ def table(rows):
             + " | " + ", ".join(f"{levels[i]}-{levels[i + 1]} {e:.2f}" for i, e in enumerate(eocs))
             + f" | {max(accuracy):.1e} | {worst[j] / accuracy[j]:.1f} | {order:.2f} | "
             + ", ".join(f"{by_level[k]['cpu']:.3g}" for k in levels))
+        finer = finer_reference(runs.get((mesh, "cotan"), {}), reference["levels"])
+        if finer is not None:
+            values, finer_accuracy, cotan_levels = finer
+            errors = [max(abs(a / r - 1) for a, r in zip(by_level[k]["area"], values))
+                      for k in levels]
+            lines.append(
+                f"    against cotan levels {cotan_levels} extrapolated (largest relative "
+                f"accuracy {finer_accuracy:.1e}): "
+                + ", ".join(f"L{k} {e:.3e}" for k, e in zip(levels, errors)) + " | EOC "
+                + ", ".join(f"{levels[i]}-{levels[i + 1]} {math.log2(a / b):.2f}"
+                            for i, (a, b) in enumerate(zip(errors, errors[1:]))))
     return lines
 
 
@@ -89,11 +126,13 @@ def main():
     parser.add_argument("--schemes", nargs="+", default=["ddfv-chord-bgn-carried", "cotan"])
     parser.add_argument("--levels", nargs="+", type=int, default=[0, 1, 2])
     parser.add_argument("--rows", type=Path, default=Path("real_mesh_orders.jsonl"))
+    parser.add_argument("--method", choices=METHODS, default="bicgstab",
+                        help="the linear solver (default the matrix's for these problems)")
     args = parser.parse_args()
     for mesh in args.meshes:
         for scheme in args.schemes:
             for level in args.levels:
-                row = measure(scheme, mesh, level)
+                row = measure(scheme, mesh, level, args.method)
                 with args.rows.open("a") as out:
                     out.write(json.dumps(row) + "\n")
                 print(f"{mesh} {scheme} level {level}: {row['status']}, "
