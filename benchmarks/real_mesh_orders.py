@@ -29,7 +29,7 @@ every checkpoint. Per scheme and mesh, the table gives:
   (``cotan`` in ``--schemes``, e.g. ``--levels 3``): each level's error and EOC
   against a finer reference, the cotangent scheme's three finest levels run,
   Richardson-extrapolated at every checkpoint as the reference files' own values are
-  (``mcfbench.running.two_scheme_references._scheme_estimate``), with its
+  (``mcfbench.running.two_scheme_references.scheme_estimate``), with its
   largest relative accuracy: is the order the stored reference shows its own?
 
 One JSON row per run goes to ``--rows`` (appended; the table is made from every row
@@ -48,7 +48,7 @@ from mcfbench.running.problems import get_problem  # noqa: E402
 from mcfbench.running.real_mesh_problems import RealMeshShape  # noqa: E402
 from mcfbench.running.run import run  # noqa: E402
 from mcfbench.running.solver import METHODS, Solver  # noqa: E402
-from mcfbench.running.two_scheme_references import _scheme_estimate  # noqa: E402
+from mcfbench.running.two_scheme_references import scheme_estimate  # noqa: E402
 
 REFERENCES = Path(__file__).resolve().parents[1] / "mcfbench/data/meshes/references"
 
@@ -73,7 +73,7 @@ def finer_reference(by_level, stored_levels):
     levels = sorted(k for k in by_level if by_level[k]["status"] == "ok")[-3:]
     if len(levels) < 3 or levels[-1] <= max(stored_levels):
         return None
-    estimates = [_scheme_estimate(values) for values in
+    estimates = [scheme_estimate(values) for values in
                  zip(*(by_level[k]["area"] for k in levels))]
     return [v for v, _, _ in estimates], max(e / abs(v) for v, e, _ in estimates), levels
 

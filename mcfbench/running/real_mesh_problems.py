@@ -171,7 +171,10 @@ class RealMeshShape:
     (:func:`mcfbench.geometry.surface_distance.mean_surface_distance`: the
     state at ``t_final`` is kept and measured once, by :meth:`result`, outside
     the run's timed part; NaN if not reached; absent from a reference without
-    a surface). Values are kept when the run breaks down after the
+    a surface, and from a run on a mesh with at least as many vertices as the
+    reference surface's: a level the reference does not resolve, where the
+    distance would be the scheme's difference from the reference's scheme,
+    not an error). Values are kept when the run breaks down after the
     checkpoints (``keeps_before_breakdown``).
     """
 
@@ -188,6 +191,7 @@ class RealMeshShape:
         surface = ref.get("distance_reference")
         self.surface = None if surface is None else \
             (ref["mesh"], surface["level"], surface["faces_sha256"], ref["length_scale"])
+        self.surface_vertices = None if surface is None else surface["vertices"]
         self.final = None
 
     def __call__(self, flow):
@@ -215,7 +219,8 @@ class RealMeshShape:
             errors = [v / r - 1.0 for v, r in zip(values, reference)]
             worst = max(errors, key=lambda e: -1.0 if math.isnan(e) else abs(e))
             out[f"{key}_error"] = math.nan if any(map(math.isnan, errors)) else worst
-        if self.surface is not None:
+        resolved = self.final is None or len(self.final[0]) < self.surface_vertices
+        if self.surface is not None and resolved:
             *key, length = self.surface
             out["distance_error"] = math.nan if self.final is None else \
                 mean_surface_distance(*self.final, *reference_surface(*key)) / length

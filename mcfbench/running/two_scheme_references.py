@@ -186,8 +186,25 @@ def first_singularity(runs, tau_0, steps):
             [{k: r[k] for k in ("scheme", "level", "status", "t_end")} for r in stopped]}
 
 
-def _scheme_estimate(values):
-    """Best value and error estimate of one scheme's levels (coarse to fine)."""
+def scheme_estimate(values):
+    """Best value and error estimate of one scheme's levels (coarse to fine).
+
+    Parameters
+    ----------
+    values : (k,) float array-like
+        One quantity on consecutive levels, coarse to fine; non-finite values
+        (levels that did not reach the time) are left out.
+
+    Returns
+    -------
+    value : float
+        Richardson-extrapolated from the three finest levels when their observed
+        order is in [0.5, 4], else the finest level's (NaN without any).
+    accuracy : float
+        ``|correction|``, or the two finest levels' difference (NaN for one level).
+    method : str
+        ``"Richardson, p = ..."``, ``"finest level"``, ``"single level"`` or ``"none"``.
+    """
     v = np.asarray(values, dtype=float)
     v = v[np.isfinite(v)]
     if len(v) == 0:
@@ -257,7 +274,7 @@ def _answers_to(N, schemes, usable):
                                   "_method", "_scheme", "_schemes")}
         disagree = []
         for j in range(1, N + 1):
-            per = {s: _scheme_estimate([r[q][j] for r in rs]) for s, rs in schemes.items()
+            per = {s: scheme_estimate([r[q][j] for r in rs]) for s, rs in schemes.items()
                    if usable(rs, j)}
             s_best = min(per, key=lambda s: per[s][1] if np.isfinite(per[s][1]) else math.inf)
             others = [s for s in per if s != s_best]

@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from mcfbench.geometry.committed_meshes import mesh_manifest
+from mcfbench.geometry.committed_meshes import mesh_manifest, real_mesh
 from mcfbench.geometry.metrics import mean_edge_length
 from mcfbench.geometry.surface_distance import mean_surface_distance
 from mcfbench.running.problems import PROBLEMS
@@ -96,16 +96,28 @@ def test_reference_surface_whose_level_changed_is_refused():
         reference_surface("nut", surface["level"], "0" * 64)
 
 
-def test_distance_of_the_reference_surface_to_itself_is_zero():
+def test_distance_is_measured_below_the_reference_level_only():
+    """A state at t_final on the reference surface's level (as many vertices) is
+    not measured (the reference does not resolve that level); one level coarser is:
+    its distance to the reference surface is that of the two surfaces; a run that
+    did not reach t_final has NaN."""
     ref = _stored("nut")
-    observer = RealMeshShape(PROBLEMS["real_nut"])
-    V, F = reference_surface("nut", ref["distance_reference"]["level"],
-                             ref["distance_reference"]["faces_sha256"])
+    level = ref["distance_reference"]["level"]
+    fine = reference_surface("nut", level, ref["distance_reference"]["faces_sha256"])
+    coarse = real_mesh("nut", level - 1)
 
-    class Flow:
-        vertices, faces, tau, n = V, F, ref["tau0"], ref["steps"]
-    observer(Flow)
-    assert observer.result()["distance_error"] == 0.0
+    def observed(V, F):
+        observer = RealMeshShape(PROBLEMS["real_nut"])
+
+        class Flow:
+            vertices, faces, tau, n = V, F, ref["tau0"], ref["steps"]
+        observer(Flow)
+        return observer.result()
+
+    assert "distance_error" not in observed(*fine)
+    assert observed(*coarse)["distance_error"] == pytest.approx(
+        mean_surface_distance(*coarse, *fine) / ref["length_scale"], rel=1e-12)
+    assert observed(*coarse)["distance_error"] > 0
     assert math.isnan(RealMeshShape(PROBLEMS["real_nut"]).result()["distance_error"])
 
 
