@@ -23,8 +23,11 @@ deturck (:class:`baselines.deturck.DeTurckFlow`)
     harmonic map heat flow onto the initial mesh, ``alpha`` its time scale.
 kll (:class:`baselines.kll.KLLFlow`)
     Kovacs, Li and Lubich (2019): the normal and the mean curvature evolved by
-    Huisken's equations with the position, velocity ``-H nu``; P1, closed surfaces.
+    Huisken's equations with the position, velocity ``-H nu``; P1, closed
+    surfaces or with their boundary held fixed.
 
-Shared: :mod:`baselines.mesh` (edge topology, CSR pattern) and
+Shared: :mod:`baselines.mesh` (edge topology, CSR pattern),
+:mod:`baselines.laplacian` (the cotangent stiffness and the lumped mass),
+:mod:`baselines.vertex_flow` (the state and checks of every vertex scheme) and
 :mod:`baselines.kernels` (the compiled assembly).
 """

@@ -65,7 +65,7 @@ system (C3) and fewer iterations (measured in ``baselines/README.md``).
 import numpy as np
 import scipy.sparse as sp
 
-from .cotan import VertexFlow
+from .vertex_flow import VertexFlow
 from .kernels import bgn_system, vertex_normals
 
 SCALINGS = ("mass", "none")

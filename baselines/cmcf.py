@@ -28,7 +28,8 @@ surface: a cylinder ``r = 1, |z| <= h`` (flat, parametrised by arc length)
 tends to ``r(z) = cosh(z) / cosh(h)``, not to the catenoid.
 """
 
-from .cotan import CotanFlow, cotangent_laplacian
+from .cotan import CotanFlow
+from .laplacian import cotangent_laplacian
 
 
 class CMCFFlow(CotanFlow):
@@ -41,7 +42,7 @@ class CMCFFlow(CotanFlow):
     faces : (m, 3) int array
     tau : float
     mass : {"barycentric", "voronoi"}
-        Lumped mass, rebuilt every step (see :func:`baselines.cotan.lumped_mass`).
+        Lumped mass, rebuilt every step (see :func:`baselines.laplacian.lumped_mass`).
     assembly : {"cached", "igl"}
         As in :class:`baselines.cotan.CotanFlow`.
     """

@@ -41,7 +41,7 @@ Where the mesh already is the package's triangulation and no triangle is
 mollified, the package's operators are the mesh's cotangent stiffness and
 barycentric mass (Bobenko and Springborn: the intrinsic Delaunay triangulation
 is reached by flipping the edges of negative weight, and there are none),
-which the compiled assembly of :class:`baselines.cotan.CotanAssembler` gives in
+which the compiled assembly of :class:`baselines.laplacian.CotanAssembler` gives in
 a fraction of the package's time; where one round of flips of edges with no
 triangle in common reaches it, those flips are applied to the mesh's operators
 (:func:`flipped_operators`). A step takes them when :func:`edges_to_flip` says
@@ -49,18 +49,19 @@ so, the package's call otherwise (baselines/README.md, "Deviations and
 interpretations").
 
 The step is solved in the row-scaled form (C3), ``(I + tau diag(1/M) L) X^n
-= X^{n-1}`` (:func:`baselines.cotan.row_scaled_matrix`), with identity rows
+= X^{n-1}`` (:func:`baselines.laplacian.row_scaled_matrix`), with identity rows
 at boundary vertices (held fixed, Dirichlet). The state, the checks of a state (on the mesh's
 own triangles: an inverted or collapsed mesh triangle ends a run as for
 ``cotan``) and the L2 weights (the mesh's barycentric lumped mass, the same
-total area) are those of :class:`baselines.cotan.VertexFlow`.
+total area) are those of :class:`baselines.vertex_flow.VertexFlow`.
 """
 
 import numpy as np
 import robust_laplacian
 import scipy.sparse as sp
 
-from .cotan import VertexFlow, row_scaled_matrix
+from .laplacian import row_scaled_matrix
+from .vertex_flow import VertexFlow
 
 MOLLIFY = 1e-5
 """The package's default ``mollify_factor`` (baselines/README.md, "Deviations and
@@ -270,7 +271,7 @@ class IntrinsicCotanFlow(VertexFlow):
         return flipped if flipped is not None else (self.assembler.laplacian(g.L_data), g.mass)
 
     def _mesh_operators(self, at):
-        """``(geometry, flipped)`` at ``at``: the mesh's :class:`baselines.cotan.SurfaceGeometry`
+        """``(geometry, flipped)`` at ``at``: the mesh's :class:`baselines.laplacian.SurfaceGeometry`
         and, when the package flips edges, the ``(L, mass)`` of :func:`flipped_operators`
         (None when it flips none); None when the package is needed."""
         g = self.geometry_at(at)

@@ -8,7 +8,7 @@ it straight into arrays laid out by a cached CSR pattern
 write the system matrices. This puts the baselines on the same footing as
 the compiled DDFV assembly: the time of a step is that of the scheme, not
 of scipy's sparse-matrix construction. ``neighbour_cosines`` is the
-compiled check of :meth:`baselines.cotan.VertexFlow.defects`.
+compiled check of :meth:`baselines.vertex_flow.VertexFlow.defects`.
 
 Formulas
 --------

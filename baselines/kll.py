@@ -90,7 +90,7 @@ stepped as before, bit for bit.
 import numpy as np
 import scipy.sparse as sp
 
-from .cotan import VertexFlow
+from .vertex_flow import VertexFlow
 from .kernels import gradient_norm_weights
 from .mdr import unit_vertex_normals
 
@@ -393,7 +393,7 @@ class KLLFlow(VertexFlow):
         super().advance(self._X)
 
     def defects(self):
-        """:meth:`baselines.cotan.VertexFlow.defects`, and ``"degenerated"`` for
+        """:meth:`baselines.vertex_flow.VertexFlow.defects`, and ``"degenerated"`` for
         non-finite normals or curvatures."""
         bad = ~np.isfinite(self._U[3:]).all(axis=0)
         if bad.any():

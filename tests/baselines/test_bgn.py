@@ -10,7 +10,7 @@ from conftest import approaches_the_catenoid, cylinder, table_3_1_error
 from scipy.sparse.linalg import spsolve
 
 from baselines.bgn import BGNFlow
-from baselines.cotan import cotangent_laplacian
+from baselines.laplacian import cotangent_laplacian
 from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate

@@ -5,7 +5,8 @@ import pytest
 from conftest import cylinder, table_3_1_error
 
 from baselines.cmcf import CMCFFlow
-from baselines.cotan import CotanFlow, cotangent_laplacian, lumped_mass
+from baselines.cotan import CotanFlow
+from baselines.laplacian import cotangent_laplacian, lumped_mass
 from mcfbench.geometry.exact import eoc, sphere_radius
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate

@@ -8,7 +8,8 @@ import pytest
 from conftest import approaches_the_catenoid, cylinder, flat_lattice, table_3_1_error
 
 from baselines import cotan
-from baselines.cotan import CotanAssembler, CotanFlow, cotangent_laplacian, lumped_mass
+from baselines.cotan import CotanFlow
+from baselines.laplacian import CotanAssembler, cotangent_laplacian, lumped_mass
 from baselines.mesh import edge_mesh
 from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.spheres import icosphere

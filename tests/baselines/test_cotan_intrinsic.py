@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from conftest import cylinder, table_3_1_error, twin_sphere
 
-from baselines.cotan import CotanFlow, cotangent_laplacian, lumped_mass
+from baselines.cotan import CotanFlow
+from baselines.laplacian import cotangent_laplacian, lumped_mass
 from baselines.cotan_intrinsic import (FLIP_BELOW, IntrinsicCotanFlow, edges_to_flip,
                                       intrinsic_operators)
 from mcfbench.geometry.exact import eoc

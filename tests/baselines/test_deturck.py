@@ -8,7 +8,8 @@ from conftest import flat_lattice
 from test_mdr import (agrees_under_rigid_motion_and_relabelling,
                       reaches_the_catenoid_keeping_its_boundary, step)
 
-from baselines.cotan import CotanFlow, cotangent_laplacian
+from baselines.cotan import CotanFlow
+from baselines.laplacian import cotangent_laplacian
 from baselines.deturck import DeTurckFlow, reference_gradients
 from baselines.kernels import vertex_gradients
 from mcfbench.geometry.spheres import icosahedron, icosphere

@@ -6,7 +6,8 @@ import pytest
 
 from baselines import kernels
 from baselines.bgn import BGNFlow
-from baselines.cotan import CotanAssembler, CotanFlow
+from baselines.cotan import CotanFlow
+from baselines.laplacian import CotanAssembler
 from baselines.mesh import edge_mesh
 from mcfbench.running.driver import simulate
 from mcfbench.running.solver import Solver

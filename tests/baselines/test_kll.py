@@ -9,7 +9,7 @@ from conftest import cylinder
 from test_mdr import (agrees_under_rigid_motion_and_relabelling,
                       reaches_the_catenoid_keeping_its_boundary)
 
-from baselines.cotan import cotangent_laplacian
+from baselines.laplacian import cotangent_laplacian
 from baselines.kll import KLLFlow, curvature_weights
 from baselines.mdr import unit_vertex_normals
 from mcfbench.geometry.exact import sphere_state_errors

@@ -7,7 +7,7 @@ import scipy.sparse as sp
 from conftest import cylinder, flat_lattice
 from scipy.sparse.linalg import spsolve
 
-from baselines.cotan import cotangent_laplacian
+from baselines.laplacian import cotangent_laplacian
 from baselines.mdr import MDRFlow
 from mcfbench.geometry.spheres import icosahedron, icosphere
 from mcfbench.running.integrators import BDF2, Euler

@@ -1,0 +1,233 @@
+"""The cotangent stiffness and the lumped mass of a triangulated surface.
+
+The operators of the vertex-based baselines: the cotangent stiffness ``L``
+(``-igl.cotmatrix``), symmetric and positive semi-definite (Pinkall and
+Polthier 1993, the cotangent formula, (C2) of :mod:`baselines.cotan`)::
+
+    (L X)_i = 1/2 sum_j (cot alpha_ij + cot beta_ij) (X_i - X_j)      (C2)
+
+and the lumped mass ``M``: barycentric, ``M_ii = 1/3 sum_{T ni i} |T|``, or
+Voronoi/mixed (Meyer, Desbrun, Schroeder, Barr 2003, Section 3.3;
+``igl.MASSMATRIX_TYPE_VORONOI``); libigl's functions
+(:func:`cotangent_laplacian`, :func:`lumped_mass`) are the reference, and
+:class:`CotanAssembler` writes both with one compiled loop over the
+triangles (:func:`baselines.kernels.cotan_geometry`) into a CSR pattern
+built once (:func:`baselines.mesh.laplacian_pattern`), with the row-scaled
+system (C3) ``I + tau diag(1/M) L`` (:func:`row_scaled_matrix`) and its
+Dirichlet rows (:func:`dirichlet_rows`).
+"""
+
+from dataclasses import dataclass
+
+import igl
+import numpy as np
+import scipy.sparse as sp
+
+from .kernels import cotan_geometry, row_scaled_system
+from .mesh import laplacian_pattern
+
+MASS_TYPES = {"barycentric": igl.MASSMATRIX_TYPE_BARYCENTRIC,
+              "voronoi": igl.MASSMATRIX_TYPE_VORONOI}
+
+
+def cotangent_laplacian(vertices, faces):
+    """Cotangent stiffness matrix ``L = -igl.cotmatrix`` (pos. semi-def.), (C2).
+
+    The libigl reference of :meth:`CotanAssembler.laplacian`.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+
+    Returns
+    -------
+    (n, n) scipy.sparse.csr_matrix
+        Symmetric, zero row sums, positive diagonal.
+    """
+    V, F = _igl_arrays(vertices, faces)
+    return (-igl.cotmatrix(V, F)).tocsr()
+
+
+def lumped_mass(vertices, faces, mass="barycentric"):
+    """Diagonal of the lumped mass matrix ``igl.massmatrix``.
+
+    The libigl reference of :meth:`CotanAssembler.geometry`.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+    mass : {"barycentric", "voronoi"}
+        Barycentric: ``M_ii = 1/3 sum_{T ni i} |T|``; Voronoi: mixed
+        Voronoi areas (Meyer et al. 2003). Both sum to the surface area.
+
+    Returns
+    -------
+    (n,) float array
+    """
+    V, F = _igl_arrays(vertices, faces)
+    return np.asarray(igl.massmatrix(V, F, MASS_TYPES[_mass_type(mass)]).diagonal())
+
+
+def _igl_arrays(vertices, faces):
+    return (np.ascontiguousarray(vertices, dtype=np.float64),
+            np.ascontiguousarray(faces, dtype=np.int64))
+
+
+def _mass_type(mass):
+    if mass not in MASS_TYPES:
+        raise ValueError(f"unknown mass {mass!r}; choose one of {', '.join(MASS_TYPES)}")
+    return mass
+
+
+@dataclass(frozen=True)
+class SurfaceGeometry:
+    """What one state of a surface contributes to a step.
+
+    Attributes
+    ----------
+    L_data : (nnz,) float array or None
+        Values of the stiffness ``L`` (C2) in the pattern of the assembler
+        (None when not computed).
+    mass : (n,) float array
+        Lumped mass ``M_ii``.
+    area_vectors : (m, 3) float array
+        ``(x_1 - x_0) x (x_2 - x_0)`` per triangle (twice the area times
+        the unit normal).
+    degenerate : int
+        Triangles of zero (or non-finite) area, left out of ``L`` and the
+        mass by the kernel instead of dividing by zero.
+    first_degenerate : int
+        The first of them, ``-1`` if none.
+    """
+
+    L_data: np.ndarray
+    mass: np.ndarray
+    area_vectors: np.ndarray
+    degenerate: int = 0
+    first_degenerate: int = -1
+
+
+class CotanAssembler:
+    """``L`` (C2), ``M`` and the system matrix (C3) on a fixed mesh, compiled.
+
+    The CSR pattern of ``L`` (edges and diagonal) is built once; every call
+    runs :func:`baselines.kernels.cotan_geometry` (one loop over the
+    triangles) and writes into fresh arrays laid out by that pattern.
+
+    Parameters
+    ----------
+    mesh : baselines.mesh.EdgeMesh
+    mass : {"barycentric", "voronoi"}
+
+    Examples
+    --------
+    >>> from baselines.mesh import edge_mesh
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0]])
+    >>> F = np.array([[0, 1, 2]])
+    >>> asm = CotanAssembler(edge_mesh(F, 3))
+    >>> g = asm.geometry(V)
+    >>> asm.laplacian(g.L_data).toarray().round(3).tolist()
+    [[1.0, -0.5, -0.5], [-0.5, 0.5, 0.0], [-0.5, 0.0, 0.5]]
+    >>> g.mass.round(4).tolist()
+    [0.1667, 0.1667, 0.1667]
+    """
+
+    def __init__(self, mesh, mass="barycentric"):
+        self.mesh = mesh
+        self.mass_type = _mass_type(mass)
+        self.pattern = laplacian_pattern(mesh)
+
+    @property
+    def shape(self):
+        return self.pattern.shape
+
+    def geometry(self, vertices, with_laplacian=True):
+        """Stiffness, lumped mass and area vectors of ``vertices``.
+
+        Parameters
+        ----------
+        vertices : (n, 3) float array
+        with_laplacian : bool
+            Compute ``L`` (False: ``L_data`` is None).
+
+        Returns
+        -------
+        SurfaceGeometry
+        """
+        p, mesh = self.pattern, self.mesh
+        L_data = np.empty(p.nnz) if with_laplacian else np.empty(0)
+        mass = np.empty(mesh.n_vertices)
+        area_vectors = np.empty((mesh.n_faces, 3))
+        degenerate, first = cotan_geometry(
+            np.ascontiguousarray(vertices, dtype=np.float64), mesh.faces, p.corner_slots,
+            p.diag_slots, self.mass_type == "voronoi", with_laplacian, L_data, mass,
+            area_vectors)
+        return SurfaceGeometry(L_data if with_laplacian else None, mass, area_vectors,
+                               int(degenerate), int(first))
+
+    def csr(self, data):
+        """A CSR matrix with the pattern of ``L`` and values ``data``."""
+        p = self.pattern
+        return sp.csr_matrix((data, p.indices, p.indptr), shape=p.shape, copy=False)
+
+    def laplacian(self, L_data):
+        """``L`` (C2) as CSR from :attr:`SurfaceGeometry.L_data`."""
+        return self.csr(L_data)
+
+    def row_scaled(self, L_data, mass, tau, fixed):
+        """``I + tau diag(1/M) L`` (C3) as CSR; rows ``fixed`` = identity.
+
+        Parameters
+        ----------
+        L_data : (nnz,) float array
+        mass : (n,) float array
+        tau : float
+        fixed : (n,) bool array
+        """
+        p = self.pattern
+        data = np.empty(p.nnz)
+        row_scaled_system(L_data, p.indptr, p.diag_slots, mass, float(tau), fixed, data)
+        return self.csr(data)
+
+
+def row_scaled_matrix(L, mass, dt, fixed):
+    """``I + dt diag(1/M) L`` (C3) of any sparsity, CSR, rows ``fixed`` = identity.
+
+    Parameters
+    ----------
+    L : (n, n) scipy.sparse matrix
+        A stiffness (not changed).
+    mass : (n,) float array
+        Its lumped mass, positive.
+    dt : float
+    fixed : (n,) bool array
+
+    Returns
+    -------
+    (n, n) scipy.sparse.csr_matrix
+    """
+    L = sp.csr_matrix(L, copy=True)
+    L.data *= np.repeat(dt / mass, np.diff(L.indptr))
+    A = (L + sp.identity(L.shape[0], format="csr")).tocsr()
+    return dirichlet_rows(A, fixed) if fixed.any() else A
+
+
+def dirichlet_rows(A, fixed):
+    """Replace the rows ``fixed`` of a CSR matrix by rows of the identity, in place.
+
+    Parameters
+    ----------
+    A : (n, n) scipy.sparse.csr_matrix
+        Must store its diagonal entries.
+    fixed : (n,) bool array
+
+    Returns
+    -------
+    A
+    """
+    rows = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))
+    slots = np.flatnonzero(fixed[rows])
+    A.data[slots] = (A.indices[slots] == rows[slots]).astype(A.dtype)
+    return A
