@@ -83,6 +83,23 @@ def is_real_world(problem):
     return is_mesh_problem(problem) or getattr(problem, "surface", "") in REAL_WORLD_SURFACES
 
 
+def reference_accuracies(plan):
+    """Problem of the plan -> the relative accuracy of its reference answer, for the
+    problems whose reference is computed by schemes and states it (the committed real
+    meshes: the largest ``area_accuracy / area`` over the checkpoints, the accuracy of
+    their main metric ``area_error``, :mod:`mcfbench.running.real_mesh_problems`)."""
+    from mcfbench.running.problems import get_problem
+
+    out = {}
+    for p in plan["problems"]:
+        ref = getattr(get_problem(p), "reference", None) or {}
+        pairs = [(a, v) for a, v in zip(ref.get("area_accuracy") or (), ref.get("area") or ())
+                 if a is not None and v]
+        if pairs:
+            out[p] = max(a / abs(v) for a, v in pairs)
+    return out
+
+
 def mesh_problems(plan):
     """The real-world-like problems of the plan (:func:`is_real_world`)."""
     from mcfbench.running.problems import get_problem

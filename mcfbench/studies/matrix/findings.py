@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from mcfbench.presentation.formats import formatted
-from mcfbench.studies.matrix import mesh_problems
+from mcfbench.studies.matrix import mesh_problems, reference_accuracies
 from mcfbench.studies.matrix.tables import (
     error_ratios,
     levels_text,
@@ -220,7 +220,7 @@ def scope_lines(plan, all_schemes, all_problems, labels=None):
 
 
 def matrix_findings(table, summary=None, labels=None, mesh_problems=(),
-                    source="tables/summary.csv", work_precision=(), scope=()):
+                    source="tables/summary.csv", work_precision=(), scope=(), accuracy=None):
     """The findings, Markdown, written from the tables only.
 
     Parameters
@@ -239,6 +239,9 @@ def matrix_findings(table, summary=None, labels=None, mesh_problems=(),
         :func:`cheapest_to_reach` of the long table (a section when given).
     scope : list of str
         :func:`scope_lines` (after the introduction).
+    accuracy : dict, optional
+        Problem -> the relative accuracy of its reference answer, where it states one
+        (:func:`mcfbench.studies.matrix.reference_accuracies`).
     """
     summary = scheme_view(with_levels(summary_table(table) if summary is None else summary,
                                       table))
@@ -316,7 +319,7 @@ def matrix_findings(table, summary=None, labels=None, mesh_problems=(),
         lines += work_precision_section(work_precision)
     lines += real_mesh_section(summary, verdict, problems, schemes)
     lines += tangential_lines(table, summary, problems, schemes)
-    lines += recommendation(summary, verdict, problems, schemes, mesh_problems)
+    lines += recommendation(summary, verdict, problems, schemes, mesh_problems, accuracy)
     solver = summary[[bool(fixed) for fixed in summary["solver_only"]]]
     if len(solver):
         lines += ["## Solver verdicts", "",
@@ -396,17 +399,25 @@ def tangential_lines(table, summary, problems, schemes):
     return tangential_section(frame, TANGENTIAL)
 
 
-def recommendation(summary, verdict, problems, schemes, mesh_problems):
+def recommendation(summary, verdict, problems, schemes, mesh_problems, accuracy=None):
     """The section "Across problems".
 
     A candidate converges on every problem with an exact error (at order ~2
     wherever at least one scheme reaches order ~2 there; otherwise it only
     has to finish every level) and breaks down on none of the
-    real-world-like meshes. Candidates are ranked by the geometric mean over
+    real-world-like meshes. Two EOCs are not held against a scheme (the
+    recommendation says so), since the numbers cannot tell what limits them:
+    one into a finest-level error within the stated accuracy of the problem's
+    reference (``accuracy``: a reference computed by schemes, the real
+    meshes'), and one of an error that stopped decreasing (EOC below the
+    order-2 band) at a value no larger than that of every scheme showing
+    order ~2 there (a floor of the problem: its stopping rule, its time
+    error). Candidates are ranked by the geometric mean over
     those problems of their finest-level error relative to the smallest
     one. The problems without an exact value (singular flows such as a
     pinching torus) only inform: which scheme reaches the latest time.
     """
+    accuracy = accuracy or {}
     mesh_problems = [p for p in problems if p in set(mesh_problems)]
     exact = [p for p in problems if bool(summary[summary["problem"] == p]["error"].any())]
     singular = [p for p in problems if p not in exact and p not in mesh_problems]
@@ -423,6 +434,22 @@ def recommendation(summary, verdict, problems, schemes, mesh_problems):
         return _classify(verdict[(p, s)]) if (p, s) in verdict else "missing"
 
     needs_order2 = {p: any(cls(p, s) == "order2" for s in schemes) for p in exact}
+    floor = {p: min(abs(verdict[(p, s)]["finest_value"]) for s in schemes
+                    if cls(p, s) == "order2") for p in exact if needs_order2[p]}
+
+    def at_floor(p, s):
+        """Why the EOC of ``s`` on ``p`` cannot be judged (empty if it can)."""
+        if cls(p, s) not in ("converging", "not_converging"):
+            return ""
+        r = verdict[(p, s)]
+        error = abs(r["finest_value"])
+        if error <= accuracy.get(p, -np.inf):
+            return "into an error within the reference's accuracy"
+        if p in floor and np.isfinite(r["eoc"]) and r["eoc"] < ORDER_BAND[0] \
+                and error <= floor[p]:
+            return "at an error no larger than that of any scheme of order ~2 there (a floor)"
+        return ""
+
     relaxed = [p for p in exact if not needs_order2[p]]
     if relaxed:
         lines.append(f"No scheme reaches order ~2 on {', '.join(relaxed)}: there a scheme "
@@ -430,7 +457,8 @@ def recommendation(summary, verdict, problems, schemes, mesh_problems):
         lines.append("")
     winners = {}
     for p in exact:
-        good = [s for s in schemes if cls(p, s) in ORDER2_ENOUGH] if needs_order2[p] \
+        good = [s for s in schemes if cls(p, s) in ORDER2_ENOUGH or at_floor(p, s)] \
+            if needs_order2[p] \
             else [s for s in schemes if cls(p, s) in ("converging", "not_converging", "exact",
                                                       "one_level", "unsettled")]
         if good:
@@ -444,7 +472,7 @@ def recommendation(summary, verdict, problems, schemes, mesh_problems):
                 reasons.append(f"not run on {p}")
             elif c == "broke_down":
                 reasons.append(f"broke down on {p}")
-            elif needs_order2[p] and c not in ORDER2_ENOUGH:
+            elif needs_order2[p] and c not in ORDER2_ENOUGH and not at_floor(p, s):
                 eoc = verdict[(p, s)]["eoc"]
                 reasons.append(f"EOC {eoc:.2f} on {p}" if np.isfinite(eoc) else
                                f"no EOC on {p}")
@@ -482,7 +510,7 @@ def recommendation(summary, verdict, problems, schemes, mesh_problems):
             if not beaten else
             ", the smallest finest-level errors on average among them, though not on every "
             "problem (smallest elsewhere: " + "; ".join(beaten) + ").")
-            + _order_caveat(best, exact, cls, verdict, needs_order2))
+            + _order_caveat(best, exact, cls, verdict, needs_order2, at_floor))
     else:
         lines.append("**No scheme wins everywhere**: none converges as required on every "
                      "problem with an exact error without breaking down on a real-world-like "
@@ -517,13 +545,15 @@ ORDER2_ENOUGH = ("order2", "exact", "unsettled")
 """Classes that meet the order-2 requirement of a problem where some scheme reaches it."""
 
 
-def _order_caveat(scheme, exact, cls, verdict, needs_order2):
+def _order_caveat(scheme, exact, cls, verdict, needs_order2, at_floor):
     """What the recommendation of ``scheme`` does not claim: its orders that are not ~2,
     in the words of the per-problem verdicts."""
     notes = []
     for p in exact:
         c, eoc = cls(p, scheme), verdict[(p, scheme)]["eoc"]
-        if c == "unsettled":
+        if at_floor(p, scheme):
+            notes.append(f"EOC {eoc:.2f} on {p}, {at_floor(p, scheme)}")
+        elif c == "unsettled":
             notes.append(f"EOC {eoc:.2f} on {p} from two levels only (the order is not settled)")
         elif c in ("converging", "not_converging", "one_level"):
             notes.append((f"EOC {eoc:.2f} on {p}, not ~2" if np.isfinite(eoc) else
@@ -544,6 +574,7 @@ def findings(summary_csv, long_csv, out, plan):
     text = matrix_findings(table, read_summary(summary_csv), labels, mesh_problems(plan),
                            source=Path(summary_csv).as_posix(),
                            work_precision=cheapest_to_reach(table),
-                           scope=scope_lines(plan, list(SCHEMES), list(PROBLEMS), labels))
+                           scope=scope_lines(plan, list(SCHEMES), list(PROBLEMS), labels),
+                           accuracy=reference_accuracies(plan))
     write_text(out, text)
     return text

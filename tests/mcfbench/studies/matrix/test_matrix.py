@@ -561,6 +561,35 @@ def test_an_eoc_from_two_levels_does_not_disqualify():
     assert "Left out: b (EOC 2.58 on sphere)." in text and "**Recommendation: a**" in text
 
 
+def test_an_error_at_a_floor_below_every_order2_scheme_does_not_disqualify():
+    """a: order 2 on the sphere down to 2.5e-3; b's error stops decreasing at 1e-3, below
+    a's finest: a floor the numbers cannot tell from the problem's, not held against b
+    (and said); c stops at 5e-3, above it: left out; d's EOC 2.58 (above the band) still
+    disqualifies, however small its error."""
+    table = _table({"a": [4e-2, 1e-2, 2.5e-3], "b": [4e-3, 1e-3, 1e-3],
+                    "c": [2e-2, 5e-3, 5e-3], "d": [3.6e-2, 6e-3, 1e-3]})
+    text = matrix_findings.matrix_findings(table)
+    assert "Left out: c (EOC 0.00 on sphere); d (EOC 2.58 on sphere)." in text
+    assert "**Recommendation: b**" in text
+    assert ("It does not show order ~2 everywhere: EOC 0.00 on sphere, at an error no larger "
+            "than that of any scheme of order ~2 there (a floor).") in text
+
+
+def test_an_eoc_into_an_error_within_the_reference_accuracy_is_not_judged():
+    """A reference computed by schemes states its accuracy (1e-3 here): d's EOC 2.58
+    into 5e-4 and b's EOC 0 at 8e-4 are not measurements, so neither is held against
+    them (and the recommendation says why); without the accuracy d's EOC above the
+    band leaves it out (b's error is at the floor below a's order-2 one either way)."""
+    table = _table({"a": [4e-2, 1e-2, 2.5e-3], "b": [3.2e-3, 8e-4, 8e-4],
+                    "d": [1.8e-2, 3e-3, 5e-4]})
+    text = matrix_findings.matrix_findings(table)
+    assert "Left out: d (EOC 2.58 on sphere)." in text and "**Recommendation: b**" in text
+    judged = matrix_findings.matrix_findings(table, accuracy={"sphere": 1e-3})
+    assert "Left out" not in judged and "**Recommendation: d**" in judged
+    assert ("It does not show order ~2 everywhere: EOC 2.58 on sphere, into an error "
+            "within the reference's accuracy.") in judged
+
+
 def test_findings_show_values_as_the_tables_do():
     """A relative error is a number, as in the summary table, never a percentage."""
     table = _table({"a": [-3.2e-2, -8.424e-4]}, problem="catenoid", metric="neck_error")
