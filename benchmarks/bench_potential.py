@@ -139,7 +139,7 @@ PARTS = {
         ("baselines.redistribution", "PotentialSolver", "__call__", "potential: solve (R2)"),
         ("baselines.cotan", None, "drift_laplacian", "drift (R4) + its D X"),
         ("baselines.cotan", "CotanFlow", "_normal_drift", "normal part (R5)"),
-        ("baselines.cotan", "CotanAssembler", "row_scaled", "system matrix (C3)"),
+        ("baselines.laplacian", "CotanAssembler", "row_scaled", "system matrix (C3)"),
     ],
     "ddfv": [
         ("ddfv.flow", "Flow", "_geometry_at", "geometry"),
