@@ -219,8 +219,8 @@ class RealMeshShape:
             errors = [v / r - 1.0 for v, r in zip(values, reference)]
             worst = max(errors, key=lambda e: -1.0 if math.isnan(e) else abs(e))
             out[f"{key}_error"] = math.nan if any(map(math.isnan, errors)) else worst
-        resolved = self.final is None or len(self.final[0]) < self.surface_vertices
-        if self.surface is not None and resolved:
+        if self.surface is not None and (self.final is None
+                                         or len(self.final[0]) < self.surface_vertices):
             *key, length = self.surface
             out["distance_error"] = math.nan if self.final is None else \
                 mean_surface_distance(*self.final, *reference_surface(*key)) / length

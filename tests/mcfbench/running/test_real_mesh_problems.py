@@ -17,6 +17,7 @@ from mcfbench.geometry.surface_distance import mean_surface_distance
 from mcfbench.running.problems import PROBLEMS
 from mcfbench.running.real_mesh_problems import (
     RealMeshShape,
+    real_mesh_problem,
     reference_path,
     reference_surface,
     surface_path,
@@ -119,6 +120,21 @@ def test_distance_is_measured_below_the_reference_level_only():
         mean_surface_distance(*coarse, *fine) / ref["length_scale"], rel=1e-12)
     assert observed(*coarse)["distance_error"] > 0
     assert math.isnan(RealMeshShape(PROBLEMS["real_nut"]).result()["distance_error"])
+
+
+def test_a_reference_without_a_surface_measures_no_distance():
+    """A reference file without ``distance_reference`` (no surface stored): a run that
+    reaches t_final gets its area and volume errors and no distance, not an error."""
+    ref = {k: v for k, v in _stored("nut").items() if k != "distance_reference"}
+    observer = RealMeshShape(real_mesh_problem("nut", ref))
+    V, F = real_mesh("nut", 0)
+
+    class Flow:
+        vertices, faces, tau = V, F, ref["tau0"]
+    for Flow.n in ref["checkpoints"]:
+        observer(Flow)
+    result = observer.result()
+    assert "distance_error" not in result and np.isfinite(result["area_error"])
 
 
 def test_metric_measures_a_run_against_the_reference():
