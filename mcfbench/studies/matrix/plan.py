@@ -206,21 +206,27 @@ def run_settings(plan, scheme, problem, level, code=""):
     return {**series_settings(plan, scheme, problem, code), "level": int(level)}
 
 
+_RECORD_PATH = re.compile(r"/runs/[^/]+/([^/]+)/level(\d+)\.json$")
+"""The scheme and the level in a record path (:data:`mcfbench.studies.matrix.RECORD`)."""
+
+
+def _record_parts(record):
+    """``(scheme, level)`` of a record path (:func:`record_path`)."""
+    match = _RECORD_PATH.search(str(record))
+    if match is None:
+        raise ValueError(f"{record}: not a matrix record path "
+                         f"(.../runs/<problem>/<scheme>/level<k>.json)")
+    return match.group(1), int(match.group(2))
+
+
 def level_of(record):
     """The level of a run from its record path (:func:`record_path`)."""
-    match = re.search(r"/level(\d+)\.json$", str(record))
-    if match is None:
-        raise ValueError(f"{record}: not a matrix record path (.../level<k>.json)")
-    return int(match.group(1))
+    return _record_parts(record)[1]
 
 
 def scheme_of(record):
     """The scheme of a run from its record path (:func:`record_path`)."""
-    match = re.search(r"/runs/[^/]+/([^/]+)/level\d+\.json$", str(record))
-    if match is None:
-        raise ValueError(f"{record}: not a matrix record path "
-                         f"(.../runs/<problem>/<scheme>/level<k>.json)")
-    return match.group(1)
+    return _record_parts(record)[0]
 
 
 def planned_runs(plan, code="", root=ROOT):
