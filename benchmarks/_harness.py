@@ -6,8 +6,9 @@
 * :func:`harness_run`: :func:`mcfbench.running.run.run` exactly as the command
   line runs it, keeping the flow so that its ``timings`` can be read.
 * :class:`OldWorker`: the previous numpy implementation (commit ``6cc720c``,
-  ``git archive`` into a temporary directory) in a persistent child
-  process: ``worker.run(level)`` times its ``ddfv.sphere.sphere_run(level)``.
+  ``git archive`` into a temporary directory, :func:`extract`) in a persistent
+  child process (:class:`Child`): ``worker.run(level)`` times its
+  ``ddfv.sphere.sphere_run(level)``.
 * :func:`footing`: the caveat printed under every table of timings.
 """
 
@@ -129,8 +130,47 @@ for line in sys.stdin:
 '''
 
 
+def extract(rev, tree, *paths):
+    """``git archive rev [paths]`` of this repository unpacked into the directory ``tree``."""
+    archive = subprocess.run(["git", "archive", rev, *paths], cwd=ROOT, capture_output=True,
+                             check=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(tree)], input=archive, check=True)
+
+
+class Child:
+    """A persistent child process of this interpreter (pinned like this one) running the
+    Python source ``script`` with ``args`` in the tree ``tree`` (its working directory
+    and ``PYTHONPATH``). The script prints one JSON line ``{"ready": ddfv.__file__}``
+    when warmed up (checked to be the tree's), then answers every request line with
+    one JSON line (:meth:`ask`)."""
+
+    def __init__(self, tree, script, args=()):
+        self.tree = str(tree)
+        self._proc = subprocess.Popen([sys.executable, "-c", script, *map(str, args)],
+                                      cwd=self.tree, env={**os.environ, "PYTHONPATH": self.tree},
+                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        ready = json.loads(self._proc.stdout.readline())["ready"]
+        if not ready.startswith(self.tree):
+            raise RuntimeError(f"the child in {self.tree} imported {ready}")
+
+    def ask(self, request):
+        """The child's answer (a dict) to one request line."""
+        self._proc.stdin.write(f"{request}\n")
+        self._proc.stdin.flush()
+        line = self._proc.stdout.readline()
+        if not line:
+            raise RuntimeError(f"the child in {self.tree} died at {request!r}")
+        return json.loads(line)
+
+    def close(self):
+        if self._proc.poll() is None:
+            self._proc.stdin.close()
+            self._proc.wait(timeout=60)
+
+
 class OldWorker:
-    """The implementation at ``rev`` in a child process (pinned like this one).
+    """The implementation at ``rev`` in a :class:`Child` (``git archive`` into a
+    temporary directory).
 
     ``run(level)`` returns ``{"wall", "cpu", "iterations", "l2_error", ...}``
     of its ``ddfv.sphere.sphere_run(level)``: flow construction, every step,
@@ -138,34 +178,16 @@ class OldWorker:
     """
 
     def __init__(self, rev=OLD_REV):
-        self._tmp = tempfile.TemporaryDirectory(prefix=f"ddfv-{rev}-")
-        tree = self._tmp.name
-        archive = subprocess.run(["git", "archive", rev], cwd=ROOT, capture_output=True,
-                                 check=True).stdout
-        subprocess.run(["tar", "-x", "-C", tree], input=archive, check=True)
-        script = Path(tree) / "_bench_worker.py"
-        script.write_text(_WORKER)
-        env = {**os.environ, "PYTHONPATH": tree}
         self.rev = rev
-        self._proc = subprocess.Popen([sys.executable, str(script)], cwd=tree, env=env,
-                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                      text=True)
-        ready = json.loads(self._proc.stdout.readline())
-        if not ready["ready"].startswith(tree):
-            raise RuntimeError(f"the old worker imported {ready['ready']}, not {tree}")
+        self._tmp = tempfile.TemporaryDirectory(prefix=f"ddfv-{rev}-")
+        extract(rev, self._tmp.name)
+        self._child = Child(self._tmp.name, _WORKER)
 
     def run(self, level):
-        self._proc.stdin.write(f"{int(level)}\n")
-        self._proc.stdin.flush()
-        line = self._proc.stdout.readline()
-        if not line:
-            raise RuntimeError(f"the old worker ({self.rev}) died at level {level}")
-        return json.loads(line)
+        return self._child.ask(int(level))
 
     def close(self):
-        if self._proc.poll() is None:
-            self._proc.stdin.close()
-            self._proc.wait(timeout=60)
+        self._child.close()
         self._tmp.cleanup()
 
     def __enter__(self):

@@ -20,12 +20,9 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMB
     os.environ[_var] = "1"          # before numpy is imported; the children inherit them
 
 import argparse  # noqa: E402
-import json  # noqa: E402
-import subprocess  # noqa: E402
-import sys  # noqa: E402
 import tempfile  # noqa: E402
 
-from _harness import ROOT, machine_line, median, one_core  # noqa: E402
+from _harness import ROOT, Child, extract, machine_line, median, one_core  # noqa: E402
 
 _CHILD = r'''
 import json, os, sys
@@ -47,34 +44,6 @@ for line in sys.stdin:
 '''
 
 
-class Tree:
-    """A persistent child process running the sphere in the tree ``path``."""
-
-    def __init__(self, path, schemes):
-        self.path = str(path)
-        self.proc = subprocess.Popen([sys.executable, "-c", _CHILD, *schemes], cwd=self.path,
-                                     env={**os.environ, "PYTHONPATH": self.path},
-                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
-        ready = json.loads(self.proc.stdout.readline())["ready"]
-        if not ready.startswith(self.path):
-            raise RuntimeError(f"the child in {self.path} imported {ready}")
-
-    def run(self, scheme, level):
-        self.proc.stdin.write(f"{scheme} {int(level)}\n")
-        self.proc.stdin.flush()
-        line = self.proc.stdout.readline()
-        if not line:
-            raise RuntimeError(f"the child in {self.path} died ({scheme}, level {level})")
-        result = json.loads(line)
-        if result["status"] != "ok":
-            raise RuntimeError(f"{scheme} level {level} in {self.path}: {result['status']}")
-        return result
-
-    def close(self):
-        self.proc.stdin.close()
-        self.proc.wait(timeout=60)
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rev", required=True, help="the tree to compare against (git revision)")
@@ -85,16 +54,19 @@ def main(argv=None):
     one_core()
     print(f"bench_ab: {machine_line()}")
     with tempfile.TemporaryDirectory(prefix=f"ab-{args.rev}-") as tree:
-        archive = subprocess.run(["git", "archive", args.rev], cwd=ROOT, capture_output=True,
-                                 check=True).stdout
-        subprocess.run(["tar", "-x", "-C", tree], input=archive, check=True)
-        trees = {"rev": Tree(tree, args.schemes), "work": Tree(ROOT, args.schemes)}
+        extract(args.rev, tree)
+        trees = {"rev": Child(tree, _CHILD, args.schemes),
+                 "work": Child(ROOT, _CHILD, args.schemes)}
         runs = {(k, s): [] for k in trees for s in args.schemes}
         try:
             for rep in range(args.repeats):
                 for scheme in args.schemes:
                     for k in (("rev", "work") if rep % 2 == 0 else ("work", "rev")):
-                        runs[k, scheme].append(trees[k].run(scheme, args.level))
+                        result = trees[k].ask(f"{scheme} {args.level}")
+                        if result["status"] != "ok":
+                            raise RuntimeError(f"{scheme} level {args.level} in "
+                                               f"{trees[k].tree}: {result['status']}")
+                        runs[k, scheme].append(result)
         finally:
             for t in trees.values():
                 t.close()

@@ -63,7 +63,7 @@ import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
-from _harness import ROOT, footing, machine_line, median, one_core  # noqa: E402
+from _harness import ROOT, extract, footing, machine_line, median, one_core  # noqa: E402
 
 from mcfbench.geometry.spheres import icosphere  # noqa: E402
 from mcfbench.running.driver import simulate  # noqa: E402
@@ -86,9 +86,7 @@ def before_packages(tree, commit):
     present = subprocess.run(["git", "ls-tree", "--name-only", commit], cwd=ROOT,
                              capture_output=True, check=True, text=True).stdout.split()
     packages = [p for p in PACKAGES if p in present]     # kept_factor: since 36cf514
-    archive = subprocess.run(["git", "archive", commit, *packages], cwd=ROOT,
-                             capture_output=True, check=True).stdout
-    subprocess.run(["tar", "-x", "-C", tree], input=archive, check=True)
+    extract(commit, tree, *packages)
     for package in packages:
         Path(tree, package).rename(Path(tree, f"{package}_before"))
     for source in Path(tree).glob("*_before/*.py"):
