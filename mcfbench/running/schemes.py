@@ -21,6 +21,7 @@ import inspect
 from dataclasses import dataclass, field, replace
 
 from mcfbench.running.integrators import INTEGRATORS
+from mcfbench.running.solver import ROBUST
 
 MATRICES = {
     "nonsymmetric": "BiCGStab (the paper's) or a sparse LU (`direct`): the matrix is not "
@@ -108,7 +109,7 @@ class Scheme:
     family: str = "vertex"
     extra_points: bool = False
     matrix: str = "nonsymmetric"
-    robust_solver: str = "direct"
+    robust_solver: str = ROBUST
     integrator: str = "euler"
     tangential: str = "none"
 
