@@ -72,57 +72,56 @@ Failures (``SolveInfo.status``)
 ``max_iterations``
     ``maxiter`` iterations without meeting the tolerance.
 
-No arithmetic exception or warning escapes: the whole iteration is one
-compiled function (numba, ``error_model="numpy"``), every scalar is
-checked, and the failures above are reported in ``SolveInfo``;
-:class:`Solver` raises :class:`SolverFailure` for them.
+No arithmetic exception or warning escapes: the iteration is one compiled function
+(numba, ``error_model="numpy"``), every scalar checked, the failures above reported in
+``SolveInfo``; :class:`Solver` raises :class:`SolverFailure` for them.
 
 Methods (:data:`METHODS`)
 -------------------------
 ``bicgstab``
-    The paper's unpreconditioned BiCGStab (default). Its iteration counts
-    are those of the former numpy implementation and its iterates agree to
-    round-off (icosphere levels 1-5, Table 3.1 setting: 8/45/113/279/654
-    iterations, every solve the same count, solutions within 3e-16).
+    The paper's unpreconditioned BiCGStab (default): the former numpy implementation's
+    iteration counts, iterates within round-off (icosphere levels 1-5, Table 3.1's
+    setting: 8/45/113/279/654 iterations every solve, solutions within 3e-16).
 ``jacobi-bicgstab``
-    BiCGStab right-preconditioned with the diagonal of ``A``. Costs one
-    extra vector pass per product.
+    Right-preconditioned with the diagonal of ``A`` (one more vector pass a product).
 ``ilu-bicgstab``
     BiCGStab right-preconditioned with an incomplete LU factorization
     (``scipy.sparse.linalg.spilu``, ``drop_tol``/``fill_factor`` from
     :class:`Solver`) of ``D^{-1} A``, ``D`` the absolute row sums (rows
     equilibrated; if that factor is exactly singular, of ``A`` itself),
-    computed once per call (once for the three rows in the shared case);
-    the triangular solves are compiled.
+    once per call (for the three rows in the shared case); compiled triangular solves.
 ``direct``
     Sparse LU (``scipy.sparse.linalg.splu``: SuperLU's symmetric mode, then,
     if that misses the tolerance, COLAMD with partial pivoting;
     :data:`LU_ORDERINGS`) factorized once per call and applied to the three
-    rows (shared case) or to ``b.ravel()``; up to three steps of iterative
-    refinement, the residual checked as above.
+    rows (shared case) or ``b.ravel()``; up to three refinement steps, residual as above.
+``jacobi-direct``
+    ``jacobi-bicgstab``, then ``direct`` from ``x0`` if that fails (:data:`ROBUST`):
+    it converges wherever ``direct`` does (iterations: Jacobi's, failed included).
 
-Right preconditioning leaves the residual, hence the stopping test,
-unchanged. Measured on cotangent systems of bad meshes (perturbed,
-random-point, anisotropic, marching-cubes surfaces, 6k-16k vertices,
-``tau`` = 1, 100, 10^4 times the mean vertex area, ``rtol = 1e-9``,
-``maxiter = 1000``): ``bicgstab`` converged in 20 of 36 systems,
-``jacobi-bicgstab`` in 33, ``ilu-bicgstab`` and ``direct`` in all 36.
-On well-shaped meshes ``bicgstab`` is by far the cheapest (level-5 sphere:
-about 13 ms per step against 0.4-1 s for the factorizations).
+Right preconditioning leaves the residual, hence the stopping test, unchanged.
+On cotangent systems of bad meshes (perturbed, random-point, anisotropic,
+marching-cubes surfaces, 6k-16k vertices, ``tau`` = 1, 100, 10^4 times the mean
+vertex area, ``rtol = 1e-9``, ``maxiter = 1000``) ``bicgstab`` converged in 20 of
+36, ``jacobi-bicgstab`` in 33, the others in all 36. On well-shaped meshes
+``bicgstab`` is by far the cheapest (level-5 sphere: 13 ms a step against 0.4-1 s
+for the factorizations).
 """
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 # scipy.sparse, the compiled kernels (numba) and ddfv's thread checks are imported
 # on first use: the command line reads METHODS and ROBUST for its help in 0.1 s.
 
-METHODS = ("bicgstab", "jacobi-bicgstab", "ilu-bicgstab", "direct")
-ROBUST = "direct"
-"""The method for meshes of unknown quality: it converged on every bad-mesh system
-measured (36 of 36 cotangent systems, against 20 for plain BiCGStab)."""
+METHODS = ("bicgstab", "jacobi-bicgstab", "ilu-bicgstab", "direct", "jacobi-direct")
+ROBUST = "jacobi-direct"
+"""The method for meshes of unknown quality: its LU converged on all 36 bad-mesh systems
+measured (plain BiCGStab on 20, Jacobi's, tried first, on 33). BGN's first step on the
+anisotropic sphere's level 4 (96 774 unknowns): 1.23 s (367 Jacobi iterations) against
+``direct``'s 3.81 s; level 3 (23 814) 0.15 s against 0.51 s; plain BiCGStab fails."""
 STATUSES = ("converged", "max_iterations", "breakdown", "stagnated")
 
 _REFINEMENTS = 3         # iterative refinement steps of "direct"
@@ -247,17 +246,15 @@ LU_ORDERINGS = (
      "options": {"SymmetricMode": True}},
     {"permc_spec": "COLAMD"},
 )
-"""SuperLU's settings for ``direct``, tried in turn until one gives the tolerance:
-its symmetric mode first (minimum degree on ``A + A^T``, the diagonal pivot
-kept unless it is below 0.1 of its column's largest entry), SuperLU's advice for
-matrices of (nearly) symmetric pattern with a strong diagonal as every
-scheme's are (the mesh's graph); then COLAMD with partial pivoting (scipy's
-default). Measured on one step's matrix (factorisation CPU s, fill of L + U):
-BGN on the anisotropic sphere's level 3 (23 814 unknowns) 0.58 s, 9.5 M with
-COLAMD, 0.28 s, 4.5 M in symmetric mode; cotan, its level 4 (32 258) 0.30 s,
-5.6 M against 0.12 s, 2.2 M; DDFV with redistribution on Enneper's level 3
-(16 361) 0.10 s, 2.3 M against 0.09 s, 1.5 M; every residual before
-refinement 1e-13 or below."""
+"""SuperLU's settings for ``direct``, tried in turn until one gives the tolerance: its
+symmetric mode (minimum degree on ``A + A^T``, the diagonal pivot kept unless below 0.1
+of its column's largest entry), SuperLU's advice for a (nearly) symmetric pattern with
+a strong diagonal as every scheme's (the mesh's graph); then COLAMD with partial
+pivoting (scipy's default). One step's matrix (CPU s, fill of L + U), COLAMD against
+symmetric mode: BGN, anisotropic sphere level 3 (23 814 unknowns) 0.58 s, 9.5 M
+against 0.28 s, 4.5 M; cotan, its level 4 (32 258) 0.30 s, 5.6 M against 0.12 s,
+2.2 M; redistributing DDFV, Enneper level 3 (16 361) 0.10 s, 2.3 M against 0.09 s,
+1.5 M; every residual before refinement 1e-13 or below."""
 
 
 def _factorize(A, ilu, drop_tol=1e-4, fill_factor=10.0, ordering=None):
@@ -355,6 +352,15 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
         if method == "direct":
             x, info = _direct(A, csr, b, x, cmean, cfull, rtol)
             return to_block(x), info
+        if method == "jacobi-direct":
+            start = x.copy()
+            x, info = solve(A, to_block(b), to_block(x), method="jacobi-bicgstab",
+                            rtol=rtol, maxiter=maxiter, stagnation_window=stagnation_window,
+                            overwrite_x0=True, threads=threads)
+            if not info.converged:
+                x, lu = _direct(A, csr, b, start, cmean, cfull, rtol)
+                info = replace(lu, iterations=info.iterations)
+            return to_block(x), replace(info, method=method)
         kind, dinv, lu = 0, _NO_FLOAT, None
         if method == "jacobi-bicgstab":
             kind = 1
@@ -461,12 +467,6 @@ def _refined(lu, csr, b, x0, cmean, cfull, ref, rtol, r):
     return x, _failed(method, "stagnated",
                       f"residual above rtol after the LU solve and {step} refinement "
                       "step(s): the matrix is too ill-conditioned", res)
-
-
-def bicgstab(A, b, x0, rtol=1e-10, maxiter=1000):
-    """The paper's BiCGStab, the former entry point: ``solve(A, b, x0,
-    method="bicgstab", rtol=rtol, maxiter=maxiter)`` (does not raise)."""
-    return solve(A, b, x0, method="bicgstab", rtol=rtol, maxiter=maxiter)
 
 
 def apply_block(A, X, out=None):

@@ -8,6 +8,7 @@ from mcfbench.running.driver import simulate
 from mcfbench.running.flow import SchemeFlow
 from mcfbench.running.integrators import Euler
 from mcfbench.running.schemes import SCHEMES, get_scheme
+from mcfbench.running.solver import ROBUST
 
 
 @pytest.mark.parametrize("name", sorted(SCHEMES))
@@ -104,7 +105,7 @@ def test_matrix_kind_of_every_scheme_is_what_the_registry_says(name):
         assert np.abs(eig.imag).max() < 1e-8 and eig.real.min() > 0
     else:
         assert misfit > 1e-4
-    assert scheme.robust_solver == "direct" and scheme.suited_solver
+    assert scheme.robust_solver == ROBUST and scheme.suited_solver
 
 
 def test_unknown_matrix_kind_is_refused():

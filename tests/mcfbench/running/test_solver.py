@@ -12,6 +12,7 @@ import scipy.sparse.linalg as spla
 
 from mcfbench.running.solver import (
     METHODS,
+    ROBUST,
     SolveInfo,
     Solver,
     SolverFailure,
@@ -379,6 +380,33 @@ def test_preconditioners_help_on_an_ill_conditioned_system():
     assert its["jacobi-bicgstab"].converged and its["jacobi-bicgstab"].iterations < 100
     assert its["ilu-bicgstab"].converged and its["ilu-bicgstab"].iterations < 30
     assert its["direct"].converged and its["direct"].residual < 1e-12
+
+
+@pytest.mark.parametrize("coupled", [False, True])
+def test_robust_method_is_jacobi_then_the_sparse_lu(coupled):
+    """``jacobi-direct`` (the robust method): Jacobi-BiCGStab's iterate where it converges,
+    bitwise; where it does not (maxiter 3 here), the sparse LU's solution from the same
+    x0, bitwise, with Jacobi's iterations counted; where both fail, the LU's verdict."""
+    A, b = ring_system(tau=1e4)
+    A = (sp.diags(np.geomspace(1e-3, 1e3, A.shape[0])) @ A).tocsr()
+    b = np.stack([A @ row for row in b])
+    A = sp.block_diag([A, A, A], format="csr") if coupled else A
+    x0 = np.zeros_like(b)
+    kept = x0.copy()
+    assert ROBUST == "jacobi-direct"
+    x_jacobi, jacobi = solve(A, b, x0, method="jacobi-bicgstab")
+    x, info = solve(A, b, x0, method=ROBUST)
+    assert jacobi.converged and np.array_equal(x, x_jacobi)
+    assert info == SolveInfo(jacobi.iterations, jacobi.residual, True, method=ROBUST)
+    assert not solve(A, b, x0, method="jacobi-bicgstab", maxiter=3)[1].converged
+    x_lu, lu = solve(A, b, x0, method="direct")
+    x, info = solve(A, b, x0, method=ROBUST, maxiter=3)
+    assert np.array_equal(x, x_lu) and x.shape == b.shape and np.array_equal(x0, kept)
+    assert info == SolveInfo(3, lu.residual, True, method=ROBUST) and lu.residual < 1e-12
+    S = sp.csr_matrix(np.array([[1.0, 1.0], [1.0, 1.0]]))
+    x, info = solve(S, np.array([[1.0, 2.0]]), np.array([[0.5, 0.25]]), method=ROBUST)
+    assert (info.status, info.method) == ("breakdown", ROBUST) and "singular" in info.detail
+    assert np.array_equal(x, [[0.5, 0.25]])
 
 
 @pytest.mark.parametrize("field, value", [("method", "cg"), ("rtol", 0.0), ("rtol", 1.5),

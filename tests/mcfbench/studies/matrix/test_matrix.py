@@ -343,7 +343,8 @@ def test_recommendation_when_one_scheme_wins():
 
 def test_solver_failure_is_rerun_with_the_robust_solver(tmp_path):
     """maxiter = 1 forces BiCGStab to fail on the sphere; the job re-runs the level with
-    ``direct``, which finishes, and the findings call it a solver verdict."""
+    the robust ``jacobi-direct`` (whose Jacobi-BiCGStab fails too at maxiter 1: every
+    solve is the sparse LU's), which finishes, and the findings call it a solver verdict."""
     plan = matrix_plan.plan({"schemes": ["cotan", "bgn"], "maxiter": 1,
                              "problems": {p: ([1, 2] if p == "sphere" else []) for p in PROBLEMS}})
     runs = matrix_plan.planned_runs(plan, code="test", root=str(tmp_path))
@@ -352,7 +353,7 @@ def test_solver_failure_is_rerun_with_the_robust_solver(tmp_path):
     for path, settings in runs.items():
         record = read_record(path, settings=settings)
         assert record["status"] == "solver_failed" and "iteration limit 1" in record["message"]
-        assert record["robust_status"] == "ok" and record["robust_solver"] == "direct"
+        assert record["robust_status"] == "ok" and record["robust_solver"] == "jacobi-direct"
         assert record["robust_message"] == "" and record["robust_steps_done"] == record["N"]
         assert record["robust_metrics"]["l2_error"] < 2e-2
     table, summary = matrix_aggregate.aggregate(runs, plan, tmp_path / "tables")
