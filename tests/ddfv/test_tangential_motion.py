@@ -15,8 +15,8 @@ import scipy.sparse as sp
 import igl
 
 from ddfv.tangential_motion import (P1Stiffness, TangentialMotion, follow_triangles,
-                                    half_cotangents, p1_stiffness, tangent_bases,
-                                    tangential_motion)
+                                    TANGENTIAL_RTOL, half_cotangents, p1_stiffness,
+                                    tangent_bases, tangential_motion)
 from ddfv.geometry import t_barycentric, vertex_normals
 from mcfbench.geometry import surfaces
 from mcfbench.geometry.exact import SphereL2Error
@@ -47,6 +47,24 @@ def test_tangent_bases_are_orthonormal_and_right_handed():
     for a, b, dot in ((t1, t1, 1), (t2, t2, 1), (t1, t2, 0), (t1, N, 0), (t2, N, 0)):
         np.testing.assert_allclose(np.einsum("ij,ij->i", a, b), dot, atol=1e-14)
     np.testing.assert_allclose(np.cross(t1, t2), N, atol=1e-14)
+
+
+def test_bases_follow_the_normals():
+    """The first bases are :func:`tangent_bases`; then each ``t1`` is the last one
+    projected on the new tangent plane and normalised, a fresh one where that
+    projection is shorter than 1/2 (the normal turned onto the old ``t1``), ``t2 =
+    N x t1``."""
+    N0 = _unit(np.random.default_rng(0).normal(size=(50, 3)))
+    motion = TangentialMotion(np.zeros((0, 3), int), "bgn")
+    t1, t2 = motion._bases(N0)
+    np.testing.assert_array_equal(t1, tangent_bases(N0)[0])
+    N1 = _unit(N0 + 0.1 * np.random.default_rng(1).normal(size=N0.shape))
+    N1[:3] = t1[:3]                                               # turned onto t1
+    u1, u2 = motion._bases(N1)
+    followed = t1[3:] - np.einsum("ij,ij->i", t1[3:], N1[3:])[:, None] * N1[3:]
+    np.testing.assert_allclose(u1[3:], _unit(followed), atol=1e-15)
+    np.testing.assert_allclose(u1[:3], tangent_bases(N1[:3])[0], atol=1e-15)
+    np.testing.assert_allclose(u2, np.cross(N1, u1), atol=1e-15)
 
 
 @pytest.mark.parametrize("kind", ["bgn", "mdr"])
@@ -211,6 +229,30 @@ def test_kept_factors_give_the_fresh_solution(kind):
         cold._history.clear()                                     # no start: S_old^{-1} b
     assert (warm.factorisations, cold.factorisations) == (1, 1)
     assert 0 < warm.iterations < cold.iterations
+
+
+@pytest.mark.parametrize("kind", ["bgn", "mdr"])
+def test_kept_factor_solves_meet_the_default_tolerance(kind):
+    """At the default :data:`TANGENTIAL_RTOL` each step's solution has the residual of
+    (TM2) ``S s + r = E^T A Y(X)``, the tangential part of ``A Y`` at the new
+    positions, at most the tolerance times the scheme's ``E^T A Y(X^*)``, and the
+    kept factor reaches it in fewer iterations than the tolerance 1e-12."""
+    V, F, N, W = _displaced_bumpy()
+    drift = [np.sin(3.0 * V + k) for k in range(3)]
+    motion, tight = TangentialMotion(F, kind), TangentialMotion(F, kind, rtol=1e-12)
+
+    def tangential_norm(Z, N):
+        return np.linalg.norm(Z - np.einsum("ij,ij->i", Z, N)[:, None] * N)
+
+    for j in range(5):
+        Vj, Wj = V + 1e-5 * j * drift[0], W + 1e-5 * j * drift[2]
+        Nj = _unit(N + 1e-5 * j * drift[1])
+        X = motion(Vj, Wj, Nj)
+        tight(Vj, Wj, Nj)
+        A, base = p1_stiffness(Vj, F), (0.0 if kind == "bgn" else Vj)
+        assert (tangential_norm(A @ (X - base), Nj)
+                <= TANGENTIAL_RTOL * tangential_norm(A @ (Wj - base), Nj) * (1 + 1e-6))
+    assert motion.factorisations == 1 and motion.iterations < tight.iterations
 
 
 def test_t_vertices_follow_their_triangles():
