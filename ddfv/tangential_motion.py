@@ -296,18 +296,20 @@ class TangentialMotion(KeptFactorSolver):
         project : callable (n, 3) -> (2 n_free,)
         apply : callable (2 n_free,) -> (2 n_free,)
         """
-        fixed = not free.all()
+        rows = None if free.all() else np.flatnonzero(free)
 
         def project(Z):
-            Z = Z[free] if fixed else Z
-            return np.stack([np.einsum("ij,ij->i", t1, Z), np.einsum("ij,ij->i", t2, Z)],
-                            axis=1).ravel()
+            Z = Z if rows is None else Z[rows]
+            out = np.empty((len(t1), 2))
+            out[:, 0] = np.einsum("ij,ij->i", t1, Z)
+            out[:, 1] = np.einsum("ij,ij->i", t2, Z)
+            return out.ravel()
 
         def apply(s):
             D = s[0::2, None] * t1 + s[1::2, None] * t2
-            if fixed:
+            if rows is not None:
                 full = np.zeros((len(free), 3))
-                full[free] = D
+                full[rows] = D
                 D = full
             return project(A @ D)
         return project, apply
