@@ -115,6 +115,8 @@ from the scheme; this is a tangential velocity of the T-vertices alone,
 applied at the end of the step (see ``ddfv/README.md``).
 """
 
+from types import SimpleNamespace
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -151,28 +153,31 @@ def neumann_stiffness(assembler, geom):
         on each family and affine functions on a planar mesh (chord
         ``|gamma|``) are in the kernel.
     """
+    from . import kernels as k
+
     mesh = assembler._mesh
-    n = mesh.n_unknowns
-    K = assembler._matrix(geom, np.ones(n), 0.0)
+    K = assembler._matrix(geom, np.ones(mesh.n_unknowns), 0.0)
     if not mesh.has_boundary:
         return K
     bnd = np.flatnonzero(mesh.boundary)
-    a, b, t1 = (mesh.diamonds[bnd, k] for k in range(3))
-    alpha, beta, alpha_hat, beta_hat = (np.asarray(c)[bnd] for c in flux_coefficients(geom))
-    row = mesh.n_f + t1
+    alpha, beta, alpha_hat, beta_hat = flux_coefficients(SimpleNamespace(**{
+        name: np.asarray(getattr(geom, name))[bnd]
+        for name in ("gamma_t", "gamma_f", "J", "len_u", "len_v", "uv")}))
     # F-rows: the assembly leaves out the ghost T_t2 = F_a + F_b - T_t1 of Section
     # 2.2.5 (its F-rows are Dirichlet rows) and its geometry measures the dual
     # curve T_t1 -> S -> ghost; on the surface the curve ends at S, the edge
     # midpoint: half of it. The flux balance needs
     # flux_a = (alpha (psi_b - psi_a) - beta (psi_a + psi_b - 2 psi_t1)) / 2 = -flux_b.
     # T-row: the ghost's flux through the boundary edge is taken out (Neumann).
-    rows = np.concatenate([a, a, b, b, row, row, row])
-    cols = np.concatenate([a, b, a, b, a, b, row])
-    vals = np.concatenate([(beta - alpha) / 2, (alpha + beta) / 2,
-                           (alpha - beta) / 2, -(alpha + beta) / 2,
-                           beta_hat + alpha_hat, alpha_hat - beta_hat, -2.0 * alpha_hat])
-    ghost = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
-    return (K + ghost).tocsr()
+    # Every entry is in the assembler's pattern (a boundary diamond has its slots
+    # (a, a), (a, b), (b, a), (b, b), (t1, a), (t1, b), (t1, t1)): added into K's data.
+    slots = assembler._slots[bnd][:, [k.SLOT_AA, k.SLOT_AB, k.SLOT_BA, k.SLOT_BB,
+                                      k.SLOT_T1_A, k.SLOT_T1_B, k.SLOT_T1_T1]]
+    vals = np.stack([(beta - alpha) / 2, (alpha + beta) / 2,
+                     (alpha - beta) / 2, -(alpha + beta) / 2,
+                     beta_hat + alpha_hat, alpha_hat - beta_hat, -2.0 * alpha_hat], axis=1)
+    K.data += np.bincount(slots.ravel(), vals.ravel(), minlength=K.nnz)
+    return K
 
 
 def redistribution_source(chi, hV, n_f, fixed=None, omega=OMEGA):

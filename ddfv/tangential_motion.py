@@ -65,6 +65,9 @@ import scipy.sparse as sp
 
 from kept_factor import KeptFactorSolver
 
+#: relative residual of (TM2)'s solve (:class:`TangentialMotion`; it was 1e-12)
+TANGENTIAL_RTOL = 1e-8
+
 KINDS = ("bgn", "mdr")
 """The tangential motions: ``"bgn"`` (the new surface's Dirichlet energy) and ``"mdr"``
 (the displacement's, the minimal deformation rate)."""
@@ -87,17 +90,48 @@ def p1_stiffness(F, faces):
     return sp.csr_matrix(-igl.cotmatrix(np.asarray(F, dtype=float), faces))
 
 
+def half_cotangents(F, faces):
+    """``w_{t,k} = cot(angle_k) / 2`` at every corner ``k`` of every triangle ``t``.
+
+    With ``e_k = F_{k+2} - F_{k+1}`` the edge opposite corner ``k`` (indices mod
+    3) and ``2 |t| = |e_1 x e_2|``, ``cot(angle_k) = -e_{k+1} . e_{k+2} / (2 |t|)``:
+    the entries ``igl.cotmatrix_entries`` gives (libigl's columns, corner ``k``
+    facing the edge ``(k+1, k+2)``) in numpy, without libigl's threads, which
+    spent a step's time waiting on a busy machine (catenoid level 2: 6.2 ms of
+    wall time and 0.56 ms of CPU a call in a run; here 0.16 ms, libigl's alone
+    0.10 ms; level 3: 0.58 and 0.28 ms).
+
+    Parameters
+    ----------
+    F : (n, 3) float array
+    faces : (m, 3) int array
+
+    Returns
+    -------
+    (m, 3) float array
+    """
+    F = np.asarray(F, dtype=np.float64)
+    p0, p1, p2 = (np.take(F, faces[:, k], axis=0) for k in range(3))
+    e0, e1, e2 = p2 - p1, p0 - p2, p1 - p0                             # e_k
+    dots = np.stack([np.einsum("ij,ij->i", e1, e2), np.einsum("ij,ij->i", e2, e0),
+                     np.einsum("ij,ij->i", e0, e1)])                   # (3, m)
+    c = np.cross(e1, e2)
+    return (dots / (-2.0 * np.sqrt(np.einsum("ij,ij->i", c, c)))).T
+
+
 class P1Stiffness:
     """:func:`p1_stiffness` of the states of one F-mesh, in a CSR pattern found once.
 
-    ``igl.cotmatrix_entries`` gives the half cotangents ``w_{t,k} = cot(angle_k) / 2``
+    :func:`half_cotangents` gives the half cotangents ``w_{t,k} = cot(angle_k) / 2``
     of every corner (the weight of the edge ``(a, b)`` opposite corner ``k`` of
     triangle ``t``); ``A_ab = -sum w``, ``A_aa = A_bb = +sum w`` over the corners
-    facing the edge, summed with ``np.bincount`` into the slots of a pattern (the
-    edges and the diagonal, rows and columns sorted) built on the first call:
-    ``-igl.cotmatrix`` to round-off (its triplet assembly sums in another order)
-    at a tenth of its cost (3.2 -> 0.3 ms on the catenoid's level 3, 6 144
-    triangles). The pattern keeps every edge, also one whose weight vanishes.
+    facing the edge, summed into the slots of a pattern (the edges and the
+    diagonal, rows and columns sorted) built on the first call, by one sparse
+    product ``data = M w`` with the signed incidence ``M`` (slots x corners,
+    built once; a quarter of the cost of the same sums by ``np.bincount``, 0.06
+    against 0.26 ms at the catenoid's level 3, 6 144 triangles):
+    ``-igl.cotmatrix`` to round-off (both sum in other orders). The pattern
+    keeps every edge, also one whose weight vanishes.
 
     Parameters
     ----------
@@ -112,18 +146,19 @@ class P1Stiffness:
         b = self.faces[:, [2, 0, 1]].T
         rows = np.concatenate([a, b, a, b]).ravel()
         cols = np.concatenate([b, a, a, b]).ravel()
-        keys, self._slots = np.unique(rows * n + cols, return_inverse=True)
-        self._sign = np.repeat([-1.0, -1.0, 1.0, 1.0], a.size)
+        keys, slots = np.unique(rows * n + cols, return_inverse=True)
+        self._incidence = sp.csr_matrix(
+            (np.repeat([-1.0, -1.0, 1.0, 1.0], a.size), (slots, np.tile(np.arange(a.size), 4))),
+            shape=(len(keys), a.size))                    # M: (slots, corners), signed
         self.indices = (keys % n).astype(np.int32)
         self.indptr = np.searchsorted(keys // n, np.arange(n + 1)).astype(np.int32)
         self.shape = (n, n)
 
     def __call__(self, F):
         """``A`` (n, n) CSR at the F-vertices ``F`` (n, 3)."""
-        w = igl.cotmatrix_entries(np.asarray(F, dtype=np.float64), self.faces).T.ravel()
-        data = np.bincount(self._slots, weights=np.tile(w, 4) * self._sign,
-                           minlength=len(self.indices))
-        return sp.csr_matrix((data, self.indices, self.indptr), shape=self.shape)
+        w = half_cotangents(F, self.faces).T.ravel()         # corner k of triangle t at k m + t
+        return sp.csr_matrix((self._incidence @ w, self.indices, self.indptr),
+                             shape=self.shape)
 
 
 def tangent_bases(N):
@@ -159,16 +194,28 @@ class TangentialMotion(KeptFactorSolver):
     the factorisation of an earlier step's matrix
     (:class:`kept_factor.KeptFactorSolver`: sparse Cholesky and conjugate
     gradients, ``S`` being symmetric positive definite; sparse LU and iterative
-    refinement otherwise), from ``S_old^{-1} b``, until ``|b - S s| <= rtol
-    |b|``; when that takes more than ``max_iterations``, ``S`` is factorised
-    again. The unknowns are interleaved, ``(k, a) -> 2 k + a``,
+    refinement otherwise), from the linear extrapolation ``2 s^{n-1} - s^{n-2}``
+    of the last two steps' solutions (the tangential displacement changes by
+    ``O(tau)`` a step too; catenoid level 2, BGN: 4.3 CG iterations a step
+    against 5.5 from ``S_old^{-1} b``), until ``|b - S s| <= rtol |b|``; when
+    that takes more than ``max_iterations``, ``S`` is factorised again. The
+    iterations apply ``S = E^T A E`` as three products (:meth:`_operator`);
+    ``S`` itself is assembled only to be factorised (:meth:`_system`). The
+    unknowns are interleaved, ``(k, a) -> 2 k + a``,
     so that ``S`` has the band of ``A`` in the caller's numbering. For the kept
     factors to fit the next matrix, the tangent bases follow the normals: each
     step's ``t1`` is the last one projected on the new tangent plane (a basis
     from :func:`tangent_bases` where that projection is shorter than 1/2, and at
     the first step), ``t2 = N x t1``. Any ``s`` keeps the normal displacement
     exactly (TM3); the accuracy of ``s`` only decides how close the tangential
-    displacement is to the minimiser.
+    displacement is to the minimiser: its error moves F-vertices within their
+    tangent planes, which changes the surface at second order and the next steps
+    only through the distribution of the points. Hence the tolerance
+    :data:`TANGENTIAL_RTOL` = 1e-8 (it was 1e-12): the records of catenoid level 2
+    and sphere level 4 (BGN, MDR) are unchanged to 10 digits, enneper level 2's
+    within the spread that the scheme's own solve (BiCGStab, 1e-9) leaves, and a
+    step takes 2 CG iterations instead of 4 (catenoid level 2, BGN;
+    ``ddfv/README.md``, "Deviations and interpretations").
 
     Parameters
     ----------
@@ -176,8 +223,8 @@ class TangentialMotion(KeptFactorSolver):
     kind : {"bgn", "mdr"}
     fixed : (n,) bool array, optional
         Vertices that do not move (Dirichlet); default none.
-    rtol : float
-        Relative residual of each solve.
+    rtol : float, optional
+        Relative residual of each solve (default :data:`TANGENTIAL_RTOL`).
     max_iterations : int
 
     Attributes
@@ -186,11 +233,11 @@ class TangentialMotion(KeptFactorSolver):
         Factorisations and iterations with a kept factor so far.
     """
 
-    def __init__(self, faces, kind, fixed=None, rtol=1e-12, max_iterations=6):
+    def __init__(self, faces, kind, fixed=None, rtol=None, max_iterations=6):
         if kind not in KINDS:
             raise ValueError(f"unknown tangential motion {kind!r}; choose one of "
                              f"{', '.join(KINDS)}")
-        super().__init__(rtol, max_iterations)
+        super().__init__(TANGENTIAL_RTOL if rtol is None else rtol, max_iterations)
         self.faces, self.kind = faces, kind
         self.fixed = None if fixed is None else np.asarray(fixed, bool)
         self._t1 = None
@@ -216,19 +263,56 @@ class TangentialMotion(KeptFactorSolver):
             fixed vertices.
         """
         F_old, F_new = np.asarray(F_old, dtype=float), np.asarray(F_new, dtype=float)
-        free = np.ones(len(F_new), bool) if self.fixed is None else ~self.fixed
-        if self._stiffness is None or self._stiffness.shape[0] != len(F_old):
-            self._stiffness = P1Stiffness(self.faces, len(F_old))
+        n = len(F_new)
+        free = np.ones(n, bool) if self.fixed is None else ~self.fixed
+        if self._stiffness is None or self._stiffness.shape[0] != n:
+            self._stiffness = P1Stiffness(self.faces, n)
         A = self._stiffness(F_old)
         Y = F_new if self.kind == "bgn" else F_new - F_old
-        AY = (A @ Y)[free]                                           # (A Y)_k, free k
-        bases = [t[free] for t in self._bases(np.asarray(N, dtype=float))]
-        S = self._system(A, free, bases)
-        r = np.stack([np.einsum("ij,ij->i", ta, AY) for ta in bases], axis=1).ravel()
-        s = self.solve(-r, S.dot, S)
+        t1, t2 = (t[free] for t in self._bases(np.asarray(N, dtype=float)))
+        project, apply = self._operator(A, free, t1, t2)
+        s = self.solve(-project(A @ Y), apply, lambda: self._system(A, free, (t1, t2)),
+                       sequence="s")
         X = F_new.copy()
-        X[free] += s[0::2, None] * bases[0] + s[1::2, None] * bases[1]
+        X[free] += s[0::2, None] * t1 + s[1::2, None] * t2
         return X
+
+    def _operator(self, A, free, t1, t2):
+        """``(project, apply)``: ``Z -> E^T Z`` and ``s -> S s = E^T A E s`` of (TM2)
+        without forming ``S`` (assembled only when it is factorised, :meth:`_system`).
+
+        ``E`` (3 n, 2 n_free) puts ``s`` into the tangent planes: ``(E s)_k = s_2k t1_k
+        + s_2k+1 t2_k`` at the free ``k``, zero at the fixed ones.
+
+        Parameters
+        ----------
+        A : (n, n) sparse matrix
+        free : (n,) bool array
+        t1, t2 : (n_free, 3) float arrays
+            The tangent bases at the free vertices.
+
+        Returns
+        -------
+        project : callable (n, 3) -> (2 n_free,)
+        apply : callable (2 n_free,) -> (2 n_free,)
+        """
+        rows = None if free.all() else np.flatnonzero(free)
+
+        def project(Z):
+            Z = Z if rows is None else Z[rows]
+            out = np.empty((len(t1), 2))
+            out[:, 0] = np.einsum("ij,ij->i", t1, Z)
+            out[:, 1] = np.einsum("ij,ij->i", t2, Z)
+            return out.ravel()
+
+        def apply(s):
+            D = s[0::2, None] * t1 + s[1::2, None] * t2
+            if rows is not None:
+                full = np.zeros((len(free), 3))
+                full[rows] = D
+                D = full
+            return project(A @ D)
+        return project, apply
 
     def _system(self, A, free, bases):
         """The matrix ``S`` of (TM2), unknowns interleaved: ``S_{2k+a, 2j+b} = A_kj
@@ -253,14 +337,17 @@ class TangentialMotion(KeptFactorSolver):
                               layout.system_indptr), shape=(m, m))
 
     def _bases(self, N):
-        """``t1, t2`` (n, 3) at the normals ``N``, ``t1`` following the last one."""
-        fresh, _ = tangent_bases(N)
-        if self._t1 is None:
-            t1 = fresh
+        """``t1, t2`` (n, 3) at the normals ``N``, ``t1`` following the last one (a
+        fresh one of :func:`tangent_bases` only where that is shorter than 1/2)."""
+        if self._t1 is None or len(self._t1) != len(N):
+            t1 = tangent_bases(N)[0]
         else:
             t1 = self._t1 - np.einsum("ij,ij->i", self._t1, N)[:, None] * N
             length = np.linalg.norm(t1, axis=1, keepdims=True)
-            t1 = np.where(length > 0.5, t1 / np.where(length > 0.5, length, 1.0), fresh)
+            short = length[:, 0] <= 0.5
+            t1 /= np.where(short[:, None], 1.0, length)
+            if short.any():
+                t1[short] = tangent_bases(N[short])[0]
         self._t1 = t1
         return t1, np.cross(N, t1)
 

@@ -65,11 +65,14 @@ def test_neumann_stiffness_balances_affine_functions_on_a_plane():
     """Chord |gamma|: inside, the flux balance of an affine function is exact
     (zero); at a boundary F-vertex it is the flux through the boundary half-edges
     that the Neumann condition leaves out (the reflected ghost is exact for
-    affine functions), and T-rows of boundary triangles miss theirs."""
+    affine functions), and T-rows of boundary triangles miss theirs. The ghost's
+    entries are added in the assembler's pattern."""
     V, F = _jittered_plane()
     mesh, T, geom, _ = _setup(V, F, "barycenter")
     n_f = mesh.n_f
-    K = neumann_stiffness(Assembler(mesh), geom)
+    assembler = Assembler(mesh)
+    K = neumann_stiffness(assembler, geom)
+    assert np.array_equal(K.indices, assembler._indices) and K.shape == assembler.shape
     scale = np.abs(K).max()
     r = K @ np.r_[_affine(V), _affine(T)]
     g = np.array([1.7, -0.6, 0.0])

@@ -12,8 +12,11 @@ import pytest
 from ddfv import Flow, variant_options
 import scipy.sparse as sp
 
+import igl
+
 from ddfv.tangential_motion import (P1Stiffness, TangentialMotion, follow_triangles,
-                                    p1_stiffness, tangent_bases, tangential_motion)
+                                    TANGENTIAL_RTOL, half_cotangents, p1_stiffness,
+                                    tangent_bases, tangential_motion)
 from ddfv.geometry import t_barycentric, vertex_normals
 from mcfbench.geometry import surfaces
 from mcfbench.geometry.exact import SphereL2Error
@@ -44,6 +47,24 @@ def test_tangent_bases_are_orthonormal_and_right_handed():
     for a, b, dot in ((t1, t1, 1), (t2, t2, 1), (t1, t2, 0), (t1, N, 0), (t2, N, 0)):
         np.testing.assert_allclose(np.einsum("ij,ij->i", a, b), dot, atol=1e-14)
     np.testing.assert_allclose(np.cross(t1, t2), N, atol=1e-14)
+
+
+def test_bases_follow_the_normals():
+    """The first bases are :func:`tangent_bases`; then each ``t1`` is the last one
+    projected on the new tangent plane and normalised, a fresh one where that
+    projection is shorter than 1/2 (the normal turned onto the old ``t1``), ``t2 =
+    N x t1``."""
+    N0 = _unit(np.random.default_rng(0).normal(size=(50, 3)))
+    motion = TangentialMotion(np.zeros((0, 3), int), "bgn")
+    t1, t2 = motion._bases(N0)
+    np.testing.assert_array_equal(t1, tangent_bases(N0)[0])
+    N1 = _unit(N0 + 0.1 * np.random.default_rng(1).normal(size=N0.shape))
+    N1[:3] = t1[:3]                                               # turned onto t1
+    u1, u2 = motion._bases(N1)
+    followed = t1[3:] - np.einsum("ij,ij->i", t1[3:], N1[3:])[:, None] * N1[3:]
+    np.testing.assert_allclose(u1[3:], _unit(followed), atol=1e-15)
+    np.testing.assert_allclose(u1[:3], tangent_bases(N1[:3])[0], atol=1e-15)
+    np.testing.assert_allclose(u2, np.cross(N1, u1), atol=1e-15)
 
 
 @pytest.mark.parametrize("kind", ["bgn", "mdr"])
@@ -90,16 +111,58 @@ def _boundary(F):
 
 def test_stiffness_of_the_kept_pattern_is_libigls():
     """:class:`P1Stiffness` is ``-igl.cotmatrix`` to round-off at two states of a closed
-    and of an open mesh, in one CSR pattern (every edge and the diagonal) kept."""
+    and of an open mesh, in one CSR pattern (every edge and the diagonal) kept (the
+    cotangents of :func:`half_cotangents` from a cross product, libigl's from edge
+    lengths and Kahan's area: a few units of 1e-15 apart)."""
     rng = np.random.default_rng(7)
     for V, F in (icosphere(2), surfaces.flat_patch(level=1, jitter=0.3, seed=1)):
         stiffness = P1Stiffness(F, len(V))
         for X in (V, V + 0.05 * rng.normal(size=V.shape)):
             A, expected = stiffness(X), p1_stiffness(X, F)
             assert A.nnz == len(V) + 2 * len(_edges(F)) and A.has_sorted_indices
-            np.testing.assert_allclose(A.toarray(), expected.toarray(), rtol=0,
+            np.testing.assert_allclose(A.toarray(), expected.toarray(), rtol=1e-13,
                                        atol=1e-14 * abs(expected).max())
             assert np.array_equal(A.indices, stiffness.indices)
+
+
+def test_half_cotangents_are_libigls():
+    """:func:`half_cotangents` is ``igl.cotmatrix_entries`` (corner ``k`` facing the
+    edge ``(k+1, k+2)``) to round-off, obtuse corners (negative) included; the right
+    isosceles triangle has ``cot 90 / 2 = 0`` and ``cot 45 / 2 = 1/2``, the
+    equilateral one ``cot 60 / 2`` at every corner."""
+    V, F = surfaces.flat_patch(level=1, jitter=0.3, seed=1)
+    w = half_cotangents(V, F)
+    expected = igl.cotmatrix_entries(V, F.astype(np.int64))
+    assert (expected < 0).any()
+    np.testing.assert_allclose(w, expected, rtol=1e-12, atol=1e-15 * abs(expected).max())
+    T = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    np.testing.assert_allclose(half_cotangents(T, np.array([[0, 1, 2]])), [[0.0, 0.5, 0.5]],
+                               atol=1e-16)
+    T[2] = [0.5, 0.5 * np.sqrt(3), 0.0]
+    np.testing.assert_allclose(half_cotangents(T, np.array([[0, 1, 2]])),
+                               np.full((1, 3), 0.5 / np.sqrt(3)), rtol=1e-15)
+
+
+def test_products_without_the_matrix_are_the_assembled_system():
+    """(TM2)'s ``S s`` and ``E^T Z`` of :meth:`TangentialMotion._operator` (what the
+    iterations use) are the assembled ``S`` (:meth:`TangentialMotion._system`) times
+    ``s`` and the tangential components at the free vertices, with fixed vertices
+    and without."""
+    V, F = surfaces.flat_patch(level=1, jitter=0.3, seed=1)
+    rng = np.random.default_rng(8)
+    X = V + 0.05 * rng.normal(size=V.shape)
+    A = p1_stiffness(X, F)
+    N = _unit(rng.normal(size=X.shape))
+    for free in (np.ones(len(V), bool), ~np.isin(np.arange(len(V)), _boundary(F))):
+        motion = TangentialMotion(F, "bgn", fixed=~free)
+        t1, t2 = (t[free] for t in tangent_bases(N))
+        project, apply = motion._operator(A, free, t1, t2)
+        S = motion._system(A, free, (t1, t2))
+        s, Z = rng.normal(size=S.shape[0]), rng.normal(size=X.shape)
+        np.testing.assert_allclose(apply(s), S @ s, rtol=0, atol=1e-13 * abs(S @ s).max())
+        np.testing.assert_allclose(project(Z).reshape(-1, 2),
+                                   np.stack([(t1 * Z[free]).sum(1), (t2 * Z[free]).sum(1)], 1),
+                                   rtol=0, atol=1e-15 * abs(Z).max())
 
 
 def _edges(F):
@@ -149,19 +212,47 @@ def test_motion_does_not_depend_on_the_tangent_bases():
 
 @pytest.mark.parametrize("kind", ["bgn", "mdr"])
 def test_kept_factors_give_the_fresh_solution(kind):
-    """Along a flow the next step's (TM2) is solved by refinement with the first
-    step's factors (and bases that follow the normals): the same positions as a
-    fresh factorisation, without factorising again."""
+    """Along a flow the next steps' (TM2) are solved by CG with the first step's
+    factor (and bases that follow the normals), started from the last solution
+    and then from the extrapolation of the last two: the positions of a fresh
+    factorisation to the solve's tolerance, without factorising again; the
+    warm start needs fewer iterations than the start ``S_old^{-1} b``."""
     V, F, N, W = _displaced_bumpy()
-    motion = TangentialMotion(F, kind)
-    motion(V, W, N)
-    rng = np.random.default_rng(6)
-    V2 = V + 1e-4 * rng.normal(size=V.shape)
-    N2 = _unit(N + 1e-3 * rng.normal(size=N.shape))
-    W2 = V2 + 0.02 * rng.normal(size=V.shape)
-    np.testing.assert_allclose(motion(V2, W2, N2), tangential_motion(V2, W2, F, N2, kind),
-                               atol=1e-13)
-    assert (motion.factorisations, motion.iterations > 0) == (1, True)
+    drift = [np.sin(3.0 * V + k) for k in range(3)]                  # smooth in space and time
+    states = [(V + 1e-5 * j * drift[0], _unit(N + 1e-5 * j * drift[1]),
+               W + 1e-5 * j * drift[2]) for j in range(5)]        # (F_old, N, F_new)
+    warm, cold = TangentialMotion(F, kind, rtol=1e-12), TangentialMotion(F, kind, rtol=1e-12)
+    for j, (Vj, Nj, Wj) in enumerate(states):
+        np.testing.assert_allclose(warm(Vj, Wj, Nj), tangential_motion(Vj, Wj, F, Nj, kind),
+                                   atol=1e-13)
+        cold(Vj, Wj, Nj)
+        cold._history.clear()                                     # no start: S_old^{-1} b
+    assert (warm.factorisations, cold.factorisations) == (1, 1)
+    assert 0 < warm.iterations < cold.iterations
+
+
+@pytest.mark.parametrize("kind", ["bgn", "mdr"])
+def test_kept_factor_solves_meet_the_default_tolerance(kind):
+    """At the default :data:`TANGENTIAL_RTOL` each step's solution has the residual of
+    (TM2) ``S s + r = E^T A Y(X)``, the tangential part of ``A Y`` at the new
+    positions, at most the tolerance times the scheme's ``E^T A Y(X^*)``, and the
+    kept factor reaches it in fewer iterations than the tolerance 1e-12."""
+    V, F, N, W = _displaced_bumpy()
+    drift = [np.sin(3.0 * V + k) for k in range(3)]
+    motion, tight = TangentialMotion(F, kind), TangentialMotion(F, kind, rtol=1e-12)
+
+    def tangential_norm(Z, N):
+        return np.linalg.norm(Z - np.einsum("ij,ij->i", Z, N)[:, None] * N)
+
+    for j in range(5):
+        Vj, Wj = V + 1e-5 * j * drift[0], W + 1e-5 * j * drift[2]
+        Nj = _unit(N + 1e-5 * j * drift[1])
+        X = motion(Vj, Wj, Nj)
+        tight(Vj, Wj, Nj)
+        A, base = p1_stiffness(Vj, F), (0.0 if kind == "bgn" else Vj)
+        assert (tangential_norm(A @ (X - base), Nj)
+                <= TANGENTIAL_RTOL * tangential_norm(A @ (Wj - base), Nj) * (1 + 1e-6))
+    assert motion.factorisations == 1 and motion.iterations < tight.iterations
 
 
 def test_t_vertices_follow_their_triangles():
