@@ -117,7 +117,7 @@ def table(rows):
                 continue
             values, finer_accuracy, finer_levels = finer
             errors = [max(abs(a / r - 1) for a, r in zip(by_level[k]["area"], values))
-                      for k in levels]
+                      if by_level[k]["status"] == "ok" else math.nan for k in levels]
             lines.append(
                 f"    against {reference_scheme} levels {finer_levels} extrapolated (largest "
                 f"relative accuracy {finer_accuracy:.1e}): "
