@@ -25,12 +25,13 @@ every checkpoint. Per scheme and mesh, the table gives:
   the final time from the three finest levels run (the scheme's own convergence,
   whatever the reference);
 * the CPU seconds of each level;
-* when the rows hold the cotangent scheme on a level finer than the reference's
-  (``cotan`` in ``--schemes``, e.g. ``--levels 3``): each level's error and EOC
-  against a finer reference, the cotangent scheme's three finest levels run,
-  Richardson-extrapolated at every checkpoint as the reference files' own values are
-  (``mcfbench.running.two_scheme_references.scheme_estimate``), with its
-  largest relative accuracy: is the order the stored reference shows its own?
+* when the rows hold a scheme of the reference file (the cotangent scheme, BGN) on a
+  level finer than its levels there (e.g. ``--schemes cotan --levels 3``,
+  ``--schemes bgn --levels 2`` on a mesh whose BGN reference stops at level 1): each
+  level's error and EOC against a finer reference, that scheme's three finest levels
+  run, Richardson-extrapolated at every checkpoint as the reference files' own values
+  are (``mcfbench.running.two_scheme_references.scheme_estimate``), with its largest
+  relative accuracy: is the order the stored reference shows its own?
 
 One JSON row per run goes to ``--rows`` (appended; the table is made from every row
 there, so levels run at different times combine).
@@ -51,6 +52,9 @@ from mcfbench.running.solver import METHODS, Solver  # noqa: E402
 from mcfbench.running.two_scheme_references import scheme_estimate  # noqa: E402
 
 REFERENCES = Path(__file__).resolve().parents[1] / "mcfbench/data/meshes/references"
+REFERENCE_SCHEMES = ("cotan", "bgn")
+"""The schemes of the reference files (``scheme_levels``), each a finer reference when run
+beyond its stored levels."""
 
 
 def measure(scheme, mesh, level, method="bicgstab"):
@@ -67,9 +71,10 @@ def measure(scheme, mesh, level, method="bicgstab"):
 
 
 def finer_reference(by_level, stored_levels):
-    """The area at every checkpoint Richardson-extrapolated from the cotangent scheme's
+    """The area at every checkpoint Richardson-extrapolated from one reference scheme's
     three finest levels run (``by_level``: level -> row), and its largest relative
-    accuracy; ``None`` unless those reach beyond ``stored_levels`` (the reference's)."""
+    accuracy; ``None`` unless those reach beyond ``stored_levels`` (that scheme's levels
+    in the reference file)."""
     levels = sorted(k for k in by_level if by_level[k]["status"] == "ok")[-3:]
     if len(levels) < 3 or levels[-1] <= max(stored_levels):
         return None
@@ -105,14 +110,17 @@ def table(rows):
             + " | " + ", ".join(f"{levels[i]}-{levels[i + 1]} {e:.2f}" for i, e in enumerate(eocs))
             + f" | {max(accuracy):.1e} | {worst[j] / accuracy[j]:.1f} | {order:.2f} | "
             + ", ".join(f"{by_level[k]['cpu']:.3g}" for k in levels))
-        finer = finer_reference(runs.get((mesh, "cotan"), {}), reference["levels"])
-        if finer is not None:
-            values, finer_accuracy, cotan_levels = finer
+        for reference_scheme in REFERENCE_SCHEMES:
+            finer = finer_reference(runs.get((mesh, reference_scheme), {}),
+                                    reference["scheme_levels"][reference_scheme])
+            if finer is None:
+                continue
+            values, finer_accuracy, finer_levels = finer
             errors = [max(abs(a / r - 1) for a, r in zip(by_level[k]["area"], values))
-                      for k in levels]
+                      if by_level[k]["status"] == "ok" else math.nan for k in levels]
             lines.append(
-                f"    against cotan levels {cotan_levels} extrapolated (largest relative "
-                f"accuracy {finer_accuracy:.1e}): "
+                f"    against {reference_scheme} levels {finer_levels} extrapolated (largest "
+                f"relative accuracy {finer_accuracy:.1e}): "
                 + ", ".join(f"L{k} {e:.3e}" for k, e in zip(levels, errors)) + " | EOC "
                 + ", ".join(f"{levels[i]}-{levels[i + 1]} {math.log2(a / b):.2f}"
                             for i, (a, b) in enumerate(zip(errors, errors[1:]))))
