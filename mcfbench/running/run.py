@@ -179,7 +179,7 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
     integrator = scheme.integrator if integrator is None else integrator
     mesh = None if mesh is None else validate_mesh(*mesh)      # a bad one named first
     check_size(scheme, problem, level, mesh=mesh, tau=tau, t_final=t_final, force=force)
-    V, F = validate_mesh(*problem.mesh(level)) if mesh is None else mesh
+    V, F = problem_mesh(problem, level) if mesh is None else mesh
     tau = problem.tau(level, (V, F)) if tau is None else float(tau)
     steps = problem.time_steps(tau, t_final)
     solver = Solver() if solver is None else solver
@@ -230,6 +230,32 @@ def _result(timed, scheme, problem, level, nF, h, tau, steps, method, integrator
         max_flipped=_worst(np.max, q["flipped"]), metrics=_metric_values(timed, problem),
         series={"t": monitor.t, "t_min_barycentric": monitor.t_monitor, **q},
         timing_repeats=repeats)
+
+
+def problem_mesh(problem, level):
+    """The validated mesh ``(vertices, faces)`` of ``problem``'s ``level``: copies of the
+    one built once per process (the last :data:`KEPT_MESHES`). The series of a
+    matrix batch share a problem and its levels, and a real mesh's file takes
+    0.1-0.3 s to read and validate (22 series on ``real_kitten`` in one process
+    read it 22 times). A problem whose parameters are not hashable (an array)
+    builds it every time."""
+    try:
+        key = (problem.surface, tuple(sorted(problem.params(int(level)).items())))
+        hash(key)
+    except TypeError:
+        return validate_mesh(*problem.mesh(level))
+    if key not in _kept_meshes:
+        if len(_kept_meshes) >= KEPT_MESHES:
+            del _kept_meshes[next(iter(_kept_meshes))]      # the oldest
+        _kept_meshes[key] = validate_mesh(*problem.mesh(level))
+    V, F = _kept_meshes[key]
+    return V.copy(), F.copy()
+
+
+KEPT_MESHES = 8
+"""Meshes :func:`problem_mesh` keeps (a problem's levels, several problems)."""
+_kept_meshes = {}
+"""(surface, parameters) -> validated mesh (:func:`problem_mesh`)."""
 
 
 SHORT_RUN = 0.01
@@ -510,7 +536,7 @@ def _final_weights(scheme, problem, level, X, t_final, options):
     """Quadrature weights of the state ``X`` (3, n_points) of the scheme's flow."""
     scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
     problem = get_problem(problem) if isinstance(problem, str) else problem
-    V, F = validate_mesh(*problem.mesh(level))
+    V, F = problem_mesh(problem, level)
     n = len(V)
     extra = {"T0": X[:, n:].T} if scheme.extra_points else {}
     flow = scheme.make(X[:, :n].T, F, 1.0, **{**options, **extra})
@@ -604,7 +630,7 @@ def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_ever
             mesh=mesh, tau=tau, on_defect=on_defect, observers=observers, robust=robust,
             **options)
     except _Unsupported as err:
-        V, F = validate_mesh(*(problem.mesh(level) if mesh is None else mesh))
+        V, F = problem_mesh(problem, level) if mesh is None else validate_mesh(*mesh)
         tau = problem.tau(level, (V, F)) if tau is None else float(tau)
         steps = problem.time_steps(tau)
         result = failed_result(scheme, problem, level, "unsupported",

@@ -12,10 +12,12 @@ import numpy as np
 import pytest
 
 from mcfbench.geometry.spheres import icosphere
+from mcfbench.running.problems import get_problem
 from mcfbench.running.run import (
     SHORT_RUN,
     has_boundary,
     level_sweep,
+    problem_mesh,
     run,
     space_convergence,
     time_convergence,
@@ -161,6 +163,21 @@ def test_a_run_continued_with_the_robust_solver_is_the_robust_run():
     for key in ("t_min_barycentric", "min_angle", "max_aspect", "covolume_ratio"):
         np.testing.assert_allclose(continued.series[key], whole.series[key], rtol=1e-9)
     assert run(scheme, "sphere", 2, solver=lu, robust=lu)[2] is None
+
+
+def test_a_problem_mesh_is_built_once_and_handed_out_as_copies(monkeypatch):
+    torus, built = get_problem("torus"), []
+    mesh = type(torus).mesh
+    monkeypatch.setattr("mcfbench.running.run._kept_meshes", {})
+    monkeypatch.setattr(type(torus), "mesh", lambda self, level: built.append(level) or
+                        mesh(self, level))
+    V, F = problem_mesh(torus, 1)
+    V[:] = 0.0                                       # a flow that moved it in place
+    again, faces = problem_mesh(torus, 1)
+    np.testing.assert_array_equal(again, torus.mesh(1)[0])
+    np.testing.assert_array_equal(faces, F)
+    assert again is not V and np.abs(again).max() > 0.5
+    assert built == [1, 1]          # once for problem_mesh, once for the comparison
 
 
 def test_has_boundary():
