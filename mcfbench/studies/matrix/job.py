@@ -47,8 +47,9 @@ def job(settings, record, frames, log_path=None):
     if result.status != "ok":
         log.warning("%s", result.message)
     if robust is not None:
-        log.info("re-run with %s: %s%s", robust.solver, robust.status,
-                 f" ({robust.message})" if robust.message else "")
+        log.info("continued with %s from step %d: %s%s, %.1f s CPU", robust.solver,
+                 result.steps_done, robust.status,
+                 f" ({robust.message})" if robust.message else "", robust.cpu_seconds)
     return result
 
 
