@@ -13,7 +13,6 @@ reference of the same scheme: order 1 expected, (2.1)) and
 solution: order 2 expected).
 """
 
-import copy
 import time
 from dataclasses import dataclass, replace
 
@@ -24,77 +23,12 @@ from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.mesh import validate_mesh
 from mcfbench.running.cost import check_size
 from mcfbench.running.driver import simulate
+from mcfbench.running.monitors import Monitor, Steady
 from mcfbench.running.problems import get_problem
 from mcfbench.running.schemes import get_scheme
 from mcfbench.running.solver import Solver
 from mcfbench.storage.frames import surface_points
 from mcfbench.storage.records import RunResult
-
-
-class _Monitor:
-    """Observer: the T monitor at every level, mesh quality every ``every`` levels."""
-
-    def __init__(self, every):
-        self.every = max(1, int(every))
-        self.t, self.t_monitor = [], []
-        self.quality = {"quality_t": [], "min_angle": [], "max_aspect": [], "flipped": [],
-                        "covolume_ratio": []}
-        self._neighbours = None
-
-    def __call__(self, flow):
-        t = flow.n * flow.tau
-        self.t.append(t)
-        monitor = getattr(flow, "t_min_barycentric", None)
-        self.t_monitor.append(monitor() if monitor is not None else float("nan"))
-        if flow.n % self.every == 0:
-            self.sample(flow)
-
-    def finished(self, flow):
-        """A copy with the last state reached included (an invalid one too, when
-        finite); this monitor stays as the run left it, for a continued run
-        (:func:`run`'s ``robust``) to go on with."""
-        done = copy.copy(self)
-        done.t, done.t_monitor = list(self.t), list(self.t_monitor)
-        done.quality = {key: list(values) for key, values in self.quality.items()}
-        if not np.isfinite(flow.X).all():
-            return done
-        if not done.t or done.t[-1] != flow.n * flow.tau:
-            done(flow)
-        done.sample(flow)
-        return done
-
-    def sample(self, flow):
-        if self.quality["quality_t"] and self.quality["quality_t"][-1] == flow.n * flow.tau:
-            return
-        if self._neighbours is None:
-            self._neighbours = metrics.edge_neighbours(flow.faces)
-        V = flow.vertices
-        q = metrics.quality(V, flow.faces, self._neighbours)
-        self.quality["quality_t"].append(flow.n * flow.tau)
-        self.quality["min_angle"].append(q["min_angle"])
-        self.quality["max_aspect"].append(q["max_aspect_ratio"])
-        self.quality["flipped"].append(q["flipped_triangles"])
-        # the scheme's own covolumes (DDFV: the F-vertices' come first); the module
-        # imports pandas, on first use (the warm-up's)
-        from mcfbench.geometry.quality import covolume_ratio
-
-        self.quality["covolume_ratio"].append(covolume_ratio(
-            np.asarray(flow.l2_weights)[:len(V)], flow.faces))
-
-
-class _Steady:
-    """``until`` of the driver: the largest vertex speed fell below ``speed``."""
-
-    def __init__(self, speed):
-        self.speed, self.previous, self.reached = speed, None, False
-
-    def __call__(self, flow):
-        V = flow.vertices.copy()
-        done = self.previous is not None and \
-            metrics.max_speed(self.previous, V, flow.tau) < self.speed
-        self.previous = V
-        self.reached = bool(done)
-        return self.reached
 
 
 def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrator=None,
@@ -273,9 +207,9 @@ class _Timed:
 
     flow: object
     trajectory: object
-    monitor: _Monitor
-    """The run's monitor with the last state's sample (:meth:`_Monitor.finished`)."""
-    running: _Monitor
+    monitor: Monitor
+    """The run's monitor with the last state's sample (:meth:`Monitor.finished`)."""
+    running: Monitor
     """The monitor as the stepping left it (a continued run goes on with it)."""
     metric_observers: list
     until: object
@@ -295,9 +229,9 @@ def _timed_run(scheme, problem, mesh, tau, steps, *, solver, integrator, warm_st
     the last quality sample. Not timed: the mesh's construction and validation, the
     warm-up (:func:`warm_up`), the metrics' final values."""
     V, F = mesh
-    monitor = _Monitor(max(1, steps // max(1, samples)))
+    monitor = Monitor(max(1, steps // max(1, samples)))
     metric_observers = problem.observers()
-    until = _Steady(problem.steady_speed) if problem.steady_speed else None
+    until = Steady(problem.steady_speed) if problem.steady_speed else None
     cpu, wall = time.process_time(), time.perf_counter()
     flow = scheme.make(V, F, tau, threads=threads, **options)
     traj = simulate(flow, steps, solver=solver, integrator=integrator, warm_start=warm_start,
