@@ -60,6 +60,16 @@ class Trajectory:
         occurrence): ``status``, ``step``, ``time``, ``detail``.
     wall_seconds, cpu_seconds : float
         Time of the stepping, observers included.
+    continue_with : callable or None
+        For a run that ended with a solver failure (a ``solver_*`` status; not one
+        turned into ``degenerated`` by a collapsed mesh), ``continue_with(solver,
+        progress=False) -> Trajectory``: the same run continued from its last
+        accepted state, the failed step tried again with ``solver`` (the flow,
+        its integrator's past states, the checks and the observers exactly as
+        the run left them; the failure is forgotten). The returned trajectory is
+        the whole run's, from step 0, its times added up. The objects are those
+        of this run, which is thereby used up: it can be continued once (the
+        continued run, if its solver fails too, once more). None otherwise.
     """
 
     frames: dict
@@ -74,6 +84,7 @@ class Trajectory:
     defects: list = field(default_factory=list)
     wall_seconds: float = 0.0
     cpu_seconds: float = 0.0
+    continue_with: object = field(default=None, repr=False, compare=False)
 
     @property
     def ok(self):
@@ -126,7 +137,8 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
         (default; the invalid state is kept as the last frame) or be
         recorded (its first occurrence per status) while the run goes on.
         Solver failures always end the run (the state stays at the last
-        valid level).
+        valid level; :attr:`Trajectory.continue_with` goes on from there with
+        another solver).
     until : callable, optional
         ``until(flow) -> bool`` after the observers of every level
         ``n >= 1``: True ends the run there (e.g. a steady state), status
@@ -163,93 +175,147 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
         raise ValueError(f"save_every must be a whole number >= 0, got {save_every!r}")
     if on_defect not in ON_DEFECT:
         raise ValueError(f"unknown on_defect {on_defect!r}; choose one of {', '.join(ON_DEFECT)}")
-    solver = Solver() if solver is None else solver
-    stepper = get_integrator(integrator, warm_start=warm_start)
-    frames, steps_kept, iterations, defects = [], [], [], []
-    seen = set()
-    collapsed = CollapseCheck(flow.vertices, flow.faces) if collapse else None
-    invariant = FlowInvariants(flow.vertices, flow.faces) if invariants else None
+    stepping = _Stepping(flow, int(steps), get_integrator(integrator, warm_start=warm_start),
+                         save_every=save_every, observers=observers, on_defect=on_defect,
+                         until=until, collapse=collapse, invariants=invariants)
+    return stepping.go(Solver() if solver is None else solver, progress)
 
-    def save():
-        steps_kept.append(flow.n)
-        frames.append(flow.frame())
 
-    def check():
+class _Stepping:
+    """The state of one :func:`simulate` between its steps: the flow, its integrator
+    (with ``X^{n-1}, ...``), the checks, the observers, the frames and defects so
+    far; :meth:`go` steps it with a solver, :meth:`continue_with` after a solver
+    failure with another one."""
+
+    def __init__(self, flow, steps, stepper, *, save_every, observers, on_defect, until,
+                 collapse, invariants):
+        self.flow, self.steps, self.stepper = flow, steps, stepper
+        self.save_every, self.observers, self.on_defect = save_every, observers, on_defect
+        self.until = until
+        self.frames, self.steps_kept, self.iterations, self.defects = [], [], [], []
+        self.seen = set()
+        self.collapsed = CollapseCheck(flow.vertices, flow.faces) if collapse else None
+        self.invariant = FlowInvariants(flow.vertices, flow.faces) if invariants else None
+        self.wall = self.cpu = 0.0
+        self.broken = None
+        self.solver_failed = False    # the run ended with a solver failure: continuable
+        self.end_frame = False        # the last frame was added when the run ended
+        wall, cpu = time.perf_counter(), time.process_time()
+        try:
+            self.check()
+            self.observe()
+        except FlowBreakdown as err:
+            self.broken = err
+        self.save()
+        self.wall, self.cpu = time.perf_counter() - wall, time.process_time() - cpu
+
+    def save(self):
+        self.steps_kept.append(self.flow.n)
+        self.frames.append(self.flow.frame())
+
+    def check(self):
         """Record the defects of the current state; raise in stop mode (always for a
         collapse)."""
-        detail = collapsed(flow.vertices) if collapsed is not None else None
+        flow = self.flow
+        detail = self.collapsed(flow.vertices) if self.collapsed is not None else None
         if detail is not None:
-            defects.append({"status": "degenerated", "step": flow.n,
-                            "time": flow.n * flow.tau, "detail": detail})
+            self.defects.append({"status": "degenerated", "step": flow.n,
+                                 "time": flow.n * flow.tau, "detail": detail})
             raise FlowBreakdown("degenerated", flow.n, flow.n * flow.tau, detail)
         found = flow.defects()
-        if invariant is not None:
-            found = [*found, *invariant(flow.vertices, flow.n)]
+        if self.invariant is not None:
+            found = [*found, *self.invariant(flow.vertices, flow.n)]
         for status, detail in found:
-            if status in seen:
+            if status in self.seen:
                 continue
-            seen.add(status)
-            defects.append({"status": status, "step": flow.n, "time": flow.n * flow.tau,
-                            "detail": detail})
-            if on_defect == "stop":
+            self.seen.add(status)
+            self.defects.append({"status": status, "step": flow.n,
+                                 "time": flow.n * flow.tau, "detail": detail})
+            if self.on_defect == "stop":
                 raise FlowBreakdown(status, flow.n, flow.n * flow.tau, detail)
 
-    def observe():
-        for observer in observers:
-            observer(flow)
+    def observe(self):
+        for observer in self.observers:
+            observer(self.flow)
 
-    wall, cpu = time.perf_counter(), time.process_time()
-    broken = None
-    try:
-        check()
-        observe()
-    except FlowBreakdown as err:
-        broken = err
-    save()
-    if progress and broken is None:
-        from tqdm import tqdm  # on first use: not paid at start-up without a bar
+    def step(self, solver):
+        """One time step, checked; raises :class:`FlowBreakdown`."""
+        flow = self.flow
+        try:
+            info = self.stepper.step(flow, solver)
+        except SolverFailure as err:
+            step = flow.n + 1
+            status, detail = err.status, str(err)
+            collapse = self.invariant.quality_collapse() if self.invariant is not None \
+                else None
+            if collapse is not None:
+                status, detail = "degenerated", f"{collapse}; then {detail}"
+            self.defects.append({"status": status, "step": step, "time": step * flow.tau,
+                                 "detail": detail})
+            self.solver_failed = collapse is None
+            raise FlowBreakdown(status, step, step * flow.tau, detail) from None
+        self.iterations.append(info.iterations)
+        self.check()
 
-        bar = tqdm(total=int(steps), delay=PROGRESS_DELAY, unit="step", leave=False)
-    else:
-        bar = _NoBar()
-    with bar:
-        for _ in range(int(steps) if broken is None else 0):
-            try:
+    def go(self, solver, progress=False):
+        """Step with ``solver`` until the run's end, a breakdown or ``until``; the
+        :class:`Trajectory` of the whole run so far."""
+        flow = self.flow
+        wall, cpu = time.perf_counter(), time.process_time()
+        if progress and self.broken is None:
+            from tqdm import tqdm  # on first use: not paid at start-up without a bar
+
+            bar = tqdm(total=self.steps, initial=len(self.iterations), delay=PROGRESS_DELAY,
+                       unit="step", leave=False)
+        else:
+            bar = _NoBar()
+        with bar:
+            for _ in range(self.steps - len(self.iterations) if self.broken is None else 0):
                 try:
-                    info = stepper.step(flow, solver)
-                except SolverFailure as err:
-                    step = flow.n + 1
-                    status, detail = err.status, str(err)
-                    collapse = invariant.quality_collapse() if invariant is not None else None
-                    if collapse is not None:
-                        status, detail = "degenerated", f"{collapse}; then {detail}"
-                    defects.append({"status": status, "step": step,
-                                    "time": step * flow.tau, "detail": detail})
-                    raise FlowBreakdown(status, step, step * flow.tau, detail) from None
-                iterations.append(info.iterations)
-                check()
-            except FlowBreakdown as err:
-                broken = err
-                break
-            finally:
-                bar.update()
-            observe()
-            if save_every and flow.n % save_every == 0:
-                save()
-            if until is not None and until(flow):
-                break
-    if steps_kept[-1] != flow.n:
-        save()
-    status, message, failed = "ok", "", -1
-    if defects:
-        first = defects[0]
-        status, failed = first["status"], first["step"]
-        message = str(broken) if broken is not None else str(
-            FlowBreakdown(first["status"], first["step"], first["time"], first["detail"]))
-    stacked = {key: np.stack([frame[key] for frame in frames]) for key in frames[0]}
-    return Trajectory(
-        frames=stacked, steps=np.array(steps_kept), t=np.array(steps_kept) * flow.tau,
-        faces=np.asarray(flow.faces), iterations=np.array(iterations, dtype=int),
-        status=status, message=message, failed_step=failed, steps_done=len(iterations),
-        defects=defects, wall_seconds=time.perf_counter() - wall,
-        cpu_seconds=time.process_time() - cpu)
+                    self.step(solver)
+                except FlowBreakdown as err:
+                    self.broken = err
+                    break
+                finally:
+                    bar.update()
+                self.observe()
+                if self.save_every and flow.n % self.save_every == 0:
+                    self.save()
+                if self.until is not None and self.until(flow):
+                    break
+        self.end_frame = self.steps_kept[-1] != flow.n
+        if self.end_frame:
+            self.save()
+        self.wall += time.perf_counter() - wall
+        self.cpu += time.process_time() - cpu
+        return self.trajectory()
+
+    def continue_with(self, solver, progress=False):
+        """:meth:`Trajectory.continue_with`."""
+        if not self.solver_failed:
+            raise ValueError("only a run that ended with a solver failure can be continued, "
+                             "and only once")
+        self.solver_failed, self.broken = False, None
+        self.defects.pop()                  # the failure: the run goes on past it
+        if self.end_frame:                  # the failed step's state, kept as its end
+            self.steps_kept.pop()
+            self.frames.pop()
+        return self.go(solver, progress)
+
+    def trajectory(self):
+        flow, defects = self.flow, list(self.defects)
+        status, message, failed = "ok", "", -1
+        if defects:
+            first = defects[0]
+            status, failed = first["status"], first["step"]
+            message = str(self.broken) if self.broken is not None else str(
+                FlowBreakdown(first["status"], first["step"], first["time"], first["detail"]))
+        stacked = {key: np.stack([frame[key] for frame in self.frames])
+                   for key in self.frames[0]}
+        return Trajectory(
+            frames=stacked, steps=np.array(self.steps_kept),
+            t=np.array(self.steps_kept) * flow.tau, faces=np.asarray(flow.faces),
+            iterations=np.array(self.iterations, dtype=int), status=status, message=message,
+            failed_step=failed, steps_done=len(self.iterations), defects=defects,
+            wall_seconds=self.wall, cpu_seconds=self.cpu,
+            continue_with=self.continue_with if self.solver_failed else None)

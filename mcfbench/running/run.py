@@ -23,6 +23,7 @@ from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.mesh import validate_mesh
 from mcfbench.running.cost import check_size
 from mcfbench.running.driver import simulate
+from mcfbench.running.monitors import Monitor, Steady
 from mcfbench.running.problems import get_problem
 from mcfbench.running.schemes import get_scheme
 from mcfbench.running.solver import Solver
@@ -30,69 +31,9 @@ from mcfbench.storage.frames import surface_points
 from mcfbench.storage.records import RunResult
 
 
-class _Monitor:
-    """Observer: the T monitor at every level, mesh quality every ``every`` levels."""
-
-    def __init__(self, every):
-        self.every = max(1, int(every))
-        self.t, self.t_monitor = [], []
-        self.quality = {"quality_t": [], "min_angle": [], "max_aspect": [], "flipped": [],
-                        "covolume_ratio": []}
-        self._neighbours = None
-
-    def __call__(self, flow):
-        t = flow.n * flow.tau
-        self.t.append(t)
-        monitor = getattr(flow, "t_min_barycentric", None)
-        self.t_monitor.append(monitor() if monitor is not None else float("nan"))
-        if flow.n % self.every == 0:
-            self.sample(flow)
-
-    def final(self, flow):
-        """Include the last state reached (an invalid one too, when finite)."""
-        if not np.isfinite(flow.X).all():
-            return
-        if not self.t or self.t[-1] != flow.n * flow.tau:
-            self(flow)
-        self.sample(flow)
-
-    def sample(self, flow):
-        if self.quality["quality_t"] and self.quality["quality_t"][-1] == flow.n * flow.tau:
-            return
-        if self._neighbours is None:
-            self._neighbours = metrics.edge_neighbours(flow.faces)
-        V = flow.vertices
-        q = metrics.quality(V, flow.faces, self._neighbours)
-        self.quality["quality_t"].append(flow.n * flow.tau)
-        self.quality["min_angle"].append(q["min_angle"])
-        self.quality["max_aspect"].append(q["max_aspect_ratio"])
-        self.quality["flipped"].append(q["flipped_triangles"])
-        # the scheme's own covolumes (DDFV: the F-vertices' come first); the module
-        # imports pandas, on first use (the warm-up's)
-        from mcfbench.geometry.quality import covolume_ratio
-
-        self.quality["covolume_ratio"].append(covolume_ratio(
-            np.asarray(flow.l2_weights)[:len(V)], flow.faces))
-
-
-class _Steady:
-    """``until`` of the driver: the largest vertex speed fell below ``speed``."""
-
-    def __init__(self, speed):
-        self.speed, self.previous, self.reached = speed, None, False
-
-    def __call__(self, flow):
-        V = flow.vertices.copy()
-        done = self.previous is not None and \
-            metrics.max_speed(self.previous, V, flow.tau) < self.speed
-        self.previous = V
-        self.reached = bool(done)
-        return self.reached
-
-
 def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrator=None,
         warm_start="extrapolate", on_defect="stop", save_every=0, samples=20, mesh=None,
-        threads=1, progress=False, observers=(), force=False, **options):
+        threads=1, progress=False, observers=(), force=False, robust=None, **options):
     """Run ``scheme`` on ``problem`` at refinement ``level``.
 
     Parameters
@@ -131,6 +72,16 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
         Run even when its estimated memory is above the machine's available
         memory (:func:`mcfbench.running.cost.check_size`, checked before the
         mesh is built).
+    robust : mcfbench.running.solver.Solver, optional
+        A run that ends with a solver failure (a ``solver_*`` status) is
+        continued with this solver from its last accepted state (the failed step
+        tried again with it; :attr:`mcfbench.running.driver.Trajectory.continue_with`):
+        the flow with its T-vertices, the integrator's past states (BDF2, BDF3),
+        the monitors, the metric observers and the driver's checks are exactly
+        those of the run at that step, so that the result is that of the whole run
+        with ``robust`` from ``t = 0`` up to the solvers' tolerances (the robust
+        re-run of the matrix, :func:`mcfbench.studies.matrix.job.job`).
+        Not when the run used ``robust``'s method already.
     **options
         Options of the scheme's flow class (override the registry's).
 
@@ -143,6 +94,13 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
         :data:`REPEAT_BUDGET` seconds, the best kept (``timing_repeats``); its
         numbers are those of the first execution.
     trajectory : mcfbench.running.driver.Trajectory
+        The run's (not the continued run's).
+    continued : RunResult or None
+        Only with ``robust``: the continued run (None when there was none): its
+        ``solver`` is ``robust``'s method, ``steps_done``, ``iterations``, status,
+        metrics and quality those of the whole run, ``cpu_seconds`` and
+        ``wall_seconds`` those of the continuation alone (after the failure, the
+        robust solver warmed up first; timed once).
 
     Raises
     ------
@@ -155,7 +113,7 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
     integrator = scheme.integrator if integrator is None else integrator
     mesh = None if mesh is None else validate_mesh(*mesh)      # a bad one named first
     check_size(scheme, problem, level, mesh=mesh, tau=tau, t_final=t_final, force=force)
-    V, F = validate_mesh(*problem.mesh(level)) if mesh is None else mesh
+    V, F = problem_mesh(problem, level) if mesh is None else mesh
     tau = problem.tau(level, (V, F)) if tau is None else float(tau)
     steps = problem.time_steps(tau, t_final)
     solver = Solver() if solver is None else solver
@@ -174,23 +132,64 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
                            progress=False, observers=(), **setup)
         cpu, wall = min(cpu, again.cpu), min(wall, again.wall)
         repeats, spent = repeats + 1, spent + again.cpu
-    values = _metric_values(timed, problem)
+    h = metrics.mean_edge_length(V, F)
+    result = _result(timed, scheme, problem, level, len(V), h, tau, steps, solver.method,
+                     integrator, cpu, wall, repeats)
+    if robust is None:
+        return result, traj
+    if traj.continue_with is None or robust.method == solver.method:
+        return result, traj, None
+    warm_up(scheme, problem, F, progress=progress, **{**setup, "solver": robust})
+    continued = _continued(timed, robust, progress)
+    return result, traj, _result(continued, scheme, problem, level, len(V), h, tau, steps,
+                                 robust.method, integrator, continued.cpu, continued.wall, 1)
+
+
+def _result(timed, scheme, problem, level, nF, h, tau, steps, method, integrator, cpu, wall,
+            repeats):
+    """The :class:`RunResult` of an execution of a run (:func:`_timed_run`,
+    :func:`_continued`) with ``nF`` mesh vertices of mean edge length ``h``."""
+    flow, traj, monitor = timed.flow, timed.trajectory, timed.monitor
     X = flow.X
     q = monitor.quality
-    result = RunResult(
+    return RunResult(
         scheme=scheme.name, problem=problem.name, level=int(level), nV=X.shape[1],
-        nF=len(V), nT=X.shape[1] - len(V),
-        h=metrics.mean_edge_length(V, F), tau=tau, N=steps, steps_done=traj.steps_done,
+        nF=nF, nT=X.shape[1] - nF, h=h, tau=tau, N=steps, steps_done=traj.steps_done,
         status=traj.status, message=traj.message, t_failed=traj.t_failed,
         t_end=flow.n * tau, steady=bool(timed.steady),
-        iterations=int(traj.iterations.sum()), solver=solver.method, integrator=integrator,
+        iterations=int(traj.iterations.sum()), solver=method, integrator=integrator,
         cpu_seconds=cpu,
         wall_seconds=wall, t_min_barycentric=_worst(np.min, monitor.t_monitor),
         min_angle=_worst(np.min, q["min_angle"]), max_aspect=_worst(np.max, q["max_aspect"]),
-        max_flipped=_worst(np.max, q["flipped"]), metrics=values,
+        max_flipped=_worst(np.max, q["flipped"]), metrics=_metric_values(timed, problem),
         series={"t": monitor.t, "t_min_barycentric": monitor.t_monitor, **q},
         timing_repeats=repeats)
-    return result, traj
+
+
+def problem_mesh(problem, level):
+    """The validated mesh ``(vertices, faces)`` of ``problem``'s ``level``: copies of the
+    one built once per process (the last :data:`KEPT_MESHES`). The series of a
+    matrix batch share a problem and its levels, and a real mesh's file takes
+    0.1-0.3 s to read and validate (22 series on ``real_kitten`` in one process
+    read it 22 times). A problem whose parameters are not hashable (an array)
+    builds it every time."""
+    try:
+        key = (problem.surface, tuple(sorted(problem.params(int(level)).items())))
+        hash(key)
+    except TypeError:
+        return validate_mesh(*problem.mesh(level))
+    if key not in _kept_meshes:
+        if len(_kept_meshes) >= KEPT_MESHES:
+            del _kept_meshes[next(iter(_kept_meshes))]      # the oldest
+        _kept_meshes[key] = validate_mesh(*problem.mesh(level))
+    V, F = _kept_meshes[key]
+    return V.copy(), F.copy()
+
+
+KEPT_MESHES = 8
+"""Meshes :func:`problem_mesh` keeps (a problem's levels, several problems)."""
+_kept_meshes = {}
+"""(surface, parameters) -> validated mesh (:func:`problem_mesh`)."""
 
 
 SHORT_RUN = 0.01
@@ -208,11 +207,18 @@ class _Timed:
 
     flow: object
     trajectory: object
-    monitor: _Monitor
+    monitor: Monitor
+    """The run's monitor with the last state's sample (:meth:`Monitor.finished`)."""
+    running: Monitor
+    """The monitor as the stepping left it (a continued run goes on with it)."""
     metric_observers: list
-    steady: bool
+    until: object
     cpu: float
     wall: float
+
+    @property
+    def steady(self):
+        return self.until is not None and self.until.reached
 
 
 def _timed_run(scheme, problem, mesh, tau, steps, *, solver, integrator, warm_start,
@@ -223,19 +229,29 @@ def _timed_run(scheme, problem, mesh, tau, steps, *, solver, integrator, warm_st
     the last quality sample. Not timed: the mesh's construction and validation, the
     warm-up (:func:`warm_up`), the metrics' final values."""
     V, F = mesh
-    monitor = _Monitor(max(1, steps // max(1, samples)))
+    monitor = Monitor(max(1, steps // max(1, samples)))
     metric_observers = problem.observers()
-    until = _Steady(problem.steady_speed) if problem.steady_speed else None
+    until = Steady(problem.steady_speed) if problem.steady_speed else None
     cpu, wall = time.process_time(), time.perf_counter()
     flow = scheme.make(V, F, tau, threads=threads, **options)
     traj = simulate(flow, steps, solver=solver, integrator=integrator, warm_start=warm_start,
                     save_every=save_every,
                     observers=[monitor, *metric_observers, *observers], on_defect=on_defect,
                     until=until, progress=progress)
-    monitor.final(flow)
+    finished = monitor.finished(flow)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
-    return _Timed(flow, traj, monitor, metric_observers, until is not None and until.reached,
-                  cpu, wall)
+    return _Timed(flow, traj, finished, monitor, metric_observers, until, cpu, wall)
+
+
+def _continued(timed, solver, progress):
+    """The run of ``timed`` (ended with a solver failure) continued with ``solver`` from
+    its last accepted state (:attr:`mcfbench.running.driver.Trajectory.continue_with`),
+    its monitor and observers going on; timed alone."""
+    cpu, wall = time.process_time(), time.perf_counter()
+    traj = timed.trajectory.continue_with(solver, progress=progress)
+    finished = timed.running.finished(timed.flow)
+    cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
+    return replace(timed, trajectory=traj, monitor=finished, cpu=cpu, wall=wall)
 
 
 WARM_UP_STEPS = 3
@@ -454,7 +470,7 @@ def _final_weights(scheme, problem, level, X, t_final, options):
     """Quadrature weights of the state ``X`` (3, n_points) of the scheme's flow."""
     scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
     problem = get_problem(problem) if isinstance(problem, str) else problem
-    V, F = validate_mesh(*problem.mesh(level))
+    V, F = problem_mesh(problem, level)
     n = len(V)
     extra = {"T0": X[:, n:].T} if scheme.extra_points else {}
     flow = scheme.make(X[:, :n].T, F, 1.0, **{**options, **extra})
@@ -523,36 +539,41 @@ def failed_result(scheme, problem, level, status, message, *, steps, method, mes
 
 
 def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_every=0,
-               on_defect="stop", observers=(), **options):
+               on_defect="stop", observers=(), robust=None, **options):
     """:func:`run` for the studies that keep frames files (by default the first and the
     last, ``save_every=0``; see :func:`mcfbench.running.driver.simulate`); a scheme
     that refuses the surface gives status ``unsupported`` (the initial surface as both
-    frames). ``on_defect``, ``observers`` and ``options`` (the scheme's) go to :func:`run`.
+    frames). ``on_defect``, ``observers``, ``robust`` and ``options`` (the scheme's) go
+    to :func:`run`.
 
     Returns
     -------
     result : RunResult
     frames : dict of arrays
         The trajectory's saved frames, ``faces``, ``steps``, ``t``: the layout of
-        :mod:`mcfbench.storage.frames`.
+        :mod:`mcfbench.storage.frames` (the run's, not the continued run's).
+    continued : RunResult or None
+        Only with ``robust``: :func:`run`'s.
     """
     scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
     problem = get_problem(problem) if isinstance(problem, str) else problem
     start = time.process_time()
     try:
-        result, traj = run(_Guarded(scheme), problem, level, solver=solver,
-                           save_every=save_every, mesh=mesh, tau=tau, on_defect=on_defect,
-                           observers=observers, **options)
+        result, traj, *continued = run(
+            _Guarded(scheme), problem, level, solver=solver, save_every=save_every,
+            mesh=mesh, tau=tau, on_defect=on_defect, observers=observers, robust=robust,
+            **options)
     except _Unsupported as err:
-        V, F = validate_mesh(*(problem.mesh(level) if mesh is None else mesh))
+        V, F = problem_mesh(problem, level) if mesh is None else validate_mesh(*mesh)
         tau = problem.tau(level, (V, F)) if tau is None else float(tau)
         steps = problem.time_steps(tau)
         result = failed_result(scheme, problem, level, "unsupported",
                                f"unsupported at step 0 (t = 0): {err}", steps=steps,
                                method=solver.method, mesh=(V, F), tau=tau,
                                seconds=time.process_time() - start)
-        return result, {"vertices": np.stack([V, V]), "faces": F, "steps": np.array([0, 0]),
-                        "t": np.zeros(2)}
+        frames = {"vertices": np.stack([V, V]), "faces": F, "steps": np.array([0, 0]),
+                  "t": np.zeros(2)}
+        return (result, frames) if robust is None else (result, frames, None)
     frames = dict(traj.frames)
     frames.update(faces=traj.faces, steps=traj.steps, t=traj.t)
-    return result, frames
+    return (result, frames, *continued)

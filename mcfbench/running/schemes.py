@@ -87,9 +87,10 @@ class Scheme:
         ``tests/mcfbench/running/test_schemes.py``). :attr:`suited_solver` says which
         solver suits it.
     robust_solver : str
-        The shared solver's method that re-runs a run that ended with a
-        ``solver_*`` status, to tell the solver's failure from the scheme's
-        (the matrix study): :data:`mcfbench.running.solver.ROBUST`, spelled out so that
+        The shared solver's method that continues a run that ended with a
+        ``solver_*`` status from its last accepted state, to tell the solver's
+        failure from the scheme's (the matrix study; :func:`mcfbench.running.run.run`'s
+        ``robust``): :data:`mcfbench.running.solver.ROBUST`, spelled out so that
         the presentation layer reads the registry without importing the solver.
     integrator : str
         The time integrator its runs use unless told otherwise

@@ -1,7 +1,6 @@
 """One run of the benchmark matrix (:func:`job`), the series of one scheme on one
-problem (:func:`series_job`), several of them in one process (:func:`batch_job`,
-the Snakemake job) and the robust re-run of a run that its solver failed
-(:func:`robust_rerun`)."""
+problem (:func:`series_job`) and several of them in one process (:func:`batch_job`,
+the Snakemake job)."""
 
 import logging
 
@@ -16,11 +15,17 @@ def job(settings, record, frames, log_path=None):
     ``log_path``: the job's log file (set up here); None logs to the logger that
     the caller set up (:func:`series_job`, one log for a series).
 
-    A run that ends with a ``solver_*`` status is run again with the scheme's robust
-    solver (:attr:`mcfbench.running.schemes.Scheme.robust_solver`, ``direct``) at the
-    same tolerance, to tell the solver's failure from the scheme's: the record gets
-    :func:`robust_fields` (``robust_status`` empty when there was no re-run); the
-    frames stay those of the run itself."""
+    A run that ends with a ``solver_*`` status is continued with the scheme's robust
+    solver (:attr:`mcfbench.running.schemes.Scheme.robust_solver`, ``jacobi-direct``) at the
+    same tolerance from its last accepted state, the failed step tried again
+    (:func:`mcfbench.running.run.run`'s ``robust``: the result is that of a re-run
+    from ``t = 0`` with the robust solver up to the solvers' tolerances, at the
+    cost of the steps after the failure only), to tell the solver's failure from
+    the scheme's: the record gets :func:`robust_fields` (``robust_status`` empty
+    when there was none); the frames stay those of the run itself."""
+    from dataclasses import replace
+
+    from mcfbench.running.schemes import get_scheme
     from mcfbench.running.solver import Solver
     from mcfbench.storage.frames import save_frames
     from mcfbench.storage.records import write_record
@@ -29,9 +34,10 @@ def job(settings, record, frames, log_path=None):
     solver = Solver.of_settings(settings)
     log.info("%s on %s level %d, solver %s", settings["scheme"], settings["problem"],
              settings["level"], solver.method)
-    result, arrays = framed_run(settings["scheme"], settings["problem"], settings["level"],
-                             solver=solver)
-    robust = robust_rerun(settings, result, solver)
+    scheme = get_scheme(settings["scheme"])
+    result, arrays, robust = framed_run(scheme, settings["problem"], settings["level"],
+                                        solver=solver,
+                                        robust=replace(solver, method=scheme.robust_solver))
     save_frames(frames, arrays)
     write_record(record, result, settings, metric_names=list(result.metrics),
                  **robust_fields(robust))
@@ -41,8 +47,9 @@ def job(settings, record, frames, log_path=None):
     if result.status != "ok":
         log.warning("%s", result.message)
     if robust is not None:
-        log.info("re-run with %s: %s%s", robust.solver, robust.status,
-                 f" ({robust.message})" if robust.message else "")
+        log.info("continued with %s from step %d: %s%s, %.1f s CPU", robust.solver,
+                 result.steps_done, robust.status,
+                 f" ({robust.message})" if robust.message else "", robust.cpu_seconds)
     return result
 
 
@@ -98,27 +105,14 @@ def series_job(series, records, frames, log_path=None):
             for r, f in zip(records, frames, strict=True)]
 
 
-def robust_rerun(settings, result, solver):
-    """The run of ``settings`` again with the scheme's robust solver when ``result``
-    ended with a ``solver_*`` status and did not already use it; else ``None``."""
-    from dataclasses import replace
-
-    from mcfbench.running.schemes import get_scheme
-    from mcfbench.storage.statuses import SOLVER_STATUSES
-
-    scheme = get_scheme(settings["scheme"])
-    if result.status not in SOLVER_STATUSES or solver.method == scheme.robust_solver:
-        return None
-    robust, _ = framed_run(scheme, settings["problem"], settings["level"],
-                           solver=replace(solver, method=scheme.robust_solver))
-    return robust
-
-
 def robust_fields(robust):
-    """The record's keys of the robust re-run (:func:`robust_rerun`): ``robust_status``
-    (``""`` without a re-run), ``robust_solver``, ``robust_message``, ``robust_t_failed``,
-    ``robust_steps_done``, ``robust_iterations``, ``robust_cpu_seconds`` and
-    ``robust_metrics`` (metric -> value, NaN unless it finished)."""
+    """The record's keys of the robust re-run (:func:`job`; None: there was none):
+    ``robust_status`` (``""`` without a re-run), ``robust_solver``, ``robust_message``,
+    ``robust_t_failed``, ``robust_steps_done``, ``robust_iterations`` (of the whole
+    run: the failed solver's steps before the failure and the robust solver's
+    after), ``robust_cpu_seconds`` (the continuation's after the failure: what the
+    robust solver cost beyond the run) and ``robust_metrics`` (metric -> value, NaN
+    unless it finished)."""
     if robust is None:
         return {"robust_status": ""}
     return {"robust_status": robust.status, "robust_solver": robust.solver,

@@ -39,7 +39,7 @@ from mcfbench.studies.matrix.tables import (
 
 TEMPLATES = Path(__file__).with_name("templates")
 
-# (name, caption) of the figures of rule matrix_plots, in page order
+# (name, caption) of the figures of rules matrix_plots and matrix_pictures, in page order
 PAGE_FIGURES = (
     ("errors", ("Error of each problem's main metric against the mesh size h, every "
                 "scheme; slope-2 guides.")),

@@ -66,8 +66,9 @@ plots, the page and the findings take these rows, :func:`main_runs`).
 ``min_angle_*``, ``covolume_ratio_*``: the mesh quality of the run over time
 (:func:`quality_over_time`; ``min_angle`` is its worst over the run).
 ``robust_*``: the re-run of a run that ended with a ``solver_*`` status with
-the robust solver (:func:`mcfbench.studies.matrix.job`; ``robust_status`` empty
-without a re-run)."""
+the robust solver, continued from its last accepted state
+(:func:`mcfbench.studies.matrix.job.job`; ``robust_status`` empty without a
+re-run)."""
 
 
 def is_error(metric):

@@ -110,6 +110,48 @@ def test_solver_failure_keeps_the_last_valid_state():
     np.testing.assert_array_equal(traj.frames["vertices"][-1], V0)
 
 
+class FailsAt:
+    """The default solver, but its ``at``-th solve fails (a zero matrix: a breakdown)."""
+
+    def __init__(self, at):
+        self.at, self.calls, self.solver = at, 0, Solver(rtol=1e-14)
+
+    def __call__(self, A, b, x0):
+        self.calls += 1
+        return self.solver(sp.csr_matrix(A.shape) if self.calls == self.at else A, b, x0)
+
+
+@pytest.mark.parametrize("save_every", [0, 1])
+def test_a_run_continued_after_a_solver_failure_is_the_run_without_it(save_every):
+    """BDF2 (its past state needed) fails at step 3 of 6; continued from step 2 with
+    another solver, the whole run's frames, steps and iterations are those of the
+    run that did not fail: BDF2's ``x^n`` of ``x' = -x``, ``(1 + 2 tau / 3) x^{n+1}
+    = (4 x^n - x^{n-1}) / 3``, to round-off. Continued with the history lost (an
+    Euler step at step 3) it is off by 30 %."""
+    whole = simulate(Decay(V0, FACES, 0.5), 6, integrator="bdf2", save_every=save_every,
+                     solver=Solver(rtol=1e-14))
+    failed = simulate(Decay(V0, FACES, 0.5), 6, integrator="bdf2", save_every=save_every,
+                      solver=FailsAt(3))
+    assert failed.status == "solver_breakdown" and failed.steps_done == 2
+    assert failed.steps[-1] == 2 and failed.continue_with is not None
+    continued = failed.continue_with(Solver("direct"))
+    assert continued.status == "ok" and continued.defects == [] and continued.steps_done == 6
+    assert continued.continue_with is None
+    np.testing.assert_array_equal(continued.steps, whole.steps)
+    np.testing.assert_allclose(continued.frames["vertices"], whole.frames["vertices"],
+                               rtol=1e-13)
+    np.testing.assert_array_equal(continued.iterations[:2], whole.iterations[:2])
+    np.testing.assert_array_equal(continued.iterations[2:], 0)      # direct: 0
+    assert failed.steps[-1] == 2 and failed.status == "solver_breakdown"   # unchanged
+    with pytest.raises(ValueError, match="only once"):
+        failed.continue_with(Solver("direct"))
+
+
+def test_only_a_solver_failure_can_be_continued():
+    assert simulate(Decay(V0, FACES, 0.5), 3).continue_with is None
+    assert simulate(Decay(V0, FACES, 0.5, defect_at=2), 3).continue_with is None
+
+
 def test_until_ends_the_run_at_a_steady_state():
     traj = simulate(Decay(V0, FACES, 0.5), 50, until=lambda f: f.X[0, 0] < 0.1)
     assert traj.status == "ok" and traj.steps_done == 6      # 1 / 1.5^6 = 0.088

@@ -6,18 +6,23 @@ import subprocess
 import sys
 from pathlib import Path
 
+from dataclasses import dataclass, field, replace
+
 import numpy as np
 import pytest
 
 from mcfbench.geometry.spheres import icosphere
+from mcfbench.running.problems import get_problem
 from mcfbench.running.run import (
     SHORT_RUN,
     has_boundary,
     level_sweep,
+    problem_mesh,
     run,
     space_convergence,
     time_convergence,
 )
+from mcfbench.running.solver import Solver
 
 
 @pytest.mark.parametrize("scheme", ["ddfv", "cotan"])
@@ -120,6 +125,59 @@ def test_a_short_run_is_timed_as_the_best_of_repeats_a_long_one_once():
     assert long.cpu_seconds > SHORT_RUN and long.timing_repeats == 1
     # the run's own result is its first execution's: the same numbers as once
     assert short.steps_done == 2 and short.iterations == 4
+
+
+@dataclass(frozen=True)
+class _FailsAt(Solver):
+    """The solver, but its ``at``-th solve of a system of ``size`` unknowns (the run's,
+    not the warm-up's) stops after one iteration: ``solver_failed``."""
+
+    at: int = 0
+    size: int = 0
+    calls: list = field(default_factory=list)
+
+    def __call__(self, A, b, x0, **kw):
+        self.calls.extend([1] if A.shape[0] == self.size else [])
+        failing = replace(self, maxiter=1) if len(self.calls) == self.at else self
+        return Solver.__call__(failing, A, b, x0, **kw)
+
+
+def test_a_run_continued_with_the_robust_solver_is_the_robust_run():
+    """DDFV with carried T-vertices and BDF2 on the level-2 sphere (162 F-, 320
+    T-vertices, 8 steps), BiCGStab failing at step 5, continued with the sparse LU:
+    the state, the BDF2 history, the T-vertices and the monitors of step 4 go on as
+    they were, so the result is the LU run's from t = 0 to the solvers' tolerance
+    (measured: the l2_error agrees to 3e-13 relative)."""
+    scheme, lu = "ddfv-chord-carried@bdf2", Solver("direct", rtol=1e-12)
+    whole, _ = run(scheme, "sphere", 2, solver=lu)
+    failing = _FailsAt(rtol=1e-12, at=5, size=whole.nV)
+    result, traj, continued = run(scheme, "sphere", 2, solver=failing, robust=lu)
+    assert result.status == "solver_failed" and result.steps_done == 4
+    assert traj.steps[-1] == 4 and np.isnan(result.metrics["l2_error"])
+    assert continued.status == "ok" and continued.solver == "direct"
+    assert continued.steps_done == whole.steps_done == 8
+    assert continued.iterations == result.iterations > 0          # LU: 0 iterations
+    assert continued.metrics["l2_error"] == pytest.approx(whole.metrics["l2_error"], rel=1e-9)
+    for key in ("t", "quality_t"):
+        assert continued.series[key] == whole.series[key]
+    for key in ("t_min_barycentric", "min_angle", "max_aspect", "covolume_ratio"):
+        np.testing.assert_allclose(continued.series[key], whole.series[key], rtol=1e-9)
+    assert run(scheme, "sphere", 2, solver=lu, robust=lu)[2] is None
+
+
+def test_a_problem_mesh_is_built_once_and_handed_out_as_copies(monkeypatch):
+    torus, built = get_problem("torus"), []
+    mesh = type(torus).mesh
+    monkeypatch.setattr("mcfbench.running.run._kept_meshes", {})
+    monkeypatch.setattr(type(torus), "mesh", lambda self, level: built.append(level) or
+                        mesh(self, level))
+    V, F = problem_mesh(torus, 1)
+    V[:] = 0.0                                       # a flow that moved it in place
+    again, faces = problem_mesh(torus, 1)
+    np.testing.assert_array_equal(again, torus.mesh(1)[0])
+    np.testing.assert_array_equal(faces, F)
+    assert again is not V and np.abs(again).max() > 0.5
+    assert built == [1, 1]          # once for problem_mesh, once for the comparison
 
 
 def test_has_boundary():

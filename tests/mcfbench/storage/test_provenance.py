@@ -71,3 +71,17 @@ def test_code_hash_follows_the_computing_layers_only(tmp_path, monkeypatch):
     with open(copy / "running" / "run.py", "a") as f:
         f.write("# changed\n")
     assert provenance.source_hash.__wrapped__("mcfbench", provenance.COMPUTING_LAYERS) != before
+
+
+def test_git_is_asked_once_per_process_and_path(monkeypatch, tmp_path):
+    from mcfbench.storage import provenance as module
+
+    calls, run = [], subprocess.run
+    monkeypatch.setattr(module.subprocess, "run",
+                        lambda args, **kw: calls.append(args[1]) or run(args, **kw))
+    module.git_commit.cache_clear()
+    first = module.git_commit()
+    assert module.git_commit() == first and calls == ["rev-parse", "status"]
+    assert module.git_commit(tmp_path) == ("unknown", None)     # another path: asked
+    assert calls == ["rev-parse", "status", "rev-parse"]
+    module.git_commit.cache_clear()
