@@ -55,6 +55,21 @@ def split_cube_file(tmp_path):
 
 
 @pytest.fixture(scope="module")
+def timed_once():
+    """``mcfbench.running.run.run`` executes each run's timed part once, for a module
+    (``pytestmark = pytest.mark.usefixtures("timed_once")``) whose tests check what a
+    run computes, not its time. A run's result is that of its first execution; a run
+    under ``SHORT_RUN`` CPU seconds (most runs of the tests) is otherwise executed
+    again for its time, up to ``MAX_REPEATS`` times in about ``REPEAT_BUDGET`` CPU
+    seconds (0.2 s a run; tested in ``tests/mcfbench/running/test_run.py``)."""
+    from mcfbench.running import run
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(run, "MAX_REPEATS", 1)
+        yield
+
+
+@pytest.fixture(scope="module")
 def noisy_sphere():
     """A level-2 icosphere with radial noise: no symmetry hides index errors."""
     V, F = icosphere(2)

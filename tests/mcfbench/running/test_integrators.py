@@ -19,6 +19,8 @@ from mcfbench.running.run import time_convergence
 from mcfbench.running.schemes import SCHEMES, get_scheme
 from mcfbench.running.solver import Solver
 
+pytestmark = pytest.mark.usefixtures("timed_once")      # what the runs compute, not their time
+
 EXACT = Solver("direct")
 ORDER = {"euler": (0.9, 1.15), "bdf2": (1.7, 2.4), "bdf3": (2.8, 3.2)}
 

@@ -35,6 +35,8 @@ from mcfbench.running.schemes import SCHEMES
 from mcfbench.running.solver import Solver
 from mcfbench.storage.statuses import STATUSES
 
+pytestmark = pytest.mark.usefixtures("timed_once")      # what the runs compute, not their time
+
 STEPS = 3
 """Time steps of each run."""
 
