@@ -125,7 +125,7 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
     warm_up(scheme, problem, F, progress=progress, **setup)
     timed = _timed_run(scheme, problem, (V, F), tau, steps, save_every=save_every,
                        progress=progress, observers=observers, **setup)
-    flow, traj, monitor = timed.flow, timed.trajectory, timed.monitor
+    traj = timed.trajectory
     cpu, wall, repeats, spent = timed.cpu, timed.wall, 1, timed.cpu
     while cpu < SHORT_RUN and repeats < MAX_REPEATS and spent < REPEAT_BUDGET:
         again = _timed_run(scheme, problem, (V, F), tau, steps, save_every=save_every,
