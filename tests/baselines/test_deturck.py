@@ -29,7 +29,7 @@ def test_system_is_d4_against_an_independent_assembly(noisy_sphere):
     """(D4) at the second state, built from libigl's stiffness, mass, normals and
     per-face gradients: ``Omega + dt diag(1/m) A + dt D``, right-hand side ``Omega B``."""
     Y, F = noisy_sphere
-    n, tau, alpha = len(Y), 0.01, 0.3
+    tau, alpha = 0.01, 0.3
     flow = DeTurckFlow(Y, F, tau, alpha=alpha)
     X = step(flow)                                       # the reference stays Y
     for scaling in ("mass", "none"):
