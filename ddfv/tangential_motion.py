@@ -59,7 +59,6 @@ angle for the height, ``height x sin`` for the projection).
 
 from typing import NamedTuple
 
-import igl
 import numpy as np
 import scipy.sparse as sp
 
@@ -71,23 +70,6 @@ TANGENTIAL_RTOL = 1e-8
 KINDS = ("bgn", "mdr")
 """The tangential motions: ``"bgn"`` (the new surface's Dirichlet energy) and ``"mdr"``
 (the displacement's, the minimal deformation rate)."""
-
-
-def p1_stiffness(F, faces):
-    """The P1 (cotangent) stiffness ``A = -igl.cotmatrix`` of the F-mesh (the libigl
-    reference of :class:`P1Stiffness`, which a flow uses).
-
-    Parameters
-    ----------
-    F : (n, 3) float array
-    faces : (m, 3) int array
-
-    Returns
-    -------
-    (n, n) scipy.sparse.csr_matrix
-        ``A_kj = int grad phi_k . grad phi_j``, symmetric positive semi-definite.
-    """
-    return sp.csr_matrix(-igl.cotmatrix(np.asarray(F, dtype=float), faces))
 
 
 def half_cotangents(F, faces):
@@ -120,7 +102,8 @@ def half_cotangents(F, faces):
 
 
 class P1Stiffness:
-    """:func:`p1_stiffness` of the states of one F-mesh, in a CSR pattern found once.
+    """The P1 (cotangent) stiffness ``A = -igl.cotmatrix`` of the states of one F-mesh
+    (``A_kj = int grad phi_k . grad phi_j``), in a CSR pattern found once.
 
     :func:`half_cotangents` gives the half cotangents ``w_{t,k} = cot(angle_k) / 2``
     of every corner (the weight of the edge ``(a, b)`` opposite corner ``k`` of

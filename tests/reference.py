@@ -8,9 +8,15 @@ corrected (chi(V_i^F) in b and c).
 :func:`bernoulli`: the Bernoulli function of the drift weights, by ``expm1``,
 against which the compiled weights (``ddfv.kernels._bernoulli``,
 ``baselines.kernels.bernoulli_weight``: a Taylor series near 0) are checked.
+
+:func:`p1_stiffness`: libigl's cotangent stiffness, against which DDFV's
+F-mesh stiffness (``ddfv.tangential_motion.P1Stiffness``, summed in numpy from
+half cotangents) is checked.
 """
 
+import igl
 import numpy as np
+import scipy.sparse as sp
 
 
 def _area(p, q, r):
@@ -95,3 +101,9 @@ def bernoulli(x):
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         b = x / np.expm1(x)
     return np.where(x == 0.0, 1.0, b)
+
+
+def p1_stiffness(F, faces):
+    """The P1 (cotangent) stiffness ``A = -igl.cotmatrix``: ``A_kj = int grad phi_k .
+    grad phi_j``, (n, n) CSR, of the (n, 3) points ``F`` on the (m, 3) ``faces``."""
+    return sp.csr_matrix(-igl.cotmatrix(np.asarray(F, dtype=float), faces))

@@ -15,7 +15,7 @@ import scipy.sparse as sp
 import igl
 
 from ddfv.tangential_motion import (P1Stiffness, TangentialMotion, follow_triangles,
-                                    TANGENTIAL_RTOL, half_cotangents, p1_stiffness,
+                                    TANGENTIAL_RTOL, half_cotangents,
                                     tangent_bases, tangential_motion)
 from ddfv.geometry import t_barycentric, vertex_normals
 from mcfbench.geometry import surfaces
@@ -24,6 +24,7 @@ from mcfbench.geometry.spheres import icosphere, random_bumpy_sphere
 from mcfbench.running.driver import simulate
 from mcfbench.running.integrators import Euler
 from mcfbench.running.solver import Solver
+from reference import p1_stiffness
 
 VARIANTS = ("chord-bgn-carried", "chord-mdr-carried")
 
