@@ -222,11 +222,11 @@ def draw_mesh(ax, F, T, faces, *, view=(20.0, -60.0), primal_width=None,
     order = np.argsort(depth[tri].mean(axis=1), kind="stable")
     if T is None:
         # the triangle, closed, stroked in the primal colour
-        verts = xy[tri[order]]
-        coll = PolyCollection(list(verts), closed=True, facecolors=fill[order],
+        # an (m, 3, 2) array: matplotlib's fast path, one template path for all
+        coll = PolyCollection(xy[tri[order]], closed=True, facecolors=fill[order],
                               edgecolors=primal_color if edges else "none",
                               linewidths=primal_width if edges else 0)
-        ax.add_collection(coll)
+        ax.add_collection(coll, autolim=False)        # the caller sets the limits
         return xy
     # each diamond-mesh triangle (F_a, F_b, T) as the open path F_b -> T -> F_a
     # (its fill is the triangle, its stroke the two F-T edges), then the
@@ -249,7 +249,7 @@ def draw_mesh(ax, F, T, faces, *, view=(20.0, -60.0), primal_width=None,
     coll = PolyCollection(list(paths), closed=False, facecolors=face_rgba,
                           edgecolors=edge_rgba, linewidths=widths,
                           joinstyle="round", capstyle="round")
-    ax.add_collection(coll)
+    ax.add_collection(coll, autolim=False)
     return xy
 
 

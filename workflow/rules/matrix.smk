@@ -46,9 +46,10 @@ MATRIX_TARGETS = [
 
 # One job per batch (mcfbench.studies.matrix.plan.batches): the cheap series of a
 # problem gathered in one process until their estimated cost reaches about
-# 10 CPU s, a heavy series alone (mcfbench.studies.matrix.job.batch_job); one
-# rule per batch since the outputs differ. Saves the start-up of a process and
-# Snakemake's work per job of every series but one per batch (about 1 s each);
+# 60 CPU s (plan.BATCH_SECONDS), a heavy series alone
+# (mcfbench.studies.matrix.job.batch_job); one rule per batch since the outputs
+# differ. Saves the start-up of a process and Snakemake's work per job of every
+# series but one per batch (about 1.7 s each);
 # a killed job redoes its own series. (Snakemake's `group:` would not do it: in
 # local execution group definitions are ignored, docs "Job Grouping".)
 for _batch in _matrix.batches(MATRIX):
@@ -80,7 +81,7 @@ for _batch in _matrix.batches(MATRIX):
         conda:
             "../envs/ddfv.yaml"
         threads: 1
-        # one heavy series at most per batch, the others' estimate under 10 s:
+        # one heavy series at most per batch, the others' estimate under 60 s:
         # the bounds of a series job hold for a batch
         resources:
             mem_mb=1500,

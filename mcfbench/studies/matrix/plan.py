@@ -244,24 +244,45 @@ written (measured 2026-11-26: a cut-down matrix of 198 runs in 8 batch jobs took
 runs' timed flows, the other 46 s (the processes' start-up and Snakemake's work
 included) 0.23 s a run)."""
 
-BATCH_SECONDS = 10.0
+BATCH_SECONDS = 60.0
 """Estimated CPU seconds of work a Snakemake job of the matrix gathers at least
-(:func:`batches`): a process's start-up and Snakemake's work per job (about 1 s
-each on the 2-core machine) are then a tenth of it or less."""
+(:func:`batches`). A job costs about 1.7 s besides its runs (the process's
+start-up, the harness's imports, Snakemake's work; and 0.14 s a series, 0.02 s
+a run: fitted to the 127 jobs of the full matrix of 2026-11-26, f699a17, their
+benchmark wall times against their records' times). The jobs of that matrix
+replayed on 2 cores (``benchmarks/matrix_batches.py``, the records' CPU seconds,
+costliest estimate first) end the runs after 1 083 s with a 10 s budget (169
+jobs), 1 009 s with 30 s (82), 984 s with 60 s (53) and 977 s with 90 s (44),
+the two cores within 2 s of each other in each: 60 s takes most of the gain and
+keeps a killed job's loss and a process's memory small."""
+
+MATRIX_FACTORS = {"ddfv": 3.7, "ddfv, redistributing": 0.51, "vertex": 2.6,
+                  "vertex, redistributing": 0.14, "bgn": 7.1, "kll": 2.6}
+"""Kind of scheme (:func:`mcfbench.running.cost.cost_class`) -> the measured CPU
+seconds of a matrix series over the cost model's estimate (:func:`series_seconds`):
+the median over the series of the full matrix of 2026-11-26 (f699a17) above 0.3 s
+(149, 56, 142, 20, 23, 16 series; ``benchmarks/matrix_batches.py``). The model
+was fitted to steps of the sphere (:data:`mcfbench.running.cost.COSTS`); the
+matrix's series take more solver iterations a step (larger steps, real meshes,
+the anisotropic sphere) and the redistributing ones mostly stop early. Within a
+kind, a series is still within a factor 2.5 of its measured time in the median,
+a factor 7-15 in one case out of ten; the factor brings the heavy series out (1 for a kind not measured)."""
 
 
 def series_seconds(plan, scheme, problem):
     """Estimated CPU seconds of one scheme's series on ``problem``: per level,
     :data:`RUN_SECONDS` and the time steps' CPU seconds of the cost model
     (:func:`mcfbench.running.cost.estimate`; the problem's first level is built
-    once per process to know its size). The model gives the order of magnitude
-    only: it tells the heavy series from the cheap ones."""
-    from mcfbench.running.cost import estimate, size
+    once per process to know its size) times the matrix's factor of the scheme's
+    kind (:data:`MATRIX_FACTORS`). The order of magnitude only: it tells the heavy
+    series from the cheap ones."""
+    from mcfbench.running.cost import cost_class, estimate, size
     from mcfbench.running.problems import get_problem
     from mcfbench.running.schemes import get_scheme
 
     entry, problem = get_scheme(scheme), get_problem(problem)
-    return sum(RUN_SECONDS + estimate(entry, *size(entry, problem, level)).seconds
+    factor = MATRIX_FACTORS.get(cost_class(entry), 1.0)
+    return sum(RUN_SECONDS + factor * estimate(entry, *size(entry, problem, level)).seconds
                for level in plan["problems"][problem.name])
 
 

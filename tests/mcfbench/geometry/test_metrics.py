@@ -73,6 +73,21 @@ def test_mean_edge_length_counts_each_edge_once():
     assert mean_edge_length(V, F) == pytest.approx((4 + np.sqrt(2)) / 5, rel=1e-15)
 
 
+def test_mean_edge_length_is_that_of_the_sorted_unique_edges_bit_for_bit():
+    # the records' h: the same number as the mean over np.unique's rows (the
+    # edges in the same order), on an irregular mesh whose indices are shuffled
+    from mcfbench.geometry.spheres import icosphere
+
+    V, F = icosphere(3)
+    V = V * (1.0 + 0.1 * np.sin(7 * V[:, :1]))
+    perm = np.random.default_rng(3).permutation(len(V))
+    V, F = V[np.argsort(perm)], perm[F]
+    edges = np.unique(np.sort(F[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1), axis=0)
+    assert len(edges) == 3 * len(F) // 2
+    assert mean_edge_length(V, F) == np.linalg.norm(V[edges[:, 1]] - V[edges[:, 0]],
+                                                    axis=1).mean()
+
+
 # ------------------------------------------------------ height metrics
 
 def test_height_of_a_raised_square_and_a_tilted_triangle():

@@ -62,3 +62,33 @@ def test_bad_input_is_refused_by_name():
         mean_surface_distance(V, F + len(V), V, F)
     with pytest.raises(ValueError, match="zero area"):
         mean_surface_distance(np.zeros_like(V), F, np.zeros_like(V), F)
+
+
+def _distance_with_fresh_trees(VA, FA, VB, FB):
+    """D(A, B) with libigl's one-call distance, which builds its tree every time."""
+    import igl
+
+    from mcfbench.geometry.metrics import lumped_mass
+
+    def one_way(P, V, F):
+        return np.sqrt(igl.point_mesh_squared_distance(P, V, F.astype(np.int64))[0])
+
+    ma, mb = lumped_mass(VA, FA), lumped_mass(VB, FB)
+    return float(ma @ one_way(VA, VB, FB) + mb @ one_way(VB, VA, FA)) / (ma.sum() + mb.sum())
+
+
+def test_a_kept_surface_gives_the_numbers_of_fresh_trees_and_follows_its_content():
+    from mcfbench.geometry import surface_distance
+
+    reference = icosphere(3, 1.0)
+    V, F = icosphere(2, 1.2)
+    V[:, 0] *= 0.9
+    first = mean_surface_distance(V, F, *reference)
+    assert first == _distance_with_fresh_trees(V, F, *reference)     # bit for bit
+    kept = len(surface_distance._kept)
+    assert mean_surface_distance(V * 1.1, F, *reference) == \
+        _distance_with_fresh_trees(V * 1.1, F, *reference)          # reference tree reused
+    reference[0][:] *= 1.5                    # the same array, changed in place: a new surface
+    assert mean_surface_distance(V, F, *reference) == \
+        _distance_with_fresh_trees(V, F, *reference) != first
+    assert kept <= len(surface_distance._kept) <= surface_distance.KEPT_SURFACES
