@@ -43,9 +43,10 @@ alpha_hat``, ``K[t1, t1] += 2 alpha_hat`` (its F-rows are Dirichlet rows).
 The entry of F-row ``i`` at T-column ``t`` thus collects the diamonds of
 the two edges of triangle ``t`` at ``i``. The CSR pattern and the CSR
 position of each of these entries are computed once per mesh
-(:class:`Assembler`); one pass over the rows sets the identity, then one
-compiled loop over the diamonds adds the values, each scaled by ``tau /
-chi`` of its row, into them (:func:`ddfv.kernels.system_kernel`).
+(:class:`Assembler`); one compiled loop over the diamonds adds the values,
+each scaled by ``tau / chi`` of its row, into them, the first write into
+each entry starting from the identity's value (no pass zeroes the array
+first: :func:`ddfv.kernels.system_kernel`).
 """
 
 import numpy as np
@@ -149,6 +150,46 @@ class Assembler:
         # Rows of boundary F-vertices are Dirichlet rows (Section 2.2.4).
         self._dirichlet = np.r_[mesh.boundary_vertices, np.zeros(n_t, bool)]
 
+    def _first_touch(self, threads):
+        """The slot table with the first write into each entry flagged, and the
+        diagonal entries no diamond writes, for the diamond order of ``threads``
+        threads (:func:`ddfv.kernels.system_kernel`; kept per thread count).
+
+        Returns
+        -------
+        slots : (n_d, N_SLOTS) uint32 array
+            ``self._slots`` with :data:`ddfv.kernels.FIRST_TOUCH` set on the
+            slots of the entries that :func:`ddfv.kernels.system_kernel` adds
+            into (not the four it assigns) at their first write in the order
+            of :meth:`DiamondMesh.diamond_blocks`: the blocks run in
+            parallel write disjoint rows, so the order within each is the
+            order of the writes into its entries.
+        untouched : uint32 array
+            CSR positions of the diagonals of the rows no diamond writes.
+        """
+        from . import kernels as k
+
+        cache = self.__dict__.setdefault("_touch", {})
+        if threads not in cache:
+            order, _ = self._mesh.diamond_blocks(threads)
+            slots = self._slots[order]
+            used = np.ones(slots.shape, dtype=bool)
+            used[~self._inner[order]] = False
+            used[:, [k.SLOT_AB, k.SLOT_BA, k.SLOT_AA, k.SLOT_BB, k.SLOT_A_T1, k.SLOT_B_T1,
+                     k.SLOT_T1_A, k.SLOT_T1_B, k.SLOT_T1_T1]] = True  # a boundary one's
+            where = np.flatnonzero(used)                 # writes in the order they happen
+            positions = slots.ravel()[where]
+            _, first = np.unique(positions, return_index=True)
+            flag = np.zeros(slots.size, dtype=bool)
+            flag[where[first]] = True
+            flag = flag.reshape(slots.shape)
+            flag[:, [k.SLOT_AB, k.SLOT_BA, k.SLOT_T1_T2, k.SLOT_T2_T1]] = False  # assigned
+            flagged = np.empty_like(slots)
+            flagged[order] = np.where(flag, slots | k.FIRST_TOUCH, slots)
+            untouched = np.setdiff1d(self._diag, positions).astype(np.uint32)
+            cache[threads] = (flagged, untouched)
+        return cache[threads]
+
     @property
     def nnz(self):
         return len(self._indices)
@@ -167,9 +208,11 @@ class Assembler:
                                  f"the mesh needs ({n_d},)")
             factors.append(x)
         data = np.empty(self.nnz)
+        order, starts = self._mesh.diamond_blocks(threads)
+        slots, untouched = self._first_touch(threads)
         for_threads(system_kernel, threads)(
-            self._inner, *factors, self._slots, self._rows, *self._mesh.diamond_blocks(threads),
-            self._indptr.view(np.uint32), self._diag, scale, float(shift), data)
+            self._inner, *factors, slots, self._rows, order, starts, untouched, scale,
+            float(shift), data)
         return sp.csr_matrix((data, self._indices, self._indptr), shape=self.shape)
 
     def stiffness(self, geom):
