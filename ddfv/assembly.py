@@ -172,22 +172,16 @@ class Assembler:
         cache = self.__dict__.setdefault("_touch", {})
         if threads not in cache:
             order, _ = self._mesh.diamond_blocks(threads)
-            slots = self._slots[order]
-            used = np.ones(slots.shape, dtype=bool)
-            used[~self._inner[order]] = False
-            used[:, [k.SLOT_AB, k.SLOT_BA, k.SLOT_AA, k.SLOT_BB, k.SLOT_A_T1, k.SLOT_B_T1,
-                     k.SLOT_T1_A, k.SLOT_T1_B, k.SLOT_T1_T1]] = True  # a boundary one's
-            where = np.flatnonzero(used)                 # writes in the order they happen
-            positions = slots.ravel()[where]
-            _, first = np.unique(positions, return_index=True)
-            flag = np.zeros(slots.size, dtype=bool)
-            flag[where[first]] = True
-            flag = flag.reshape(slots.shape)
-            flag[:, [k.SLOT_AB, k.SLOT_BA, k.SLOT_T1_T2, k.SLOT_T2_T1]] = False  # assigned
-            flagged = np.empty_like(slots)
-            flagged[order] = np.where(flag, slots | k.FIRST_TOUCH, slots)
-            untouched = np.setdiff1d(self._diag, positions).astype(np.uint32)
-            cache[threads] = (flagged, untouched)
+            boundary_used = np.zeros(k.N_SLOTS, dtype=bool)
+            boundary_used[[k.SLOT_AB, k.SLOT_BA, k.SLOT_AA, k.SLOT_BB, k.SLOT_A_T1,
+                           k.SLOT_B_T1, k.SLOT_T1_A, k.SLOT_T1_B, k.SLOT_T1_T1]] = True
+            accumulated = np.ones(k.N_SLOTS, dtype=bool)
+            accumulated[[k.SLOT_AB, k.SLOT_BA, k.SLOT_T1_T2, k.SLOT_T2_T1]] = False
+            seen = np.empty(self.nnz, dtype=bool)
+            flagged = np.empty_like(self._slots)
+            k.first_touch_kernel(self._slots, self._inner, order, boundary_used, accumulated,
+                                 seen, flagged)
+            cache[threads] = (flagged, self._diag[~seen[self._diag]])
         return cache[threads]
 
     @property

@@ -405,6 +405,40 @@ def system_kernel(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, rows, ord
                      order, starts[parts], starts[parts + 1], data)
 
 
+@numba.njit("void(uint32[:, ::1], boolean[::1], uint64[::1], boolean[::1], boolean[::1], "
+            "boolean[::1], uint32[:, ::1])", **_OPTIONS)
+def first_touch_kernel(slots, inner, order, boundary_used, accumulated, seen, flagged):
+    """The slot table of :func:`system_kernel` with the first write into each entry
+    flagged (:meth:`ddfv.assembly.Assembler._first_touch`).
+
+    Parameters
+    ----------
+    slots : (n_d, N_SLOTS) uint32 array
+        CSR position of each entry of each diamond (in range by construction).
+    inner : (n_d,) bool array
+    order : (n_d,) uint64 array
+        The diamonds in the order :func:`system_kernel` writes them.
+    boundary_used : (N_SLOTS,) bool array
+        The slots a boundary diamond writes.
+    accumulated : (N_SLOTS,) bool array
+        The slots :func:`system_kernel` adds into (the others it assigns).
+    seen : (nnz,) bool array, output
+        Whether a diamond writes the entry.
+    flagged : (n_d, N_SLOTS) uint32 array, output
+        ``slots``, :data:`FIRST_TOUCH` set on the accumulated slots of first writes.
+    """
+    seen[:] = False
+    for j in range(order.shape[0]):
+        d = order[j]
+        for c in range(N_SLOTS):
+            s = slots[d, c]
+            flagged[d, c] = s
+            if (inner[d] or boundary_used[c]) and not seen[s]:
+                seen[s] = True
+                if accumulated[c]:
+                    flagged[d, c] = s | FIRST_TOUCH
+
+
 @numba.njit("float64(float64)", **_OPTIONS, inline="always")
 def _bernoulli(x):
     """``x / (e^x - 1)``, 1 at 0 (the Bernoulli function of the drift
