@@ -43,9 +43,10 @@ alpha_hat``, ``K[t1, t1] += 2 alpha_hat`` (its F-rows are Dirichlet rows).
 The entry of F-row ``i`` at T-column ``t`` thus collects the diamonds of
 the two edges of triangle ``t`` at ``i``. The CSR pattern and the CSR
 position of each of these entries are computed once per mesh
-(:class:`Assembler`); one pass over the rows sets the identity, then one
-compiled loop over the diamonds adds the values, each scaled by ``tau /
-chi`` of its row, into them (:func:`ddfv.kernels.system_kernel`).
+(:class:`Assembler`); one compiled loop over the diamonds adds the values,
+each scaled by ``tau / chi`` of its row, into them, the first write into
+each entry starting from the identity's value (no pass zeroes the array
+first: :func:`ddfv.kernels.system_kernel`).
 """
 
 import numpy as np
@@ -149,6 +150,40 @@ class Assembler:
         # Rows of boundary F-vertices are Dirichlet rows (Section 2.2.4).
         self._dirichlet = np.r_[mesh.boundary_vertices, np.zeros(n_t, bool)]
 
+    def _first_touch(self, threads):
+        """The slot table with the first write into each entry flagged, and the
+        diagonal entries no diamond writes, for the diamond order of ``threads``
+        threads (:func:`ddfv.kernels.system_kernel`; kept per thread count).
+
+        Returns
+        -------
+        slots : (n_d, N_SLOTS) uint32 array
+            ``self._slots`` with :data:`ddfv.kernels.FIRST_TOUCH` set on the
+            slots of the entries that :func:`ddfv.kernels.system_kernel` adds
+            into (not the four it assigns) at their first write in the order
+            of :meth:`DiamondMesh.diamond_blocks`: the blocks run in
+            parallel write disjoint rows, so the order within each is the
+            order of the writes into its entries.
+        untouched : uint32 array
+            CSR positions of the diagonals of the rows no diamond writes.
+        """
+        from . import kernels as k
+
+        cache = self.__dict__.setdefault("_touch", {})
+        if threads not in cache:
+            order, _ = self._mesh.diamond_blocks(threads)
+            boundary_used = np.zeros(k.N_SLOTS, dtype=bool)
+            boundary_used[[k.SLOT_AB, k.SLOT_BA, k.SLOT_AA, k.SLOT_BB, k.SLOT_A_T1,
+                           k.SLOT_B_T1, k.SLOT_T1_A, k.SLOT_T1_B, k.SLOT_T1_T1]] = True
+            accumulated = np.ones(k.N_SLOTS, dtype=bool)
+            accumulated[[k.SLOT_AB, k.SLOT_BA, k.SLOT_T1_T2, k.SLOT_T2_T1]] = False
+            seen = np.empty(self.nnz, dtype=bool)
+            flagged = np.empty_like(self._slots)
+            k.first_touch_kernel(self._slots, self._inner, order, boundary_used, accumulated,
+                                 seen, flagged)
+            cache[threads] = (flagged, self._diag[~seen[self._diag]])
+        return cache[threads]
+
     @property
     def nnz(self):
         return len(self._indices)
@@ -167,9 +202,11 @@ class Assembler:
                                  f"the mesh needs ({n_d},)")
             factors.append(x)
         data = np.empty(self.nnz)
+        order, starts = self._mesh.diamond_blocks(threads)
+        slots, untouched = self._first_touch(threads)
         for_threads(system_kernel, threads)(
-            self._inner, *factors, self._slots, self._rows, *self._mesh.diamond_blocks(threads),
-            self._indptr.view(np.uint32), self._diag, scale, float(shift), data)
+            self._inner, *factors, slots, self._rows, order, starts, untouched, scale,
+            float(shift), data)
         return sp.csr_matrix((data, self._indices, self._indptr), shape=self.shape)
 
     def stiffness(self, geom):

@@ -47,6 +47,10 @@ GEOMETRY_ROWS = 19
  SLOT_T1_A, SLOT_T1_B, SLOT_T2_A, SLOT_T2_B, SLOT_T1_T2, SLOT_T2_T1, SLOT_T1_T1,
  SLOT_T2_T2) = range(16)
 N_SLOTS = 16
+#: flag bit of a slot in :func:`system_kernel`'s table: the first write into its
+#: entry (:meth:`ddfv.assembly.Assembler._first_touch`); the other bits are the position
+FIRST_TOUCH = np.uint32(2**31)
+POSITION = np.uint32(2**31 - 1)
 
 
 def padded_length(n):
@@ -302,9 +306,20 @@ def flux_coefficients_kernel(gamma_t, gamma_f, J, len_u, len_v, uv):
 
 
 @numba.njit(**_OPTIONS, inline="always")
-def _scatter_entries(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, rows, scale, order,
-                     lo, hi, data):
-    """The diamonds ``order[lo:hi]`` of :func:`system_kernel`."""
+def _accumulate(data, slot, init, value):
+    """``data[i] += value``, ``i`` the position of ``slot``; at a slot flagged
+    :data:`FIRST_TOUCH` ``data[i] = init + value`` instead (``init`` the value
+    the entry would have been set to before any diamond: bitwise the same)."""
+    i = slot & POSITION
+    old = data[i]          # read either way: a select, not a branch
+    data[i] = (init if slot >= FIRST_TOUCH else old) + value
+
+
+@numba.njit(**_OPTIONS, inline="always")
+def _scatter_entries(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, rows, scale, shift,
+                     order, lo, hi, data):
+    """The diamonds ``order[lo:hi]`` of :func:`system_kernel`. A subtraction
+    ``x - y`` is added as ``x + (-y)`` (IEEE: the same)."""
     for j in range(lo, hi):
         d = order[j]
         alpha, beta, alpha_hat, beta_hat = flux_coefficients_kernel(
@@ -313,47 +328,51 @@ def _scatter_entries(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, rows, 
         r = rows[d]
         s_a, s_b, s_t1 = scale[r[0]], scale[r[1]], scale[r[2]]
         # F-rows: flux_a = alpha (f_b - f_a) - beta (f_t2 - f_t1) = -flux_b
-        data[s[SLOT_AB]] = -(alpha * s_a)
+        data[s[SLOT_AB]] = -(alpha * s_a)           # entries of one diamond only
         data[s[SLOT_BA]] = -(alpha * s_b)
-        data[s[SLOT_AA]] += alpha * s_a
-        data[s[SLOT_BB]] += alpha * s_b
-        data[s[SLOT_A_T1]] -= beta * s_a
-        data[s[SLOT_B_T1]] += beta * s_b
+        _accumulate(data, s[SLOT_AA], shift, alpha * s_a)
+        _accumulate(data, s[SLOT_BB], shift, alpha * s_b)
+        _accumulate(data, s[SLOT_A_T1], 0.0, -(beta * s_a))
+        _accumulate(data, s[SLOT_B_T1], 0.0, beta * s_b)
         if inner[d]:
             s_t2 = scale[r[3]]
-            data[s[SLOT_A_T2]] += beta * s_a
-            data[s[SLOT_B_T2]] -= beta * s_b
+            _accumulate(data, s[SLOT_A_T2], 0.0, beta * s_a)
+            _accumulate(data, s[SLOT_B_T2], 0.0, -(beta * s_b))
             # T-rows: flux_t1 = alpha_hat (f_t2 - f_t1) - beta_hat (f_b - f_a) = -flux_t2
-            data[s[SLOT_T1_A]] -= beta_hat * s_t1
-            data[s[SLOT_T1_B]] += beta_hat * s_t1
-            data[s[SLOT_T2_A]] += beta_hat * s_t2
-            data[s[SLOT_T2_B]] -= beta_hat * s_t2
+            _accumulate(data, s[SLOT_T1_A], 0.0, -(beta_hat * s_t1))
+            _accumulate(data, s[SLOT_T1_B], 0.0, beta_hat * s_t1)
+            _accumulate(data, s[SLOT_T2_A], 0.0, beta_hat * s_t2)
+            _accumulate(data, s[SLOT_T2_B], 0.0, -(beta_hat * s_t2))
             data[s[SLOT_T1_T2]] = -(alpha_hat * s_t1)
             data[s[SLOT_T2_T1]] = -(alpha_hat * s_t2)
-            data[s[SLOT_T1_T1]] += alpha_hat * s_t1
-            data[s[SLOT_T2_T2]] += alpha_hat * s_t2
+            _accumulate(data, s[SLOT_T1_T1], shift, alpha_hat * s_t1)
+            _accumulate(data, s[SLOT_T2_T2], shift, alpha_hat * s_t2)
         else:
             # f_t2 = f_a + f_b - f_t1 in the T-equation (Section 2.2.5)
-            data[s[SLOT_T1_A]] -= (beta_hat + alpha_hat) * s_t1
-            data[s[SLOT_T1_B]] += (beta_hat - alpha_hat) * s_t1
-            data[s[SLOT_T1_T1]] += (2.0 * alpha_hat) * s_t1
+            _accumulate(data, s[SLOT_T1_A], 0.0, -((beta_hat + alpha_hat) * s_t1))
+            _accumulate(data, s[SLOT_T1_B], 0.0, (beta_hat - alpha_hat) * s_t1)
+            _accumulate(data, s[SLOT_T1_T1], shift, (2.0 * alpha_hat) * s_t1)
 
 
 @numba.njit("void(boolean[::1], float64[:], float64[:], float64[:], float64[:], float64[:], "
             "float64[:], uint32[:, ::1], uint32[:, ::1], uint64[::1], uint64[::1], "
-            "uint32[::1], uint32[::1], float64[::1], float64, float64[::1])", **_OPTIONS)
+            "uint32[::1], float64[::1], float64, float64[::1])", **_OPTIONS)
 def system_kernel(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, rows, order, starts,
-                  indptr, diag, scale, shift, data):
+                  untouched, scale, shift, data):
     """Values of ``diag(scale) K + shift I`` in a fixed CSR pattern (2.10)-(2.15).
 
-    One pass over the rows sets the values to ``shift I``; then each diamond
-    adds its entries of ``K`` (minus its fluxes, see :mod:`ddfv.assembly`),
-    each times the ``scale`` of its row, into their CSR slots, the blocks of
-    :meth:`ddfv.topology.DiamondMesh.diamond_blocks` one per thread, then
-    the diamonds across blocks. The slots, ``rows``, ``indptr`` and ``diag``
-    come from :class:`ddfv.assembly.Assembler` (positions in its CSR
-    pattern and rows, all in range by construction) and are not checked
-    here.
+    Each diamond adds its entries of ``K`` (minus its fluxes, see
+    :mod:`ddfv.assembly`), each times the ``scale`` of its row, into their CSR
+    slots, the blocks of :meth:`ddfv.topology.DiamondMesh.diamond_blocks` one
+    per thread, then the diamonds across blocks. No pass sets the values
+    first: the first write into each entry, flagged in its slot
+    (:data:`FIRST_TOUCH`), starts from ``shift`` (diagonal) or 0, the value
+    the entry would have had, so the sums are bitwise those of a zeroed
+    array; the diagonal entries no diamond writes (``untouched``: rows of
+    vertices in no triangle) are set to ``shift``. The slots, ``rows`` and
+    ``untouched`` come from :class:`ddfv.assembly.Assembler` (positions in
+    its CSR pattern and rows, all in range by construction) and are not
+    checked here.
 
     Parameters
     ----------
@@ -362,31 +381,62 @@ def system_kernel(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, rows, ord
     gamma_t, gamma_f, J, len_u, len_v, uv : (n_d,) float64 arrays
         The geometric factors of :class:`ddfv.geometry.DiamondGeometry`.
     slots : (n_d, N_SLOTS) uint32 array
-        CSR position of each entry of the diamond (``SLOT_*``); the ``t2``
-        slots of boundary diamonds are unused.
+        CSR position of each entry of the diamond (``SLOT_*``), flagged
+        :data:`FIRST_TOUCH` at the first write into the entry in the order
+        of ``order``; the ``t2`` slots of boundary diamonds are unused.
     rows : (n_d, 4) uint32 array
         The rows ``a, b, n_f + t1, n_f + t2`` of each diamond (the last unused
         on boundary diamonds).
     order, starts : uint64 arrays
         The diamond blocks.
-    indptr : (n + 1,) uint32 array
-    diag : (n,) uint32 array
-        CSR position of the diagonal entry of each row.
+    untouched : uint32 array
+        CSR positions of the diagonal entries no diamond writes.
     scale : (n,) float64 array
     shift : float
     data : (nnz,) float64 array, output
     """
-    n = diag.shape[0]
-    for i in numba.prange(n):
-        for j in range(indptr[i], indptr[i + 1]):
-            data[j] = 0.0
-        data[diag[i]] = shift
+    for i in range(untouched.shape[0]):
+        data[untouched[i]] = shift
     parts = starts.shape[0] - 2
     for k in numba.prange(parts):
         _scatter_entries(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, rows, scale,
-                         order, starts[k], starts[k + 1], data)
-    _scatter_entries(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, rows, scale, order,
-                     starts[parts], starts[parts + 1], data)
+                         shift, order, starts[k], starts[k + 1], data)
+    _scatter_entries(inner, gamma_t, gamma_f, J, len_u, len_v, uv, slots, rows, scale, shift,
+                     order, starts[parts], starts[parts + 1], data)
+
+
+@numba.njit("void(uint32[:, ::1], boolean[::1], uint64[::1], boolean[::1], boolean[::1], "
+            "boolean[::1], uint32[:, ::1])", **_OPTIONS)
+def first_touch_kernel(slots, inner, order, boundary_used, accumulated, seen, flagged):
+    """The slot table of :func:`system_kernel` with the first write into each entry
+    flagged (:meth:`ddfv.assembly.Assembler._first_touch`).
+
+    Parameters
+    ----------
+    slots : (n_d, N_SLOTS) uint32 array
+        CSR position of each entry of each diamond (in range by construction).
+    inner : (n_d,) bool array
+    order : (n_d,) uint64 array
+        The diamonds in the order :func:`system_kernel` writes them.
+    boundary_used : (N_SLOTS,) bool array
+        The slots a boundary diamond writes.
+    accumulated : (N_SLOTS,) bool array
+        The slots :func:`system_kernel` adds into (the others it assigns).
+    seen : (nnz,) bool array, output
+        Whether a diamond writes the entry.
+    flagged : (n_d, N_SLOTS) uint32 array, output
+        ``slots``, :data:`FIRST_TOUCH` set on the accumulated slots of first writes.
+    """
+    seen[:] = False
+    for j in range(order.shape[0]):
+        d = order[j]
+        for c in range(N_SLOTS):
+            s = slots[d, c]
+            flagged[d, c] = s
+            if (inner[d] or boundary_used[c]) and not seen[s]:
+                seen[s] = True
+                if accumulated[c]:
+                    flagged[d, c] = s | FIRST_TOUCH
 
 
 @numba.njit("float64(float64)", **_OPTIONS, inline="always")

@@ -100,6 +100,29 @@ def spmv(indptr, indices, data, X, Y, R):
 
 
 @njit(**_JIT)
+def _shared_floor(indptr, indices, data, b, c):
+    """``(nnz_row + 1) eps | |b| + |A| |c| |`` for a shared ``A`` and a (3, m) ``b``,
+    ``c`` the three per-row constants: the round-off bound of :func:`residual`,
+    summed in its order (rows in turn, then the three rows of ``b``)."""
+    m = b.shape[1]
+    c0 = abs(c[0])
+    c1 = abs(c[1])
+    c2 = abs(c[2])
+    total = 0.0
+    width = 0
+    for i in range(m):
+        ra = 0.0
+        for jj in range(indptr[i], indptr[i + 1]):
+            ra += abs(data[jj])
+        width = max(width, np.int64(indptr[i + 1] - indptr[i]))
+        f0 = abs(b[0, i]) + ra * c0
+        f1 = abs(b[1, i]) + ra * c1
+        f2 = abs(b[2, i]) + ra * c2
+        total += f0 * f0 + f1 * f1 + f2 * f2
+    return (width + 1) * _EPS * math.sqrt(total)
+
+
+@njit(**_JIT)
 def residual(indptr, indices, data, b, x, cmean, cfull, r):
     """``r = b - A x`` in one pass over ``A``.
 
@@ -108,6 +131,18 @@ def residual(indptr, indices, data, b, x, cmean, cfull, r):
     ``|b - A c|^2``, ``|b|^2``, ``|x|^2``, ``|A|_inf`` (largest absolute row
     sum), a code (0, or 8/9/10 for NaN/inf in ``b``/``x``/``A``) and the
     round-off bound of ``b - A c``: ``(nnz_row + 1) eps | |b| + |A| |c| |``.
+
+    A shared ``A`` with three rows of ``b`` (the surface schemes' systems)
+    takes the pass of the fewest sums: a non-finite entry shows in ``|b|^2``,
+    ``|x|^2`` or the sum of the squared absolute row sums, and only then is
+    the array checked entry by entry (those sums may also overflow); the
+    round-off bound (only compared with ``|b - A c|``, to find ``c`` the
+    solution) is computed in a second pass (:func:`_shared_floor`) only when
+    ``|b - A c|`` is below twice its upper bound by Minkowski's inequality,
+    ``(nnz_row + 1) eps (|b| + |rowsum |A|| |c|)``; otherwise that upper bound
+    is returned. The comparison has the same outcome as with the bound
+    itself; the pass costs 0.415 ms against 0.49 ms with the four sums
+    (level-5 sphere, DDFV, min of 300 calls).
     """
     k, m = b.shape
     rr = 0.0
@@ -115,19 +150,16 @@ def residual(indptr, indices, data, b, x, cmean, cfull, r):
     bb = 0.0
     xx = 0.0
     norm_a = 0.0
-    nan_a = 0.0      # entry * 0 is NaN exactly for NaN/inf entries
-    nan_b = 0.0
-    nan_x = 0.0
-    cfloor = 0.0
     width = 0
     shared = cfull.shape[1] == 0
     if shared and k == 3:
         c0 = cmean[0]
         c1 = cmean[1]
         c2 = cmean[2]
+        ra2 = 0.0
         for i in prange(m):
             a0, a1, a2, rs, ra = _row3(indptr, indices, data, x, i)
-            nan_a += ra * 0.0
+            ra2 += ra * ra
             norm_a = max(norm_a, ra)
             width = max(width, np.int64(indptr[i + 1] - indptr[i]))
             b0 = b[0, i]
@@ -144,56 +176,65 @@ def residual(indptr, indices, data, b, x, cmean, cfull, r):
             d1 = b1 - c1 * rs
             d2 = b2 - c2 * rs
             ref += d0 * d0 + d1 * d1 + d2 * d2
-            f0 = abs(b0) + ra * abs(c0)
-            f1 = abs(b1) + ra * abs(c1)
-            f2 = abs(b2) + ra * abs(c2)
-            cfloor += f0 * f0 + f1 * f1 + f2 * f2
             bb += b0 * b0 + b1 * b1 + b2 * b2
-            nan_b += b0 * 0.0 + b1 * 0.0 + b2 * 0.0
             x0 = x[0, i]
             x1 = x[1, i]
             x2 = x[2, i]
             xx += x0 * x0 + x1 * x1 + x2 * x2
-            nan_x += x0 * 0.0 + x1 * 0.0 + x2 * 0.0
-    else:
-        ax = np.empty(k)
-        ac = np.empty(k)
-        acabs = np.empty(k)
-        for i in range(m):
-            ax[:] = 0.0
-            ac[:] = 0.0
-            acabs[:] = 0.0
-            rs = 0.0
-            ra = 0.0
-            for jj in range(indptr[i], indptr[i + 1]):
-                a = data[jj]
-                j = indices[jj]
-                rs += a
-                ra += abs(a)
-                for q in range(k):
-                    ax[q] += a * x[q, j]
-                if not shared:
-                    for q in range(k):
-                        ac[q] += a * cfull[q, j]
-                        acabs[q] += abs(a * cfull[q, j])
-            nan_a += ra * 0.0
-            if ra > norm_a:
-                norm_a = ra
-            width = max(width, np.int64(indptr[i + 1] - indptr[i]))
+        code = 0
+        if not math.isfinite(bb) and not np.isfinite(b).all():
+            code = 8
+        elif not math.isfinite(xx) and not np.isfinite(x).all():
+            code = 9
+        elif not math.isfinite(ra2) and not np.isfinite(data[indptr[0]:indptr[m]]).all():
+            code = 10
+        bound = (width + 1) * _EPS * (math.sqrt(bb) + math.sqrt(ra2) *
+                                      math.sqrt(c0 * c0 + c1 * c1 + c2 * c2))
+        if code == 0 and not ref > 4.0 * bound * bound:     # |b - A c| <= 2 bound
+            bound = _shared_floor(indptr, indices, data, b, cmean)
+        return rr, ref, bb, xx, norm_a, code, bound
+    nan_a = 0.0      # entry * 0 is NaN exactly for NaN/inf entries
+    nan_b = 0.0
+    nan_x = 0.0
+    cfloor = 0.0
+    ax = np.empty(k)
+    ac = np.empty(k)
+    acabs = np.empty(k)
+    for i in range(m):
+        ax[:] = 0.0
+        ac[:] = 0.0
+        acabs[:] = 0.0
+        rs = 0.0
+        ra = 0.0
+        for jj in range(indptr[i], indptr[i + 1]):
+            a = data[jj]
+            j = indices[jj]
+            rs += a
+            ra += abs(a)
             for q in range(k):
-                bq = b[q, i]
-                rq = bq - ax[q]
-                r[q, i] = rq
-                rr += rq * rq
-                d = bq - (cmean[q] * rs if shared else ac[q])
-                ref += d * d
-                f = abs(bq) + (ra * abs(cmean[q]) if shared else acabs[q])
-                cfloor += f * f
-                bb += bq * bq
-                nan_b += bq * 0.0
-                xq = x[q, i]
-                xx += xq * xq
-                nan_x += xq * 0.0
+                ax[q] += a * x[q, j]
+            if not shared:
+                for q in range(k):
+                    ac[q] += a * cfull[q, j]
+                    acabs[q] += abs(a * cfull[q, j])
+        nan_a += ra * 0.0
+        if ra > norm_a:
+            norm_a = ra
+        width = max(width, np.int64(indptr[i + 1] - indptr[i]))
+        for q in range(k):
+            bq = b[q, i]
+            rq = bq - ax[q]
+            r[q, i] = rq
+            rr += rq * rq
+            d = bq - (cmean[q] * rs if shared else ac[q])
+            ref += d * d
+            f = abs(bq) + (ra * abs(cmean[q]) if shared else acabs[q])
+            cfloor += f * f
+            bb += bq * bq
+            nan_b += bq * 0.0
+            xq = x[q, i]
+            xx += xq * xq
+            nan_x += xq * 0.0
     code = 0
     if nan_b != 0.0:
         code = 8

@@ -167,3 +167,52 @@ def test_geometry_of_another_mesh_is_refused():
         Assembler(mesh).stiffness(other_geom)
     with pytest.raises(ValueError, match="chi"):
         Assembler(mesh).system(geom, np.ones(other_mesh.n_unknowns), 0.1)
+
+
+def _kernel_values(assembler, geom, scale, shift, threads, first_touch):
+    """The values of :func:`kernels.system_kernel`: with ``first_touch`` from an array
+    of NaN with the flagged slots (no entry may depend on what the array held), else
+    summed into a zeroed array (identity set first) with the slots unflagged, as the
+    kernel did before it flagged the first write into each entry."""
+    from ddfv.threads import for_threads
+
+    if first_touch:
+        data = np.full(assembler.nnz, np.nan)
+        slots, untouched = assembler._first_touch(threads)
+    else:
+        data = np.zeros(assembler.nnz)
+        data[assembler._diag] = shift
+        slots, untouched = assembler._slots, np.zeros(0, np.uint32)
+    factors = [np.asarray(getattr(geom, n)) for n in ("gamma_t", "gamma_f", "J", "len_u",
+                                                      "len_v", "uv")]
+    for_threads(kernels.system_kernel, threads)(
+        assembler._inner, *factors, slots, assembler._rows,
+        *assembler._mesh.diamond_blocks(threads), untouched, scale, shift, data)
+    return data
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+@pytest.mark.parametrize("make", [lambda: cylinder(10, 4), lambda: bumpy_sphere(1)])
+def test_first_writes_give_the_zeroed_sums_bitwise(make, threads):
+    """No zeroing pass: the flagged first write into each entry starts from
+    what the zeroed array held, so the values are bitwise those of the sums into
+    a zeroed array (boundary diamonds, the blocks of two threads); a vertex in
+    no triangle keeps its identity row."""
+    V, F = make()
+    V = np.vstack([V, [[5.0, 5.0, 5.0]]])          # a vertex in no triangle
+    mesh, T, geom = _state(V, F, t_init="barycenter", noise=0.02, seed=4)
+    assembler = Assembler(mesh)
+    chi = np.concatenate(covolume_areas(mesh, geom))
+    chi[mesh.n_f - 1] = 1.0                        # the lone vertex: no covolume
+    scale = 0.05 / chi
+    scale[np.r_[mesh.boundary_vertices, np.zeros(mesh.n_t, bool)]] = 0.0
+    zeroed = _kernel_values(assembler, geom, scale, 1.0, threads, False)
+    assert np.array_equal(_kernel_values(assembler, geom, scale, 1.0, threads, True), zeroed)
+    A = assembler.system(geom, chi, 0.05, threads=threads)
+    assert np.array_equal(A.data, zeroed)
+    _, untouched = assembler._first_touch(threads)
+    assert len(untouched) == 1 and A[mesh.n_f - 1, mesh.n_f - 1] == 1.0
+    assert A[mesh.n_f - 1].nnz == 1
+    K = assembler.stiffness(geom)                  # one thread
+    assert np.array_equal(K.data, _kernel_values(
+        assembler, geom, (~assembler._dirichlet).astype(float), 0.0, 1, False))

@@ -482,3 +482,53 @@ def test_one_solver_of_either_settings_shape():
     assert (gallery.method, gallery.rtol, gallery.maxiter) == ("direct", 1e-9, 1000)
     with pytest.raises(ValueError, match="unknown solver method 'lu'"):
         Solver.of_settings({"solver": "lu", "rtol": 1e-9})
+
+
+def _floor(A, b, c):
+    """The round-off bound of ``b - A c`` by its definition, for a shared A:
+    ``(nnz_row + 1) eps | |b| + |A| |c| |``."""
+    width = np.diff(A.indptr).max()
+    f = abs(b) + np.outer(abs(c), abs(A).sum(axis=1).A1)
+    return (width + 1) * np.finfo(float).eps * np.linalg.norm(f)
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e-15, 1e-3])
+def test_residual_round_off_bound(offset):
+    """The shared three-row pass returns the bound itself when ``|b - A c|`` is near
+    it (c nearly the solution) and otherwise an upper bound that ``|b - A c|``
+    exceeds, so the test ``|b - A c| <= bound`` decides as with the bound."""
+    from mcfbench.running import krylov
+    from mcfbench.running.solver import _csr
+
+    A, _ = ring_system()
+    c = np.array([1.0, -2.0, 3.0])
+    b = A @ np.outer(np.ones(A.shape[0]), c)
+    b = np.ascontiguousarray(b.T) + offset * np.sin(np.arange(b.size)).reshape(3, -1)
+    r = np.empty_like(b)
+    rr, ref2, bb, xx, norm_a, code, bound = krylov.residual(
+        *_csr(A), b, np.ascontiguousarray(b), c, np.empty((3, 0)), r)
+    exact = _floor(A, b, c)
+    assert code == 0 and norm_a == pytest.approx(abs(A).sum(axis=1).max(), rel=1e-14)
+    assert ref2 == pytest.approx(np.sum((b - c[:, None] * A.sum(axis=1).A1) ** 2), rel=1e-10)
+    if offset < 1e-14:
+        assert np.sqrt(ref2) <= bound == pytest.approx(exact, rel=1e-12)
+    else:
+        assert bound >= exact and np.sqrt(ref2) > bound
+
+
+@pytest.mark.parametrize("where", ["b", "x0", "A"])
+def test_overflowing_but_finite_input_is_not_called_non_finite(where):
+    """A sum of squares overflows with entries of 1e200: the pass checks the
+    entries before naming NaN/inf in the input (code 0), and names them when one is."""
+    from mcfbench.running import krylov
+    from mcfbench.running.solver import _csr
+
+    A, b = ring_system(n=50)
+    x0 = b.copy()
+    A = A.copy()
+    target = {"b": b, "x0": x0, "A": A.data}[where]
+    target.flat[3] = 1e200
+    args = (b, x0, np.zeros(3), np.empty((3, 0)), np.empty_like(b))
+    assert krylov.residual(*_csr(A), *args)[5] == 0
+    target.flat[4] = np.inf
+    assert krylov.residual(*_csr(A), *args)[5] == {"b": 8, "x0": 9, "A": 10}[where]
