@@ -3,9 +3,9 @@
 Imported on first use by the functions they serve (numba is not imported
 before, so a command that measures nothing does not pay for it), each kernel
 loaded from numba's cache: :func:`quality_pass` (:func:`mcfbench.geometry.metrics.quality`),
-:func:`invariants_pass` and :func:`count_folds` (:class:`mcfbench.geometry.invariants.FlowInvariants`;
-the fold count also the quality monitor's), :func:`component_extents`
-(:class:`mcfbench.geometry.collapse.CollapseCheck`) and :func:`sphere_error_sum`
+:func:`count_folds` (the quality monitor's fold count), :func:`state_pass`
+(:class:`mcfbench.geometry.measures.StateMeasures`: what the driver's collapse and
+invariant checks read of every state, with the same fold count) and :func:`sphere_error_sum`
 (:class:`mcfbench.geometry.exact.SphereL2Error`), tested through them (the quality
 monitor's and the sphere error's against numpy evaluations of their formulas).
 
@@ -82,39 +82,6 @@ def quality_pass(V, F, work):
 
 
 @numba.njit(**_OPTIONS)
-def invariants_pass(V, F, N):
-    """Total area and the smallest tangent of the smallest angles of the
-    triangles (the smallest angle of a triangle, opposite its shortest side, is
-    at most 60 degrees, so its tangent ``|u x v| / (u . v)`` is increasing in
-    it); ``N[t]``: the normal ``n`` of triangle ``t``. NaN
-    propagates to the area and the tangent."""
-    m = F.shape[0]
-    area = 0.0
-    tangent = np.inf
-    for t in range(m):
-        a0, a1, a2, b0, b1, b2, c0, c1, c2, n0, n1, n2 = _triangle(V, F, t)
-        N[t, 0] = n0
-        N[t, 1] = n1
-        N[t, 2] = n2
-        twice = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
-        area += 0.5 * twice
-        la = a0 * a0 + a1 * a1 + a2 * a2
-        lb = b0 * b0 + b1 * b1 + b2 * b2
-        lc = c0 * c0 + c1 * c1 + c2 * c2
-        # the two sides at the smallest angle: the two longest
-        if lb <= la and lb <= lc:
-            dot = -(a0 * c0 + a1 * c1 + a2 * c2)     # corner 0: a and -c
-        elif lc <= la:
-            dot = -(a0 * b0 + a1 * b1 + a2 * b2)     # corner 1: -a and b
-        else:
-            dot = -(b0 * c0 + b1 * c1 + b2 * c2)     # corner 2: -b and c
-        tan = twice / dot if dot > 0 else (0.0 if twice == twice else twice)
-        if tangent == tangent and (tan < tangent or tan != tan):
-            tangent = tan
-    return area, tangent
-
-
-@numba.njit(**_OPTIONS)
 def count_folds(N, t1, t2, skip, R, S):
     """Number of triangles ``t`` with ``skip[t] == 0`` whose normal ``N[t]`` has
     ``N_t . sum_s N_s < 0`` over its edge-neighbours ``s`` (the pairs ``t1, t2``);
@@ -140,13 +107,44 @@ def count_folds(N, t1, t2, skip, R, S):
 
 
 @numba.njit(**_OPTIONS)
-def component_extents(V, F, face_label, labels, area, box):
-    """``area[c] +=`` the areas of the triangles of component ``c``; ``box[0, c]``,
-    ``box[1, c]``: the smallest and largest coordinates of its vertices (NaN
-    propagates to the area)."""
+def state_pass(V, F, face_label, labels, t1, t2, skip, N, R, S, area, box):
+    """The measures of a state that the driver's checks read, in one call: one pass
+    over the triangles, one over the points, one over the pairs of edge-neighbours.
+
+    Returns the total area, the smallest tangent of the smallest angles of the
+    triangles (the smallest angle of a triangle, opposite its shortest side, is at
+    most 60 degrees, so its tangent ``|u x v| / (u . v)`` is increasing in it) and
+    :func:`count_folds` of the normals; ``N[t]``: the normal ``n`` of triangle
+    ``t``; ``area[c]``: the sum of the areas of the triangles of component ``c`` (the total
+    and every component summed in triangle order); ``box[0, c]``, ``box[1, c]``:
+    the smallest and largest coordinates of its points. NaN propagates to the
+    areas and the tangent. ``area`` and ``box`` are overwritten."""
+    area[:] = 0.0
+    box[0, :, :] = np.inf
+    box[1, :, :] = -np.inf
+    total = 0.0
+    tangent = np.inf
     for t in range(F.shape[0]):
-        n0, n1, n2 = _triangle(V, F, t)[9:]
-        area[face_label[t]] += 0.5 * np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+        a0, a1, a2, b0, b1, b2, c0, c1, c2, n0, n1, n2 = _triangle(V, F, t)
+        N[t, 0] = n0
+        N[t, 1] = n1
+        N[t, 2] = n2
+        twice = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+        total += 0.5 * twice
+        area[face_label[t]] += 0.5 * twice
+        la = a0 * a0 + a1 * a1 + a2 * a2
+        lb = b0 * b0 + b1 * b1 + b2 * b2
+        lc = c0 * c0 + c1 * c1 + c2 * c2
+        # the two sides at the smallest angle: the two longest
+        if lb <= la and lb <= lc:
+            dot = -(a0 * c0 + a1 * c1 + a2 * c2)     # corner 0: a and -c
+        elif lc <= la:
+            dot = -(a0 * b0 + a1 * b1 + a2 * b2)     # corner 1: -a and b
+        else:
+            dot = -(b0 * c0 + b1 * c1 + b2 * c2)     # corner 2: -b and c
+        tan = twice / dot if dot > 0 else (0.0 if twice == twice else twice)
+        if tangent == tangent and (tan < tangent or tan != tan):
+            tangent = tan
     for i in range(V.shape[0]):
         c = labels[i]
         for k in range(3):
@@ -155,6 +153,7 @@ def component_extents(V, F, face_label, labels, area, box):
                 box[0, c, k] = x
             if x > box[1, c, k]:
                 box[1, c, k] = x
+    return total, tangent, count_folds(N, t1, t2, skip, R, S)
 
 
 @numba.njit(**_OPTIONS)
