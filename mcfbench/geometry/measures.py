@@ -47,6 +47,35 @@ def vertex_components(faces, n):
     return int(count), labels
 
 
+def neighbour_table(t1, t2, m):
+    """Every triangle's edge-neighbours in a table, as
+    :func:`mcfbench.geometry.kernels.state_pass` gathers them.
+
+    Parameters
+    ----------
+    t1, t2 : (k,) int arrays
+        The pairs of edge-neighbours (:func:`mcfbench.geometry.metrics.edge_neighbours`).
+    m : int
+        Number of triangles.
+
+    Returns
+    -------
+    table : (m, w) int64 array
+        Row ``t``: the triangles paired with ``t`` where ``t`` is first (in the order
+        of the pairs), then those where it is second, padded with ``m``; ``w`` the
+        largest count, at least 3 (3 on a manifold mesh).
+    split : (m,) int64 array
+        How many of row ``t`` pair with ``t`` first.
+    """
+    owner, other = np.concatenate([t1, t2]), np.concatenate([t2, t1])
+    order = np.argsort(owner, kind="stable")
+    counts = np.bincount(owner, minlength=m)
+    table = np.full((m, max(3, int(counts.max(initial=0)))), m, dtype=np.int64)
+    rows = owner[order]
+    table[rows, np.arange(len(rows)) - (np.cumsum(counts) - counts)[rows]] = other[order]
+    return table, np.bincount(t1, minlength=m).astype(np.int64)
+
+
 class Measured(NamedTuple):
     """The measures of one state (:meth:`StateMeasures.__call__`).
 
@@ -112,7 +141,8 @@ class StateMeasures:
                                 for t in edge_neighbours(self.faces))
         self.folded0 = ~(neighbour_cosines(V, self.faces, self.neighbours) >= 0.0)
         self._skip = self.folded0.astype(np.uint8)
-        self._work = np.empty((3, len(self.faces), 3))
+        self._table, self._split = neighbour_table(*self.neighbours, len(self.faces))
+        self._normals = np.empty((len(self.faces) + 1, 3))
         self._area = np.empty(self.count)
         self._box = np.empty((2, self.count, 3))
 
@@ -121,10 +151,9 @@ class StateMeasures:
         from mcfbench.geometry.kernels import state_pass  # numba on first use
 
         V = np.ascontiguousarray(vertices, dtype=np.float64)
-        N, R, S = self._work
         area, tangent, folded = state_pass(V, self.faces, self.face_label, self.labels,
-                                           *self.neighbours, self._skip, N, R, S,
-                                           self._area, self._box)
+                                           self._table, self._split, self._skip,
+                                           self._normals, self._area, self._box)
         box = self._box
         return Measured(float(area), float(np.degrees(np.arctan(tangent))), int(folded),
                         self._area, np.sqrt(((box[1] - box[0]) ** 2).sum(axis=1)))

@@ -98,3 +98,36 @@ def test_components_are_found():
     V, F = two_spheres()
     count, labels = vertex_components(F, len(V))
     assert count == 2 and (labels[:162] == 0).all() and (labels[162:] == 1).all()
+
+
+def _fin():
+    """A non-manifold mesh: a tetrahedron with a fin, a third triangle on edge (0, 1)."""
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0], [0.5, -1, 0.3]])
+    F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3], [0, 1, 4]])
+    return V, F
+
+
+@pytest.mark.parametrize("mesh", ["sphere", "patch", "fin"])
+def test_the_fold_count_is_the_quality_monitors_on_noisy_states(mesh):
+    """Many folds, many near-zero sums (a noise of the size of an edge): the gathered
+    sums count exactly the triangles of the scattered ones
+    (:func:`mcfbench.geometry.kernels.count_folds`), at a boundary (padded rows) and on
+    a non-manifold edge (a wider table) too."""
+    from mcfbench.geometry.kernels import count_folds
+    from mcfbench.geometry.metrics import edge_neighbours
+
+    V, F = {"sphere": lambda: icosphere(3), "patch": lambda: flat_patch(level=2, seed=1),
+            "fin": _fin}[mesh]()
+    measures = StateMeasures(V, F)
+    assert measures._table.shape[1] == (4 if mesh == "fin" else 3)
+    t1, t2 = (np.asarray(t, dtype=np.int64) for t in edge_neighbours(F))
+    rng = np.random.default_rng(3)
+    counts = []
+    for scale in (0.02, 0.1, 0.5):
+        W = V + scale * rng.standard_normal(V.shape)
+        work = np.empty((3, len(F), 3))
+        work[0] = np.cross(W[F[:, 1]] - W[F[:, 0]], W[F[:, 2]] - W[F[:, 0]])
+        expected = count_folds(work[0], t1, t2, measures._skip, work[1], work[2])
+        assert measures(W).folded == expected
+        counts.append(expected)
+    assert counts[-1] > 0
