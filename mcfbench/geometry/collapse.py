@@ -19,6 +19,8 @@ square root of the area (both directions shrank), *a line* when the area
 shrank much faster than the diameter squared.
 """
 
+import math
+
 import numpy as np
 
 from mcfbench.geometry.measures import StateMeasures
@@ -77,6 +79,10 @@ class CollapseCheck:
         self._first = np.unique(self.labels, return_index=True)[1]
         measured = self.measures(V)
         self.area0, self.diameter0 = measured.component_area.copy(), measured.diameter
+        # one component of positive size (every surface of the registry): its ratios
+        # in Python floats, as numpy divides them, without numpy's per-call overhead
+        self._one = (float(self.area0[0]), float(self.diameter0[0])) if self.count == 1 \
+            and self.area0[0] > 0 and self.diameter0[0] > 0 else None
 
     def __call__(self, vertices, measured=None):
         """What collapsed in the state ``vertices``, one sentence naming the component,
@@ -87,6 +93,11 @@ class CollapseCheck:
         if measured is None:
             measured = self.measures(V)
         area, diameter = measured.component_area, measured.diameter
+        if self._one is not None:
+            a, d = float(area[0]), float(diameter[0])
+            if math.isfinite(a) and math.isfinite(d) and not (
+                    a / self._one[0] < self.area_tol or d / self._one[1] < self.diameter_tol):
+                return None
         if not (np.isfinite(area).all() and np.isfinite(diameter).all()):
             bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
             if len(bad):
