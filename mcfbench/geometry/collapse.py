@@ -78,7 +78,7 @@ class CollapseCheck:
         self._sizes = np.bincount(self.labels, minlength=self.count)
         self._first = np.unique(self.labels, return_index=True)[1]
         measured = self.measures(V)
-        self.area0, self.diameter0 = measured.component_area.copy(), measured.diameter
+        self.area0, self.diameter0 = measured.component_area.copy(), measured.diameter.copy()
         # one component of positive size (every surface of the registry): its ratios
         # in Python floats, as numpy divides them, without numpy's per-call overhead
         self._one = (float(self.area0[0]), float(self.diameter0[0])) if self.count == 1 \

@@ -107,7 +107,7 @@ def count_folds(N, t1, t2, skip, R, S):
 
 
 @numba.njit(**_OPTIONS)
-def state_pass(V, F, face_label, labels, neighbours, split, skip, N, area, box):
+def state_pass(V, F, face_label, labels, neighbours, split, skip, N, area, box, diameter):
     """The measures of a state that the driver's checks read, in one call: one pass
     over the triangles, one over the points, one gathering each triangle's
     edge-neighbours.
@@ -129,7 +129,7 @@ def state_pass(V, F, face_label, labels, neighbours, split, skip, N, area, box):
     m = F.shape[0]
     N[m, :] = 0.0
     total, tangent = _triangles(V, F, face_label, N, area)
-    _boxes(V, labels, box)
+    _boxes(V, labels, box, diameter)
     return total, tangent, _folds(N, neighbours, split, skip)
 
 
@@ -164,7 +164,7 @@ def _triangles(V, F, face_label, N, area):
 
 
 @numba.njit(**_OPTIONS)
-def _boxes(V, labels, box):
+def _boxes(V, labels, box, diameter):
     box[0, :, :] = np.inf
     box[1, :, :] = -np.inf
     for i in range(V.shape[0]):
@@ -175,6 +175,11 @@ def _boxes(V, labels, box):
                 box[0, c, k] = x
             if x > box[1, c, k]:
                 box[1, c, k] = x
+    for c in range(box.shape[1]):
+        d0 = box[1, c, 0] - box[0, c, 0]
+        d1 = box[1, c, 1] - box[0, c, 1]
+        d2 = box[1, c, 2] - box[0, c, 2]
+        diameter[c] = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
 
 
 @numba.njit(**_OPTIONS)

@@ -145,6 +145,7 @@ class StateMeasures:
         self._normals = np.empty((len(self.faces) + 1, 3))
         self._area = np.empty(self.count)
         self._box = np.empty((2, self.count, 3))
+        self._diameter = np.empty(self.count)
 
     def __call__(self, vertices):
         """The :class:`Measured` of the state ``vertices`` (n, 3)."""
@@ -153,7 +154,7 @@ class StateMeasures:
         V = np.ascontiguousarray(vertices, dtype=np.float64)
         area, tangent, folded = state_pass(V, self.faces, self.face_label, self.labels,
                                            self._table, self._split, self._skip,
-                                           self._normals, self._area, self._box)
-        box = self._box
+                                           self._normals, self._area, self._box,
+                                           self._diameter)
         return Measured(float(area), float(np.degrees(np.arctan(tangent))), int(folded),
-                        self._area, np.sqrt(((box[1] - box[0]) ** 2).sum(axis=1)))
+                        self._area, self._diameter)
