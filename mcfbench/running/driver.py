@@ -223,16 +223,18 @@ class _Stepping:
         """Record the defects of the current state; raise in stop mode (always for a
         collapse)."""
         flow = self.flow
-        measured = self.measures(flow.vertices) if self.measures is not None else None
-        detail = self.collapsed(flow.vertices, measured) if self.collapsed is not None \
-            else None
+        # the mesh vertices once (DDFV's are a gather of its F-vertices), measured once
+        # for both checks
+        V = flow.vertices if self.measures is not None else None
+        measured = self.measures(V) if V is not None else None
+        detail = self.collapsed(V, measured) if self.collapsed is not None else None
         if detail is not None:
             self.defects.append({"status": "degenerated", "step": flow.n,
                                  "time": flow.n * flow.tau, "detail": detail})
             raise FlowBreakdown("degenerated", flow.n, flow.n * flow.tau, detail)
         found = flow.defects()
         if self.invariant is not None:
-            found = [*found, *self.invariant(flow.vertices, flow.n, measured)]
+            found = [*found, *self.invariant(V, flow.n, measured)]
         for status, detail in found:
             if status in self.seen:
                 continue
