@@ -123,9 +123,11 @@ def state_pass(V, F, face_label, labels, neighbours, split, skip, N, area, box, 
     ``m``; ``N`` (m + 1, 3): ``N[t]`` the normal ``n`` of triangle ``t``, ``N[m]``
     zero; ``area[c]``: the sum of the areas of the triangles of component ``c``
     (the total and every component summed in triangle order); ``box[0, c]``,
-    ``box[1, c]``: the smallest and largest coordinates of its points. NaN
-    propagates to the areas and the tangent. ``area``, ``box`` and ``N`` are
-    overwritten."""
+    ``box[1, c]``: the smallest and largest coordinates of its points (a NaN
+    coordinate is skipped: comparisons with NaN are false); ``diameter[c]``: the
+    diagonal of that box, rounded as ``np.sqrt(((box[1] - box[0]) ** 2).sum(axis=1))``.
+    NaN propagates to the areas and the tangent. ``area``, ``box``, ``diameter``
+    and ``N`` are overwritten."""
     m = F.shape[0]
     N[m, :] = 0.0
     total, tangent = _triangles(V, F, face_label, N, area)
