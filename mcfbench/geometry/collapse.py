@@ -19,9 +19,11 @@ square root of the area (both directions shrank), *a line* when the area
 shrank much faster than the diameter squared.
 """
 
+import math
+
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
+
+from mcfbench.geometry.measures import StateMeasures
 
 AREA_TOL = 1e-3
 """A component whose area is below this fraction of its initial area has collapsed.
@@ -42,30 +44,6 @@ POINT = 10.0
 """Diameter ratio below ``POINT * sqrt(area ratio)``: the component shrank to a point (else a line)."""
 
 
-def vertex_components(faces, n):
-    """Connected component of every vertex (shared edges or vertices connect).
-
-    Parameters
-    ----------
-    faces : (m, 3) int array
-    n : int
-        Number of vertices.
-
-    Returns
-    -------
-    count : int
-    labels : (n,) int array
-        Component of each vertex, ``0 .. count - 1`` (a vertex in no triangle
-        is a component of its own).
-    """
-    F = np.asarray(faces, dtype=np.int64)
-    rows = np.concatenate([F[:, 0], F[:, 1]])
-    cols = np.concatenate([F[:, 1], F[:, 2]])
-    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
-    count, labels = connected_components(graph, directed=False)
-    return int(count), labels
-
-
 class CollapseCheck:
     """The collapse check of one flow: the components and their initial size.
 
@@ -76,6 +54,9 @@ class CollapseCheck:
     faces : (m, 3) int array
     area_tol, diameter_tol : float
         :data:`AREA_TOL`, :data:`DIAMETER_TOL`.
+    measures : mcfbench.geometry.measures.StateMeasures, optional
+        The measures of this mesh's states, shared with the invariant checks
+        (the driver's); by default its own.
 
     Examples
     --------
@@ -88,35 +69,34 @@ class CollapseCheck:
     component 0 of 1 (4 vertices, e.g. vertex 0) shrank to a point: area 2.37e-08 (1e-08 x its initial 2.37), diameter 0.000173 (0.0001 x its initial 1.73)
     """
 
-    def __init__(self, vertices, faces, *, area_tol=AREA_TOL, diameter_tol=DIAMETER_TOL):
+    def __init__(self, vertices, faces, *, area_tol=AREA_TOL, diameter_tol=DIAMETER_TOL,
+                 measures=None):
         V = np.asarray(vertices, dtype=float)
-        self.faces = np.asarray(faces, dtype=np.int64)
+        self.measures = StateMeasures(V, faces) if measures is None else measures
         self.area_tol, self.diameter_tol = float(area_tol), float(diameter_tol)
-        self.count, self.labels = vertex_components(self.faces, len(V))
-        self._face_label = self.labels[self.faces[:, 0]]
-        self.labels = np.ascontiguousarray(self.labels, dtype=np.int64)
+        self.count, self.labels = self.measures.count, self.measures.labels
         self._sizes = np.bincount(self.labels, minlength=self.count)
         self._first = np.unique(self.labels, return_index=True)[1]
-        self.area0, self.diameter0 = self.extents(V)
+        measured = self.measures(V)
+        self.area0, self.diameter0 = measured.component_area.copy(), measured.diameter.copy()
+        # one component of positive size (every surface of the registry): its ratios
+        # in Python floats, as numpy divides them, without numpy's per-call overhead
+        self._one = (float(self.area0[0]), float(self.diameter0[0])) if self.count == 1 \
+            and self.area0[0] > 0 and self.diameter0[0] > 0 else None
 
-    def extents(self, vertices):
-        """Area and bounding-box diagonal of every component, two ``(count,)`` arrays
-        (one compiled pass: about 1.5 ms per 100 000 triangles, 4-5 ms a step at
-        level 7 of the sphere, whose steps take about 85 ms each: 696 s / 8192)."""
-        from mcfbench.geometry.kernels import component_extents  # numba on first use
-
-        V = np.asarray(vertices, dtype=np.float64)
-        area = np.zeros(self.count)
-        box = np.empty((2, self.count, 3))
-        box[0], box[1] = np.inf, -np.inf
-        component_extents(V, self.faces, self._face_label, self.labels, area, box)
-        return area, np.sqrt(((box[1] - box[0]) ** 2).sum(axis=1))
-
-    def __call__(self, vertices):
+    def __call__(self, vertices, measured=None):
         """What collapsed in the state ``vertices``, one sentence naming the component,
-        or ``None``."""
+        or ``None``; ``measured``: the state's :class:`~mcfbench.geometry.measures.Measured`
+        when the caller has it (the driver, for both of its checks), else measured here."""
         V = np.asarray(vertices, dtype=float)
-        area, diameter = self.extents(V)
+        if measured is None:
+            measured = self.measures(V)
+        area, diameter = measured.component_area, measured.diameter
+        if self._one is not None:
+            a, d = float(area[0]), float(diameter[0])
+            if math.isfinite(a) and math.isfinite(d) and not (
+                    a / self._one[0] < self.area_tol or d / self._one[1] < self.diameter_tol):
+                return None
         if not (np.isfinite(area).all() and np.isfinite(diameter).all()):
             bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
             if len(bad):

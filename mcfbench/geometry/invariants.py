@@ -44,7 +44,8 @@ the torus and the dumbbell.
 
 import numpy as np
 
-from mcfbench.geometry.metrics import edge_neighbours, neighbour_cosines
+from mcfbench.geometry.measures import StateMeasures
+from mcfbench.geometry.metrics import neighbour_cosines
 
 AREA_TOL = 1e-3
 """Largest relative growth of the area over its smallest earlier value."""
@@ -68,6 +69,9 @@ class FlowInvariants:
         Consistently oriented triangles.
     area_tol : float
         :data:`AREA_TOL`.
+    measures : mcfbench.geometry.measures.StateMeasures, optional
+        The measures of this mesh's states (area, smallest angle, folds), shared
+        with the collapse check (the driver's); by default its own.
 
     Examples
     --------
@@ -83,18 +87,15 @@ class FlowInvariants:
     the area grew to 11.7 at step 2, 0.235 above its smallest value 9.45 (step 1): mean curvature flow never increases the area (tolerance 0.001)
     """
 
-    def __init__(self, vertices, faces, *, area_tol=AREA_TOL):
-        self.faces = np.asarray(faces, dtype=np.int64)
-        self.area_tol = float(area_tol)
-        self.neighbours = tuple(np.asarray(t, dtype=np.int64)
-                                for t in edge_neighbours(self.faces))
+    def __init__(self, vertices, faces, *, area_tol=AREA_TOL, measures=None):
         V = np.asarray(vertices, dtype=float)
-        self._work = np.empty((3, len(self.faces), 3))
-        self.folded0 = ~(neighbour_cosines(V, self.faces, self.neighbours) >= 0.0)
-        self._skip = self.folded0.astype(np.uint8)
-        area, angle, _ = self.measure(V)
-        self.smallest_area, self.smallest_area_step = area, 0
-        self.angle0 = self.angle = angle
+        self.measures = StateMeasures(V, faces) if measures is None else measures
+        self.faces, self.neighbours = self.measures.faces, self.measures.neighbours
+        self.folded0 = self.measures.folded0
+        self.area_tol = float(area_tol)
+        measured = self.measures(V)
+        self.smallest_area, self.smallest_area_step = measured.area, 0
+        self.angle0 = self.angle = measured.angle
         self.angle_step = 0
         self.collapsed_since = None
 
@@ -103,8 +104,10 @@ class FlowInvariants:
         """Degrees below which the smallest angle counts as collapsed."""
         return min(ANGLE_FLOOR, ANGLE_COLLAPSE * self.angle0)
 
-    def __call__(self, vertices, step):
-        """The invariants the state ``vertices`` of time level ``step`` violates.
+    def __call__(self, vertices, step, measured=None):
+        """The invariants the state ``vertices`` of time level ``step`` violates;
+        ``measured``: the state's :class:`~mcfbench.geometry.measures.Measured` when the
+        caller has it (the driver, for both of its checks), else measured here.
 
         Returns
         -------
@@ -113,7 +116,9 @@ class FlowInvariants:
             triangle or the growth. Empty for a state that keeps both.
         """
         V = np.asarray(vertices, dtype=float)
-        area, self.angle, folded = self.measure(V)
+        if measured is None:
+            measured = self.measures(V)
+        area, self.angle, folded = measured.area, measured.angle, measured.folded
         self.angle_step = int(step)
         if not self.angle >= self.angle_threshold:
             if self.collapsed_since is None:
@@ -132,18 +137,6 @@ class FlowInvariants:
         elif area < self.smallest_area:
             self.smallest_area, self.smallest_area_step = area, int(step)
         return violations
-
-    def measure(self, vertices):
-        """Area, smallest angle (degrees) and the number of triangles folded that
-        were not at step 0, of the state ``vertices`` (n, 3): one compiled pass over
-        the triangles and one over the pairs of edge-neighbours."""
-        from mcfbench.geometry.kernels import count_folds, invariants_pass  # numba on first use
-
-        V = np.ascontiguousarray(vertices, dtype=np.float64)
-        N, R, S = self._work
-        area, tangent = invariants_pass(V, self.faces, N)
-        folded = count_folds(N, *self.neighbours, self._skip, R, S)
-        return float(area), float(np.degrees(np.arctan(tangent))), int(folded)
 
     def _folded(self, V):
         """The sentence on the triangles folded now and not at step 0."""

@@ -3,9 +3,9 @@
 Imported on first use by the functions they serve (numba is not imported
 before, so a command that measures nothing does not pay for it), each kernel
 loaded from numba's cache: :func:`quality_pass` (:func:`mcfbench.geometry.metrics.quality`),
-:func:`invariants_pass` and :func:`count_folds` (:class:`mcfbench.geometry.invariants.FlowInvariants`;
-the fold count also the quality monitor's), :func:`component_extents`
-(:class:`mcfbench.geometry.collapse.CollapseCheck`) and :func:`sphere_error_sum`
+:func:`count_folds` (the quality monitor's fold count), :func:`state_pass`
+(:class:`mcfbench.geometry.measures.StateMeasures`: what the driver's collapse and
+invariant checks read of every state, with the same fold count) and :func:`sphere_error_sum`
 (:class:`mcfbench.geometry.exact.SphereL2Error`), tested through them (the quality
 monitor's and the sphere error's against numpy evaluations of their formulas).
 
@@ -82,39 +82,6 @@ def quality_pass(V, F, work):
 
 
 @numba.njit(**_OPTIONS)
-def invariants_pass(V, F, N):
-    """Total area and the smallest tangent of the smallest angles of the
-    triangles (the smallest angle of a triangle, opposite its shortest side, is
-    at most 60 degrees, so its tangent ``|u x v| / (u . v)`` is increasing in
-    it); ``N[t]``: the normal ``n`` of triangle ``t``. NaN
-    propagates to the area and the tangent."""
-    m = F.shape[0]
-    area = 0.0
-    tangent = np.inf
-    for t in range(m):
-        a0, a1, a2, b0, b1, b2, c0, c1, c2, n0, n1, n2 = _triangle(V, F, t)
-        N[t, 0] = n0
-        N[t, 1] = n1
-        N[t, 2] = n2
-        twice = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
-        area += 0.5 * twice
-        la = a0 * a0 + a1 * a1 + a2 * a2
-        lb = b0 * b0 + b1 * b1 + b2 * b2
-        lc = c0 * c0 + c1 * c1 + c2 * c2
-        # the two sides at the smallest angle: the two longest
-        if lb <= la and lb <= lc:
-            dot = -(a0 * c0 + a1 * c1 + a2 * c2)     # corner 0: a and -c
-        elif lc <= la:
-            dot = -(a0 * b0 + a1 * b1 + a2 * b2)     # corner 1: -a and b
-        else:
-            dot = -(b0 * c0 + b1 * c1 + b2 * c2)     # corner 2: -b and c
-        tan = twice / dot if dot > 0 else (0.0 if twice == twice else twice)
-        if tangent == tangent and (tan < tangent or tan != tan):
-            tangent = tan
-    return area, tangent
-
-
-@numba.njit(**_OPTIONS)
 def count_folds(N, t1, t2, skip, R, S):
     """Number of triangles ``t`` with ``skip[t] == 0`` whose normal ``N[t]`` has
     ``N_t . sum_s N_s < 0`` over its edge-neighbours ``s`` (the pairs ``t1, t2``);
@@ -140,13 +107,68 @@ def count_folds(N, t1, t2, skip, R, S):
 
 
 @numba.njit(**_OPTIONS)
-def component_extents(V, F, face_label, labels, area, box):
-    """``area[c] +=`` the areas of the triangles of component ``c``; ``box[0, c]``,
-    ``box[1, c]``: the smallest and largest coordinates of its vertices (NaN
-    propagates to the area)."""
+def state_pass(V, F, face_label, labels, neighbours, split, skip, N, area, box, diameter):
+    """The measures of a state that the driver's checks read, in one call: one pass
+    over the triangles, one over the points, one gathering each triangle's
+    edge-neighbours.
+
+    Returns the total area, the smallest tangent of the smallest angles of the
+    triangles (the smallest angle of a triangle, opposite its shortest side, is at
+    most 60 degrees, so its tangent ``|u x v| / (u . v)`` is increasing in it) and
+    the number of triangles ``t`` with ``skip[t] == 0`` whose normal has ``N_t .
+    sum_s N_s < 0`` over its edge-neighbours ``s``: the count of
+    :func:`count_folds`, bitwise (:func:`_neighbour_sum`). ``neighbours`` (m, w):
+    the neighbours of every triangle, those it is the first of a pair ``t1, t2``
+    with first (``split[t]`` of them), in the order of the pairs, padded with
+    ``m``; ``N`` (m + 1, 3): ``N[t]`` the normal ``n`` of triangle ``t``, ``N[m]``
+    zero; ``area[c]``: the sum of the areas of the triangles of component ``c``
+    (the total and every component summed in triangle order); ``box[0, c]``,
+    ``box[1, c]``: the smallest and largest coordinates of its points (a NaN
+    coordinate is skipped: comparisons with NaN are false); ``diameter[c]``: the
+    diagonal of that box, rounded as ``np.sqrt(((box[1] - box[0]) ** 2).sum(axis=1))``.
+    NaN propagates to the areas and the tangent. ``area``, ``box``, ``diameter``
+    and ``N`` are overwritten."""
+    m = F.shape[0]
+    N[m, :] = 0.0
+    total, tangent = _triangles(V, F, face_label, N, area)
+    _boxes(V, labels, box, diameter)
+    return total, tangent, _folds(N, neighbours, split, skip)
+
+
+# the three passes of state_pass: one compiled function each (in one, the fold count
+# ran several times slower)
+@numba.njit(**_OPTIONS)
+def _triangles(V, F, face_label, N, area):
+    area[:] = 0.0
+    total = 0.0
+    tangent = np.inf
     for t in range(F.shape[0]):
-        n0, n1, n2 = _triangle(V, F, t)[9:]
-        area[face_label[t]] += 0.5 * np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+        a0, a1, a2, b0, b1, b2, c0, c1, c2, n0, n1, n2 = _triangle(V, F, t)
+        N[t, 0] = n0
+        N[t, 1] = n1
+        N[t, 2] = n2
+        twice = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+        total += 0.5 * twice
+        area[face_label[t]] += 0.5 * twice
+        la = a0 * a0 + a1 * a1 + a2 * a2
+        lb = b0 * b0 + b1 * b1 + b2 * b2
+        lc = c0 * c0 + c1 * c1 + c2 * c2
+        # the two sides at the smallest angle: the two longest (all three dot
+        # products, then one chosen: no branch to mispredict)
+        d0 = -(a0 * c0 + a1 * c1 + a2 * c2)     # corner 0: a and -c
+        d1 = -(a0 * b0 + a1 * b1 + a2 * b2)     # corner 1: -a and b
+        d2 = -(b0 * c0 + b1 * c1 + b2 * c2)     # corner 2: -b and c
+        dot = d0 if (lb <= la) & (lb <= lc) else (d1 if lc <= la else d2)
+        tan = twice / dot if dot > 0 else (0.0 if twice == twice else twice)
+        if tangent == tangent and (tan < tangent or tan != tan):
+            tangent = tan
+    return total, tangent
+
+
+@numba.njit(**_OPTIONS)
+def _boxes(V, labels, box, diameter):
+    box[0, :, :] = np.inf
+    box[1, :, :] = -np.inf
     for i in range(V.shape[0]):
         c = labels[i]
         for k in range(3):
@@ -155,6 +177,50 @@ def component_extents(V, F, face_label, labels, area, box):
                 box[0, c, k] = x
             if x > box[1, c, k]:
                 box[1, c, k] = x
+    for c in range(box.shape[1]):
+        d0 = box[1, c, 0] - box[0, c, 0]
+        d1 = box[1, c, 1] - box[0, c, 1]
+        d2 = box[1, c, 2] - box[0, c, 2]
+        diameter[c] = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+
+
+@numba.njit(**_OPTIONS)
+def _folds(N, neighbours, split, skip):
+    folded = 0
+    for t in range(N.shape[0] - 1):
+        r0, r1, r2 = _neighbour_sum(N, neighbours, split, t)
+        d = (N[t, 0] * r0 + N[t, 2] * r2) + N[t, 1] * r1
+        if d < 0 and skip[t] == 0:
+            folded += 1
+    return folded
+
+
+@numba.njit(inline="always", **_OPTIONS)
+def _neighbour_sum(N, neighbours, split, t):
+    """``R_t + S_t`` of :func:`count_folds`, rounded as there: ``R_t`` the sum of the
+    normals of the first ``split[t]`` neighbours, ``S_t`` of the others, each from
+    zero in the order of the pairs. With three neighbours (every triangle of a
+    closed manifold mesh; padded with the zero ``N[m]`` at a boundary) that is
+    ``N_p + (N_q + N_r)`` when ``split[t] == 1``, else ``(N_p + N_q) + N_r``."""
+    if neighbours.shape[1] == 3:
+        p, q, r = neighbours[t, 0], neighbours[t, 1], neighbours[t, 2]
+        if split[t] == 1:
+            return (N[p, 0] + (N[q, 0] + N[r, 0]), N[p, 1] + (N[q, 1] + N[r, 1]),
+                    N[p, 2] + (N[q, 2] + N[r, 2]))
+        return ((N[p, 0] + N[q, 0]) + N[r, 0], (N[p, 1] + N[q, 1]) + N[r, 1],
+                (N[p, 2] + N[q, 2]) + N[r, 2])
+    r0 = r1 = r2 = s0 = s1 = s2 = 0.0          # more: a non-manifold edge
+    for j in range(neighbours.shape[1]):
+        s = neighbours[t, j]
+        if j < split[t]:
+            r0 += N[s, 0]
+            r1 += N[s, 1]
+            r2 += N[s, 2]
+        else:
+            s0 += N[s, 0]
+            s1 += N[s, 1]
+            s2 += N[s, 2]
+    return r0 + s0, r1 + s1, r2 + s2
 
 
 @numba.njit(**_OPTIONS)

@@ -19,6 +19,7 @@ import numpy as np
 
 from mcfbench.geometry.collapse import CollapseCheck
 from mcfbench.geometry.invariants import FlowInvariants
+from mcfbench.geometry.measures import StateMeasures
 from mcfbench.running.flow import FlowBreakdown
 from mcfbench.running.integrators import get_integrator
 from mcfbench.running.solver import Solver, SolverFailure
@@ -194,8 +195,13 @@ class _Stepping:
         self.until = until
         self.frames, self.steps_kept, self.iterations, self.defects = [], [], [], []
         self.seen = set()
-        self.collapsed = CollapseCheck(flow.vertices, flow.faces) if collapse else None
-        self.invariant = FlowInvariants(flow.vertices, flow.faces) if invariants else None
+        # one compiled measuring pass per state serves both checks
+        self.measures = StateMeasures(flow.vertices, flow.faces) \
+            if collapse or invariants else None
+        self.collapsed = CollapseCheck(flow.vertices, flow.faces, measures=self.measures) \
+            if collapse else None
+        self.invariant = FlowInvariants(flow.vertices, flow.faces, measures=self.measures) \
+            if invariants else None
         self.wall = self.cpu = 0.0
         self.broken = None
         self.solver_failed = False    # the run ended with a solver failure: continuable
@@ -217,14 +223,18 @@ class _Stepping:
         """Record the defects of the current state; raise in stop mode (always for a
         collapse)."""
         flow = self.flow
-        detail = self.collapsed(flow.vertices) if self.collapsed is not None else None
+        # the mesh vertices once (DDFV's are a gather of its F-vertices), measured once
+        # for both checks
+        V = flow.vertices if self.measures is not None else None
+        measured = self.measures(V) if V is not None else None
+        detail = self.collapsed(V, measured) if self.collapsed is not None else None
         if detail is not None:
             self.defects.append({"status": "degenerated", "step": flow.n,
                                  "time": flow.n * flow.tau, "detail": detail})
             raise FlowBreakdown("degenerated", flow.n, flow.n * flow.tau, detail)
         found = flow.defects()
         if self.invariant is not None:
-            found = [*found, *self.invariant(flow.vertices, flow.n)]
+            found = [*found, *self.invariant(V, flow.n, measured)]
         for status, detail in found:
             if status in self.seen:
                 continue

@@ -5,6 +5,7 @@ from functools import partial
 import igl
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from conftest import approaches_the_catenoid, cylinder, flat_lattice, table_3_1_error
 
 from baselines import cotan
@@ -87,6 +88,22 @@ def test_system_matrix_is_row_scaled_c1(noisy_sphere, mass):
         A, b = CotanFlow(V, F, tau, mass=mass, assembly=assembly).system()
         np.testing.assert_allclose(A.toarray(), expected, rtol=0, atol=1e-13)
         np.testing.assert_array_equal(b, V.T)
+
+
+def test_matrices_of_the_pattern_share_it_and_keep_their_own_values(noisy_sphere):
+    """:meth:`CotanAssembler.csr` (a shallow copy of one matrix of the pattern): each
+    matrix is scipy's CSR of its values, and a later one does not change an earlier."""
+    V, F = noisy_sphere
+    assembler = CotanAssembler(edge_mesh(F, len(V)))
+    g, h = assembler.geometry(V), assembler.geometry(1.5 * V + 0.1)
+    A, B = assembler.laplacian(g.L_data), assembler.laplacian(h.L_data)
+    p = assembler.pattern
+    for M, data in ((A, g.L_data), (B, h.L_data)):
+        expected = sp.csr_matrix((data.copy(), p.indices, p.indptr), shape=p.shape)
+        assert type(M) is type(expected) and M.indices.dtype == expected.indices.dtype
+        assert M.data is data and (M != expected).nnz == 0
+    assert A.indices is B.indices and not np.array_equal(A.data, B.data)
+    np.testing.assert_allclose(A.toarray(), -igl.cotmatrix(V, F).toarray(), rtol=0, atol=2e-15)
 
 
 def test_dirichlet_rows_are_identity():

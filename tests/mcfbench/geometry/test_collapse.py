@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from mcfbench.cli import main
-from mcfbench.geometry.collapse import AREA_TOL, CollapseCheck, vertex_components
+from mcfbench.geometry.collapse import AREA_TOL, CollapseCheck
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate
 from mcfbench.running.schemes import SCHEMES
@@ -23,12 +23,6 @@ def two_spheres():
     """Unit sphere around the origin and a sphere of radius 0.3 around (3, 0, 0)."""
     V, F = icosphere(2)
     return np.vstack([V, 0.3 * V + [3.0, 0.0, 0.0]]), np.vstack([F, F + len(V)])
-
-
-def test_components_are_found():
-    V, F = two_spheres()
-    count, labels = vertex_components(F, len(V))
-    assert count == 2 and (labels[:162] == 0).all() and (labels[162:] == 1).all()
 
 
 def test_intact_surface_passes_at_any_scale():
