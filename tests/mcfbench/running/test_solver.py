@@ -102,7 +102,7 @@ def test_methods_solve_against_spsolve(method, system):
     assert residual(A, b, x) <= 1.01e-12 * np.linalg.norm(b)   # c = 0 here: |b - A c| = |b|
     if method == "direct":
         assert info.iterations == 0
-    elif method == "ilu-bicgstab":
+    elif "ilu" in method:
         assert 1 <= info.iterations <= 5
     else:
         assert 5 <= info.iterations <= 60
@@ -118,7 +118,7 @@ def test_shared_and_coupled_matrices_agree(method):
     assert xc.shape == b.shape
     assert np.abs(xs - xc).max() < 1e-10 * np.abs(xs).max()
     assert infos.converged and infoc.converged
-    if method != "ilu-bicgstab":     # spilu orders the (3n, 3n) matrix differently
+    if "ilu" not in method:          # spilu orders the (3n, 3n) matrix differently
         assert infos.iterations == infoc.iterations
         assert infos.residual == pytest.approx(infoc.residual, rel=1e-3)
 
