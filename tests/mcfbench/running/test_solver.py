@@ -537,3 +537,13 @@ def test_kept_ilu_runs_the_anisotropic_sphere_as_bicgstab_does(scheme):
     for name, value in plain.metrics.items():
         assert kept.metrics[name] == pytest.approx(value, rel=1e-6), name
     assert 10 * kept.iterations <= plain.iterations
+
+
+def test_kept_ilu_solves_a_coupled_system_by_plain_bicgstab():
+    """``kept-ilu-bicgstab`` factors only a shared (n, n) matrix: a coupled (3n, 3n)
+    one is BiCGStab's solve, bitwise, under the method's name."""
+    A, b = ring_system(tau=1.0)
+    coupled = sp.block_diag([A, A, A], format="csr")
+    x, info = Solver("kept-ilu-bicgstab")(coupled, b, None)
+    x_plain, plain = Solver()(coupled, b, None)
+    assert np.array_equal(x, x_plain) and info == replace(plain, method="kept-ilu-bicgstab")
