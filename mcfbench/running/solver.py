@@ -99,12 +99,10 @@ Methods (:data:`METHODS`)
     ILU (BGN, DeTurck at the anisotropic sphere's level 3) needs 100 iterations or more,
     or misses the tolerance, where the shared (n, n) factor serves the three rows in a
     few. Called through :func:`solve` alone it is ``ilu-bicgstab``.
-    The anisotropic sphere's level 4 (DDFV chord, 96 770 unknowns): the factor 1.6 s,
-    an iteration 0.1 s; step 1's factor solves steps 1, 2, 10, 30 in 4, 3, 2, 2
-    iterations (0.2-0.5 s) against plain BiCGStab's 262, 269, 211, 170 (0.7-1.1 s);
-    SuperLU's ILU with more dropping (``drop_tol`` 1e-2, 1e-3) does not converge in
-    400 iterations, and algebraic multigrid (pyamg's smoothed aggregation, root-node)
-    needs 40-95 iterations a row.
+    Anisotropic sphere level 4, DDFV chord (96 770 unknowns): the factor 1.6 s; step 1's
+    solves steps 1, 2, 10, 30 in 4, 3, 2, 2 iterations (0.2-0.5 s) against BiCGStab's 262,
+    269, 211, 170 (0.7-1.1 s); ``drop_tol`` 1e-2 does not converge, pyamg's AMG
+    (smoothed aggregation, root-node) takes 40-95 iterations a row.
 ``direct``
     Sparse LU (``scipy.sparse.linalg.splu``: SuperLU's symmetric mode, then,
     if that misses the tolerance, COLAMD with partial pivoting;
@@ -127,6 +125,9 @@ import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+
+from mcfbench.running.factorizations import (LU_ORDERINGS, NO_FLOAT, factorize, ilu_arrays,
+                                             ilu_factor, unsigned)
 
 # scipy.sparse, the compiled kernels (numba) and ddfv's thread checks are imported
 # on first use: the command line reads METHODS and ROBUST for its help in 0.1 s.
@@ -184,18 +185,7 @@ class SolveInfo:
 
 
 # ---------------------------------------------------------------------------
-# Python side: layouts, factorizations, reports
-
-_NO_INT = np.zeros(1, dtype=np.uint32)
-_NO_FLOAT = np.zeros(0)
-
-
-def _unsigned(a):
-    """A view (or copy) of a non-negative index array as uint32/uint64."""
-    a = np.asarray(a)
-    if a.dtype in (np.int32, np.uint32):
-        return np.ascontiguousarray(a).view(np.uint32)
-    return np.ascontiguousarray(a, dtype=np.int64).view(np.uint64)
+# Python side: layouts, reports (factorizations: mcfbench.running.factorizations)
 
 
 def _csr(A):
@@ -208,7 +198,7 @@ def _csr(A):
             if A.ndim != 2:
                 raise ValueError(f"A must be a 2-D matrix, got shape {A.shape}")
         A = sp.csr_matrix(A)
-    return _unsigned(A.indptr), _unsigned(A.indices), np.ascontiguousarray(A.data, np.float64)
+    return unsigned(A.indptr), unsigned(A.indices), np.ascontiguousarray(A.data, np.float64)
 
 
 def _coupled(A, shape):
@@ -255,80 +245,6 @@ def _blocks(A, b, x0, overwrite_x0=False):
     cfull = np.repeat(cmean, n).reshape(1, k * n)
     return (b.reshape(1, k * n), x.reshape(1, k * n), cmean, cfull,
             lambda z: z.reshape(k, n))
-
-
-LU_ORDERINGS = (
-    {"permc_spec": "MMD_AT_PLUS_A", "diag_pivot_thresh": 0.1,
-     "options": {"SymmetricMode": True}},
-    {"permc_spec": "COLAMD"},
-)
-"""SuperLU's settings for ``direct``, tried in turn until one gives the tolerance: its
-symmetric mode (minimum degree on ``A + A^T``, the diagonal pivot kept unless below 0.1
-of its column's largest entry), SuperLU's advice for a (nearly) symmetric pattern with
-a strong diagonal as every scheme's (the mesh's graph); then COLAMD with partial
-pivoting (scipy's default). One step's matrix (CPU s, fill of L + U), COLAMD against
-symmetric mode: BGN, anisotropic sphere level 3 (23 814 unknowns) 0.58 s, 9.5 M
-against 0.28 s, 4.5 M; cotan, its level 4 (32 258) 0.30 s, 5.6 M against 0.12 s,
-2.2 M; redistributing DDFV, Enneper level 3 (16 361) 0.10 s, 2.3 M against 0.09 s,
-1.5 M; every residual before refinement 1e-13 or below."""
-
-
-def _factorize(A, ilu, drop_tol=1e-4, fill_factor=10.0, ordering=None):
-    """SuperLU ``splu``/``spilu`` of ``A``: ``(lu, None)`` or ``(None, detail)``;
-    ``ordering``: ``splu``'s settings (one of :data:`LU_ORDERINGS`, default scipy's)."""
-    import scipy.sparse as sp
-    import scipy.sparse.linalg as spla  # on first use (import cost at start-up)
-
-    what = "ILU" if ilu else "LU"
-    try:
-        with np.errstate(all="ignore"):
-            Ac = sp.csc_matrix(A, dtype=float)
-            lu = (spla.spilu(Ac, drop_tol=drop_tol, fill_factor=fill_factor) if ilu
-                  else spla.splu(Ac, **(ordering or {})))
-    except RuntimeError as err:      # "Factor is exactly singular"
-        return None, f"{what} factorization failed: {str(err).rstrip('.').lower()}"
-    return lu, None
-
-
-def ilu_factor(A, drop_tol=1e-4, fill_factor=10.0):
-    """The incomplete LU factor of ``ilu-bicgstab`` (module docstring) of ``A``.
-
-    Parameters
-    ----------
-    A : (m, m) sparse matrix
-        The matrix of the kernel's layout: shared (n, n) or coupled (3n, 3n).
-    drop_tol, fill_factor : float
-        ``scipy.sparse.linalg.spilu``'s.
-
-    Returns
-    -------
-    factor : tuple or None
-        ``(dinv, arrays)``: ``dinv`` (m,) the inverse row scaling, ``arrays`` the CSR
-        arrays of ``L`` and ``U`` and the permutations (:func:`_ilu_arrays`); None
-        when both factorizations met an exactly zero pivot.
-    detail : str or None
-        Why there is no factor.
-    """
-    import scipy.sparse as sp
-
-    A = sp.csr_matrix(A, dtype=float)
-    rows = np.asarray(abs(A).sum(axis=1)).ravel()
-    dinv = np.where(rows > 0.0, 1.0 / np.where(rows > 0.0, rows, 1.0), 1.0)
-    lu, detail = _factorize(sp.diags(dinv) @ A, True, drop_tol, fill_factor)
-    if lu is None:                   # an exactly zero pivot: try the rows unscaled
-        dinv = np.ones(A.shape[0])
-        lu, detail = _factorize(A, True, drop_tol, fill_factor)
-    return (None, detail) if lu is None else ((dinv, _ilu_arrays(lu)), None)
-
-
-def _ilu_arrays(lu):
-    """CSR arrays of the ILU factors and the permutations, for the kernel."""
-    if lu is None:
-        return (_NO_INT, _NO_INT, _NO_FLOAT, _NO_INT, _NO_INT, _NO_FLOAT, _NO_INT, _NO_INT)
-    L, U = lu.L.tocsr(), lu.U.tocsr()
-    return (_unsigned(L.indptr), _unsigned(L.indices), np.ascontiguousarray(L.data, float),
-            _unsigned(U.indptr), _unsigned(U.indices), np.ascontiguousarray(U.data, float),
-            _unsigned(lu.perm_r), _unsigned(lu.perm_c))
 
 
 def _failed(method, status, detail, residual=math.nan, iterations=0):
@@ -412,7 +328,7 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
                 x, lu = _direct(A, csr, b, start, cmean, cfull, rtol)
                 info = replace(lu, iterations=info.iterations)
             return to_block(x), replace(info, method=method)
-        kind, dinv, lu = 0, _NO_FLOAT, None
+        kind, dinv, lu = 0, NO_FLOAT, None
         if method == "jacobi-bicgstab":
             kind = 1
             d = sp.csr_matrix(A).diagonal().astype(float)
@@ -430,7 +346,7 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
                              residual=krylov.residual)
         code, dcode, it, rnorm, ref = kernel(
             *csr, b, x, cmean, cfull, float(rtol), int(maxiter), int(stagnation_window),
-            kind, dinv, *(lu or _ilu_arrays(None)))
+            kind, dinv, *(lu or ilu_arrays(None)))
         residual = (rnorm / ref if ref > 0.0 else
                     0.0 if rnorm == 0.0 else math.nan if math.isnan(ref) else math.inf)
     detail = ""
@@ -477,7 +393,7 @@ def _direct(A, csr, b, x0, cmean, cfull, rtol):
         x[...] = cmean[:, None] if cfull.shape[1] == 0 else cfull
         return x, SolveInfo(0, 0.0, True, "converged", method)
     for ordering in LU_ORDERINGS:    # the last one's failure is the answer
-        lu, detail = _factorize(A, False, ordering=ordering)
+        lu, detail = factorize(A, False, ordering=ordering)
         if lu is None:
             x, info = x0, _failed(method, "breakdown", detail)
             continue

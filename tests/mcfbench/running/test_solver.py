@@ -330,7 +330,7 @@ def test_direct_tries_symmetric_mode_then_partial_pivoting(monkeypatch):
     the second's; with every ordering failing, the last failure is named."""
     import mcfbench.running.solver as solver
 
-    factorize, seen = solver._factorize, []
+    factorize, seen = solver.factorize, []
 
     def first_fails(A, ilu, *args, ordering=None, **kwargs):
         seen.append(ordering)
@@ -338,7 +338,7 @@ def test_direct_tries_symmetric_mode_then_partial_pivoting(monkeypatch):
             return None, "LU factorization failed: the first ordering"
         return factorize(A, ilu, *args, ordering=ordering, **kwargs)
 
-    monkeypatch.setattr(solver, "_factorize", first_fails)
+    monkeypatch.setattr(solver, "factorize", first_fails)
     P = sp.csr_matrix(np.array([[0.0, 2.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 3.0]]))
     x, info = Solver("direct")(P, np.array([[4.0, 1.0, 6.0]]), None)
     np.testing.assert_allclose(x, [[1.0, 2.0, 2.0]], rtol=1e-15)
