@@ -90,6 +90,19 @@ Methods (:data:`METHODS`)
     :class:`Solver`) of ``D^{-1} A``, ``D`` the absolute row sums (rows
     equilibrated; if that factor is exactly singular, of ``A`` itself),
     once per call (for the three rows in the shared case); compiled triangular solves.
+``kept-ilu-bicgstab``
+    ``ilu-bicgstab`` with the factor kept by the :class:`Solver` across its calls (a
+    run's steps: the matrices of nearby steps are nearby) and renewed when a solve
+    with it took more than ``ilu_refresh`` iterations, for another shape, or when it
+    did not converge (then the solve is repeated from ``x0`` with the new factor,
+    iterations summed). A coupled (3n, 3n) system is solved by plain ``bicgstab``: its
+    ILU (BGN, DeTurck at the anisotropic sphere's level 3) needs 100 iterations or more,
+    or misses the tolerance, where the shared (n, n) factor serves the three rows in a
+    few. Called through :func:`solve` alone it is ``ilu-bicgstab``.
+    Anisotropic sphere level 4, DDFV chord (96 770 unknowns): the factor 1.6 s; step 1's
+    solves steps 1, 2, 10, 30 in 4, 3, 2, 2 iterations (0.2-0.5 s) against BiCGStab's 262,
+    269, 211, 170 (0.7-1.1 s); ``drop_tol`` 1e-2 does not converge, pyamg's AMG
+    (smoothed aggregation, root-node) takes 40-95 iterations a row.
 ``direct``
     Sparse LU (``scipy.sparse.linalg.splu``: SuperLU's symmetric mode, then,
     if that misses the tolerance, COLAMD with partial pivoting;
@@ -109,14 +122,18 @@ for the factorizations).
 """
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
+
+from mcfbench.running.factorizations import (LU_ORDERINGS, NO_FLOAT, factorize, ilu_arrays,
+                                             ilu_factor, unsigned)
 
 # scipy.sparse, the compiled kernels (numba) and ddfv's thread checks are imported
 # on first use: the command line reads METHODS and ROBUST for its help in 0.1 s.
 
-METHODS = ("bicgstab", "jacobi-bicgstab", "ilu-bicgstab", "direct", "jacobi-direct")
+METHODS = ("bicgstab", "jacobi-bicgstab", "ilu-bicgstab", "kept-ilu-bicgstab", "direct",
+           "jacobi-direct")
 ROBUST = "jacobi-direct"
 """The method for meshes of unknown quality: its LU converged on all 36 bad-mesh systems
 measured (plain BiCGStab on 20, Jacobi's, tried first, on 33). BGN's first step on the
@@ -168,18 +185,7 @@ class SolveInfo:
 
 
 # ---------------------------------------------------------------------------
-# Python side: layouts, factorizations, reports
-
-_NO_INT = np.zeros(1, dtype=np.uint32)
-_NO_FLOAT = np.zeros(0)
-
-
-def _unsigned(a):
-    """A view (or copy) of a non-negative index array as uint32/uint64."""
-    a = np.asarray(a)
-    if a.dtype in (np.int32, np.uint32):
-        return np.ascontiguousarray(a).view(np.uint32)
-    return np.ascontiguousarray(a, dtype=np.int64).view(np.uint64)
+# Python side: layouts, reports (factorizations: mcfbench.running.factorizations)
 
 
 def _csr(A):
@@ -192,7 +198,7 @@ def _csr(A):
             if A.ndim != 2:
                 raise ValueError(f"A must be a 2-D matrix, got shape {A.shape}")
         A = sp.csr_matrix(A)
-    return _unsigned(A.indptr), _unsigned(A.indices), np.ascontiguousarray(A.data, np.float64)
+    return unsigned(A.indptr), unsigned(A.indices), np.ascontiguousarray(A.data, np.float64)
 
 
 def _coupled(A, shape):
@@ -241,56 +247,13 @@ def _blocks(A, b, x0, overwrite_x0=False):
             lambda z: z.reshape(k, n))
 
 
-LU_ORDERINGS = (
-    {"permc_spec": "MMD_AT_PLUS_A", "diag_pivot_thresh": 0.1,
-     "options": {"SymmetricMode": True}},
-    {"permc_spec": "COLAMD"},
-)
-"""SuperLU's settings for ``direct``, tried in turn until one gives the tolerance: its
-symmetric mode (minimum degree on ``A + A^T``, the diagonal pivot kept unless below 0.1
-of its column's largest entry), SuperLU's advice for a (nearly) symmetric pattern with
-a strong diagonal as every scheme's (the mesh's graph); then COLAMD with partial
-pivoting (scipy's default). One step's matrix (CPU s, fill of L + U), COLAMD against
-symmetric mode: BGN, anisotropic sphere level 3 (23 814 unknowns) 0.58 s, 9.5 M
-against 0.28 s, 4.5 M; cotan, its level 4 (32 258) 0.30 s, 5.6 M against 0.12 s,
-2.2 M; redistributing DDFV, Enneper level 3 (16 361) 0.10 s, 2.3 M against 0.09 s,
-1.5 M; every residual before refinement 1e-13 or below."""
-
-
-def _factorize(A, ilu, drop_tol=1e-4, fill_factor=10.0, ordering=None):
-    """SuperLU ``splu``/``spilu`` of ``A``: ``(lu, None)`` or ``(None, detail)``;
-    ``ordering``: ``splu``'s settings (one of :data:`LU_ORDERINGS`, default scipy's)."""
-    import scipy.sparse as sp
-    import scipy.sparse.linalg as spla  # on first use (import cost at start-up)
-
-    what = "ILU" if ilu else "LU"
-    try:
-        with np.errstate(all="ignore"):
-            Ac = sp.csc_matrix(A, dtype=float)
-            lu = (spla.spilu(Ac, drop_tol=drop_tol, fill_factor=fill_factor) if ilu
-                  else spla.splu(Ac, **(ordering or {})))
-    except RuntimeError as err:      # "Factor is exactly singular"
-        return None, f"{what} factorization failed: {str(err).rstrip('.').lower()}"
-    return lu, None
-
-
-def _ilu_arrays(lu):
-    """CSR arrays of the ILU factors and the permutations, for the kernel."""
-    if lu is None:
-        return (_NO_INT, _NO_INT, _NO_FLOAT, _NO_INT, _NO_INT, _NO_FLOAT, _NO_INT, _NO_INT)
-    L, U = lu.L.tocsr(), lu.U.tocsr()
-    return (_unsigned(L.indptr), _unsigned(L.indices), np.ascontiguousarray(L.data, float),
-            _unsigned(U.indptr), _unsigned(U.indices), np.ascontiguousarray(U.data, float),
-            _unsigned(lu.perm_r), _unsigned(lu.perm_c))
-
-
 def _failed(method, status, detail, residual=math.nan, iterations=0):
     return SolveInfo(int(iterations), float(residual), False, status, method, detail)
 
 
 def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
           stagnation_window=50, ilu_drop_tol=1e-4, ilu_fill_factor=10.0, overwrite_x0=False,
-          threads=1):
+          threads=1, factor=None):
     """Solve ``A x = b`` for a (k, n) block ``b`` from ``x0``; reports failures in ``info``.
 
     Parameters
@@ -319,6 +282,10 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
         ``numba.config.NUMBA_NUM_THREADS``. With more than one the inner
         products are summed in another order: the iterates agree to
         round-off, not bitwise.
+    factor : tuple, optional
+        The ILU methods' preconditioner, an :func:`ilu_factor` of this or another
+        matrix of the same shape (of ``A.shared`` for a block triangular ``A``),
+        instead of one of ``A``.
 
     Returns
     -------
@@ -344,7 +311,7 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
         return _by_blocks(A, b, x0, method=method, rtol=rtol, maxiter=maxiter,
                           stagnation_window=stagnation_window, ilu_drop_tol=ilu_drop_tol,
                           ilu_fill_factor=ilu_fill_factor, overwrite_x0=overwrite_x0,
-                          threads=threads)
+                          threads=threads, factor=factor)
     check_threads(threads)
     b, x, cmean, cfull, to_block = _blocks(A, b, x0, overwrite_x0)
     csr = _csr(A)
@@ -361,30 +328,25 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
                 x, lu = _direct(A, csr, b, start, cmean, cfull, rtol)
                 info = replace(lu, iterations=info.iterations)
             return to_block(x), replace(info, method=method)
-        kind, dinv, lu = 0, _NO_FLOAT, None
+        kind, dinv, lu = 0, NO_FLOAT, None
         if method == "jacobi-bicgstab":
             kind = 1
             d = sp.csr_matrix(A).diagonal().astype(float)
             dinv = np.where(d != 0.0, 1.0 / np.where(d != 0.0, d, 1.0), 1.0)
-        elif method == "ilu-bicgstab":
+        elif method in ("ilu-bicgstab", "kept-ilu-bicgstab"):
             if np.isfinite(csr[2]).all() and np.isfinite(b).all() and np.isfinite(x).all():
                 kind = 2
-                A = sp.csr_matrix(A, dtype=float)
-                rows = np.asarray(abs(A).sum(axis=1)).ravel()
-                dinv = np.where(rows > 0.0, 1.0 / np.where(rows > 0.0, rows, 1.0), 1.0)
-                lu, detail = _factorize(sp.diags(dinv) @ A, True, ilu_drop_tol,
-                                        ilu_fill_factor)
-                if lu is None:       # an exactly zero pivot: try the rows unscaled
-                    dinv = np.ones(A.shape[0])
-                    lu, detail = _factorize(A, True, ilu_drop_tol, ilu_fill_factor)
-                if lu is None:
-                    return to_block(x), _failed(method, "breakdown", detail)
+                if factor is None:
+                    factor, detail = ilu_factor(A, ilu_drop_tol, ilu_fill_factor)
+                    if factor is None:
+                        return to_block(x), _failed(method, "breakdown", detail)
+                dinv, lu = factor
             # else: kind 0, the kernel reports the non-finite input
         kernel = for_threads(krylov.bicgstab_kernel, threads, spmv=krylov.spmv,
                              residual=krylov.residual)
         code, dcode, it, rnorm, ref = kernel(
             *csr, b, x, cmean, cfull, float(rtol), int(maxiter), int(stagnation_window),
-            kind, dinv, *_ilu_arrays(lu))
+            kind, dinv, *(lu or ilu_arrays(None)))
         residual = (rnorm / ref if ref > 0.0 else
                     0.0 if rnorm == 0.0 else math.nan if math.isnan(ref) else math.inf)
     detail = ""
@@ -431,7 +393,7 @@ def _direct(A, csr, b, x0, cmean, cfull, rtol):
         x[...] = cmean[:, None] if cfull.shape[1] == 0 else cfull
         return x, SolveInfo(0, 0.0, True, "converged", method)
     for ordering in LU_ORDERINGS:    # the last one's failure is the answer
-        lu, detail = _factorize(A, False, ordering=ordering)
+        lu, detail = factorize(A, False, ordering=ordering)
         if lu is None:
             x, info = x0, _failed(method, "breakdown", detail)
             continue
@@ -539,9 +501,13 @@ class Solver:
     stagnation_window : int
         Iterations without a new residual minimum that count as stagnation.
     ilu_drop_tol, ilu_fill_factor : float
-        ``scipy.sparse.linalg.spilu`` parameters of ``"ilu-bicgstab"``.
+        ``scipy.sparse.linalg.spilu`` parameters of the ILU methods.
     threads : int
         Threads of the BiCGStab products and vector updates (see :func:`solve`).
+    ilu_refresh : int
+        ``"kept-ilu-bicgstab"``: the kept factor is renewed after a solve that took
+        more iterations (module docstring). Default 10: at the anisotropic sphere's
+        level 4 ten iterations with the factor cost about 1 s, a new factor 1.6 s.
     """
 
     method: str = "bicgstab"
@@ -551,6 +517,8 @@ class Solver:
     ilu_drop_tol: float = 1e-4
     ilu_fill_factor: float = 10.0
     threads: int = 1
+    ilu_refresh: int = 10
+    _kept: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     #: ``solver(A, b, x0, overwrite_x0=True)`` iterates in ``x0`` (no copy), see :func:`solve`
     can_overwrite_x0 = True
@@ -577,7 +545,7 @@ class Solver:
                              f"{', '.join(METHODS)}")
         if not (isinstance(self.rtol, (int, float)) and 0 < self.rtol < 1):
             raise ValueError(f"rtol must lie in (0, 1), got {self.rtol!r}")
-        for name in ("maxiter", "stagnation_window"):
+        for name in ("maxiter", "stagnation_window", "ilu_refresh"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) \
                     or value < 1:
@@ -590,11 +558,41 @@ class Solver:
         check_threads(self.threads)
 
     def __call__(self, A, b, x0, *, overwrite_x0=False):
-        x, info = solve(A, b, x0, method=self.method, rtol=self.rtol, maxiter=self.maxiter,
-                        stagnation_window=self.stagnation_window,
-                        ilu_drop_tol=self.ilu_drop_tol,
-                        ilu_fill_factor=self.ilu_fill_factor, overwrite_x0=overwrite_x0,
-                        threads=self.threads)
+        options = dict(method=self.method, rtol=self.rtol, maxiter=self.maxiter,
+                       stagnation_window=self.stagnation_window,
+                       ilu_drop_tol=self.ilu_drop_tol, ilu_fill_factor=self.ilu_fill_factor,
+                       threads=self.threads)
+        if self.method == "kept-ilu-bicgstab":
+            x, info = self._with_kept_factor(A, b, x0, overwrite_x0, options)
+        else:
+            x, info = solve(A, b, x0, overwrite_x0=overwrite_x0, **options)
         if not info.converged:
             raise SolverFailure(info, self.rtol, self.maxiter)
+        return x, info
+
+    def _with_kept_factor(self, A, b, x0, overwrite_x0, options):
+        """:func:`solve` with the kept ILU factor (``"kept-ilu-bicgstab"``, module
+        docstring): renewed for another shape, after a solve of more than
+        :attr:`ilu_refresh` iterations, and when a solve with it fails (then
+        repeated from ``x0``)."""
+        shared = A.shared if hasattr(A, "substitute") else A
+        n = np.shape(b)[-1]
+        if shared.shape != (n, n):       # coupled: plain BiCGStab (module docstring)
+            x, info = solve(A, b, x0, overwrite_x0=overwrite_x0,
+                            **{**options, "method": "bicgstab"})
+            return x, replace(info, method=self.method)
+        kept = self._kept
+        old = kept.get("shape") == shared.shape and not kept.get("stale", True)
+        if old:
+            start = None if x0 is None else np.array(x0, dtype=float)
+        else:
+            kept["factor"], _ = ilu_factor(shared, self.ilu_drop_tol, self.ilu_fill_factor)
+            kept["shape"] = shared.shape     # no factor: solve() says why (input, pivot)
+        x, info = solve(A, b, x0, overwrite_x0=overwrite_x0, factor=kept["factor"],
+                        **options)
+        if old and not info.converged:
+            kept["stale"] = True
+            x, again = self._with_kept_factor(A, b, start, True, options)
+            return x, replace(again, iterations=info.iterations + again.iterations)
+        kept["stale"] = info.iterations > self.ilu_refresh
         return x, info

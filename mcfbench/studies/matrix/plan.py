@@ -50,7 +50,8 @@ def plan(section=None, schemes=None, problems=None):
         not named runs at its registry levels, ``[]`` leaves it out),
         ``rtol``, ``maxiter``, ``solver`` (method of the refinement series),
         ``mesh_solver`` (method of the real-world-like meshes, ``"robust"``
-        = :func:`robust_method`), ``select`` (a cut-down matrix: ``schemes``,
+        = :func:`robust_method`), ``problem_solvers`` (problem -> method, instead of
+        those two for that problem's runs), ``select`` (a cut-down matrix: ``schemes``,
         exactly these, ``NAME@INTEGRATOR`` included, ``with_integrators`` then
         adds none; ``problems``, problem -> levels, exactly these; either
         omitted keeps the full matrix's).
@@ -63,7 +64,7 @@ def plan(section=None, schemes=None, problems=None):
     dict
         ``schemes`` (list; those of ``with_integrators`` last), ``problems``
         (name -> sorted levels, registry order), ``rtol``, ``maxiter``, ``solver``,
-        ``mesh_solver``, ``selected`` (whether ``select`` cut the matrix down).
+        ``mesh_solver``, ``problem_solvers`` (a dict), ``selected`` (whether ``select`` cut the matrix down).
 
     Raises
     ------
@@ -113,6 +114,17 @@ def plan(section=None, schemes=None, problems=None):
             raise ConfigError(f"config key 'matrix.{key}': unknown solver {method!r}; choose "
                               f"one of {', '.join(_solver.METHODS)} or robust")
         methods[key] = method
+    own = section.get("problem_solvers") or {}
+    if not isinstance(own, dict):
+        raise ConfigError(f"config key 'matrix.problem_solvers': a mapping problem -> "
+                          f"solver, got {own!r}")
+    for name, method in own.items():
+        if name not in problems:
+            raise ConfigError(f"config key 'matrix.problem_solvers': unknown problem "
+                              f"{name!r}; choose among {', '.join(problems)}")
+        if method not in _solver.METHODS:
+            raise ConfigError(f"config key 'matrix.problem_solvers.{name}': unknown solver "
+                              f"{method!r}; choose one of {', '.join(_solver.METHODS)}")
     rtol = float(section.get("rtol", 1e-9))
     if not 0 < rtol < 1:
         raise ConfigError(f"config key 'matrix.rtol': must lie in (0, 1), got {rtol!r}")
@@ -122,7 +134,8 @@ def plan(section=None, schemes=None, problems=None):
     # another integrator only for the schemes that are run (`schemes` may list fewer)
     chosen = [*chosen, *(s for s, name in stepped.items() if name in chosen)]
     return {"schemes": list(chosen), "problems": plan_problems, "rtol": rtol,
-            "maxiter": maxiter, **methods, "selected": bool(select)}
+            "maxiter": maxiter, **methods, "problem_solvers": dict(own),
+            "selected": bool(select)}
 
 
 def _names(value, key):
@@ -169,11 +182,13 @@ def _plan_problems(levels, key, problems, only=False):
 
 
 def solver_method(plan, problem):
-    """The method of ``problem``'s runs: robust on real-world-like meshes."""
+    """The method of ``problem``'s runs: its own (``problem_solvers``), else robust on
+    real-world-like meshes."""
     from mcfbench.running.problems import get_problem
 
     problem = get_problem(problem) if isinstance(problem, str) else problem
-    return plan["mesh_solver"] if is_mesh_problem(problem) else plan["solver"]
+    own = plan.get("problem_solvers", {}).get(problem.name)
+    return own or (plan["mesh_solver"] if is_mesh_problem(problem) else plan["solver"])
 
 
 def record_path(problem, scheme, level, root=ROOT):

@@ -170,6 +170,9 @@ def test_series_seconds_scale_the_cost_model_by_the_kind_of_scheme(monkeypatch):
     ({"problems": {"spere": [1]}}, "matrix.problems"),
     ({"problems": {"sphere": [0]}}, "matrix.problems.sphere"),
     ({"solver": "gmres"}, "matrix.solver"),
+    ({"problem_solvers": {"spere": "bicgstab"}}, "matrix.problem_solvers"),
+    ({"problem_solvers": {"sphere": "ilu"}}, "matrix.problem_solvers.sphere"),
+    ({"problem_solvers": ["sphere"]}, "matrix.problem_solvers"),
     ({"select": {"schemes": ["fem"]}}, "matrix.select.schemes"),
     ({"select": {"problems": {"spere": [1]}}}, "matrix.select.problems"),
     ({"select": {"problems": {"sphere": []}}}, "matrix.select.problems.sphere"),
@@ -186,6 +189,16 @@ def test_mesh_problems_get_the_robust_solver():
     for name, problem in PROBLEMS.items():
         expected = plan["mesh_solver"] if problem.tau_rule == "mesh" else "bicgstab"
         assert matrix_plan.solver_method(plan, name) == expected
+
+
+def test_a_problem_of_its_own_solver_gets_it_the_others_not():
+    own = {"anisotropic_sphere": "kept-ilu-bicgstab", "blobby": "direct"}
+    plan = matrix_plan.plan({"problem_solvers": own})
+    default = matrix_plan.plan({})
+    for name in PROBLEMS:
+        expected = own.get(name, matrix_plan.solver_method(default, name))
+        assert matrix_plan.solver_method(plan, name) == expected
+        assert matrix_plan.problem_settings(plan, name)["solver"]["method"] == expected
 
 
 # ------------------------------------------------------------ a tiny matrix for real
