@@ -167,3 +167,21 @@ def test_until_ends_the_run_at_a_steady_state():
 def test_bad_arguments_are_named(kwargs, message):
     with pytest.raises(ValueError, match=message):
         simulate(Decay(V0, FACES, 0.1), **kwargs)
+
+
+def test_every_run_builds_its_own_kept_factor(monkeypatch):
+    """A solver that keeps an ILU factor across solves keeps it for one run: a second
+    run with the same solver (a timed repeat after the first execution or a warm-up)
+    factors again inside its own steps, and the caller's solver keeps nothing."""
+    from mcfbench.running import solver as solver_module
+
+    factored = []
+    ilu_factor = solver_module.ilu_factor
+    monkeypatch.setattr(solver_module, "ilu_factor",
+                        lambda A, *args: factored.append(A.shape) or ilu_factor(A, *args))
+    solver = Solver("kept-ilu-bicgstab", rtol=1e-12)
+    first = simulate(Decay(V0, FACES, 0.1), 3, solver=solver)
+    assert factored == [(4, 4)]                   # once for the run's three solves
+    again = simulate(Decay(V0, FACES, 0.1), 3, solver=solver)
+    assert factored == [(4, 4), (4, 4)] and solver._kept == {}
+    assert np.array_equal(first.frames["vertices"], again.frames["vertices"])
