@@ -26,6 +26,10 @@ import scipy.sparse.linalg as spla
 #: relative asymmetry ``|A - A^T|_inf / |A|_inf`` below which ``A`` counts as symmetric
 SYMMETRY = 1e-12
 
+#: degree -> weights of the last solutions, newest first, in the extrapolated start
+#: (:class:`KeptFactorSolver`): the polynomial through them, evaluated one step on
+EXTRAPOLATION = {0: (1.0,), 1: (2.0, -1.0), 2: (3.0, -3.0, 1.0)}
+
 
 def cholesky_solve(A):
     """``b -> A^{-1} b`` by the sparse Cholesky factorisation of ``A``, or None.
@@ -120,11 +124,19 @@ class KeptFactorSolver:
     Each system is solved with the factorisation ``P`` of an earlier matrix of
     the sequence (``factorise``, default :func:`factorise`), iterated from a
     start until ``|b - A x| <= rtol |b|``: the caller's start, else, for a named
-    sequence of solutions, the linear extrapolation ``2 x_{k-1} - x_{k-2}`` of its
-    last two (the last one alone after one), else ``P^{-1} b``. When that takes
-    more than ``max_iterations`` (or the size changed), ``A`` is factorised and
-    the iteration runs from ``P^{-1} b`` of the new factor (for an exact
-    factorisation one residual check).
+    sequence of solutions, the polynomial extrapolation of its last solutions
+    (:data:`EXTRAPOLATION`: ``2 x_{k-1} - x_{k-2}`` from two, ``3 x_{k-1} - 3
+    x_{k-2} + x_{k-3}`` from three with ``extrapolation=2``; the last one alone
+    after one), else ``P^{-1} b``. When that takes more than ``max_iterations``
+    (or the size changed), ``A`` is factorised and the iteration runs from
+    ``P^{-1} b`` of the new factor (for an exact factorisation one residual
+    check). With a ``budget``, ``A`` is also factorised before a solve once the
+    iterations beyond one a solve, summed since the last factorisation, reach
+    it: a factorisation that costs about ``budget`` iterations is bought when
+    the stale factor has cost that much more than a fresh one would (the rule
+    of renting until the rent paid equals the price), so that a factor that
+    ages slowly is neither kept at a growing cost nor given up at the first
+    hard step.
 
     Parameters
     ----------
@@ -136,6 +148,12 @@ class KeptFactorSolver:
         ``A -> (method, solve)``, default :func:`factorise`; ``solve`` may be an
         approximate inverse (a preconditioner), symmetric positive definite for
         ``"cg"``.
+    budget : int, optional
+        Iterations beyond one a solve, summed since the last factorisation, after
+        which the next solve factorises anew; default None (only when a solve
+        takes more than ``max_iterations``).
+    extrapolation : {1, 2}
+        Degree of the polynomial extrapolation of a sequence's start.
 
     Attributes
     ----------
@@ -145,10 +163,15 @@ class KeptFactorSolver:
         The iteration of the kept factor (None before the first).
     """
 
-    def __init__(self, rtol=1e-7, max_iterations=4, factorise=factorise):
+    def __init__(self, rtol=1e-7, max_iterations=4, factorise=factorise, budget=None,
+                 extrapolation=1):
+        if extrapolation not in (1, 2):
+            raise ValueError(f"extrapolation must be 1 or 2, not {extrapolation!r}")
         self.rtol, self.max_iterations = rtol, max_iterations
         self._factorise = factorise
+        self.budget, self.extrapolation = budget, extrapolation
         self.factorisations = self.iterations = 0
+        self._excess = 0                                # iterations beyond one a solve
         self.method = self._factor = None
         self._history = {}                              # sequence -> its last two solutions
 
@@ -176,19 +199,23 @@ class KeptFactorSolver:
         b = np.asarray(b, dtype=float)
         history = [x for x in self._history.get(sequence, []) if len(x) == len(b)]
         converged = False
-        if self._factor is not None and self._factor[1] == len(b):
-            if start is None:
-                start = (history[-1] if len(history) == 1 else
-                         2.0 * history[-1] - history[-2] if history else None)
+        if (self._factor is not None and self._factor[1] == len(b)
+                and (self.budget is None or self._excess < self.budget)):
+            if start is None and history:
+                weights = EXTRAPOLATION[min(len(history) - 1, self.extrapolation)]
+                start = sum(w * x for w, x in zip(weights, reversed(history)))
+            before = self.iterations
             x, converged = self._iterate(apply, b, start)
+            self._excess += max(0, self.iterations - before - 1)
         if not converged:
             self.method, solve = self._factorise(matrix() if callable(matrix) else matrix)
             self._factor = solve, len(b)
             self.factorisations += 1
+            self._excess = 0
             x, _ = self._iterate(apply, b, None)
             history = []
         if sequence is not None:
-            self._history[sequence] = history[-1:] + [x]
+            self._history[sequence] = history[-self.extrapolation:] + [x]
         return x
 
     def _iterate(self, apply, b, start):

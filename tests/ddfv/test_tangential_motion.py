@@ -256,6 +256,26 @@ def test_kept_factor_solves_meet_the_default_tolerance(kind):
     assert motion.factorisations == 1 and motion.iterations < tight.iterations
 
 
+@pytest.mark.parametrize("kind", ["bgn", "mdr"])
+def test_factorising_on_budget_gives_the_fresh_solution(kind):
+    """The kept factor given up once its extra CG iterations reach the budget (a budget
+    of one: a new factorisation every few steps of a fast drift) and the quadratic
+    extrapolation of the starts give the positions of a fresh factorisation at every
+    step to the solve's tolerance, as the present path (no budget) does."""
+    V, F, N, W = _displaced_bumpy()
+    drift = [np.sin(3.0 * V + k) for k in range(3)]
+    budgeted = TangentialMotion(F, kind, budget=1)
+    kept = TangentialMotion(F, kind, budget=None)
+    for j in range(8):
+        Vj, Wj = V + 1e-3 * j * drift[0], W + 1e-3 * j * drift[2]
+        Nj = _unit(N + 1e-3 * j * drift[1])
+        fresh = tangential_motion(Vj, Wj, F, Nj, kind)
+        scale = np.abs(fresh - Wj).max()
+        for motion in (budgeted, kept):
+            assert np.abs(motion(Vj, Wj, Nj) - fresh).max() <= 1e-7 * scale
+    assert budgeted.factorisations >= 3 and kept.factorisations == 1
+
+
 def test_t_vertices_follow_their_triangles():
     """(TM4): a T-vertex keeps its offset from the point of its barycentric
     coordinates in its moving triangle; in the triangle's plane (no offset) it keeps

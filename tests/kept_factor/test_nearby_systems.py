@@ -8,6 +8,7 @@ when they jump; the nonsymmetric fallback; the extrapolated start.
 
 import igl
 import numpy as np
+import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
@@ -94,6 +95,49 @@ def test_extrapolated_start():
     np.testing.assert_allclose(x, spla.spsolve(A.tocsc(), b0 + 4 * b1), atol=1e-8)
     _solve(solver, A, b0, start=np.zeros(len(V)))           # a far start: iterations
     assert solver.iterations > before
+
+
+def test_quadratic_extrapolation():
+    """With ``b_k`` quadratic in ``k`` (the matrix fixed) the solutions are too: from
+    the fourth solve on, ``extrapolation=2`` starts at the solution (no iteration),
+    the linear extrapolation does not; any other degree is refused by name."""
+    A = _matrix(0)
+    b0, b1, b2 = _rhs(0), V[:, 1], V[:, 0] * V[:, 2]
+    counts = {}
+    for degree in (1, 2):
+        solver = KeptFactorSolver(rtol=1e-9, extrapolation=degree)
+        for k in range(3):
+            _solve(solver, A, b0 + k * b1 + k * k * b2, sequence="x")
+        before = solver.iterations
+        x = _solve(solver, A, b0 + 3 * b1 + 9 * b2, sequence="x")
+        counts[degree] = solver.iterations - before
+        assert np.linalg.norm(b0 + 3 * b1 + 9 * b2 - A @ x) <= 1e-9 * np.linalg.norm(
+            b0 + 3 * b1 + 9 * b2)
+    assert counts[2] == 0 < counts[1]
+    with pytest.raises(ValueError, match="extrapolation must be 1 or 2"):
+        KeptFactorSolver(extrapolation=3)
+
+
+def test_budget_factorises_once_the_extra_iterations_reach_it():
+    """A drifting sequence whose solves take several CG iterations each with the first
+    factor: without a budget one factorisation serves them all; with ``budget`` the
+    matrix is factorised again at the first solve after the iterations beyond one a
+    solve, summed since the last factorisation, reach it (a fresh factor's solve
+    counts none), and every solution meets the tolerance."""
+    plain = KeptFactorSolver(rtol=1e-10, max_iterations=50)
+    budgeted = KeptFactorSolver(rtol=1e-10, max_iterations=50, budget=6)
+    expected, excess = [], None
+    for k in range(12):
+        A, b = _matrix(k, step=2e-2), _rhs(k)
+        _solve(plain, A, b, sequence="x")
+        factorise_now = excess is None or excess >= 6
+        before = budgeted.iterations
+        x = _solve(budgeted, A, b, sequence="x")
+        assert np.linalg.norm(b - A @ x) <= 1e-10 * np.linalg.norm(b)
+        expected.append(factorise_now)
+        excess = 0 if factorise_now else excess + max(0, budgeted.iterations - before - 1)
+    assert plain.factorisations == 1 and plain.iterations >= 2 * 11
+    assert budgeted.factorisations == sum(expected) >= 3
 
 
 def test_size_change_factorises_again():
