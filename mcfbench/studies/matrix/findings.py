@@ -3,8 +3,9 @@ the long table, whose rows give each level's value): which scheme converges at w
 order on which problem, which breaks down where, and the recommendation.
 
 A verdict is the scheme's, not its linear solver's: a run that ended with a
-``solver_*`` status and that the robust solver (``direct``) finished when run
-again (:func:`mcfbench.studies.matrix.job`) counts as finished, with the
+``solver_*`` status and that the scheme's robust solver
+(:attr:`mcfbench.running.schemes.Scheme.robust_solver`, recorded as ``robust_solver``)
+finished when continued (:func:`mcfbench.studies.matrix.job`) counts as finished, with the
 robust run's value, and its text says that the failure was the solver's
 (:func:`scheme_view`)."""
 
@@ -164,7 +165,7 @@ def scheme_view(summary):
             notes.append("")
             continue
         notes.append(f"A solver verdict, not a scheme verdict: the matrix's solver failed "
-                     f"({_where(fixed)}) and the robust solver (direct) finished "
+                     f"({_where(fixed)}) and the robust solver finished "
                      f"{'that run' if len(fixed) == 1 else 'those runs'} when run again.")
         if r["runs_robust_ok"] == r["runs"]:
             for column in ("eoc", "eoc_levels", "finest_level", "finest_value", "values"):
@@ -177,7 +178,7 @@ def scheme_view(summary):
         if failed:
             summary.at[i, "solver_note"] = (
                 r["solver_note"] + " " if r["solver_note"] else "") + (
-                f"The robust solver (direct) failed too ({_where(failed)}): a scheme verdict.")
+                f"The robust solver failed too ({_where(failed)}): a scheme verdict.")
     return summary
 
 

@@ -445,7 +445,7 @@ def test_findings_tell_solver_verdicts_from_scheme_verdicts():
     assert "**a** converges at order ~2: EOC 2.00 (levels 2-3)" in text
     assert "A solver verdict, not a scheme verdict" in text
     assert "**b** broke down in 1 of 3 runs (level 3: solver_failed at t = 0.03)" in text
-    assert "The robust solver (direct) failed too (level 3: solver_breakdown): a scheme " \
+    assert "The robust solver failed too (level 3: solver_breakdown): a scheme " \
            "verdict." in text
     assert "a on sphere (level 3: solver_failed at t = 0.03)" in text
     assert "**Recommendation: a**" in text
