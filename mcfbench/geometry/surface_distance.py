@@ -44,9 +44,10 @@ _kept = {}
 
 
 def _surface(vertices, faces):
-    """``(V, F, lumped masses, AABB tree)`` of a mesh (float64 and int64 copies,
-    validated by :func:`~mcfbench.geometry.metrics.lumped_mass`), the last
-    :data:`KEPT_SURFACES` kept."""
+    """``(V, F, lumped masses, AABB tree)`` of a mesh (float64 and int64 copies of its
+    own, which a caller's later change of its arrays cannot reach; validated by
+    :func:`~mcfbench.geometry.metrics.lumped_mass`), the last :data:`KEPT_SURFACES`
+    kept."""
     V = np.ascontiguousarray(vertices, dtype=float)
     F = np.ascontiguousarray(faces, dtype=np.int64)
     key = hashlib.sha1(V.tobytes() + F.tobytes() + repr((V.shape, F.shape)).encode()).digest()
@@ -56,6 +57,7 @@ def _surface(vertices, faces):
     masses = lumped_mass(V, F)                         # validates the mesh
     if len(F) == 0:
         raise ValueError("a surface has no triangle: no distance to it")
+    V, F = V.copy(), F.copy()                          # kept: never the caller's arrays
     tree = igl.AABB()
     tree.init(V, F)
     if len(_kept) >= KEPT_SURFACES:

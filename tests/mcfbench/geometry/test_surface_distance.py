@@ -88,7 +88,11 @@ def test_a_kept_surface_gives_the_numbers_of_fresh_trees_and_follows_its_content
     kept = len(surface_distance._kept)
     assert mean_surface_distance(V * 1.1, F, *reference) == \
         _distance_with_fresh_trees(V * 1.1, F, *reference)          # reference tree reused
+    original = reference[0].copy()
     reference[0][:] *= 1.5                    # the same array, changed in place: a new surface
     assert mean_surface_distance(V, F, *reference) == \
         _distance_with_fresh_trees(V, F, *reference) != first
+    # the first surface again, in another array: its kept entry holds its own copy of the
+    # points, not the array changed since
+    assert mean_surface_distance(V, F, original, reference[1]) == first
     assert kept <= len(surface_distance._kept) <= surface_distance.KEPT_SURFACES
