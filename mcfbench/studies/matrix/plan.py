@@ -64,7 +64,8 @@ def plan(section=None, schemes=None, problems=None):
     dict
         ``schemes`` (list; those of ``with_integrators`` last), ``problems``
         (name -> sorted levels, registry order), ``rtol``, ``maxiter``, ``solver``,
-        ``mesh_solver``, ``problem_solvers`` (a dict), ``selected`` (whether ``select`` cut the matrix down).
+        ``mesh_solver``, ``problem_solvers`` (a dict), ``selected`` (whether
+        ``select`` cut the matrix down).
 
     Raises
     ------
@@ -281,7 +282,8 @@ was fitted to steps of the sphere (:data:`mcfbench.running.cost.COSTS`); the
 matrix's series take more solver iterations a step (larger steps, real meshes,
 the anisotropic sphere) and the redistributing ones mostly stop early. Within a
 kind, a series is still within a factor 2.5 of its measured time in the median,
-a factor 7-15 in one case out of ten; the factor brings the heavy series out (1 for a kind not measured)."""
+a factor 7-15 in one case out of ten; the factor brings the heavy series out (1 for
+a kind not measured)."""
 
 
 def series_seconds(plan, scheme, problem):
