@@ -149,6 +149,7 @@ class Assembler:
         self._has_boundary = mesh.has_boundary
         # Rows of boundary F-vertices are Dirichlet rows (Section 2.2.4).
         self._dirichlet = np.r_[mesh.boundary_vertices, np.zeros(n_t, bool)]
+        self._touch = {}                # threads -> (flagged slots, untouched diagonals)
 
     def _first_touch(self, threads):
         """The slot table with the first write into each entry flagged, and the
@@ -169,7 +170,7 @@ class Assembler:
         """
         from . import kernels as k
 
-        cache = self.__dict__.setdefault("_touch", {})
+        cache = self._touch
         if threads not in cache:
             order, _ = self._mesh.diamond_blocks(threads)
             boundary_used = np.zeros(k.N_SLOTS, dtype=bool)
