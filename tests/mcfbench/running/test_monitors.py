@@ -13,8 +13,9 @@ from mcfbench.running.monitors import Steady
 @pytest.mark.parametrize("layout", ["C", "F"])
 def test_steady_compares_exactly_the_largest_vertex_speed(layout):
     """At a threshold equal to :func:`max_speed` of the last two states the steady
-    state is not reached, one ulp above it is: the buffered computation is the
-    speed itself, bitwise, for the vertex schemes' (n, 3) views of (3, n) arrays too."""
+    state is not reached, one ulp above it is: the monitor's buffers (the previous
+    state, the work array) give the speed itself, bitwise, for the vertex schemes'
+    (n, 3) views of (3, n) arrays too."""
     rng = np.random.default_rng(0)
     states = [np.asarray(rng.standard_normal((50, 3)), order=layout) for _ in range(4)]
     tau = 0.003
