@@ -219,14 +219,20 @@ def one_round_flips(V, faces, edges, edge_faces, face_edges, to_pattern, L_mesh,
         yc = np.sqrt(max(l_ac ** 2 - xc ** 2, 0.0))
         yd = np.sqrt(max(l_ad ** 2 - xd ** 2, 0.0))
         l_cd = np.hypot(xc - xd, yc + yd)
-        s_ab, s_bc, s_ac = edge_slots[e], edge_slots[bc], edge_slots[ac]
-        s_ad, s_bd, s_cd = edge_slots[ad], edge_slots[bd], diagonal_slots[e]
-        # (its corners, the sides opposite them and their slots, -1 taken out / +1 put in)
-        _triangle(L_data, mass, diag_slots, -1.0, a, b, c, l_bc, l_ac, l_ab, s_bc, s_ac, s_ab)
-        _triangle(L_data, mass, diag_slots, -1.0, b, a, d, l_ad, l_bd, l_ab, s_ad, s_bd, s_ab)
-        _triangle(L_data, mass, diag_slots, 1.0, a, d, c, l_cd, l_ac, l_ad, s_cd, s_ac, s_ad)
-        _triangle(L_data, mass, diag_slots, 1.0, b, c, d, l_cd, l_bd, l_bc, s_cd, s_bd, s_bc)
-        L_data[s_ab[0]] = L_data[s_ab[1]] = 0.0
+        # (its corners, the sides opposite them and their edges, -1 taken out / +1 put in)
+        _triangle(L_data, mass, diag_slots, -1.0, a, b, c, l_bc, l_ac, l_ab,
+                  edge_slots[bc, 0], edge_slots[bc, 1], edge_slots[ac, 0], edge_slots[ac, 1],
+                  edge_slots[e, 0], edge_slots[e, 1])
+        _triangle(L_data, mass, diag_slots, -1.0, b, a, d, l_ad, l_bd, l_ab,
+                  edge_slots[ad, 0], edge_slots[ad, 1], edge_slots[bd, 0], edge_slots[bd, 1],
+                  edge_slots[e, 0], edge_slots[e, 1])
+        _triangle(L_data, mass, diag_slots, 1.0, a, d, c, l_cd, l_ac, l_ad,
+                  diagonal_slots[e, 0], diagonal_slots[e, 1], edge_slots[ac, 0],
+                  edge_slots[ac, 1], edge_slots[ad, 0], edge_slots[ad, 1])
+        _triangle(L_data, mass, diag_slots, 1.0, b, c, d, l_cd, l_bd, l_bc,
+                  diagonal_slots[e, 0], diagonal_slots[e, 1], edge_slots[bd, 0],
+                  edge_slots[bd, 1], edge_slots[bc, 0], edge_slots[bc, 1])
+        L_data[edge_slots[e, 0]] = L_data[edge_slots[e, 1]] = 0.0
     for i in range(len(mass)):
         for p in range(indptr[i], indptr[i + 1]):
             if p != diag_slots[i] and not -L_data[p] >= FLIP_BELOW + MARGIN:
@@ -244,16 +250,16 @@ def _distance(V, p, q):
 
 
 @njit(cache=True, inline="always")
-def _triangle(L_data, mass, diag_slots, sign, p0, p1, p2, l0, l1, l2, s0, s1, s2):
+def _triangle(L_data, mass, diag_slots, sign, p0, p1, p2, l0, l1, l2, s0, t0, s1, t1, s2, t2):
     """Add ``sign`` x the cotangent weights (C2) and the thirds of the area of the
     triangle ``(p0, p1, p2)`` of sides ``l0, l1, l2`` (``l_k`` opposite ``p_k``, its
-    slots ``s_k``): ``(l_j^2 + l_k^2 - l_i^2) / (8 area)`` (cotangent / 2), Heron's
+    slots ``s_k, t_k``): ``(l_j^2 + l_k^2 - l_i^2) / (8 area)`` (cotangent / 2), Heron's
     area."""
     x, y, z = l0, l1, l2
     area = 0.25 * np.sqrt(max((x + y + z) * (-x + y + z) * (x - y + z) * (x + y - z), 0.0))
-    _edge(L_data, diag_slots, p1, p2, s0, sign * (y * y + z * z - x * x) / (8.0 * area))
-    _edge(L_data, diag_slots, p2, p0, s1, sign * (z * z + x * x - y * y) / (8.0 * area))
-    _edge(L_data, diag_slots, p0, p1, s2, sign * (x * x + y * y - z * z) / (8.0 * area))
+    _edge(L_data, diag_slots, p1, p2, s0, t0, sign * (y * y + z * z - x * x) / (8.0 * area))
+    _edge(L_data, diag_slots, p2, p0, s1, t1, sign * (z * z + x * x - y * y) / (8.0 * area))
+    _edge(L_data, diag_slots, p0, p1, s2, t2, sign * (x * x + y * y - z * z) / (8.0 * area))
     third = sign * area / 3.0
     mass[p0] += third
     mass[p1] += third
@@ -261,10 +267,10 @@ def _triangle(L_data, mass, diag_slots, sign, p0, p1, p2, l0, l1, l2, s0, s1, s2
 
 
 @njit(cache=True, inline="always")
-def _edge(L_data, diag_slots, p, q, slots, w):
-    """Add the weight ``w`` of the edge ``(p, q)`` (its ``slots``) to ``L`` (C2)."""
-    L_data[slots[0]] -= w
-    L_data[slots[1]] -= w
+def _edge(L_data, diag_slots, p, q, s, t, w):
+    """Add the weight ``w`` of the edge ``(p, q)`` (its slots ``s``, ``t``) to ``L`` (C2)."""
+    L_data[s] -= w
+    L_data[t] -= w
     L_data[diag_slots[p]] += w
     L_data[diag_slots[q]] += w
 
