@@ -152,9 +152,9 @@ def one_round_flips(V, faces, edges, edge_faces, face_edges, to_pattern, L_mesh,
     flipped : (E,) bool array, output
         The edges flipped.
     L_data : (nnz,) float64 array, output
-        The stiffness of the flipped triangulation (the mesh's when none is found).
+        The stiffness of the flipped triangulation (written when edges flip).
     mass : (n,) float64 array, output
-        Its barycentric lumped mass (written when flips are found).
+        Its barycentric lumped mass (written when edges flip).
 
     Returns
     -------
