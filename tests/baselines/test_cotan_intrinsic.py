@@ -6,12 +6,13 @@ from conftest import cylinder, table_3_1_error, twin_sphere
 
 from baselines.cotan import CotanFlow
 from baselines.laplacian import cotangent_laplacian, lumped_mass
-from baselines.cotan_intrinsic import (FLIP_BELOW, IntrinsicCotanFlow, edges_to_flip,
-                                      intrinsic_operators)
+from baselines.cotan_intrinsic import FLIP_BELOW, IntrinsicCotanFlow, intrinsic_operators
 from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate
-from mcfbench.running.solver import Solver
+from mcfbench.running.problems import get_problem
+from mcfbench.running.run import problem_mesh
+from mcfbench.running.solver import Solver, solve
 
 EXACT = Solver(method="direct", rtol=1e-12)
 
@@ -28,6 +29,21 @@ def flipped_icosphere(level=2):
     d = next(v for v in F[k] if v not in (a, b))    # triangle (b, a, d)
     F[0], F[k] = (c, d, b), (d, c, a)               # edge (c, d), orientation kept
     return V, F
+
+
+def assert_intrinsic_delaunay(L, mass, area):
+    """Every edge weight ``(cot alpha + cot beta) / 2 = -L_ij`` of the triangulation is
+    above the package's threshold (intrinsic Delaunay), ``L`` symmetric with zero row
+    sums, the mass positive and summing to the surface's area."""
+    off = L.tocoo()
+    assert -off.data[off.row != off.col].max() >= FLIP_BELOW
+    assert abs(L - L.T).max() < 1e-15 and np.abs(np.asarray(L.sum(axis=1))).max() < 1e-13
+    assert mass.min() > 0 and mass.sum() == pytest.approx(area, rel=1e-13)
+
+
+def mesh_area(V, F):
+    return 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]),
+                                axis=1).sum()
 
 
 def test_on_a_delaunay_mesh_the_operators_are_the_cotangent_ones():
@@ -58,10 +74,7 @@ def test_on_a_non_delaunay_mesh_every_edge_weight_is_nonnegative():
     L, mass = intrinsic_operators(V, F)
     off = L.tocoo()
     assert off.data[off.row != off.col].max() <= 0.0
-    assert abs(L - L.T).max() < 1e-15 and np.abs(np.asarray(L.sum(axis=1))).max() < 1e-13
-    area = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]),
-                                axis=1).sum()
-    assert mass.min() > 0 and mass.sum() == pytest.approx(area, rel=1e-13)
+    assert_intrinsic_delaunay(L, mass, mesh_area(V, F))
     traj = simulate(IntrinsicCotanFlow(V, F, 0.001), 10, solver=EXACT, save_every=0)
     assert traj.status == "ok", traj.message
 
@@ -121,7 +134,7 @@ def planar_quad(weight):
 def test_the_mesh_operators_flip_exactly_where_the_package_does(weight, flips):
     """The package keeps an edge of weight above ``FLIP_BELOW`` = -1e-6 (-8e-7: kept) and
     flips one below (-3e-6: the other diagonal gets the weight ``3e-6``); so do the
-    mesh's operators (:func:`edges_to_flip`, a flip next to the boundary, whose edges
+    mesh's operators (:meth:`FlipPattern.flip`, a flip next to the boundary, whose edges
     count twice in the tufted cover), and they are the package's to round-off."""
     V, F = planar_quad(weight)
     flow = IntrinsicCotanFlow(V, F, 0.01)
@@ -129,7 +142,7 @@ def test_the_mesh_operators_flip_exactly_where_the_package_does(weight, flips):
     kept = L[0, 1] == pytest.approx(-weight, rel=1e-6)         # L_ab = -weight
     assert kept == (weight > FLIP_BELOW)
     assert kept or L[2, 3] == pytest.approx(weight, rel=1e-6)
-    flip = edges_to_flip(V, flow.mesh, flow.geometry.L_data, flow.assembler.pattern.edge_slots)
+    flip, _, _ = flow.flips.flip(V, flow.geometry.L_data, flow.geometry.mass)
     assert len(flip) == flips
     L_flow, mass_flow = flow.operators()
     np.testing.assert_allclose(L_flow.toarray(), L.toarray(), rtol=0, atol=1e-15)
@@ -146,8 +159,8 @@ def test_a_sliver_within_the_mollification_margin_takes_the_package():
         F = np.array([[0, 1, 2]])
         flow = IntrinsicCotanFlow(V, F, 0.01)
         zero = np.zeros_like(flow.geometry.L_data)
-        flip = edges_to_flip(V, flow.mesh, zero, flow.assembler.pattern.edge_slots)
-        assert (flip is not None) == from_mesh
+        found = flow.flips.flip(V, zero, flow.geometry.mass)
+        assert (found is not None) == from_mesh
 
 
 def test_one_flip_back_to_the_icosphere_is_the_packages_triangulation():
@@ -157,7 +170,7 @@ def test_one_flip_back_to_the_icosphere_is_the_packages_triangulation():
     round-off; so are the flow's states, step by step."""
     V, F = flipped_icosphere()
     flow = IntrinsicCotanFlow(V, F, 0.001)
-    flip = edges_to_flip(V, flow.mesh, flow.geometry.L_data, flow.assembler.pattern.edge_slots)
+    flip, _, _ = flow.flips.flip(V, flow.geometry.L_data, flow.geometry.mass)
     assert len(flip) == 1 and set(flow.mesh.edges[flip[0]]) == set(F[0][:2])
     L, mass = flow.operators()
     L_package, mass_package = intrinsic_operators(V, F)
@@ -186,3 +199,68 @@ def test_along_the_catenoid_flow_every_step_takes_the_mesh_operators():
     assert slow.delaunay_steps == 0
     np.testing.assert_allclose(traj.frames["vertices"], reference.frames["vertices"], rtol=0,
                                atol=1e-13)
+
+
+def test_the_catenoids_flips_are_the_packages_intrinsic_delaunay_triangulation():
+    """Along the registry's catenoid at level 1 (216 vertices, 60 steps) the mesh's
+    rectangles' diagonals (weight 0 at ``t = 0``) turn non-Delaunay, all 192 of them every
+    other step at first: the compiled round of flips (:func:`one_round_flips`) gives the
+    systems of 42 steps, each of its states' operators is intrinsic Delaunay and the
+    package's to round-off, and the trajectory is that of a run that calls the package
+    at every step to 1e-12."""
+    catenoid = get_problem("catenoid")
+    V, F = problem_mesh(catenoid, 1)
+    tau = catenoid.tau(1, (V, F))
+    fast = IntrinsicCotanFlow(V, F, tau)
+    flips = []
+    for _ in range(60):
+        flip, _, _ = fast.flips.flip(fast.X.T, fast.geometry.L_data, fast.geometry.mass)
+        flips.append(len(flip))
+        L, mass = fast.operators()
+        L_package, mass_package = intrinsic_operators(fast.X.T, F)
+        np.testing.assert_allclose(L.toarray(), L_package.toarray(), rtol=0,
+                                   atol=4e-15 * abs(L_package).max())
+        np.testing.assert_allclose(mass, mass_package, rtol=1e-14)
+        assert_intrinsic_delaunay(L, mass, mesh_area(fast.X.T, F))
+        A, b = fast.system()
+        fast.advance(solve(A, b, b, method="direct", rtol=1e-12)[0])
+    assert (fast.delaunay_steps, fast.flipped_steps) == (18, 42)
+    assert flips[:4] == [0, 192, 0, 192] and max(flips) == 192     # every rectangle's
+    slow = IntrinsicCotanFlow(V, F, tau)
+    slow._mesh_operators = lambda at: None
+    reference = simulate(slow, 60, solver=EXACT, save_every=0)
+    np.testing.assert_allclose(fast.X.T, reference.frames["vertices"][-1], rtol=0, atol=1e-12)
+
+
+def planar_fan():
+    """Triangle (0, 1, 2) between (1, 0, 3) and (2, 1, 4) in the plane, both of its
+    interior edges non-Delaunay (opposite angles 112 + 157 and 23 + 172 degrees)."""
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0.7, 0.3, 0], [0.5, -0.1, 0], [0.87, 0.17, 0]])
+    return V, np.array([[0, 1, 2], [1, 0, 3], [2, 1, 4]])
+
+
+def flat_tetrahedron():
+    """A tetrahedron whose edge (0, 1) has opposite angles of 145 degrees each: its flip
+    would make the edge (2, 3) it already has."""
+    V = np.array([[-1.0, 0, 0], [1, 0, 0], [0, 0.3, 0.1], [0, -0.3, 0.1]])
+    return V, np.array([[0, 1, 2], [1, 0, 3], [0, 2, 3], [1, 3, 2]])
+
+
+@pytest.mark.parametrize("mesh", [planar_fan, flat_tetrahedron])
+def test_flips_one_round_cannot_take_are_left_to_the_package(mesh):
+    """Two edges to flip on one triangle (the fan), or a flip onto an existing edge (the
+    tetrahedron): no compiled round (None), the flow takes the package's operators,
+    which flip them (every weight >= the threshold)."""
+    V, F = mesh()
+    flow = IntrinsicCotanFlow(V, F, 0.01)
+    weights = -flow.geometry.L_data[flow.assembler.pattern.edge_slots[:, 0]]
+    assert np.sum(weights < FLIP_BELOW) == (2 if mesh is planar_fan else 1)
+    assert flow.flips.flip(V, flow.geometry.L_data, flow.geometry.mass) is None
+    L, mass = flow.operators()
+    L_package, mass_package = intrinsic_operators(V, F)
+    np.testing.assert_array_equal(L.toarray(), L_package.toarray())
+    np.testing.assert_array_equal(mass, mass_package)
+    off = L.tocoo()
+    assert -off.data[off.row != off.col].min() >= FLIP_BELOW
+    flow.system()
+    assert (flow.delaunay_steps, flow.flipped_steps) == (0, 0)
