@@ -90,15 +90,19 @@ Methods (:data:`METHODS`)
     :class:`Solver`) of ``D^{-1} A``, ``D`` the absolute row sums (rows
     equilibrated; if that factor is exactly singular, of ``A`` itself),
     once per call (for the three rows in the shared case); compiled triangular solves.
+    A coupled (3n, 3n) ``A`` (BGN, MDR, DeTurck) is preconditioned by the factor of its
+    isotropic part, the (n, n) mean of its three diagonal blocks, applied to each
+    component (:func:`mcfbench.running.factorizations.isotropic_ilu_factor`; the ILU of
+    the coupled matrix itself took 100-270 iterations at the anisotropic sphere's level 3,
+    this one 8-22).
 ``kept-ilu-bicgstab``
     ``ilu-bicgstab`` with the factor kept by the :class:`Solver` across its calls (a
     run's steps: the matrices of nearby steps are nearby) and renewed when a solve
     with it took more than ``ilu_refresh`` iterations, for another shape, or when it
     did not converge (then the solve is repeated from ``x0`` with the new factor,
-    iterations summed). A coupled (3n, 3n) system is solved by plain ``bicgstab``: its
-    ILU (BGN, DeTurck at the anisotropic sphere's level 3) needs 100 iterations or more,
-    or misses the tolerance, where the shared (n, n) factor serves the three rows in a
-    few. Called through :func:`solve` alone it is ``ilu-bicgstab``.
+    iterations summed); a coupled (3n, 3n) system's factor is that of its isotropic part
+    (``ilu-bicgstab``), kept and renewed by the same rule. Called through :func:`solve`
+    alone it is ``ilu-bicgstab``.
     Anisotropic sphere level 4, DDFV chord (96 770 unknowns): the factor 1.6 s; step 1's
     solves steps 1, 2, 10, 30 in 4, 3, 2, 2 iterations (0.2-0.5 s) against BiCGStab's 262,
     269, 211, 170 (0.7-1.1 s); ``drop_tol`` 1e-2 does not converge, pyamg's AMG
@@ -127,7 +131,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from mcfbench.running.factorizations import (LU_ORDERINGS, NO_FLOAT, factorize, ilu_arrays,
-                                             ilu_factor, unsigned)
+                                             ilu_factor, isotropic_ilu_factor, unsigned)
 
 # scipy.sparse, the compiled kernels (numba) and ddfv's thread checks are imported
 # on first use: the command line reads METHODS and ROBUST for its help in 0.1 s.
@@ -313,6 +317,7 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
                           ilu_fill_factor=ilu_fill_factor, overwrite_x0=overwrite_x0,
                           threads=threads, factor=factor)
     check_threads(threads)
+    k = np.shape(b)[0]
     b, x, cmean, cfull, to_block = _blocks(A, b, x0, overwrite_x0)
     csr = _csr(A)
     with np.errstate(all="ignore"):
@@ -337,7 +342,8 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
             if np.isfinite(csr[2]).all() and np.isfinite(b).all() and np.isfinite(x).all():
                 kind = 2
                 if factor is None:
-                    factor, detail = ilu_factor(A, ilu_drop_tol, ilu_fill_factor)
+                    factor, detail = _ilu(A, k, cfull.shape[1] > 0, ilu_drop_tol,
+                                          ilu_fill_factor)
                     if factor is None:
                         return to_block(x), _failed(method, "breakdown", detail)
                 dinv, lu = factor
@@ -361,6 +367,14 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
         detail = krylov.BREAKDOWN_DETAILS[dcode]
     return to_block(x), SolveInfo(int(it), float(residual), code == krylov.CONVERGED,
                                   krylov.STATUS_NAMES[code], method, detail)
+
+
+def _ilu(A, k, coupled, drop_tol, fill_factor):
+    """The ILU methods' factor of ``A`` for a (k, n) block: :func:`ilu_factor` of a
+    shared ``A``, :func:`isotropic_ilu_factor` of a coupled one (module docstring)."""
+    if coupled:
+        return isotropic_ilu_factor(A, k, drop_tol, fill_factor)
+    return ilu_factor(A, drop_tol, fill_factor)
 
 
 def _by_blocks(A, b, x0, **options):
@@ -576,17 +590,14 @@ class Solver:
         :attr:`ilu_refresh` iterations, and when a solve with it fails (then
         repeated from ``x0``)."""
         shared = A.shared if hasattr(A, "substitute") else A
-        n = np.shape(b)[-1]
-        if shared.shape != (n, n):       # coupled: plain BiCGStab (module docstring)
-            x, info = solve(A, b, x0, overwrite_x0=overwrite_x0,
-                            **{**options, "method": "bicgstab"})
-            return x, replace(info, method=self.method)
+        k, n = np.shape(b)
         kept = self._kept
         old = kept.get("shape") == shared.shape and not kept.get("stale", True)
         if old:
             start = None if x0 is None else np.array(x0, dtype=float)
         else:
-            kept["factor"], _ = ilu_factor(shared, self.ilu_drop_tol, self.ilu_fill_factor)
+            kept["factor"], _ = _ilu(shared, k, shared.shape != (n, n), self.ilu_drop_tol,
+                                     self.ilu_fill_factor)
             kept["shape"] = shared.shape     # no factor: solve() says why (input, pivot)
         x, info = solve(A, b, x0, overwrite_x0=overwrite_x0, factor=kept["factor"],
                         **options)
