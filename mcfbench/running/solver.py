@@ -587,23 +587,27 @@ class Solver:
     def _with_kept_factor(self, A, b, x0, overwrite_x0, options):
         """:func:`solve` with the kept ILU factor (``"kept-ilu-bicgstab"``, module
         docstring): renewed for another shape, after a solve of more than
-        :attr:`ilu_refresh` iterations, and when a solve with it fails (then
+        :attr:`ilu_refresh` iterations (a coupled system's: more than the fewest a solve
+        with it took plus :attr:`ilu_refresh`), and when a solve with it fails (then
         repeated from ``x0``)."""
         shared = A.shared if hasattr(A, "substitute") else A
         k, n = np.shape(b)
+        coupled = shared.shape != (n, n)
         kept = self._kept
         old = kept.get("shape") == shared.shape and not kept.get("stale", True)
         if old:
             start = None if x0 is None else np.array(x0, dtype=float)
         else:
-            kept["factor"], _ = _ilu(shared, k, shared.shape != (n, n), self.ilu_drop_tol,
+            kept["factor"], _ = _ilu(shared, k, coupled, self.ilu_drop_tol,
                                      self.ilu_fill_factor)
             kept["shape"] = shared.shape     # no factor: solve() says why (input, pivot)
+            kept["fewest"] = math.inf
         x, info = solve(A, b, x0, overwrite_x0=overwrite_x0, factor=kept["factor"],
                         **options)
         if old and not info.converged:
             kept["stale"] = True
             x, again = self._with_kept_factor(A, b, start, True, options)
             return x, replace(again, iterations=info.iterations + again.iterations)
-        kept["stale"] = info.iterations > self.ilu_refresh
+        kept["fewest"] = min(kept["fewest"], info.iterations)
+        kept["stale"] = info.iterations > self.ilu_refresh + (kept["fewest"] if coupled else 0)
         return x, info

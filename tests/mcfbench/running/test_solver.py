@@ -636,3 +636,24 @@ def test_coupled_ilu_solves_as_bicgstab_in_fewer_iterations(method):
     for solution in (x, x_plain):
         assert np.linalg.norm(b.ravel() - A @ solution.ravel()) <= 1e-10 * np.linalg.norm(b)
         assert np.abs(solution - exact).max() <= 1e-8 * np.abs(exact).max()
+
+
+def test_kept_coupled_factor_is_renewed_when_its_iterations_grow(monkeypatch):
+    """``kept-ilu-bicgstab`` on coupled systems: a factor whose solves take more than
+    ``ilu_refresh`` iterations, as many as a new one's (17 here), is kept; it is renewed
+    after a solve of more than ``ilu_refresh`` above the fewest it took (23 > 17 + 5)."""
+    from mcfbench.running import solver as solver_module
+
+    factored = []
+    isotropic = solver_module.isotropic_ilu_factor
+    monkeypatch.setattr(solver_module, "isotropic_ilu_factor",
+                        lambda A, *args: factored.append(A.shape) or isotropic(A, *args))
+    kept = Solver("kept-ilu-bicgstab", rtol=1e-10, ilu_refresh=5)
+    for tau in (3.0, 3.03, 3.06, 0.3, 30.0):
+        A, b, _ = bgn_like(tau=tau)
+        x, info = kept(A, b, None)
+        assert np.linalg.norm(b.ravel() - A @ x.ravel()) <= 1e-10 * np.linalg.norm(b)
+        assert info.iterations > 5 and factored == [(1200, 1200)]
+    assert info.iterations > 17 + 5
+    x, again = kept(A, b, None)
+    assert len(factored) == 2 and again.iterations < info.iterations
