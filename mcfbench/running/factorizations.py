@@ -101,12 +101,14 @@ def isotropic_ilu_factor(A, k=3, drop_tol=1e-4, fill_factor=10.0):
     coupling only joins a vertex's own components. The preconditioner is
     ``M = I_k (x) S`` with ``S = (1/k) sum_c A_cc`` (the trace of every vertex block over
     ``k``: ``K`` plus ``|omega_k|^2 / 3``, ``1 / 3``, ``alpha + (1 - alpha) / 3``): one
-    :func:`ilu_factor` of the (n, n) ``S`` for the k components, in the kernel's arrays
-    of the (k n, k n) block diagonal. Measured (step 1 of the anisotropic sphere, BiCGStab
-    iterations, ``rtol`` 1e-9): level 3 (23 814 unknowns) BGN 22, MDR 15, DeTurck 8,
-    against 239, 266, 100 with the ILU of the coupled matrix (also with its unknowns
-    ordered by vertex) and 1000 (not converged), 779, 279 unpreconditioned; level 4
-    (96 774) 27, 13, 7 against 1000 (not converged), 1000 (not converged), 546.
+    :func:`ilu_factor` of the (n, n) ``S``, which the kernel applies to the k components
+    in one pass over the factor (:func:`mcfbench.running.krylov.precondition`).
+    Measured (step 1 of the anisotropic sphere, BiCGStab iterations, ``rtol`` 1e-9):
+    level 3 (23 814 unknowns) BGN 22, MDR 15, DeTurck 8, against 239, 266, 100 with the
+    ILU of the coupled matrix (225, -, 118 with its unknowns ordered by vertex), 26, 19,
+    11 with one ILU of each diagonal block, and 1000 (not converged), 779, 279
+    unpreconditioned; level 4 (96 774) 27, 13, 7 against 46, 26, 12 (each block's ILU)
+    and 1000 (not converged), 1000 (not converged), 546.
 
     Parameters
     ----------
@@ -120,7 +122,7 @@ def isotropic_ilu_factor(A, k=3, drop_tol=1e-4, fill_factor=10.0):
     Returns
     -------
     factor, detail
-        As :func:`ilu_factor`'s, of the size of ``A``.
+        :func:`ilu_factor`'s of ``S``.
     """
     import scipy.sparse as sp
 
@@ -129,32 +131,4 @@ def isotropic_ilu_factor(A, k=3, drop_tol=1e-4, fill_factor=10.0):
     diagonal = A.row // n == A.col // n                      # entries of the blocks A_cc
     S = sp.csr_matrix((A.data[diagonal] / k, (A.row[diagonal] % n, A.col[diagonal] % n)),
                       shape=(n, n))                          # duplicates summed
-    factor, detail = ilu_factor(S, drop_tol, fill_factor)
-    if factor is None:
-        return None, detail
-    dinv, (lp, li, lx, up, ui, ux, perm_r, perm_c) = factor
-    return (np.tile(dinv, k), (*_block_diagonal(lp, li, lx, k, n),
-                               *_block_diagonal(up, ui, ux, k, n),
-                               _repeated(perm_r, k, n), _repeated(perm_c, k, n))), None
-
-
-def _repeated(index, k, step):
-    """``index`` (m,) repeated for k diagonal blocks, the c-th copy shifted by ``c step``."""
-    return _narrow(np.asarray(index, dtype=np.int64)[None, :]
-                   + step * np.arange(k, dtype=np.int64)[:, None])
-
-
-def _narrow(index):
-    """:func:`unsigned` of ``index`` raveled, as uint32 when it fits (scipy's int32
-    indices: the kernel compiled once for the shared and the coupled factors)."""
-    index = index.ravel()
-    return unsigned(index.astype(np.int32) if index.size == 0 or index.max() < 2**31
-                    else index)
-
-
-def _block_diagonal(indptr, indices, data, k, n):
-    """The CSR arrays of ``I_k (x) M`` from those of the (n, n) ``M``."""
-    nnz = len(data)
-    rows = np.append(np.asarray(indptr[:-1], dtype=np.int64)[None, :]
-                     + nnz * np.arange(k, dtype=np.int64)[:, None], k * nnz)
-    return _narrow(rows), _repeated(indices, k, n), np.tile(data, k)
+    return ilu_factor(S, drop_tol, fill_factor)

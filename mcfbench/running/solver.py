@@ -288,8 +288,8 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
         round-off, not bitwise.
     factor : tuple, optional
         The ILU methods' preconditioner, an :func:`ilu_factor` of this or another
-        matrix of the same shape (of ``A.shared`` for a block triangular ``A``),
-        instead of one of ``A``.
+        matrix of the same shape (of ``A.shared`` for a block triangular ``A``, an
+        :func:`isotropic_ilu_factor` for a coupled one), instead of one of ``A``.
 
     Returns
     -------
