@@ -421,12 +421,15 @@ def test_solver_validates_its_fields(field, value):
         Solver(**{field: value})
 
 
-def test_shapes_are_checked():
+@pytest.mark.parametrize("method", ["bicgstab", "kept-ilu-bicgstab"])
+def test_shapes_are_checked(method):
     A, b = ring_system(n=20)
     with pytest.raises(ValueError, match="shape"):
-        Solver()(A, b[:, :10], None)
+        Solver(method)(A, b[:, :10], None)
+    with pytest.raises(ValueError, match=r"b must be a \(k, n\) block, got shape \(20,\)"):
+        Solver(method)(A, b[0], None)
     with pytest.raises(ValueError, match="x0"):
-        Solver()(A, b, b[:2])
+        Solver(method)(A, b, b[:2])
 
 
 def test_solve_info_api():
