@@ -90,28 +90,18 @@ Methods (:data:`METHODS`)
     :class:`Solver`) of ``D^{-1} A``, ``D`` the absolute row sums (rows
     equilibrated; if that factor is exactly singular, of ``A`` itself),
     once per call (for the three rows in the shared case); compiled triangular solves.
-    A coupled (3n, 3n) ``A`` (BGN, MDR, DeTurck) is preconditioned by the factor of its
-    isotropic part, the (n, n) mean of its three diagonal blocks, applied to each
-    component (:func:`mcfbench.running.factorizations.isotropic_ilu_factor`; the ILU of
-    the coupled matrix itself took 100-270 iterations at the anisotropic sphere's level 3,
-    this one 8-22).
+    A coupled ``A`` (BGN, MDR, DeTurck): its isotropic part's, :func:`isotropic_ilu_factor`.
 ``kept-ilu-bicgstab``
     ``ilu-bicgstab`` with the factor kept by the :class:`Solver` across its calls (a
     run's steps: the matrices of nearby steps are nearby) and renewed when a solve
-    with it took more than ``ilu_refresh`` iterations, for another shape, or when it
-    did not converge (then the solve is repeated from ``x0`` with the new factor,
-    iterations summed); a coupled (3n, 3n) system's factor is that of its isotropic part
-    (``ilu-bicgstab``), kept likewise and renewed after a solve of ``ilu_refresh``
-    iterations more than the fewest a solve with it took (a new factor of BGN's takes
-    10-14 at the anisotropic sphere's level 3: the shared rule renewed it at every step,
-    32 steps 2.6 CPU s against 5.1). Called through :func:`solve` alone it is
-    ``ilu-bicgstab``.
+    with it took more than ``ilu_refresh`` iterations (a coupled system's: more than the
+    fewest it took plus these), for another shape, or when it did not converge (then the
+    solve is repeated from ``x0`` with the new factor, iterations summed). Called through
+    :func:`solve` alone it is ``ilu-bicgstab``.
     Anisotropic sphere level 4, DDFV chord (96 770 unknowns): the factor 1.6 s; step 1's
     solves steps 1, 2, 10, 30 in 4, 3, 2, 2 iterations (0.2-0.5 s) against BiCGStab's 262,
     269, 211, 170 (0.7-1.1 s); ``drop_tol`` 1e-2 does not converge, pyamg's AMG
-    (smoothed aggregation, root-node) takes 40-95 iterations a row. Its coupled systems
-    (96 774 unknowns), whole runs: BGN, MDR, DeTurck 6.3, 3.4, 3.2 iterations a step,
-    14, 9, 10 CPU s, against plain BiCGStab's failure at step 1 (BGN, MDR) and 163 (47 s).
+    (smoothed aggregation, root-node) takes 40-95 iterations a row.
 ``direct``
     Sparse LU (``scipy.sparse.linalg.splu``: SuperLU's symmetric mode, then,
     if that misses the tolerance, COLAMD with partial pivoting;
@@ -322,7 +312,6 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
                           ilu_fill_factor=ilu_fill_factor, overwrite_x0=overwrite_x0,
                           threads=threads, factor=factor)
     check_threads(threads)
-    k = np.shape(b)[0]
     b, x, cmean, cfull, to_block = _blocks(A, b, x0, overwrite_x0)
     csr = _csr(A)
     with np.errstate(all="ignore"):
@@ -347,8 +336,9 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
             if np.isfinite(csr[2]).all() and np.isfinite(b).all() and np.isfinite(x).all():
                 kind = 2
                 if factor is None:
-                    factor, detail = _ilu(A, k, cfull.shape[1] > 0, ilu_drop_tol,
-                                          ilu_fill_factor)
+                    spilu = (ilu_drop_tol, ilu_fill_factor)      # k rows: len(cmean)
+                    factor, detail = (isotropic_ilu_factor(A, len(cmean), *spilu)
+                                      if cfull.shape[1] else ilu_factor(A, *spilu))
                     if factor is None:
                         return to_block(x), _failed(method, "breakdown", detail)
                 dinv, lu = factor
@@ -372,14 +362,6 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
         detail = krylov.BREAKDOWN_DETAILS[dcode]
     return to_block(x), SolveInfo(int(it), float(residual), code == krylov.CONVERGED,
                                   krylov.STATUS_NAMES[code], method, detail)
-
-
-def _ilu(A, k, coupled, drop_tol, fill_factor):
-    """The ILU methods' factor of ``A`` for a (k, n) block: :func:`ilu_factor` of a
-    shared ``A``, :func:`isotropic_ilu_factor` of a coupled one (module docstring)."""
-    if coupled:
-        return isotropic_ilu_factor(A, k, drop_tol, fill_factor)
-    return ilu_factor(A, drop_tol, fill_factor)
 
 
 def _by_blocks(A, b, x0, **options):
@@ -525,8 +507,7 @@ class Solver:
         Threads of the BiCGStab products and vector updates (see :func:`solve`).
     ilu_refresh : int
         ``"kept-ilu-bicgstab"``: the kept factor is renewed after a solve that took
-        more iterations (a coupled system's factor: more than the fewest a solve with it
-        took plus these; module docstring). Default 10: at the anisotropic sphere's
+        more iterations (module docstring). Default 10: at the anisotropic sphere's
         level 4 ten iterations with the factor cost about 1 s, a new factor 1.6 s.
     """
 
@@ -593,21 +574,19 @@ class Solver:
     def _with_kept_factor(self, A, b, x0, overwrite_x0, options):
         """:func:`solve` with the kept ILU factor (``"kept-ilu-bicgstab"``, module
         docstring): renewed for another shape, after a solve of more than
-        :attr:`ilu_refresh` iterations (a coupled system's: more than the fewest a solve
-        with it took plus :attr:`ilu_refresh`), and when a solve with it fails (then
+        :attr:`ilu_refresh` iterations, and when a solve with it fails (then
         repeated from ``x0``)."""
-        if np.ndim(b) != 2:
-            raise ValueError(f"b must be a (k, n) block, got shape {np.shape(b)}")
         shared = A.shared if hasattr(A, "substitute") else A
-        k, n = np.shape(b)
+        k, n = np.shape(b)[0], np.shape(b)[-1]       # not a (k, n) block: solve() says so
         coupled = shared.shape != (n, n)
+        spilu = (self.ilu_drop_tol, self.ilu_fill_factor)
         kept = self._kept
         old = kept.get("shape") == shared.shape and not kept.get("stale", True)
         if old:
             start = None if x0 is None else np.array(x0, dtype=float)
         else:
-            kept["factor"], _ = _ilu(shared, k, coupled, self.ilu_drop_tol,
-                                     self.ilu_fill_factor)
+            kept["factor"], _ = (isotropic_ilu_factor(shared, k, *spilu) if coupled
+                                 else ilu_factor(shared, *spilu))
             kept["shape"] = shared.shape     # no factor: solve() says why (input, pivot)
             kept["fewest"] = math.inf
         x, info = solve(A, b, x0, overwrite_x0=overwrite_x0, factor=kept["factor"],
@@ -616,7 +595,6 @@ class Solver:
             kept["stale"] = True
             x, again = self._with_kept_factor(A, b, start, True, options)
             return x, replace(again, iterations=info.iterations + again.iterations)
-        kept["fewest"] = min(kept["fewest"], info.iterations)
-        allowed = self.ilu_refresh + (kept["fewest"] if coupled else 0)
-        kept["stale"] = info.iterations > allowed
+        kept["fewest"] = min(kept["fewest"], info.iterations) if coupled else 0
+        kept["stale"] = info.iterations > self.ilu_refresh + kept["fewest"]
         return x, info
