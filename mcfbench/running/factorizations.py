@@ -110,6 +110,14 @@ def isotropic_ilu_factor(A, k=3, drop_tol=1e-4, fill_factor=10.0):
     unpreconditioned; level 4 (96 774) 27, 13, 7 against 46, 26, 12 (each block's ILU)
     and 1000 (not converged), 1000 (not converged), 546.
 
+    ``kept-ilu-bicgstab`` renews it after a solve of ``ilu_refresh`` iterations more than
+    the fewest a solve with it took: a new factor of BGN's takes 10-14 every step at
+    level 3, so the shared factor's rule (more than ``ilu_refresh``) renewed it at every
+    step for nothing (32 steps 5.1 CPU s against 2.6, the same iterations). Whole runs,
+    level 4: BGN, MDR, DeTurck 6.3, 3.4, 3.2 iterations a step, 14, 9, 10 CPU s, against
+    plain BiCGStab's failure at step 1 (BGN, MDR; robust re-runs 64, 55 s) and 163 (47 s)
+    (``benchmarks/bench_dumbbell.py --solver``, ``mcfbench/README.md``).
+
     Parameters
     ----------
     A : (k n, k n) sparse matrix
