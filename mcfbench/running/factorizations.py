@@ -88,3 +88,55 @@ def ilu_arrays(lu):
     return (unsigned(L.indptr), unsigned(L.indices), np.ascontiguousarray(L.data, float),
             unsigned(U.indptr), unsigned(U.indices), np.ascontiguousarray(U.data, float),
             unsigned(lu.perm_r), unsigned(lu.perm_c))
+
+
+def isotropic_ilu_factor(A, k=3, drop_tol=1e-4, fill_factor=10.0):
+    """The ILU methods' preconditioner of a coupled (k n, k n) system (BGN, MDR, DeTurck):
+    the incomplete LU factor of its isotropic part, applied to each component.
+
+    The coupled matrices of :mod:`baselines.bgn` (B4), :mod:`baselines.mdr` (M5) and
+    :mod:`baselines.deturck` (D4) are ``K (x) I_3`` plus a 3 x 3 block at every vertex
+    (``omega_k omega_k^T``, ``alpha I + (1 - alpha) nu_k nu_k^T``), unknowns by
+    components: their diagonal blocks ``A_cc`` differ only on the diagonal and the
+    coupling only joins a vertex's own components. The preconditioner is
+    ``M = I_k (x) S`` with ``S = (1/k) sum_c A_cc`` (the trace of every vertex block over
+    ``k``: ``K`` plus ``|omega_k|^2 / 3``, ``1 / 3``, ``alpha + (1 - alpha) / 3``): one
+    :func:`ilu_factor` of the (n, n) ``S``, which the kernel applies to the k components
+    in one pass over the factor (:func:`mcfbench.running.krylov.precondition`).
+    Measured (step 1 of the anisotropic sphere, BiCGStab iterations, ``rtol`` 1e-9):
+    level 3 (23 814 unknowns) BGN 22, MDR 15, DeTurck 8, against 239, 266, 100 with the
+    ILU of the coupled matrix (225, -, 118 with its unknowns ordered by vertex), 26, 19,
+    11 with one ILU of each diagonal block, and 1000 (not converged), 779, 279
+    unpreconditioned; level 4 (96 774) 27, 13, 7 against 46, 26, 12 (each block's ILU)
+    and 1000 (not converged), 1000 (not converged), 546.
+
+    ``kept-ilu-bicgstab`` renews it after a solve of ``ilu_refresh`` iterations more than
+    the fewest a solve with it took: a new factor of BGN's takes 10-14 every step at
+    level 3, so the shared factor's rule (more than ``ilu_refresh``) renewed it at every
+    step for nothing (32 steps 5.1 CPU s against 2.6, the same iterations). Whole runs,
+    level 4: BGN, MDR, DeTurck 6.3, 3.4, 3.2 iterations a step, 14, 9, 10 CPU s, against
+    plain BiCGStab's failure at step 1 (BGN, MDR; robust re-runs 64, 55 s) and 163 (47 s)
+    (``benchmarks/bench_dumbbell.py --solver``, ``mcfbench/README.md``).
+
+    Parameters
+    ----------
+    A : (k n, k n) sparse matrix
+        Unknowns by components (:mod:`mcfbench.running.solver`).
+    k : int
+        The components.
+    drop_tol, fill_factor : float
+        ``scipy.sparse.linalg.spilu``'s.
+
+    Returns
+    -------
+    factor, detail
+        :func:`ilu_factor`'s of ``S``.
+    """
+    import scipy.sparse as sp
+
+    A = sp.coo_matrix(A)
+    n = A.shape[0] // k
+    diagonal = A.row // n == A.col // n                      # entries of the blocks A_cc
+    S = sp.csr_matrix((A.data[diagonal] / k, (A.row[diagonal] % n, A.col[diagonal] % n)),
+                      shape=(n, n))                          # duplicates summed
+    return ilu_factor(S, drop_tol, fill_factor)

@@ -263,13 +263,23 @@ def roundoff_floor(indptr, indices, data, b, x):
 @njit(**_JIT)
 def precondition(kind, y, z, dinv, lp, li, lx, up, ui, ux, perm_r, perm_c, w):
     """``z = M^{-1} y``: Jacobi (``kind`` 1, ``dinv = 1 / diag(A)``) or ILU
-    (2; ``Pr D^{-1} A Pc ~ L U``, ``dinv = 1 / D``, ``D`` the absolute row sums)."""
+    (2; ``Pr D^{-1} A Pc ~ L U``, ``dinv = 1 / D``, ``D`` the absolute row sums).
+    An ILU factor smaller than ``y``'s rows, (n, n) for (k, c n), is applied to each of
+    their c n-blocks (a coupled system's isotropic part,
+    :func:`mcfbench.running.factorizations.isotropic_ilu_factor`): one pass over the
+    factor for all of them."""
     k, m = y.shape
     if kind == 1:
         for q in range(k):
             for i in range(m):
                 z[q, i] = dinv[i] * y[q, i]
         return
+    n = perm_r.shape[0]
+    if n != m:
+        y = y.reshape(k * (m // n), n)
+        z = z.reshape(k * (m // n), n)
+        w = w.reshape(k * (m // n), n)
+        k, m = y.shape
     for q in range(k):                       # w = Pr D^{-1} y (rows equilibrated)
         for i in range(m):
             w[q, perm_r[i]] = dinv[i] * y[q, i]

@@ -90,15 +90,14 @@ Methods (:data:`METHODS`)
     :class:`Solver`) of ``D^{-1} A``, ``D`` the absolute row sums (rows
     equilibrated; if that factor is exactly singular, of ``A`` itself),
     once per call (for the three rows in the shared case); compiled triangular solves.
+    A coupled ``A`` (BGN, MDR, DeTurck): its isotropic part's, :func:`isotropic_ilu_factor`.
 ``kept-ilu-bicgstab``
     ``ilu-bicgstab`` with the factor kept by the :class:`Solver` across its calls (a
     run's steps: the matrices of nearby steps are nearby) and renewed when a solve
-    with it took more than ``ilu_refresh`` iterations, for another shape, or when it
-    did not converge (then the solve is repeated from ``x0`` with the new factor,
-    iterations summed). A coupled (3n, 3n) system is solved by plain ``bicgstab``: its
-    ILU (BGN, DeTurck at the anisotropic sphere's level 3) needs 100 iterations or more,
-    or misses the tolerance, where the shared (n, n) factor serves the three rows in a
-    few. Called through :func:`solve` alone it is ``ilu-bicgstab``.
+    with it took more than ``ilu_refresh`` iterations (a coupled system's: more than the
+    fewest it took plus these), for another shape, or when it did not converge (then the
+    solve is repeated from ``x0`` with the new factor, iterations summed). Called through
+    :func:`solve` alone it is ``ilu-bicgstab``.
     Anisotropic sphere level 4, DDFV chord (96 770 unknowns): the factor 1.6 s; step 1's
     solves steps 1, 2, 10, 30 in 4, 3, 2, 2 iterations (0.2-0.5 s) against BiCGStab's 262,
     269, 211, 170 (0.7-1.1 s); ``drop_tol`` 1e-2 does not converge, pyamg's AMG
@@ -127,7 +126,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from mcfbench.running.factorizations import (LU_ORDERINGS, NO_FLOAT, factorize, ilu_arrays,
-                                             ilu_factor, unsigned)
+                                             ilu_factor, isotropic_ilu_factor, unsigned)
 
 # scipy.sparse, the compiled kernels (numba) and ddfv's thread checks are imported
 # on first use: the command line reads METHODS and ROBUST for its help in 0.1 s.
@@ -284,8 +283,8 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
         round-off, not bitwise.
     factor : tuple, optional
         The ILU methods' preconditioner, an :func:`ilu_factor` of this or another
-        matrix of the same shape (of ``A.shared`` for a block triangular ``A``),
-        instead of one of ``A``.
+        matrix of the same shape (of ``A.shared`` for a block triangular ``A``, an
+        :func:`isotropic_ilu_factor` for a coupled one), instead of one of ``A``.
 
     Returns
     -------
@@ -337,7 +336,9 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
             if np.isfinite(csr[2]).all() and np.isfinite(b).all() and np.isfinite(x).all():
                 kind = 2
                 if factor is None:
-                    factor, detail = ilu_factor(A, ilu_drop_tol, ilu_fill_factor)
+                    spilu = (ilu_drop_tol, ilu_fill_factor)      # k rows: len(cmean)
+                    factor, detail = (isotropic_ilu_factor(A, len(cmean), *spilu)
+                                      if cfull.shape[1] else ilu_factor(A, *spilu))
                     if factor is None:
                         return to_block(x), _failed(method, "breakdown", detail)
                 dinv, lu = factor
@@ -576,23 +577,24 @@ class Solver:
         :attr:`ilu_refresh` iterations, and when a solve with it fails (then
         repeated from ``x0``)."""
         shared = A.shared if hasattr(A, "substitute") else A
-        n = np.shape(b)[-1]
-        if shared.shape != (n, n):       # coupled: plain BiCGStab (module docstring)
-            x, info = solve(A, b, x0, overwrite_x0=overwrite_x0,
-                            **{**options, "method": "bicgstab"})
-            return x, replace(info, method=self.method)
+        k, n = np.shape(b)[0], np.shape(b)[-1]       # not a (k, n) block: solve() says so
+        coupled = shared.shape != (n, n)
+        spilu = (self.ilu_drop_tol, self.ilu_fill_factor)
         kept = self._kept
         old = kept.get("shape") == shared.shape and not kept.get("stale", True)
         if old:
             start = None if x0 is None else np.array(x0, dtype=float)
         else:
-            kept["factor"], _ = ilu_factor(shared, self.ilu_drop_tol, self.ilu_fill_factor)
+            kept["factor"], _ = (isotropic_ilu_factor(shared, k, *spilu) if coupled
+                                 else ilu_factor(shared, *spilu))
             kept["shape"] = shared.shape     # no factor: solve() says why (input, pivot)
+            kept["fewest"] = math.inf
         x, info = solve(A, b, x0, overwrite_x0=overwrite_x0, factor=kept["factor"],
                         **options)
         if old and not info.converged:
             kept["stale"] = True
             x, again = self._with_kept_factor(A, b, start, True, options)
             return x, replace(again, iterations=info.iterations + again.iterations)
-        kept["stale"] = info.iterations > self.ilu_refresh
+        kept["fewest"] = min(kept["fewest"], info.iterations) if coupled else 0
+        kept["stale"] = info.iterations > self.ilu_refresh + kept["fewest"]
         return x, info
