@@ -574,6 +574,27 @@ def test_kept_ilu_factor_is_kept_renewed_and_retried(monkeypatch):
     assert residual(far, far_b, x) <= 1e-8 * np.linalg.norm(far_b)
 
 
+def test_ilu_preconditioner_is_superlus_solve_for_every_row():
+    """The compiled ILU preconditioner (``krylov.precondition``) is ``M^{-1} y`` of
+    SuperLU's factor, ``M = D Pr^T L U Pc^T``, for a (3, n) block, its three rows in one
+    pass bitwise those of the one-row path (the same sums in the same order)."""
+    from mcfbench.running import krylov
+    from mcfbench.running.factorizations import ilu_factor
+
+    A, _ = nonsymmetric(n=400, seed=3)
+    y = np.random.default_rng(3).normal(size=(3, 400))
+    (dinv, arrays), _ = ilu_factor(A, drop_tol=1e-2)
+    z = np.empty_like(y)
+    krylov.precondition(2, y, z, dinv, *arrays, np.empty_like(y))
+    rows = np.empty_like(y)
+    for q in range(3):
+        krylov.precondition(2, y[q:q + 1], rows[q:q + 1], dinv, *arrays, np.empty((1, 400)))
+    assert np.array_equal(z, rows)
+    lu = spla.spilu(sp.csc_matrix(sp.diags(dinv) @ A), drop_tol=1e-2)
+    assert np.abs(z - lu.solve((dinv * y).T).T).max() <= 1e-13 * np.abs(z).max()
+    assert np.abs(z - spla.spsolve(A.tocsc(), y.T).T).max() > 1e-8 * np.abs(z).max()
+
+
 @pytest.mark.parametrize("scheme", ["ddfv-chord", "cotan"])
 def test_kept_ilu_runs_the_anisotropic_sphere_as_bicgstab_does(scheme):
     """The anisotropic sphere (level 2: 2 018 vertices, 8 steps): the kept ILU
