@@ -86,8 +86,9 @@ Methods (:data:`METHODS`)
     Right-preconditioned with the diagonal of ``A`` (one more vector pass a product).
 ``ilu-bicgstab``
     BiCGStab right-preconditioned with an incomplete LU factorization
-    (``scipy.sparse.linalg.spilu``, ``drop_tol``/``fill_factor`` from
-    :class:`Solver`) of ``D^{-1} A``, ``D`` the absolute row sums (rows
+    (``scipy.sparse.linalg.spilu``, minimum degree on ``A + A^T``,
+    :data:`~mcfbench.running.factorizations.ILU_ORDERING`; ``drop_tol``/``fill_factor``
+    from :class:`Solver`, 1e-5 and 10) of ``D^{-1} A``, ``D`` the absolute row sums (rows
     equilibrated; if that factor is exactly singular, of ``A`` itself),
     once per call (for the three rows in the shared case); compiled triangular solves.
 ``kept-ilu-bicgstab``
@@ -99,9 +100,9 @@ Methods (:data:`METHODS`)
     ILU (BGN, DeTurck at the anisotropic sphere's level 3) needs 100 iterations or more,
     or misses the tolerance, where the shared (n, n) factor serves the three rows in a
     few. Called through :func:`solve` alone it is ``ilu-bicgstab``.
-    Anisotropic sphere level 4, DDFV chord (96 770 unknowns): the factor 1.6 s; step 1's
-    solves steps 1, 2, 10, 30 in 4, 3, 2, 2 iterations (0.2-0.5 s) against BiCGStab's 262,
-    269, 211, 170 (0.7-1.1 s); ``drop_tol`` 1e-2 does not converge, pyamg's AMG
+    Anisotropic sphere level 4, DDFV chord (96 770 unknowns): one factor (1.0 s) for the
+    run's 128 steps, 181 iterations (1.4 a step, 9.1 CPU s of the run; plain BiCGStab
+    170-290 a step, 0.9-1.2 s); ``drop_tol`` 1e-2 does not converge, pyamg's AMG
     (smoothed aggregation, root-node) takes 40-95 iterations a row.
 ``direct``
     Sparse LU (``scipy.sparse.linalg.splu``: SuperLU's symmetric mode, then,
@@ -252,7 +253,7 @@ def _failed(method, status, detail, residual=math.nan, iterations=0):
 
 
 def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
-          stagnation_window=50, ilu_drop_tol=1e-4, ilu_fill_factor=10.0, overwrite_x0=False,
+          stagnation_window=50, ilu_drop_tol=1e-5, ilu_fill_factor=10.0, overwrite_x0=False,
           threads=1, factor=None):
     """Solve ``A x = b`` for a (k, n) block ``b`` from ``x0``; reports failures in ``info``.
 
@@ -514,7 +515,7 @@ class Solver:
     rtol: float = 1e-9
     maxiter: int = 1000
     stagnation_window: int = 50
-    ilu_drop_tol: float = 1e-4
+    ilu_drop_tol: float = 1e-5
     ilu_fill_factor: float = 10.0
     threads: int = 1
     ilu_refresh: int = 10
