@@ -86,22 +86,21 @@ Methods (:data:`METHODS`)
     Right-preconditioned with the diagonal of ``A`` (one more vector pass a product).
 ``ilu-bicgstab``
     BiCGStab right-preconditioned with an incomplete LU factorization
-    (``scipy.sparse.linalg.spilu``, ``drop_tol``/``fill_factor`` from
-    :class:`Solver`) of ``D^{-1} A``, ``D`` the absolute row sums (rows
-    equilibrated; if that factor is exactly singular, of ``A`` itself),
-    once per call (for the three rows in the shared case); compiled triangular solves.
-    A coupled ``A`` (BGN, MDR, DeTurck): its isotropic part's, :func:`isotropic_ilu_factor`.
+    (``scipy.sparse.linalg.spilu``, minimum degree on ``A + A^T``,
+    :data:`~mcfbench.running.factorizations.ILU_ORDERING`; ``drop_tol``/``fill_factor``
+    from :class:`Solver`, 1e-5 and 10) of ``D^{-1} A``, ``D`` the absolute row sums (rows
+    equilibrated; if that factor is exactly singular, of ``A`` itself), once per call;
+    compiled triangular solves. A coupled ``A`` (BGN, MDR, DeTurck): the factor of its
+    isotropic part (:func:`~mcfbench.running.factorizations.isotropic_ilu_factor`).
 ``kept-ilu-bicgstab``
     ``ilu-bicgstab`` with the factor kept by the :class:`Solver` across its calls (a
     run's steps: the matrices of nearby steps are nearby) and renewed when a solve
     with it took more than ``ilu_refresh`` iterations (a coupled system's: more than the
     fewest it took plus these), for another shape, or when it did not converge (then the
-    solve is repeated from ``x0`` with the new factor, iterations summed). Called through
-    :func:`solve` alone it is ``ilu-bicgstab``.
-    Anisotropic sphere level 4, DDFV chord (96 770 unknowns): the factor 1.6 s; step 1's
-    solves steps 1, 2, 10, 30 in 4, 3, 2, 2 iterations (0.2-0.5 s) against BiCGStab's 262,
-    269, 211, 170 (0.7-1.1 s); ``drop_tol`` 1e-2 does not converge, pyamg's AMG
-    (smoothed aggregation, root-node) takes 40-95 iterations a row.
+    solve is repeated from ``x0`` with the new factor, iterations summed); through
+    :func:`solve` alone ``ilu-bicgstab``. Anisotropic sphere level 4, DDFV chord: one
+    factor (1.0 s) for the run's 128 steps, 1.4 iterations a step (plain BiCGStab
+    170-290; pyamg's AMG 40-95: ``mcfbench/README.md``, "A problem's own solver").
 ``direct``
     Sparse LU (``scipy.sparse.linalg.splu``: SuperLU's symmetric mode, then,
     if that misses the tolerance, COLAMD with partial pivoting;
@@ -251,7 +250,7 @@ def _failed(method, status, detail, residual=math.nan, iterations=0):
 
 
 def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
-          stagnation_window=50, ilu_drop_tol=1e-4, ilu_fill_factor=10.0, overwrite_x0=False,
+          stagnation_window=50, ilu_drop_tol=1e-5, ilu_fill_factor=10.0, overwrite_x0=False,
           threads=1, factor=None):
     """Solve ``A x = b`` for a (k, n) block ``b`` from ``x0``; reports failures in ``info``.
 
@@ -508,14 +507,15 @@ class Solver:
     ilu_refresh : int
         ``"kept-ilu-bicgstab"``: the kept factor is renewed after a solve that took
         more iterations (module docstring). Default 10: at the anisotropic sphere's
-        level 4 ten iterations with the factor cost about 1 s, a new factor 1.6 s.
+        level 4 (DDFV) ten iterations with the factor cost about 0.25 s, a new factor
+        1.0 s, after which a step takes 1-2.
     """
 
     method: str = "bicgstab"
     rtol: float = 1e-9
     maxiter: int = 1000
     stagnation_window: int = 50
-    ilu_drop_tol: float = 1e-4
+    ilu_drop_tol: float = 1e-5
     ilu_fill_factor: float = 10.0
     threads: int = 1
     ilu_refresh: int = 10
