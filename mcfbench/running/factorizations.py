@@ -116,7 +116,8 @@ def isotropic_ilu_factor(A, k=3, drop_tol=1e-5, fill_factor=10.0):
     ``k``: ``K`` plus ``|omega_k|^2 / 3``, ``1 / 3``, ``alpha + (1 - alpha) / 3``): one
     :func:`ilu_factor` of the (n, n) ``S``, which the kernel applies to the k components
     in one pass over the factor (:func:`mcfbench.running.krylov.precondition`).
-    Measured (step 1 of the anisotropic sphere, BiCGStab iterations, ``rtol`` 1e-9):
+    Measured (step 1 of the anisotropic sphere, BiCGStab iterations, ``rtol`` 1e-9; these
+    with scipy's COLAMD ordering and ``drop_tol`` 1e-4):
     level 3 (23 814 unknowns) BGN 22, MDR 15, DeTurck 8, against 239, 266, 100 with the
     ILU of the coupled matrix (225, -, 118 with its unknowns ordered by vertex), 26, 19,
     11 with one ILU of each diagonal block, and 1000 (not converged), 779, 279
@@ -127,9 +128,11 @@ def isotropic_ilu_factor(A, k=3, drop_tol=1e-5, fill_factor=10.0):
     the fewest a solve with it took: a new factor of BGN's takes 10-14 every step at
     level 3, so the shared factor's rule (more than ``ilu_refresh``) renewed it at every
     step for nothing (32 steps 5.1 CPU s against 2.6, the same iterations). Whole runs,
-    level 4: BGN, MDR, DeTurck 6.3, 3.4, 3.2 iterations a step, 14, 9, 10 CPU s, against
-    plain BiCGStab's failure at step 1 (BGN, MDR; robust re-runs 64, 55 s) and 163 (47 s)
-    (``benchmarks/bench_dumbbell.py --solver``, ``mcfbench/README.md``).
+    level 4, with :func:`ilu_factor`'s ordering and ``drop_tol`` 1e-5: BGN, MDR, DeTurck
+    5.9, 2.4, 2.2 iterations a step, 8.0, 6.1, 7.3 CPU s, against plain BiCGStab's failure
+    at step 1 (BGN, MDR; robust re-runs 64, 55 s) and 163 (47 s); Enneper level 3 6.6,
+    4.0, 2.8 against 37.5, 28.2, 19.1 (``benchmarks/bench_dumbbell.py --solver``,
+    ``mcfbench/README.md``).
 
     Parameters
     ----------
