@@ -67,9 +67,10 @@ from kept_factor import KeptFactorSolver
 #: relative residual of (TM2)'s solve (:class:`TangentialMotion`; it was 1e-12)
 TANGENTIAL_RTOL = 1e-8
 
-#: CG iterations beyond one a step, summed since (TM2) was last factorised, after which
-#: it is factorised anew (:class:`TangentialMotion`): a factorisation of the dumbbell's
-#: level 3 (81 228 unknowns) costs about 70 iterations (1.4 s against 20 ms)
+#: CG iterations beyond the fewest a step (at least one), summed since (TM2) was last
+#: factorised, after which it is factorised anew (:class:`TangentialMotion`): a
+#: factorisation of the dumbbell's level 3 (81 228 unknowns) costs about 70 iterations
+#: (1.4 s against 20 ms)
 TANGENTIAL_BUDGET = 64
 
 KINDS = ("bgn", "mdr")
@@ -199,8 +200,9 @@ class TangentialMotion(KeptFactorSolver):
     step from the linear extrapolation against 5.5 from ``S_old^{-1} b``; the
     dumbbell's level 3, 40 fresh steps: 4.1 against 4.6 from the linear one),
     until ``|b - S s| <= rtol |b|``. ``S`` is factorised again when a solve takes
-    more than ``max_iterations``, and before a solve once the iterations beyond one
-    a step, summed since the last factorisation, reach ``budget``
+    more than ``max_iterations``, and before a solve once the iterations beyond the
+    fewest a step (at least one; a fresh factor takes two at the angenent's level
+    3), summed since the last factorisation, reach ``budget``
     (:data:`TANGENTIAL_BUDGET`, about what a factorisation costs in iterations: a
     stale factor is kept until it has cost one factorisation more than a fresh
     one would; ``ddfv/README.md``, item 23). The
