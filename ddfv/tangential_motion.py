@@ -277,16 +277,23 @@ class TangentialMotion(KeptFactorSolver):
         F_old, F_new = np.asarray(F_old, dtype=float), np.asarray(F_new, dtype=float)
         n = len(F_new)
         free = np.ones(n, bool) if self.fixed is None else ~self.fixed
+        rows = None if free.all() else np.flatnonzero(free)
         if self._stiffness is None or self._stiffness.shape[0] != n:
             self._stiffness = P1Stiffness(self.faces, n)
         A = self._stiffness(F_old)
         Y = F_new if self.kind == "bgn" else F_new - F_old
-        t1, t2 = (t[free] for t in self._bases(np.asarray(N, dtype=float)))
+        t1, t2 = self._bases(np.asarray(N, dtype=float))
+        if rows is not None:                    # np.take: faster than a boolean mask
+            t1, t2 = np.take(t1, rows, axis=0), np.take(t2, rows, axis=0)
         project, apply = self._operator(A, free, t1, t2)
         s = self.solve(-project(A @ Y), apply, lambda: self._system(A, free, (t1, t2)),
                        sequence="s")
         X = F_new.copy()
-        X[free] += s[0::2, None] * t1 + s[1::2, None] * t2
+        D = s[0::2, None] * t1 + s[1::2, None] * t2
+        if rows is None:
+            X += D
+        else:
+            X[rows] += D
         return X
 
     def _operator(self, A, free, t1, t2):
@@ -316,12 +323,12 @@ class TangentialMotion(KeptFactorSolver):
         rows = None if free.all() else np.flatnonzero(free)
         vertices = (np.arange(len(free)) if rows is None else rows).astype(np.uint64)
         D = np.zeros((len(free), 3))                # E s: zero at the fixed vertices
-        A = sp.csr_matrix(A)
+        A = A.tocsr()
         indptr, indices = (np.asarray(i, dtype=np.int32) for i in (A.indptr, A.indices))
         data = np.asarray(A.data, dtype=np.float64)
 
         def project(Z):
-            Z = Z if rows is None else Z[rows]
+            Z = Z if rows is None else np.take(Z, rows, axis=0)
             out = np.empty((len(t1), 2))
             out[:, 0] = np.einsum("ij,ij->i", t1, Z)
             out[:, 1] = np.einsum("ij,ij->i", t2, Z)
