@@ -15,15 +15,29 @@ Parts:
   smallest angle at the end;
 * ``sphere``: the Table 3.1 setting, levels 1-3: the L2 error (3.2) and its EOC;
 * ``catenoid``: the cylinder between two fixed circles relaxing to the catenoid,
-  levels 1-2: the neck error and its EOC (a fixed boundary).
+  levels 1-2: the neck error and its EOC (a fixed boundary);
+* ``step``: the cost of a step (not a default part): per scheme, the CPU ms a step of
+  the run and the wall ms of the flow's phases (``Flow.timings``: ``tangential``
+  for BGN and MDR, ``potential`` for the redistribution), the factorisations and
+  CG iterations a step of the motion's (or the potential's) kept factor, at
+  ``--problem`` and ``--level`` (default catenoid 3), ``--steps`` steps (default
+  the whole run), after a warm-up of 3 steps at level 1; one core, one thread:
+
+      python benchmarks/ddfv_tangential_motion.py --parts step --level 3 \
+          --schemes ddfv-chord-carried ddfv-chord-bgn-carried ddfv-chord-mdr-carried \
+          ddfv-chord-redistribute-carried
 
 The runs are those of the command line (:func:`mcfbench.running.run.run`, the sparse LU).
 """
 
 import argparse
 import os
+import sys
+import time
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import numpy as np  # noqa: E402
 
@@ -98,14 +112,43 @@ def catenoid(schemes, levels=(1, 2)):
               f"{', '.join(f'{x:.3f}' for x in eoc)} |", flush=True)
 
 
+def step(schemes, problem="catenoid", level=3, steps=None):
+    from _harness import harness_run, machine_line, one_core
+
+    one_core()
+    print(f"step: {machine_line()}; {problem} level {level}")
+    print("| scheme | steps | CPU ms/step | wall ms/step by phase | factorisations | "
+          "CG iterations/step |")
+    print("| --- | --- | --- | --- | --- | --- |")
+    for scheme in schemes:
+        harness_run(scheme, 1, problem=problem, steps=3)                 # warm-up
+        clock = time.process_time()
+        result, flow = harness_run(scheme, level, problem=problem, steps=steps)
+        cpu, n = time.process_time() - clock, result.steps_done
+        phases = ", ".join(f"{k} {1e3 * v / n:.3f}" for k, v in flow.timings.items() if v)
+        solver = flow._motion or flow._potential
+        kept = ("-", "-") if solver is None else (solver.factorisations,
+                                                  f"{solver.iterations / n:.2f}")
+        print(f"| {scheme} | {n} | {1e3 * cpu / n:.3f} | {phases} | {kept[0]} | {kept[1]} |",
+              flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parts = {"problems": problems, "long": long_runs, "sphere": sphere, "catenoid": catenoid}
-    parser.add_argument("--parts", nargs="+", default=list(parts), choices=list(parts))
+    parts = {"problems": problems, "long": long_runs, "sphere": sphere, "catenoid": catenoid,
+             "step": step}
+    parser.add_argument("--parts", nargs="+", default=[p for p in parts if p != "step"],
+                        choices=list(parts))
     parser.add_argument("--schemes", nargs="+", default=list(SCHEMES))
+    parser.add_argument("--problem", default="catenoid", help="of the step part")
+    parser.add_argument("--level", type=int, default=3, help="of the step part")
+    parser.add_argument("--steps", type=int, help="of the step part (default: the run's)")
     args = parser.parse_args()
     for part in args.parts:
-        parts[part](args.schemes)
+        if part == "step":
+            step(args.schemes, args.problem, args.level, args.steps)
+        else:
+            parts[part](args.schemes)
 
 
 if __name__ == "__main__":

@@ -2,11 +2,12 @@
 
 One loop over the diamonds (or triangles, or CSR rows) per kernel; the
 formulas are those of :mod:`ddfv.geometry` and :mod:`ddfv.assembly`, whose
-public functions call these kernels and document the results. This is the
-only module of ``ddfv`` that compiles with numba (loading its kernels from
-numba's cache takes about 0.1 s: a run that does not step DDFV never imports
-it); :mod:`ddfv.geometry` and :mod:`ddfv.assembly` import it on first use,
-so ``import ddfv`` does not pay for it. Their threaded copies are made by
+public functions call these kernels and document the results. With
+:mod:`ddfv.tangential_kernels` (the tangential motions' passes, in its
+conventions) the only module of ``ddfv`` that compiles with numba (loading its
+kernels from numba's cache takes about 0.1 s: a run that does not step DDFV
+never imports it); :mod:`ddfv.geometry` and :mod:`ddfv.assembly` import it on
+first use, so ``import ddfv`` does not pay for it. Their threaded copies are made by
 :mod:`ddfv.threads`.
 
 Conventions

@@ -449,13 +449,13 @@ def carry_t_vertices(F, T, faces, lam):
     (n_t, 3) float array
         ``Q + ((T - Q) . n) n`` with ``Q = sum_k lam_k F_k`` and ``n`` the
         unit normal of the triangle: the height of ``T`` above the plane of
-        its triangle is kept, its projection is put at ``Q``.
+        its triangle is kept, its projection is put at ``Q`` (one compiled pass,
+        :func:`ddfv.tangential_kernels.t_vertices_kernel`: catenoid level 3, 6 144
+        triangles, 0.61 ms in numpy, 0.10 ms compiled).
     """
-    p = np.take(F, faces, axis=0)         # (n_t, 3, 3); 2.5 x faster than F[faces] here
-    Q = np.einsum("tk,tkj->tj", lam, p)
-    nrm = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
-    return Q + np.einsum("ij,ij->i", T - Q, nrm)[:, None] * nrm
+    from .tangential_kernels import moved_t_vertices
+
+    return moved_t_vertices(F, T, faces, lam, carry=True)
 
 
 def surface_components(faces, n_vertices):

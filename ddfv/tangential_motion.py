@@ -67,9 +67,10 @@ from kept_factor import KeptFactorSolver
 #: relative residual of (TM2)'s solve (:class:`TangentialMotion`; it was 1e-12)
 TANGENTIAL_RTOL = 1e-8
 
-#: CG iterations beyond one a step, summed since (TM2) was last factorised, after which
-#: it is factorised anew (:class:`TangentialMotion`): a factorisation of the dumbbell's
-#: level 3 (81 228 unknowns) costs about 70 iterations (1.4 s against 20 ms)
+#: CG iterations beyond the fewest a step (at least one), summed since (TM2) was last
+#: factorised, after which it is factorised anew (:class:`TangentialMotion`): a
+#: factorisation of the dumbbell's level 3 (81 228 unknowns) costs about 70 iterations
+#: (1.4 s against 20 ms)
 TANGENTIAL_BUDGET = 64
 
 KINDS = ("bgn", "mdr")
@@ -83,10 +84,11 @@ def half_cotangents(F, faces):
     With ``e_k = F_{k+2} - F_{k+1}`` the edge opposite corner ``k`` (indices mod
     3) and ``2 |t| = |e_1 x e_2|``, ``cot(angle_k) = -e_{k+1} . e_{k+2} / (2 |t|)``:
     the entries ``igl.cotmatrix_entries`` gives (libigl's columns, corner ``k``
-    facing the edge ``(k+1, k+2)``) in numpy, without libigl's threads, which
-    spent a step's time waiting on a busy machine (catenoid level 2: 6.2 ms of
-    wall time and 0.56 ms of CPU a call in a run; here 0.16 ms, libigl's alone
-    0.10 ms; level 3: 0.58 and 0.28 ms).
+    facing the edge ``(k+1, k+2)``), in one compiled pass
+    (:func:`ddfv.tangential_kernels.half_cotangents_kernel`), without libigl's
+    threads, which spent a step's time waiting on a busy machine (catenoid level
+    2: 6.2 ms of wall time and 0.56 ms of CPU a call in a run). Catenoid level 3
+    (6 144 triangles): 0.36 ms a call in numpy, 0.07 ms compiled.
 
     Parameters
     ----------
@@ -97,13 +99,21 @@ def half_cotangents(F, faces):
     -------
     (m, 3) float array
     """
-    F = np.asarray(F, dtype=np.float64)
-    p0, p1, p2 = (np.take(F, faces[:, k], axis=0) for k in range(3))
-    e0, e1, e2 = p2 - p1, p0 - p2, p1 - p0                             # e_k
-    dots = np.stack([np.einsum("ij,ij->i", e1, e2), np.einsum("ij,ij->i", e2, e0),
-                     np.einsum("ij,ij->i", e0, e1)])                   # (3, m)
-    c = np.cross(e1, e2)
-    return (dots / (-2.0 * np.sqrt(np.einsum("ij,ij->i", c, c)))).T
+    return _half_cotangents(np.asarray(F, dtype=np.float64), _indices(faces)).T
+
+
+def _indices(faces):
+    """``faces`` as the kernels' uint64 indices (a negative index becomes out of range)."""
+    return np.asarray(faces).astype(np.int64, copy=False).view(np.uint64)
+
+
+def _half_cotangents(F, faces):
+    """(3, m) :func:`half_cotangents` by corner (row ``k``), ``faces`` uint64."""
+    from .tangential_kernels import half_cotangents_kernel
+
+    out = np.empty((3, len(faces)))
+    half_cotangents_kernel(F, faces, out)
+    return out
 
 
 class P1Stiffness:
@@ -130,6 +140,7 @@ class P1Stiffness:
 
     def __init__(self, faces, n):
         self.faces = np.ascontiguousarray(faces, dtype=np.int64)
+        self._faces = _indices(self.faces)
         a = self.faces[:, [1, 2, 0]].T                     # (3, m): corner k's edge (a, b)
         b = self.faces[:, [2, 0, 1]].T
         rows = np.concatenate([a, b, a, b]).ravel()
@@ -144,7 +155,8 @@ class P1Stiffness:
 
     def __call__(self, F):
         """``A`` (n, n) CSR at the F-vertices ``F`` (n, 3)."""
-        w = half_cotangents(F, self.faces).T.ravel()         # corner k of triangle t at k m + t
+        w = _half_cotangents(np.asarray(F, dtype=np.float64), self._faces).ravel()
+        # corner k of triangle t at k m + t
         return sp.csr_matrix((self._incidence @ w, self.indices, self.indptr),
                              shape=self.shape)
 
@@ -188,12 +200,13 @@ class TangentialMotion(KeptFactorSolver):
     step from the linear extrapolation against 5.5 from ``S_old^{-1} b``; the
     dumbbell's level 3, 40 fresh steps: 4.1 against 4.6 from the linear one),
     until ``|b - S s| <= rtol |b|``. ``S`` is factorised again when a solve takes
-    more than ``max_iterations``, and before a solve once the iterations beyond one
-    a step, summed since the last factorisation, reach ``budget``
+    more than ``max_iterations``, and before a solve once the iterations beyond the
+    fewest a step (at least one; a fresh factor takes two at the angenent's level
+    3), summed since the last factorisation, reach ``budget``
     (:data:`TANGENTIAL_BUDGET`, about what a factorisation costs in iterations: a
     stale factor is kept until it has cost one factorisation more than a fresh
     one would; ``ddfv/README.md``, item 23). The
-    iterations apply ``S = E^T A E`` as three products (:meth:`_operator`);
+    iterations apply ``S = E^T A E`` in one compiled pass (:meth:`_operator`);
     ``S`` itself is assembled only to be factorised (:meth:`_system`). The
     unknowns are interleaved, ``(k, a) -> 2 k + a``,
     so that ``S`` has the band of ``A`` in the caller's numbering. For the kept
@@ -264,16 +277,23 @@ class TangentialMotion(KeptFactorSolver):
         F_old, F_new = np.asarray(F_old, dtype=float), np.asarray(F_new, dtype=float)
         n = len(F_new)
         free = np.ones(n, bool) if self.fixed is None else ~self.fixed
+        rows = None if free.all() else np.flatnonzero(free)
         if self._stiffness is None or self._stiffness.shape[0] != n:
             self._stiffness = P1Stiffness(self.faces, n)
         A = self._stiffness(F_old)
         Y = F_new if self.kind == "bgn" else F_new - F_old
-        t1, t2 = (t[free] for t in self._bases(np.asarray(N, dtype=float)))
+        t1, t2 = self._bases(np.asarray(N, dtype=float))
+        if rows is not None:                    # np.take: faster than a boolean mask
+            t1, t2 = np.take(t1, rows, axis=0), np.take(t2, rows, axis=0)
         project, apply = self._operator(A, free, t1, t2)
         s = self.solve(-project(A @ Y), apply, lambda: self._system(A, free, (t1, t2)),
                        sequence="s")
         X = F_new.copy()
-        X[free] += s[0::2, None] * t1 + s[1::2, None] * t2
+        D = s[0::2, None] * t1 + s[1::2, None] * t2
+        if rows is None:
+            X += D
+        else:
+            X[rows] += D
         return X
 
     def _operator(self, A, free, t1, t2):
@@ -281,7 +301,10 @@ class TangentialMotion(KeptFactorSolver):
         without forming ``S`` (assembled only when it is factorised, :meth:`_system`).
 
         ``E`` (3 n, 2 n_free) puts ``s`` into the tangent planes: ``(E s)_k = s_2k t1_k
-        + s_2k+1 t2_k`` at the free ``k``, zero at the fixed ones.
+        + s_2k+1 t2_k`` at the free ``k``, zero at the fixed ones. ``apply`` is one
+        compiled pass (:func:`ddfv.tangential_kernels.tangent_product_kernel`; numpy's
+        three products, ``E s``, ``A (E s)`` and ``E^T``, bit for bit: catenoid level 3,
+        0.18 ms a product in numpy, 0.08 ms compiled).
 
         Parameters
         ----------
@@ -295,22 +318,27 @@ class TangentialMotion(KeptFactorSolver):
         project : callable (n, 3) -> (2 n_free,)
         apply : callable (2 n_free,) -> (2 n_free,)
         """
+        from .tangential_kernels import tangent_product_kernel
+
         rows = None if free.all() else np.flatnonzero(free)
+        vertices = (np.arange(len(free)) if rows is None else rows).astype(np.uint64)
+        D = np.zeros((len(free), 3))                # E s: zero at the fixed vertices
+        A = A.tocsr()
+        indptr, indices = (np.asarray(i, dtype=np.int32) for i in (A.indptr, A.indices))
+        data = np.asarray(A.data, dtype=np.float64)
 
         def project(Z):
-            Z = Z if rows is None else Z[rows]
+            Z = Z if rows is None else np.take(Z, rows, axis=0)
             out = np.empty((len(t1), 2))
             out[:, 0] = np.einsum("ij,ij->i", t1, Z)
             out[:, 1] = np.einsum("ij,ij->i", t2, Z)
             return out.ravel()
 
         def apply(s):
-            D = s[0::2, None] * t1 + s[1::2, None] * t2
-            if rows is not None:
-                full = np.zeros((len(free), 3))
-                full[rows] = D
-                D = full
-            return project(A @ D)
+            out = np.empty(2 * len(t1))
+            tangent_product_kernel(indptr, indices, data, t1, t2, vertices,
+                                   np.asarray(s, dtype=np.float64), D, out)
+            return out
         return project, apply
 
     def _system(self, A, free, bases):
@@ -338,17 +366,19 @@ class TangentialMotion(KeptFactorSolver):
     def _bases(self, N):
         """``t1, t2`` (n, 3) at the normals ``N``, ``t1`` following the last one (a
         fresh one of :func:`tangent_bases` only where that is shorter than 1/2)."""
+        from .tangential_kernels import follow_bases_kernel
+
         if self._t1 is None or len(self._t1) != len(N):
             t1 = tangent_bases(N)[0]
+            t2 = np.cross(N, t1)
         else:
-            t1 = self._t1 - np.einsum("ij,ij->i", self._t1, N)[:, None] * N
-            length = np.linalg.norm(t1, axis=1, keepdims=True)
-            short = length[:, 0] <= 0.5
-            t1 /= np.where(short[:, None], 1.0, length)
-            if short.any():
+            t1, t2 = np.empty(N.shape), np.empty(N.shape)
+            short = np.empty(len(N), dtype=bool)
+            if follow_bases_kernel(self._t1, N, t1, t2, short):
                 t1[short] = tangent_bases(N[short])[0]
+                t2[short] = np.cross(N[short], t1[short])
         self._t1 = t1
-        return t1, np.cross(N, t1)
+        return t1, t2
 
 
 class SystemLayout(NamedTuple):
@@ -434,6 +464,9 @@ def follow_triangles(T, displacement, faces, lam):
     -------
     (n_t, 3) float array
         ``T + sum_j lam_j displacement_j``: the offset of ``T`` from the point of
-        coordinates ``lam`` of its triangle is kept.
+        coordinates ``lam`` of its triangle is kept (one compiled pass,
+        :func:`ddfv.tangential_kernels.t_vertices_kernel`).
     """
-    return T + np.einsum("tk,tkj->tj", lam, displacement[faces])
+    from .tangential_kernels import moved_t_vertices
+
+    return moved_t_vertices(displacement, T, faces, lam, carry=False)

@@ -131,12 +131,16 @@ class KeptFactorSolver:
     (or the size changed), ``A`` is factorised and the iteration runs from
     ``P^{-1} b`` of the new factor (for an exact factorisation one residual
     check). With a ``budget``, ``A`` is also factorised before a solve once the
-    iterations beyond one a solve, summed since the last factorisation, reach
-    it: a factorisation that costs about ``budget`` iterations is bought when
-    the stale factor has cost that much more than a fresh one would (the rule
-    of renting until the rent paid equals the price), so that a factor that
-    ages slowly is neither kept at a growing cost nor given up at the first
-    hard step.
+    iterations beyond ``max(1, fewest)`` a solve (``fewest``: the fewest any solve
+    with the kept factor has taken, the estimate of what a fresh factor takes),
+    summed over the solves since the last factorisation, reach it: a
+    factorisation that costs about ``budget`` iterations is bought when the stale
+    factor has cost that much more than a fresh one would (the rule of renting
+    until the rent paid equals the price), so that a factor that ages slowly is
+    neither kept at a growing cost nor given up at the first hard step. (Counted
+    beyond one, a sequence that takes two iterations with a fresh factor, as the
+    tangential motion's at its tolerance, paid one factorisation every
+    ``budget`` solves for no iteration saved.)
 
     Parameters
     ----------
@@ -149,9 +153,9 @@ class KeptFactorSolver:
         approximate inverse (a preconditioner), symmetric positive definite for
         ``"cg"``.
     budget : int, optional
-        Iterations beyond one a solve, summed since the last factorisation, after
-        which the next solve factorises anew; default None (only when a solve
-        takes more than ``max_iterations``).
+        Iterations beyond ``max(1, fewest)`` a solve, summed since the last
+        factorisation, after which the next solve factorises anew; default None
+        (only when a solve takes more than ``max_iterations``).
     extrapolation : {1, 2}
         Degree of the polynomial extrapolation of a sequence's start.
 
@@ -171,7 +175,7 @@ class KeptFactorSolver:
         self._factorise = factorise
         self.budget, self.extrapolation = budget, extrapolation
         self.factorisations = self.iterations = 0
-        self._excess = 0                                # iterations beyond one a solve
+        self._kept = []                 # iterations of each solve with the kept factor
         self.method = self._factor = None
         self._history = {}                              # sequence -> its last two solutions
 
@@ -200,23 +204,27 @@ class KeptFactorSolver:
         history = [x for x in self._history.get(sequence, []) if len(x) == len(b)]
         converged = False
         if (self._factor is not None and self._factor[1] == len(b)
-                and (self.budget is None or self._excess < self.budget)):
+                and (self.budget is None or self._excess() < self.budget)):
             if start is None and history:
                 weights = EXTRAPOLATION[min(len(history) - 1, self.extrapolation)]
                 start = sum(w * x for w, x in zip(weights, reversed(history)))
             before = self.iterations
             x, converged = self._iterate(apply, b, start)
-            self._excess += max(0, self.iterations - before - 1)
+            self._kept.append(self.iterations - before)
         if not converged:
             self.method, solve = self._factorise(matrix() if callable(matrix) else matrix)
             self._factor = solve, len(b)
             self.factorisations += 1
-            self._excess = 0
+            self._kept = []
             x, _ = self._iterate(apply, b, None)
             history = []
         if sequence is not None:
             self._history[sequence] = history[-self.extrapolation:] + [x]
         return x
+
+    def _excess(self):
+        """Iterations beyond ``max(1, fewest)`` a solve since the last factorisation."""
+        return sum(self._kept) - len(self._kept) * max(1, min(self._kept, default=1))
 
     def _iterate(self, apply, b, start):
         """``(x, converged)`` from ``start`` (None: ``P^{-1} b``) with the kept factor

@@ -394,6 +394,8 @@ def test_carried_t_vertices_keep_their_barycentric_coordinates_and_height():
     n /= np.linalg.norm(n, axis=1, keepdims=True)
     height = lambda X: np.einsum("ij,ij->i", X - p[:, 0], n)
     np.testing.assert_allclose(height(out), height(Tm), atol=1e-13)
+    with pytest.raises(IndexError, match="face index out of range"):    # compiled pass
+        carry_t_vertices(V, Tm, np.where(F == 0, len(V), F), lam)
 
 
 @pytest.mark.parametrize("variant", ["chord-redistribute-carried", "redistribute"])

@@ -375,3 +375,28 @@ def test_unknown_motion_is_named():
     with pytest.raises(ValueError, match="unknown tangential motion 'bgm'; choose one of "
                                          "bgn, mdr"):
         tangential_motion(V, W, F, N, "bgm")
+
+
+def test_compiled_passes_refuse_a_face_index_out_of_range_and_take_strided_views():
+    """The compiled passes (:mod:`ddfv.tangential_kernels`) name a face index out of
+    range (also a negative one) instead of reading outside the array, and give on the
+    flow's strided views (``F`` and the normals are transposed views of its state)
+    what they give on contiguous copies."""
+    V, F, N, W = _displaced_bumpy()
+    lam = np.full((len(F), 3), 1.0 / 3.0)
+    for faces in (np.where(F == F.max(), len(V), F), np.where(F == 0, -1, F)):
+        with pytest.raises(IndexError, match="face index out of range"):
+            half_cotangents(V, faces)
+        with pytest.raises(IndexError, match="face index out of range"):
+            follow_triangles(V[F].mean(axis=1), W - V, faces, lam)
+    strided = np.ascontiguousarray(V.T).T
+    assert not strided.flags.c_contiguous
+    np.testing.assert_array_equal(half_cotangents(strided, F), half_cotangents(V, F))
+    T = V[F].mean(axis=1)
+    np.testing.assert_array_equal(follow_triangles(np.ascontiguousarray(T.T).T, strided, F, lam),
+                                  follow_triangles(T, V, F, lam))
+    motion, copy = TangentialMotion(F, "bgn"), TangentialMotion(F, "bgn")
+    for normals in (N, _unit(N + 0.1)):
+        bases = motion._bases(np.ascontiguousarray(normals.T).T)
+        for got, expected in zip(bases, copy._bases(normals)):
+            np.testing.assert_allclose(got, expected, rtol=0, atol=1e-16)

@@ -121,23 +121,37 @@ def test_quadratic_extrapolation():
 def test_budget_factorises_once_the_extra_iterations_reach_it():
     """A drifting sequence whose solves take several CG iterations each with the first
     factor: without a budget one factorisation serves them all; with ``budget`` the
-    matrix is factorised again at the first solve after the iterations beyond one a
-    solve, summed since the last factorisation, reach it (a fresh factor's solve
-    counts none), and every solution meets the tolerance."""
+    matrix is factorised again at the first solve after the iterations beyond the
+    fewest a kept-factor solve has taken (at least one), summed since the last
+    factorisation, reach it (a fresh factor's solve counts none), and every solution
+    meets the tolerance."""
     plain = KeptFactorSolver(rtol=1e-10, max_iterations=50)
     budgeted = KeptFactorSolver(rtol=1e-10, max_iterations=50, budget=6)
-    expected, excess = [], None
-    for k in range(12):
+    expected, kept = [], None
+    for k in range(16):
         A, b = _matrix(k, step=2e-2), _rhs(k)
         _solve(plain, A, b, sequence="x")
-        factorise_now = excess is None or excess >= 6
+        factorise_now = kept is None or sum(kept) - len(kept) * max(1, min(kept, default=1)) >= 6
         before = budgeted.iterations
         x = _solve(budgeted, A, b, sequence="x")
         assert np.linalg.norm(b - A @ x) <= 1e-10 * np.linalg.norm(b)
         expected.append(factorise_now)
-        excess = 0 if factorise_now else excess + max(0, budgeted.iterations - before - 1)
-    assert plain.factorisations == 1 and plain.iterations >= 2 * 11
+        kept = [] if factorise_now else kept + [budgeted.iterations - before]
+    assert plain.factorisations == 1 and plain.iterations >= 2 * 15
     assert budgeted.factorisations == sum(expected) >= 3
+
+
+def test_budget_counts_iterations_beyond_the_fewest_of_the_kept_factor():
+    """A sequence whose solves take two iterations each with the kept factor (a fresh one
+    would too) spends no budget: one factorisation for all, where counting beyond one
+    a solve factorised every ``budget`` solves; one that grows from two spends the
+    growth."""
+    solver = KeptFactorSolver(budget=3)
+    for counts, factorisations in (([2] * 10, 0), ([2, 3, 3, 3, 2], 1), ([2, 4, 2], 0)):
+        solver._kept = list(counts)
+        assert (solver._excess() >= solver.budget) == bool(factorisations), counts
+    solver._kept = []
+    assert solver._excess() == 0
 
 
 def test_size_change_factorises_again():

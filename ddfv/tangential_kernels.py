@@ -1,0 +1,188 @@
+"""Compiled (numba) kernels of the tangential motions of a step: (TM1)-(TM4) and the
+carried T-vertices.
+
+The formulas are those of :mod:`ddfv.tangential_motion` and
+:func:`ddfv.redistribution.carry_t_vertices`, whose functions call these kernels
+and document the results; each kernel does in one loop what numpy did in a
+chain of gathers, ``einsum``, ``cross`` and norms over ``(n, 3)`` arrays, with
+the same operations in the same order (the results are numpy's, bit for bit:
+tested). The conventions of :mod:`ddfv.kernels` hold (explicit signatures,
+layout ``A`` for coordinates, unsigned ``uint64`` indices checked against their
+arrays, ``cache=True``); like it, this module is imported on first use only.
+"""
+
+import numba
+import numpy as np
+
+from .kernels import _OPTIONS
+
+
+@numba.njit("float64(float64, float64, float64, float64, float64, float64)", **_OPTIONS,
+            inline="always")
+def _dot(x0, x1, x2, y0, y1, y2):
+    """``x . y`` summed as numpy's ``einsum("ij,ij->i")`` sums three terms of contiguous
+    rows, ``(x0 y0 + x2 y2) + x1 y1`` (in order for strided ones): the kernels give the
+    numpy path's numbers bit for bit."""
+    return (x0 * y0 + x2 * y2) + x1 * y1
+
+
+@numba.njit("UniTuple(float64, 3)(float64, float64, float64, float64, float64, float64)",
+            **_OPTIONS, inline="always")
+def _cross(x0, x1, x2, y0, y1, y2):
+    """``x x y``, each component as ``np.cross`` forms it."""
+    return x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0
+
+
+@numba.njit("void(float64[:, :], uint64[:, :], float64[:, ::1])", **_OPTIONS)
+def half_cotangents_kernel(F, faces, out):
+    """``out[k, t] = cot(angle_k) / 2`` at corner ``k`` of triangle ``t``
+    (:func:`ddfv.tangential_motion.half_cotangents`).
+
+    Parameters
+    ----------
+    F : (n, 3) float64 array
+    faces : (m, 3) uint64 array
+    out : (3, m) float64 array, output
+    """
+    n = np.uint64(F.shape[0])
+    bad = 0
+    for t in range(faces.shape[0]):
+        i0, i1, i2 = faces[t, 0], faces[t, 1], faces[t, 2]
+        if i0 >= n or i1 >= n or i2 >= n:
+            bad += 1
+            continue
+        e0x, e0y, e0z = F[i2, 0] - F[i1, 0], F[i2, 1] - F[i1, 1], F[i2, 2] - F[i1, 2]
+        e1x, e1y, e1z = F[i0, 0] - F[i2, 0], F[i0, 1] - F[i2, 1], F[i0, 2] - F[i2, 2]
+        e2x, e2y, e2z = F[i1, 0] - F[i0, 0], F[i1, 1] - F[i0, 1], F[i1, 2] - F[i0, 2]
+        cx, cy, cz = _cross(e1x, e1y, e1z, e2x, e2y, e2z)       # e_1 x e_2 = 2 |t| n
+        scale = -2.0 * np.sqrt(_dot(cx, cy, cz, cx, cy, cz))
+        out[0, t] = _dot(e1x, e1y, e1z, e2x, e2y, e2z) / scale
+        out[1, t] = _dot(e2x, e2y, e2z, e0x, e0y, e0z) / scale
+        out[2, t] = _dot(e0x, e0y, e0z, e1x, e1y, e1z) / scale
+    if bad > 0:
+        raise IndexError("face index out of range")
+
+
+@numba.njit("void(int32[::1], int32[::1], float64[::1], float64[:, :], float64[:, :], "
+            "uint64[::1], float64[::1], float64[:, ::1], float64[::1])", **_OPTIONS)
+def tangent_product_kernel(indptr, indices, data, t1, t2, rows, s, D, out):
+    """``out = S s = E^T A E s`` of (TM2) without ``S``
+    (:meth:`ddfv.tangential_motion.TangentialMotion._operator`).
+
+    Parameters
+    ----------
+    indptr, indices, data : int32, int32, float64 arrays
+        ``A`` (n, n) in CSR, sorted or not.
+    t1, t2 : (n_free, 3) float64 arrays
+        Tangent bases at the free vertices.
+    rows : (n_free,) uint64 array
+        The vertex of each free unknown pair.
+    s : (2 n_free,) float64 array
+        Interleaved, ``(k, a) -> 2 k + a``.
+    D : (n, 3) float64 array, work space
+        Zero at the fixed vertices (its free rows are overwritten by ``E s``).
+    out : (2 n_free,) float64 array, output
+    """
+    n = np.uint64(D.shape[0])
+    for i in range(rows.shape[0]):
+        if rows[i] >= n:
+            raise IndexError("vertex index out of range")
+        for c in range(3):                                      # (E s)_k
+            D[rows[i], c] = s[2 * i] * t1[i, c] + s[2 * i + 1] * t2[i, c]
+    for i in range(rows.shape[0]):
+        k = rows[i]
+        y0 = y1 = y2 = 0.0                                      # (A E s)_k
+        for p in range(indptr[k], indptr[k + 1]):
+            j, a = indices[p], data[p]
+            y0 += a * D[j, 0]
+            y1 += a * D[j, 1]
+            y2 += a * D[j, 2]
+        out[2 * i] = _dot(t1[i, 0], t1[i, 1], t1[i, 2], y0, y1, y2)
+        out[2 * i + 1] = _dot(t2[i, 0], t2[i, 1], t2[i, 2], y0, y1, y2)
+
+
+@numba.njit("int64(float64[:, :], float64[:, :], float64[:, ::1], float64[:, ::1], "
+            "boolean[::1])", **_OPTIONS)
+def follow_bases_kernel(t1_old, N, t1, t2, short):
+    """``t1`` the last ``t1_old`` projected on the tangent planes of ``N`` and normalised,
+    ``t2 = N x t1`` (:meth:`ddfv.tangential_motion.TangentialMotion._bases`); where the
+    projection is not longer than 1/2, ``short`` is set and ``t1``, ``t2`` are left for
+    the caller. Returns the number of short rows.
+
+    Parameters
+    ----------
+    t1_old, N : (n, 3) float64 arrays
+    t1, t2 : (n, 3) float64 arrays, output
+    short : (n,) bool array, output
+    """
+    count = 0
+    for i in range(N.shape[0]):
+        # in order, as numpy's einsum sums with a strided N (the flow's normals, a view)
+        d = t1_old[i, 0] * N[i, 0] + t1_old[i, 1] * N[i, 1] + t1_old[i, 2] * N[i, 2]
+        p0 = t1_old[i, 0] - d * N[i, 0]
+        p1 = t1_old[i, 1] - d * N[i, 1]
+        p2 = t1_old[i, 2] - d * N[i, 2]
+        length = np.sqrt(p0 * p0 + p1 * p1 + p2 * p2)
+        short[i] = length <= 0.5
+        if short[i]:
+            count += 1
+            continue
+        p0, p1, p2 = p0 / length, p1 / length, p2 / length
+        t1[i, 0], t1[i, 1], t1[i, 2] = p0, p1, p2
+        t2[i, 0], t2[i, 1], t2[i, 2] = _cross(N[i, 0], N[i, 1], N[i, 2], p0, p1, p2)
+    return count
+
+
+@numba.njit("void(float64[:, :], float64[:, :], uint64[:, :], float64[:, :], boolean, "
+            "float64[:, :])", **_OPTIONS)
+def t_vertices_kernel(F, T, faces, lam, carry, out):
+    """The T-vertices moved with their triangles: ``carry`` False, ``out = T + sum_k
+    lam_k F_k`` (``F`` the F-vertices' displacement; (TM4),
+    :func:`ddfv.tangential_motion.follow_triangles`); ``carry`` True, ``out = Q + ((T -
+    Q) . n) n``, ``Q = sum_k lam_k F_k``, ``n`` the unit normal of the triangle
+    (:func:`ddfv.redistribution.carry_t_vertices`).
+
+    Parameters
+    ----------
+    F : (n_f, 3) float64 array
+    T : (n_t, 3) float64 array
+    faces : (n_t, 3) uint64 array
+    lam : (n_t, 3) float64 array
+    carry : bool
+    out : (n_t, 3) float64 array, output (may be ``T``)
+    """
+    n_f = np.uint64(F.shape[0])
+    bad = 0
+    for t in range(faces.shape[0]):
+        i0, i1, i2 = faces[t, 0], faces[t, 1], faces[t, 2]
+        if i0 >= n_f or i1 >= n_f or i2 >= n_f:
+            bad += 1
+            continue
+        l0, l1, l2 = lam[t, 0], lam[t, 1], lam[t, 2]
+        qx = l0 * F[i0, 0] + l1 * F[i1, 0] + l2 * F[i2, 0]
+        qy = l0 * F[i0, 1] + l1 * F[i1, 1] + l2 * F[i2, 1]
+        qz = l0 * F[i0, 2] + l1 * F[i1, 2] + l2 * F[i2, 2]
+        if not carry:
+            out[t, 0], out[t, 1], out[t, 2] = T[t, 0] + qx, T[t, 1] + qy, T[t, 2] + qz
+            continue
+        e1x, e1y, e1z = F[i1, 0] - F[i0, 0], F[i1, 1] - F[i0, 1], F[i1, 2] - F[i0, 2]
+        e2x, e2y, e2z = F[i2, 0] - F[i0, 0], F[i2, 1] - F[i0, 1], F[i2, 2] - F[i0, 2]
+        nx, ny, nz = _cross(e1x, e1y, e1z, e2x, e2y, e2z)
+        length = np.sqrt(nx * nx + ny * ny + nz * nz)
+        nx, ny, nz = nx / length, ny / length, nz / length
+        h = _dot(T[t, 0] - qx, T[t, 1] - qy, T[t, 2] - qz, nx, ny, nz)
+        out[t, 0], out[t, 1], out[t, 2] = qx + h * nx, qy + h * ny, qz + h * nz
+    if bad > 0:
+        raise IndexError("face index out of range")
+
+
+def moved_t_vertices(F, T, faces, lam, carry):
+    """(n_t, 3) :func:`t_vertices_kernel` of any arrays: ``F`` (n_f, 3), ``T`` (n_t,
+    3), ``faces`` (n_t, 3) int, ``lam`` (n_t, 3), ``carry`` bool (views are not copied;
+    a face index out of range, also a negative one, raises ``IndexError``)."""
+    T = np.asarray(T, dtype=np.float64)
+    out = np.empty(T.shape)
+    t_vertices_kernel(np.asarray(F, dtype=np.float64), T,
+                      np.asarray(faces).astype(np.int64, copy=False).view(np.uint64),
+                      np.asarray(lam, dtype=np.float64), carry, out)
+    return out
