@@ -5,8 +5,6 @@ The oracle is a literal copy of the former numpy BiCGStab (ddfv/solver.py at
 iterates up to round-off.
 """
 
-from dataclasses import replace
-
 import numpy as np
 import pytest
 import scipy.sparse as sp
