@@ -261,6 +261,21 @@ def roundoff_floor(indptr, indices, data, b, x):
 
 
 @njit(**_JIT, inline="always")
+def _substitute(ptr, idx, val, w, q, i, lower):
+    """Row ``i`` of a triangular factor (CSR) against row ``q`` of ``w``: the sum and the
+    diagonal entry of :func:`_substitute3`, for a block of other than three rows."""
+    d = 1.0 if lower else 0.0
+    acc = w[q, i]
+    for jj in range(ptr[i], ptr[i + 1]):
+        j = idx[jj]
+        if (j < i) if lower else (j > i):
+            acc -= val[jj] * w[q, j]
+        elif j == i:
+            d = val[jj]
+    return acc, d
+
+
+@njit(**_JIT, inline="always")
 def _substitute3(ptr, idx, val, w, i, lower):
     """Row ``i`` of a triangular factor (CSR) against the three rows of ``w``: ``w[q, i]
     - sum_j a_ij w[q, j]`` over its entries strictly below (``lower``) or above the
@@ -318,14 +333,7 @@ def precondition(kind, y, z, dinv, lp, li, lx, up, ui, ux, perm_r, perm_c, w):
             w[2, i] = w2 / d if d != 1.0 else w2
             continue
         for q in range(k):
-            d = 1.0
-            acc = w[q, i]
-            for jj in range(lp[i], lp[i + 1]):
-                j = li[jj]
-                if j < i:
-                    acc -= lx[jj] * w[q, j]
-                elif j == i:
-                    d = lx[jj]
+            acc, d = _substitute(lp, li, lx, w, q, i, True)
             w[q, i] = acc / d if d != 1.0 else acc
     for i in range(m - 1, -1, -1):           # U w = w, backward
         if k == 3:
@@ -335,14 +343,7 @@ def precondition(kind, y, z, dinv, lp, li, lx, up, ui, ux, perm_r, perm_c, w):
             w[2, i] = w2 / d
             continue
         for q in range(k):
-            d = 0.0
-            acc = w[q, i]
-            for jj in range(up[i], up[i + 1]):
-                j = ui[jj]
-                if j > i:
-                    acc -= ux[jj] * w[q, j]
-                elif j == i:
-                    d = ux[jj]
+            acc, d = _substitute(up, ui, ux, w, q, i, False)
             w[q, i] = acc / d
     for q in range(k):                       # z = Pc w
         for i in range(m):
