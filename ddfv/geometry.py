@@ -250,7 +250,7 @@ def t_barycentric(F, T, faces, return_min=False, threads=1):
     (n_t, 3) float array
         With ``return_min``: ``(coordinates, smallest)``.
     """
-    from .kernels import t_barycentric_kernel
+    from .kernels import t_barycentric_kernel, unsigned
     from .threads import for_threads
 
     faces = np.asarray(faces)
@@ -259,8 +259,7 @@ def t_barycentric(F, T, faces, return_min=False, threads=1):
     T = _coordinates(T, len(faces), "T")
     out = np.empty((len(faces), 3))
     kernel = for_threads(t_barycentric_kernel, threads)
-    low = kernel(_coordinates(F, None, "F"), T,
-                 faces.astype(np.int64, copy=False).view(np.uint64), out)
+    low = kernel(_coordinates(F, None, "F"), T, unsigned(faces), out)
     return (out, float(low)) if return_min else out
 
 
@@ -275,10 +274,9 @@ def _coordinates(X, n, name):
 
 def _diamond_indices(mesh):
     """(4, n_d) uint64 view of ``mesh.diamonds`` (``t2 = -1`` -> ``kernels.NO_T``)."""
-    diamonds = mesh.diamonds.T
-    if diamonds.dtype != np.int64:
-        diamonds = diamonds.astype(np.int64)
-    return diamonds.view(np.uint64)
+    from .kernels import unsigned
+
+    return unsigned(mesh.diamonds.T)
 
 
 def _diamond_array(x, shape, name):

@@ -54,6 +54,13 @@ FIRST_TOUCH = np.uint32(2**31)
 POSITION = np.uint32(2**31 - 1)
 
 
+def unsigned(indices):
+    """An int index array as the kernels' uint64 indices (a view when it is int64 already,
+    any strides): a negative index becomes one out of range, which the kernels' check
+    reports (``t2 = -1`` becomes :data:`NO_T`)."""
+    return np.asarray(indices).astype(np.int64, copy=False).view(np.uint64)
+
+
 def padded_length(n):
     """Row length ``>= n`` for buffers of many rows of ``n`` float64.
 

@@ -14,7 +14,7 @@ arrays, ``cache=True``); like it, this module is imported on first use only.
 import numba
 import numpy as np
 
-from .kernels import _OPTIONS
+from .kernels import _OPTIONS, unsigned
 
 
 @numba.njit("float64(float64, float64, float64, float64, float64, float64)", **_OPTIONS,
@@ -182,7 +182,6 @@ def moved_t_vertices(F, T, faces, lam, carry):
     a face index out of range, also a negative one, raises ``IndexError``)."""
     T = np.asarray(T, dtype=np.float64)
     out = np.empty(T.shape)
-    t_vertices_kernel(np.asarray(F, dtype=np.float64), T,
-                      np.asarray(faces).astype(np.int64, copy=False).view(np.uint64),
+    t_vertices_kernel(np.asarray(F, dtype=np.float64), T, unsigned(faces),
                       np.asarray(lam, dtype=np.float64), carry, out)
     return out

@@ -99,12 +99,9 @@ def half_cotangents(F, faces):
     -------
     (m, 3) float array
     """
-    return _half_cotangents(np.asarray(F, dtype=np.float64), _indices(faces)).T
+    from .kernels import unsigned
 
-
-def _indices(faces):
-    """``faces`` as the kernels' uint64 indices (a negative index becomes out of range)."""
-    return np.asarray(faces).astype(np.int64, copy=False).view(np.uint64)
+    return _half_cotangents(np.asarray(F, dtype=np.float64), unsigned(faces)).T
 
 
 def _half_cotangents(F, faces):
@@ -139,8 +136,10 @@ class P1Stiffness:
     """
 
     def __init__(self, faces, n):
+        from .kernels import unsigned
+
         self.faces = np.ascontiguousarray(faces, dtype=np.int64)
-        self._faces = _indices(self.faces)
+        self._faces = unsigned(self.faces)
         a = self.faces[:, [1, 2, 0]].T                     # (3, m): corner k's edge (a, b)
         b = self.faces[:, [2, 0, 1]].T
         rows = np.concatenate([a, b, a, b]).ravel()
