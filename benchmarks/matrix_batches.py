@@ -3,7 +3,9 @@ finished matrix's records and benchmark files (issue 32).
 
 Three parts, each printed:
 
-1. *Outside the runs*: per batch job of the matrix as it ran (``--ran-budget``:
+1. *Outside the runs*: per batch job of the matrix as it ran
+   (:func:`~mcfbench.studies.matrix.plan.batches`, as this code packs them; for
+   a matrix of older code, ``--ran-budget``:
    :func:`~mcfbench.studies.matrix.plan.pack` of the cost model's estimates
    without :data:`~mcfbench.studies.matrix.plan.MATRIX_FACTORS`, as before
    them, by that budget: 10 s up to f699a17), its wall seconds (Snakemake's
@@ -23,9 +25,10 @@ Three parts, each printed:
    estimate first on 2 cores (as Snakemake's priorities do): the job count, the
    time both cores are done and their difference.
 
-Usage (the full matrix of f699a17, kept in /work/scratch/matrix-s5)::
+Usage (``CLONE``: a checkout where ``snakemake --cores 2 matrix`` finished, its
+``results/`` in place; ``--ran-budget``: the budget of code before the factors)::
 
-    python benchmarks/matrix_batches.py /work/scratch/matrix-s5 [--ran-budget 10] \\
+    python benchmarks/matrix_batches.py CLONE [--ran-budget 10] \\
         [--budgets 10 30 60 90]
 """
 
@@ -40,9 +43,10 @@ from pathlib import Path
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("checkout", type=Path, help="the checkout the matrix ran in")
-    parser.add_argument("--ran-budget", type=float, default=10.0,
-                        help="BATCH_SECONDS of the code that ran the matrix (before "
-                        "MATRIX_FACTORS)")
+    parser.add_argument("--ran-budget", type=float, default=None,
+                        help="BATCH_SECONDS of the code that ran the matrix, when that "
+                        "code packed its batches without MATRIX_FACTORS (default: the "
+                        "batches of this code, plan.batches)")
     parser.add_argument("--budgets", type=float, nargs="+", default=[10, 30, 60, 90])
     args = parser.parse_args()
     import numpy as np
@@ -74,17 +78,23 @@ def main():
             series[problem, scheme] = (model, cpu, wall, len(levels))
 
     # 1. outside the runs, per batch job of the matrix as it ran
+    if args.ran_budget is None:
+        ran = [(b.problem, b.index, b.schemes) for b in matrix_plan.batches(plan)]
+    else:
+        ran = []
+        for problem, levels in plan["problems"].items():
+            old = {s: series[problem, s][0] + matrix_plan.RUN_SECONDS * len(levels)
+                   for s in plan["schemes"]}
+            ran += [(problem, index, group) for index, group
+                    in enumerate(matrix_plan.pack(old, args.ran_budget), start=1)]
     rows = []
-    for problem, levels in plan["problems"].items():
-        ran = {s: series[problem, s][0] + matrix_plan.RUN_SECONDS * len(levels)
-               for s in plan["schemes"]}
-        for index, group in enumerate(matrix_plan.pack(ran, args.ran_budget), start=1):
-            tsv = root / "benchmarks/matrix" / problem / f"batch{index}.tsv"
-            with open(tsv) as handle:
-                job_wall = float(next(csv.DictReader(handle, delimiter="\t"))["s"])
-            parts = [series[problem, s] for s in group]
-            rows.append((job_wall - sum(p[2] for p in parts), len(parts),
-                         sum(p[3] for p in parts)))
+    for problem, index, group in ran:
+        tsv = root / "benchmarks/matrix" / problem / f"batch{index}.tsv"
+        with open(tsv) as handle:
+            job_wall = float(next(csv.DictReader(handle, delimiter="\t"))["s"])
+        parts = [series[problem, s] for s in group]
+        rows.append((job_wall - sum(p[2] for p in parts), len(parts),
+                     sum(p[3] for p in parts)))
     outside = np.array([r[0] for r in rows])
     fit = np.linalg.lstsq(np.array([[1.0, r[1], r[2]] for r in rows]), outside, rcond=None)[0]
     print(f"1. {len(rows)} batch jobs, {sum(r[2] for r in rows)} runs: outside the runs "
