@@ -95,6 +95,17 @@ def test_the_checks_on_one_shared_measurement_say_what_they_say_alone(name, V0, 
     assert (alone_invariants.quality_collapse() is not None) == collapsed_angle
 
 
+def test_a_state_measures_the_same_in_either_layout():
+    """The vertex schemes' states are (n, 3) views of (3, n) arrays (Fortran order),
+    measured as they are: the same numbers, bitwise, as a C-ordered copy's."""
+    V, F = two_spheres()
+    state = np.ascontiguousarray((0.9 * V).T)
+    view, copy = StateMeasures(V, F)(state.T), StateMeasures(V, F)(state.T.copy())
+    assert view[:3] == copy[:3]
+    assert np.array_equal(view.component_area, copy.component_area)
+    assert np.array_equal(view.diameter, copy.diameter)
+
+
 def test_components_are_found():
     V, F = two_spheres()
     count, labels = vertex_components(F, len(V))
