@@ -5,9 +5,11 @@ before, so a command that measures nothing does not pay for it), each kernel
 loaded from numba's cache: :func:`quality_pass` (:func:`mcfbench.geometry.metrics.quality`),
 :func:`count_folds` (the quality monitor's fold count), :func:`state_pass`
 (:class:`mcfbench.geometry.measures.StateMeasures`: what the driver's collapse and
-invariant checks read of every state, with the same fold count) and :func:`sphere_error_sum`
-(:class:`mcfbench.geometry.exact.SphereL2Error`), tested through them (the quality
-monitor's and the sphere error's against numpy evaluations of their formulas).
+invariant checks read of every state, with the same fold count), :func:`largest_step`
+(:func:`mcfbench.geometry.metrics.max_speed`, the steady state's test) and
+:func:`sphere_error_sum` (:class:`mcfbench.geometry.exact.SphereL2Error`), tested
+through them (the quality monitor's, the speed's and the sphere error's against numpy
+evaluations of their formulas).
 
 A triangle ``(x_0, x_1, x_2)`` is read by :func:`_triangle`: its edges ``a = x_1 -
 x_0``, ``b = x_2 - x_1``, ``c = x_0 - x_2`` and its normal ``n = (x_1 - x_0) x (x_2 -
@@ -221,6 +223,22 @@ def _neighbour_sum(N, neighbours, split, t):
             s1 += N[s, 1]
             s2 += N[s, 2]
     return r0 + s0, r1 + s1, r2 + s2
+
+
+@numba.njit(**_OPTIONS)
+def largest_step(P, V):
+    """``max_i |V_i - P_i|^2`` of two (n, 3) states in one pass (no temporaries), each
+    row's squares summed as ``np.add.reduce(..., axis=1)`` sums three: ``(d_0^2 +
+    d_1^2) + d_2^2``. NaN propagates as in numpy's max; ``-inf`` for ``n = 0``."""
+    largest = -np.inf
+    for i in range(V.shape[0]):
+        d0 = V[i, 0] - P[i, 0]
+        d1 = V[i, 1] - P[i, 1]
+        d2 = V[i, 2] - P[i, 2]
+        s = (d0 * d0 + d1 * d1) + d2 * d2
+        if largest == largest and (s > largest or s != s):
+            largest = s
+    return largest
 
 
 @numba.njit(**_OPTIONS)

@@ -64,23 +64,21 @@ class Steady:
     """``until`` of the driver: the largest vertex speed fell below ``speed``.
 
     The speed is :func:`mcfbench.geometry.metrics.max_speed` of the last two
-    states, computed in two buffers kept for the run (the previous state and the
-    squared steps): a steady-state problem takes thousands of steps on a small
-    mesh, where numpy's temporaries cost more than the arithmetic.
+    states (one compiled pass), the previous one kept in a buffer for the run: a
+    steady-state problem takes thousands of steps on a small mesh, where numpy's
+    temporaries cost more than the arithmetic.
     """
 
     def __init__(self, speed):
         self.speed, self.previous, self.reached = speed, None, False
-        self._step = None
 
     def __call__(self, flow):
         V = flow.vertices
         if self.previous is None:
-            self.previous = np.array(V, dtype=float)
-            self._step = np.empty_like(self.previous)
+            self.previous = np.array(V, dtype=float, order="F")
             self.reached = False
             return False
-        largest = metrics.max_speed(self.previous, V, flow.tau, out=self._step)
+        largest = metrics.max_speed(self.previous, V, flow.tau)
         np.copyto(self.previous, V)
         self.reached = bool(largest < self.speed)
         return self.reached
