@@ -49,6 +49,8 @@ each entry starting from the identity's value (no pass zeroes the array
 first: :func:`ddfv.kernels.system_kernel`).
 """
 
+import copy
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -145,6 +147,11 @@ class Assembler:
         self._diag = np.ascontiguousarray(s_diag)
         self._indices = cols[perm].astype(np.int32)
         self._indptr = np.searchsorted(rows[perm], np.arange(n + 1)).astype(np.int32)
+        # a step's matrix is a shallow copy of this one with its values put in: the
+        # pattern's arrays shared as the constructor shares them, without its checks of
+        # the pattern at every step (33 us a step at 9 000 unknowns)
+        self._pattern = sp.csr_matrix((np.zeros(len(self._indices)), self._indices,
+                                       self._indptr), shape=self.shape)
         self._inner = np.ascontiguousarray(inner)
         self._has_boundary = mesh.has_boundary
         # Rows of boundary F-vertices are Dirichlet rows (Section 2.2.4).
@@ -208,7 +215,9 @@ class Assembler:
         for_threads(system_kernel, threads)(
             self._inner, *factors, slots, self._rows, order, starts, untouched, scale,
             float(shift), data)
-        return sp.csr_matrix((data, self._indices, self._indptr), shape=self.shape)
+        A = copy.copy(self._pattern)
+        A.data = data
+        return A
 
     def stiffness(self, geom):
         """``K``: minus the sum of fluxes, zero rows at Dirichlet vertices.
