@@ -86,6 +86,20 @@ def test_public_arrays_are_copies_of_the_current_state(bumpy):
     np.testing.assert_array_equal(X[:, len(V):].T, flow.T)
 
 
+def test_the_mesh_vertices_are_gathered_once_per_state(bumpy):
+    """``vertices`` (what the driver's checks and the observers read every step) is one
+    read-only array per state, the state's F-vertices, gathered anew after a step."""
+    V, F = bumpy
+    flow = Flow(V, F, 0.01)
+    first = flow.vertices
+    assert flow.vertices is first and not first.flags.writeable
+    np.testing.assert_array_equal(first, V)
+    flow.advance(2.0 * flow.state)
+    assert flow.vertices is not first
+    np.testing.assert_array_equal(flow.vertices, 2.0 * V)
+    np.testing.assert_array_equal(first, V)
+
+
 def test_trajectory_invariant_under_relabelling(bumpy):
     V, F = bumpy
     rng = np.random.default_rng(5)
