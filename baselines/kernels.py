@@ -46,7 +46,8 @@ def cotan_geometry(V, faces, corner_slots, diag_slots, voronoi, with_laplacian,
     Parameters
     ----------
     V : (n, 3) float64 array
-        Vertices (C-contiguous).
+        Vertices (any layout; :meth:`baselines.laplacian.CotanAssembler.geometry`
+        passes Fortran order).
     faces : (m, 3) int64 array
     corner_slots : (m, 3, 2) int64 array
         CSR positions of ``(i, j)`` and ``(j, i)`` for the edge opposite each

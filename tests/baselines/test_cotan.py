@@ -38,6 +38,17 @@ def test_compiled_assembly_matches_igl(noisy_sphere, mass):
                                rtol=1e-13)
 
 
+def test_the_geometry_of_a_flows_state_view_is_that_of_its_copy(noisy_sphere):
+    """The flows pass (n, 3) views of their (3, n) states (Fortran order), assembled as
+    they are: bitwise the geometry of a C-ordered copy."""
+    V, F = noisy_sphere
+    X = np.ascontiguousarray(V.T)
+    asm = CotanAssembler(edge_mesh(F, len(V)), "voronoi")
+    view, copy = asm.geometry(X.T), asm.geometry(X.T.copy())
+    for name in ("L_data", "mass", "area_vectors"):
+        np.testing.assert_array_equal(getattr(view, name), getattr(copy, name))
+
+
 def test_voronoi_mass_of_an_obtuse_triangle():
     # Meyer et al. 2003: |T|/2 at the obtuse corner, |T|/4 at the others
     V = np.array([[0.0, 0, 0], [1, 0, 0], [0.2, 0.1, 0]])
