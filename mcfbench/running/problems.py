@@ -156,8 +156,9 @@ class _Final:
         self.t = 0.0
 
     def __call__(self, flow):
-        self.V, self.faces, self.t = flow.vertices, flow.faces, flow.n * flow.tau
-        self.fixed = getattr(flow, "fixed", None)
+        self.V, self.t = flow.vertices, flow.n * flow.tau
+        if self.faces is None:     # the flow's for the whole run (DDFV's fixed: a gather)
+            self.faces, self.fixed = flow.faces, getattr(flow, "fixed", None)
 
     def result(self):
         raise NotImplementedError
