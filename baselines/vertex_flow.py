@@ -215,7 +215,9 @@ class VertexFlow:
             return [("degenerated", f"{g.degenerate} triangle(s) of zero area (no cotangent "
                      f"weights), e.g. triangle {g.first_degenerate}")]
         area = self._triangle_checks[1]
-        threshold = max(COLLAPSED * area.mean(), 1e-2 * COLLAPSED * self._area0)
+        # area.mean() without its Python wrapper: the same pairwise sum and division
+        threshold = max(COLLAPSED * (np.add.reduce(area) / len(area)),
+                        1e-2 * COLLAPSED * self._area0)
         # the minimum first (one pass; NaN fails it): the indices only for a message
         collapsed = np.flatnonzero(~(area > threshold)) if not area.min() > threshold else ()
         if len(collapsed):
