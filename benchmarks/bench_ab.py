@@ -12,7 +12,9 @@ the same status; a run that is not ``ok`` is timed to where it stopped).
 Prints per scheme the
 medians of the wall and CPU seconds, the median of the paired ratios
 (working tree / revision), iterations and the metrics (the sphere's: the L2
-error (3.2)) of both.
+error (3.2)) of both, and whether every run of both trees ended with the same
+status, iterations and metrics to the last bit (a change meant to leave the
+results alone).
 
     python benchmarks/bench_ab.py --rev 951fb48 [--level 5] [--repeats 5]
         [--schemes ddfv cotan] [--problem sphere]
@@ -27,6 +29,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMB
     os.environ[_var] = "1"          # before numpy is imported; the children inherit them
 
 import argparse  # noqa: E402
+import json  # noqa: E402
 import tempfile  # noqa: E402
 
 from _harness import ROOT, Child, extract, machine_line, median, one_core  # noqa: E402
@@ -94,6 +97,11 @@ def main(argv=None):
         for name in a[0]["metrics"]:
             print(f"{'':>10}{name} {a[0]['metrics'][name]:.6e} / "
                   f"{b[0]['metrics'].get(name, float('nan')):.6e}")
+        same = all(json.dumps([r[k] for k in ("status", "iterations", "metrics")])
+                   == json.dumps([a[0][k] for k in ("status", "iterations", "metrics")])
+                   for r in a + b)        # JSON floats are the shortest exact repr
+        print(f"{'':>10}every run's status, iterations and metrics "
+              f"{'bitwise equal' if same else 'DIFFER'} (rev and work)")
     print(f"load average at the end: {machine_line()}")
 
 
