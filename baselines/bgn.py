@@ -67,6 +67,7 @@ import scipy.sparse as sp
 
 from .vertex_flow import VertexFlow
 from .kernels import bgn_system, vertex_normals
+from .laplacian import with_values
 
 SCALINGS = ("mass", "none")
 
@@ -136,6 +137,9 @@ class BGNFlow(VertexFlow):
         self.scaling = scaling
         super().__init__(vertices, faces, tau, mass="barycentric")
         self._indptr, self._indices = block_pattern(self.assembler.pattern)
+        n = 3 * self.mesh.n_vertices                 # a step's matrix: with_values of it
+        self._pattern = sp.csr_matrix((np.zeros(len(self._indices)), self._indices,
+                                       self._indptr), shape=(n, n))
 
     @property
     def omega(self):
@@ -195,6 +199,4 @@ class BGNFlow(VertexFlow):
         b = np.empty((3, n))
         bgn_system(self._laplacian_data(g), p.indptr, p.diag_slots, g.mass, self._normals(g),
                    np.ascontiguousarray(base), dt, self.fixed, scaling == "mass", data, b)
-        A = sp.csr_matrix((data, self._indices, self._indptr), shape=(3 * n, 3 * n),
-                          copy=False)
-        return A, b
+        return with_values(self._pattern, data), b

@@ -58,6 +58,21 @@ def test_matrix_is_b4_and_symmetric(noisy_sphere):
     assert np.linalg.eigvalsh(A.toarray()).min() > 0.1
 
 
+def test_the_matrices_of_two_states_share_the_pattern_and_keep_their_values(noisy_sphere):
+    """A step's matrix is :func:`baselines.laplacian.with_values` of one matrix of the
+    (3n, 3n) pattern: the next state's does not change it, and it is the matrix a flow
+    started at that state assembles."""
+    V, F = noisy_sphere
+    flow = BGNFlow(V, F, 0.01)
+    A, _ = flow.system()
+    kept = A.toarray()
+    flow.advance(1.5 * flow.state)
+    B, _ = flow.system()
+    assert A.indices is B.indices and A.indptr is B.indptr
+    np.testing.assert_array_equal(A.toarray(), kept)
+    assert (B != BGNFlow(1.5 * V, F, 0.01).system()[0]).nnz == 0 and (A != B).nnz > 0
+
+
 def test_step_solves_the_mixed_system_b1_b2(noisy_sphere):
     # the (X, kappa) saddle-point system of (B1)-(B2), assembled and solved
     # as it stands, against the eliminated (B4)
