@@ -254,12 +254,14 @@ def warm_kernels(threads=1):
     """Compile every kernel, or load it from numba's cache when it is there.
 
     One level-1 sphere step of every scheme of the registry, on one thread
-    and on ``threads`` when more (the threaded copies), and one small solve
-    with every solver method, for a shared and a coupled matrix.
+    and on ``threads`` when more (the threaded copies), one small solve
+    with every solver method, for a shared and a coupled matrix, and the steady-state
+    problems' speed (:func:`mcfbench.geometry.metrics.max_speed`; not a sphere's).
     """
     import numpy as np
     import scipy.sparse as sp
 
+    from mcfbench.geometry.metrics import max_speed
     from mcfbench.running.run import run
     from mcfbench.running.solver import METHODS, solve
 
@@ -274,6 +276,7 @@ def warm_kernels(threads=1):
     for method in METHODS:
         solve(A, b, None, method=method)
         solve(sp.kron(sp.eye(3), A, format="csr"), b, None, method=method)
+    max_speed(np.zeros((2, 3)), np.ones((2, 3)), 1.0)      # two rows: Fortran order
 
 
 def compile_job(threads, output, log):
