@@ -76,6 +76,26 @@ def spmv(indptr, indices, data, X, Y, R):
             Y[2, i] = y2
             ry += R[0, i] * y0 + R[1, i] * y1 + R[2, i] * y2
             yy += y0 * y0 + y1 * y1 + y2 * y2
+    elif k == 4:         # kll's four shared rows (baselines.kll), the sums in registers
+        for i in prange(m):
+            y0 = 0.0
+            y1 = 0.0
+            y2 = 0.0
+            y3 = 0.0
+            for jj in range(indptr[i], indptr[i + 1]):
+                a = data[jj]
+                j = indices[jj]
+                y0 += a * X[0, j]
+                y1 += a * X[1, j]
+                y2 += a * X[2, j]
+                y3 += a * X[3, j]
+            Y[0, i] = y0
+            Y[1, i] = y1
+            Y[2, i] = y2
+            Y[3, i] = y3
+            for q in range(4):       # as the general path (one reduction statement each)
+                ry += R[q, i] * Y[q, i]
+                yy += Y[q, i] * Y[q, i]
     elif k == 1:
         for i in prange(m):
             y0 = 0.0
@@ -201,22 +221,41 @@ def residual(indptr, indices, data, b, x, cmean, cfull, r):
     ac = np.empty(k)
     acabs = np.empty(k)
     for i in range(m):
-        ax[:] = 0.0
-        ac[:] = 0.0
-        acabs[:] = 0.0
         rs = 0.0
         ra = 0.0
-        for jj in range(indptr[i], indptr[i + 1]):
-            a = data[jj]
-            j = indices[jj]
-            rs += a
-            ra += abs(a)
-            for q in range(k):
-                ax[q] += a * x[q, j]
-            if not shared:
+        if shared and k == 4:    # kll's four shared rows: the sums in registers
+            a0 = 0.0
+            a1 = 0.0
+            a2 = 0.0
+            a3 = 0.0
+            for jj in range(indptr[i], indptr[i + 1]):
+                a = data[jj]
+                j = indices[jj]
+                rs += a
+                ra += abs(a)
+                a0 += a * x[0, j]
+                a1 += a * x[1, j]
+                a2 += a * x[2, j]
+                a3 += a * x[3, j]
+            ax[0] = a0
+            ax[1] = a1
+            ax[2] = a2
+            ax[3] = a3
+        else:
+            ax[:] = 0.0
+            ac[:] = 0.0
+            acabs[:] = 0.0
+            for jj in range(indptr[i], indptr[i + 1]):
+                a = data[jj]
+                j = indices[jj]
+                rs += a
+                ra += abs(a)
                 for q in range(k):
-                    ac[q] += a * cfull[q, j]
-                    acabs[q] += abs(a * cfull[q, j])
+                    ax[q] += a * x[q, j]
+                if not shared:
+                    for q in range(k):
+                        ac[q] += a * cfull[q, j]
+                        acabs[q] += abs(a * cfull[q, j])
         nan_a += ra * 0.0
         if ra > norm_a:
             norm_a = ra
