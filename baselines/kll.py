@@ -125,9 +125,10 @@ def curvature_weights(vertices, faces, nu):
     ([13.0], [2.1667, 2.1667, 2.1667])
     """
     w, squared = np.empty(len(vertices)), np.empty(len(faces))
-    gradient_norm_weights(np.ascontiguousarray(vertices, dtype=np.float64),
-                          np.ascontiguousarray(faces, dtype=np.int64),
-                          np.ascontiguousarray(nu, dtype=np.float64), w, squared)
+    # any strides: the flow's (n, 3) views of its (3, n) state are not copied
+    gradient_norm_weights(np.asarray(vertices, dtype=np.float64),
+                          np.asarray(faces, dtype=np.int64),
+                          np.asarray(nu, dtype=np.float64), w, squared)
     return w, squared
 
 
