@@ -52,7 +52,7 @@ from .bgn import BGNFlow
 from .kernels import vertex_normals
 
 
-def unit_vertex_normals(faces, area_vectors, n):
+def unit_vertex_normals(faces, area_vectors, n, rows=None):
     """The unit area-weighted vertex normals (BGN's (B3) normalised).
 
     Parameters
@@ -62,14 +62,17 @@ def unit_vertex_normals(faces, area_vectors, n):
         Twice the area times the unit normal of each triangle.
     n : int
         Number of vertices.
+    rows : (b,) int array, optional
+        Only the normals of these vertices (default all).
 
     Returns
     -------
-    (n, 3) float array
+    (n, 3) or (b, 3) float array
         Zero at a vertex whose triangles all vanished.
     """
     omega = np.empty((n, 3))
     vertex_normals(faces, area_vectors, n, omega)
+    omega = omega if rows is None else np.take(omega, rows, axis=0)
     length = np.linalg.norm(omega, axis=1)
     return np.divide(omega, length[:, None], out=np.zeros_like(omega),
                      where=length[:, None] > 0)

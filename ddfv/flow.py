@@ -337,10 +337,8 @@ class Flow:
         clock = self._tick("geometry", clock)
         A = self._assembler.system(geometry, covolumes, dt, self.threads)
         rhs = base
-        if self.tangential == "eliminate":
-            h = (at - (A @ at.T).T) / dt                              # h*
-            N = vertex_normals(self._mesh, geometry)                  # N*
-            rhs = base - dt * (h - (h * N).sum(axis=0) * N)           # (3.6)
+        if self.tangential == "eliminate":                            # (3.6)
+            rhs = self._eliminated(A, at, base, vertex_normals(self._mesh, geometry), dt)
         elif self.tangential == "redistribute":                       # (R6)-(R7)
             N = vertex_normals(self._mesh, geometry)
             psi = self._potential_of(at, A, dt, geometry, covolumes, N)
@@ -349,6 +347,29 @@ class Flow:
             rhs = base + np.einsum("ij,ij->j", drifted, N) * N        # + dt g*: normal part back
         self._tick("assembly", clock)
         return A, rhs
+
+    @staticmethod
+    def _eliminated(A, at, base, N, dt):
+        """(3, n) ``base - dt (h - (h.N) N)``, ``h = (at - A at) / dt`` (3.6): the
+        right-hand side of the elimination in one compiled pass
+        (:func:`ddfv.tangential_kernels.eliminated_kernel`; numpy's ``h = (at - (A @
+        at.T).T) / dt``, ``base - dt * (h - (h * N).sum(axis=0) * N)`` bit for bit, without
+        their six (3, n) temporaries: catenoid level 3, the fastest of 500 calls 0.31 ms
+        in numpy, 0.20 ms compiled, the product with ``A`` most of it).
+
+        Parameters
+        ----------
+        A : (n, n) scipy.sparse.csr_matrix
+            The step's matrix (the assembler's, int32 indices).
+        at, base, N : (3, n) float arrays
+        dt : float
+        """
+        from .tangential_kernels import eliminated_kernel
+
+        out = np.empty((3, A.shape[0]))
+        eliminated_kernel(A.indptr, A.indices, A.data, np.asarray(at, dtype=np.float64),
+                          np.asarray(base, dtype=np.float64), N, float(dt), out)
+        return out
 
     def advance(self, X):
         """Accept ``X`` (3, n_f + n_t), own numbering, as the state ``n + 1``.

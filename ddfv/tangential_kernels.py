@@ -1,14 +1,15 @@
-"""Compiled (numba) kernels of the tangential motions of a step: (TM1)-(TM4) and the
-carried T-vertices.
+"""Compiled (numba) kernels of the tangential motions of a step: (TM1)-(TM4), the
+carried T-vertices and the right-hand side of the elimination (3.6).
 
-The formulas are those of :mod:`ddfv.tangential_motion` and
-:func:`ddfv.redistribution.carry_t_vertices`, whose functions call these kernels
-and document the results; each kernel does in one loop what numpy did in a
-chain of gathers, ``einsum``, ``cross`` and norms over ``(n, 3)`` arrays, with
-the same operations in the same order (the results are numpy's, bit for bit:
-tested). The conventions of :mod:`ddfv.kernels` hold (explicit signatures,
-layout ``A`` for coordinates, unsigned ``uint64`` indices checked against their
-arrays, ``cache=True``); like it, this module is imported on first use only.
+The formulas are those of :mod:`ddfv.tangential_motion`,
+:func:`ddfv.redistribution.carry_t_vertices` and :meth:`ddfv.flow.Flow.system`,
+which call these kernels and document the results; each kernel does in one loop
+what numpy did in a chain of gathers, sparse products, ``einsum``, ``cross`` and
+norms over ``(n, 3)`` arrays, with the same operations in the same order (the
+results are numpy's, bit for bit: tested). The conventions of :mod:`ddfv.kernels`
+hold (explicit signatures, layout ``A`` for coordinates, unsigned ``uint64``
+indices checked against their arrays, ``cache=True``); like it, this module is
+imported on first use only.
 """
 
 import numba
@@ -174,6 +175,42 @@ def t_vertices_kernel(F, T, faces, lam, carry, out):
         out[t, 0], out[t, 1], out[t, 2] = qx + h * nx, qy + h * ny, qz + h * nz
     if bad > 0:
         raise IndexError("face index out of range")
+
+
+@numba.njit("void(int32[::1], int32[::1], float64[::1], float64[:, :], float64[:, :], "
+            "float64[:, :], float64, float64[:, ::1])", **_OPTIONS)
+def eliminated_kernel(indptr, indices, data, X, B, N, dt, out):
+    """The right-hand side of the elimination (3.6), ``out = B - dt (h - (h.N) N)``
+    with ``h = (X - A X) / dt`` (:meth:`ddfv.flow.Flow.system`), in one pass over the
+    rows of ``A``: numpy's ``(A @ X.T).T`` (scipy sums each row's products in storage
+    order from 0), ``(h * N).sum(axis=0)`` (the components in order) and the
+    elementwise arithmetic, bit for bit.
+
+    Parameters
+    ----------
+    indptr, indices, data : int32, int32, float64 arrays
+        ``A`` (n, n) in CSR (the assembler's: its column indices are in range by
+        construction and not checked here).
+    X, B, N : (3, n) float64 arrays
+        The state of the operators ``X*``, the base ``B`` and the unit vertex normals.
+    dt : float
+    out : (3, n) float64 array, output
+    """
+    n = X.shape[1]
+    if indptr.shape[0] != n + 1 or B.shape[1] != n or N.shape[1] != n or out.shape[1] != n:
+        raise ValueError("the matrix, states, normals and output do not fit")
+    for i in range(n):
+        y0 = y1 = y2 = 0.0                                      # (A X)_i
+        for p in range(indptr[i], indptr[i + 1]):
+            j, a = indices[p], data[p]
+            y0 += a * X[0, j]
+            y1 += a * X[1, j]
+            y2 += a * X[2, j]
+        h0, h1, h2 = (X[0, i] - y0) / dt, (X[1, i] - y1) / dt, (X[2, i] - y2) / dt
+        hN = (h0 * N[0, i] + h1 * N[1, i]) + h2 * N[2, i]
+        out[0, i] = B[0, i] - dt * (h0 - hN * N[0, i])
+        out[1, i] = B[1, i] - dt * (h1 - hN * N[1, i])
+        out[2, i] = B[2, i] - dt * (h2 - hN * N[2, i])
 
 
 def moved_t_vertices(F, T, faces, lam, carry):

@@ -12,6 +12,9 @@ against which the compiled weights (``ddfv.kernels._bernoulli``,
 :func:`p1_stiffness`: libigl's cotangent stiffness, against which DDFV's
 F-mesh stiffness (``ddfv.tangential_motion.P1Stiffness``, summed in numpy from
 half cotangents) is checked.
+
+:func:`boundary_normals`: kll's quadric fit (KL8) in numpy, against which its
+compiled pass (``baselines.kll.quadric_normals_kernel``) is checked.
 """
 
 import igl
@@ -107,3 +110,27 @@ def p1_stiffness(F, faces):
     """The P1 (cotangent) stiffness ``A = -igl.cotmatrix``: ``A_kj = int grad phi_k .
     grad phi_j``, (n, n) CSR, of the (n, 3) points ``F`` on the (m, 3) ``faces``."""
     return sp.csr_matrix(-igl.cotmatrix(np.asarray(F, dtype=float), faces))
+
+
+def boundary_normals(vertices, centres, ring, member, rough):
+    """kll's boundary normals (KL8) in numpy, as ``baselines.kll.boundary_normals``
+    computed them before its compiled pass (``baselines.kll.quadric_normals_kernel``):
+    the quadric of each two-ring fitted by ``np.linalg.solve`` of its weighted normal
+    equations; (b, 3)."""
+    offsets = vertices[ring] - vertices[centres][:, None]                   # (b, k, 3)
+    seed = offsets[np.arange(len(ring)), np.argmax(member * np.linalg.norm(
+        np.cross(offsets, rough[:, None]), axis=2), axis=1)]
+    u1 = np.cross(np.cross(rough, seed), rough)
+    u1 /= np.linalg.norm(u1, axis=1, keepdims=True)
+    u2 = np.cross(rough, u1)
+    squared = (offsets ** 2).sum(axis=2)
+    weight = np.divide(1.0, squared, out=np.zeros_like(squared), where=member)
+    scale = np.sqrt((member * squared).sum(axis=1) / member.sum(axis=1))
+    u, v, w = (np.einsum("bkc,bc->bk", offsets, e) / scale[:, None] for e in (u1, u2, rough))
+    # in units of the ring's size, the slopes a, b unchanged
+    design = np.stack([u, v, u * u, u * v, v * v], axis=2)
+    gram = np.einsum("bki,bk,bkj->bij", design, weight, design)
+    moments = np.einsum("bki,bk,bk->bi", design, weight, w)
+    a, b = np.linalg.solve(gram, moments[..., None])[:, :2, 0].T
+    normal = rough - a[:, None] * u1 - b[:, None] * u2
+    return normal / np.linalg.norm(normal, axis=1, keepdims=True)

@@ -6,11 +6,12 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from conftest import cylinder
+from reference import boundary_normals as numpy_boundary_normals
 from test_mdr import (agrees_under_rigid_motion_and_relabelling,
                       reaches_the_catenoid_keeping_its_boundary)
 
 from baselines.laplacian import cotangent_laplacian
-from baselines.kll import KLLFlow, curvature_weights
+from baselines.kll import KLLFlow, boundary_normals, curvature_weights
 from baselines.mdr import unit_vertex_normals
 from mcfbench.geometry.exact import sphere_state_errors
 from mcfbench.geometry.metrics import catenoid_parameter
@@ -254,6 +255,24 @@ def test_boundary_normals_are_second_order_where_the_vertex_normals_are_first():
     V, F = shapes.flat_patch(1)
     flow = KLLFlow(V @ ROTATION.T, F, 0.01)
     np.testing.assert_allclose(flow.nu, np.tile(ROTATION[:, 2], (len(V), 1)), atol=1e-14)
+
+
+def test_compiled_boundary_normals_are_numpys_to_round_off():
+    """(KL8)'s quadric fit in one compiled pass against the numpy arrays of its formulas
+    (``tests/reference.py``) on the catenoid of level 2 (96 boundary vertices) moved
+    off the catenoid at random; a two-ring on a line (the fit singular) is named."""
+    V, F, _ = catenoid(2)
+    V = V + 0.01 * np.random.default_rng(5).standard_normal(V.shape)
+    flow = KLLFlow(V, F, 0.01)
+    rough = unit_vertex_normals(F, flow.geometry.area_vectors, len(V))[flow._boundary]
+    arguments = (V, flow._boundary, *flow._rings, rough)
+    compiled, numpy = boundary_normals(*arguments), numpy_boundary_normals(*arguments)
+    assert len(compiled) == 96 and np.abs(compiled - rough).max() > 1e-3
+    np.testing.assert_allclose(compiled, numpy, rtol=0, atol=1e-14)
+    line = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [-1, 0, 0], [-2, 0, 0], [3, 0, 0]])
+    with pytest.raises(ValueError, match="two-ring of boundary vertex 0 is singular"):
+        boundary_normals(line, np.array([0]), np.array([[1, 2, 3, 4, 5]]),
+                         np.ones((1, 5), bool), np.array([[0.0, 0, 1]]))
 
 
 def test_flat_disk_stays_flat_and_still():

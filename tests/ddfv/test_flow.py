@@ -194,6 +194,26 @@ def test_elimination_keeps_t_vertices_inside_their_triangles():
     assert simulate(V, F, 0.0025, 800, save_every=0).status == "t_escaped"
 
 
+@pytest.mark.parametrize("dual_length", ["broken", "chord"])
+@pytest.mark.parametrize("surface", ["bumpy", "hemisphere"])
+def test_elimination_right_hand_side_is_numpys_bitwise(surface, dual_length, request):
+    """(3.6) in one compiled pass (Flow._eliminated): numpy's ``h = (X* - A X*) / dt``,
+    ``B - dt (h - (h.N) N)`` bit for bit, at a state, base and step of their own (as
+    BDF2 asks) and with Dirichlet rows (the hemisphere's equator)."""
+    from ddfv.geometry import vertex_normals
+
+    V, F = request.getfixturevalue("bumpy") if surface == "bumpy" else hemisphere(rings=4)
+    flow = Flow(V, F, 0.002, tangential="eliminate", dual_length=dual_length)
+    rng = np.random.default_rng(3)
+    at = flow.state + 0.01 * rng.standard_normal(flow.state.shape)
+    base, dt = flow.state + 0.01 * rng.standard_normal(flow.state.shape), 0.0013
+    A, rhs = flow.system(at, base, dt)
+    h = (at - (A @ at.T).T) / dt
+    N = vertex_normals(flow._mesh, flow._geometry_at(at)[0])
+    assert np.array_equal(rhs, base - dt * (h - (h * N).sum(axis=0) * N))
+    assert not np.array_equal(rhs, base)
+
+
 @pytest.mark.parametrize("options, message", [
     (dict(tau=0.0), "tau must be a positive number"),
     (dict(tau=float("nan")), "tau must be a positive number"),

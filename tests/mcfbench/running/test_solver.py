@@ -519,6 +519,29 @@ def test_residual_round_off_bound(offset):
         assert bound >= exact and np.sqrt(ref2) > bound
 
 
+def test_four_row_passes_are_the_general_ones_bitwise():
+    """The product and the residual of a shared matrix and four rows (kll's block solve)
+    keep their sums in registers: the numbers of the general path, which a fifth row of
+    zeros takes (it adds +0.0 to every sum)."""
+    from mcfbench.running import krylov
+    from mcfbench.running.solver import _csr
+
+    A, b3 = ring_system()
+    rng = np.random.default_rng(4)
+    b = np.vstack([b3, rng.normal(size=(1, A.shape[0]))])
+    x, R = b + 0.01 * rng.normal(size=b.shape), rng.normal(size=b.shape)
+    five = [np.vstack([z, np.zeros((1, A.shape[0]))]) for z in (b, x, R)]
+    Y, Y5 = np.empty_like(b), np.empty_like(five[0])
+    assert krylov.spmv(*_csr(A), x, Y, R) == krylov.spmv(*_csr(A), five[1], Y5, five[2])
+    assert np.array_equal(Y, Y5[:4]) and np.array_equal(Y, (A @ x.T).T)
+    c = np.array([0.5, -1.0, 2.0, 0.25])
+    r, r5 = np.empty_like(b), np.empty_like(five[0])
+    sums = krylov.residual(*_csr(A), b, x, c, np.empty((4, 0)), r)
+    assert sums == krylov.residual(*_csr(A), five[0], five[1], np.r_[c, 0.0],
+                                   np.empty((5, 0)), r5)
+    assert np.array_equal(r, r5[:4]) and sums[0] > 0.0
+
+
 @pytest.mark.parametrize("where", ["b", "x0", "A"])
 def test_overflowing_but_finite_input_is_not_called_non_finite(where):
     """A sum of squares overflows with entries of 1e200: the pass checks the
