@@ -284,8 +284,10 @@ def bgn_system(L_data, indptr, diag_slots, mass, omega, X, tau, fixed, scaled, a
             if fixed[i] or not mass[i] > 0.0:
                 for p in range(start, start + length + 2):
                     A_data[p] = 0.0
-                A_data[start + c + diag_slots[i] - lo] = 1.0
-                b[c, i] = X[c, i]
+                # the identity row (X^m): for alpha > 0 within an ulp, rounded as the
+                # numpy assembly of (D4) rounded it (DeTurck's states bit for bit)
+                A_data[start + c + diag_slots[i] - lo] = 1.0 - alpha + alpha
+                b[c, i] = X[c, i] - alpha * X[c, i] + alpha * X[c, i]
                 continue
             coef = 1.0 if scaled else mass[i] / tau
             s = tau / mass[i] if scaled else 1.0
