@@ -131,6 +131,10 @@ class BGNFlow(VertexFlow):
     ((12, 12), (3, 4), True)
     """
 
+    alpha = 0.0
+    """The weight of the identity in the matrix of the normal velocity, ``Omega_k =
+    alpha I + (1 - alpha) omega_k omega_k^T``: 0 here (B4), DeTurck's ``alpha`` (D4)."""
+
     def __init__(self, vertices, faces, tau, *, scaling="mass"):
         if scaling not in SCALINGS:
             raise ValueError(f"unknown scaling {scaling!r}; choose one of {', '.join(SCALINGS)}")
@@ -198,5 +202,6 @@ class BGNFlow(VertexFlow):
         data = np.empty(len(self._indices))
         b = np.empty((3, n))
         bgn_system(self._laplacian_data(g), p.indptr, p.diag_slots, g.mass, self._normals(g),
-                   np.ascontiguousarray(base), dt, self.fixed, scaling == "mass", data, b)
+                   np.ascontiguousarray(base), dt, self.fixed, scaling == "mass", self.alpha,
+                   data, b)
         return with_values(self._pattern, data), b

@@ -58,7 +58,7 @@ plus ``dt D``. Boundary vertices are fixed (Dirichlet identity rows).
 
 import numpy as np
 
-from .kernels import bgn_system
+from .kernels import advected_stiffness
 from .mdr import UnitNormalBGN
 
 ALPHA = 0.1
@@ -136,44 +136,25 @@ class DeTurckFlow(UnitNormalBGN):
             raise ValueError(f"alpha must be a positive finite number, got {alpha!r}")
         self.alpha = float(alpha)
         super().__init__(vertices, faces, tau, scaling=scaling)
-        self._Y = np.array(self.vertices)                        # the reference surface
+        self._Y = np.ascontiguousarray(self.vertices)            # the reference surface
         self._n0 = self._normals(self.geometry)
         self._G = reference_gradients(self._Y, self.faces, self.assembler.pattern)
-        p, n = self.assembler.pattern, self.mesh.n_vertices
-        block = p.nnz + 2 * n
-        # the diagonal of row c n + i in the layout of baselines.bgn.block_pattern
-        self._diagonal = np.concatenate([c * block + 2 * np.arange(n) + c + p.diag_slots
-                                         for c in range(3)])
 
     def tension(self, at=None):
         """``tau`` (D3) at the state ``at`` (default the current one), (n, 3): the
         reference-tangent tension of the identity from ``at`` to the reference."""
-        return self._tension(self.geometry_at(self._X if at is None else at))
+        return self._advected(self.geometry_at(self._X if at is None else at))[0]
 
-    def _tension(self, geometry):
-        AY = self.assembler.laplacian(geometry.L_data) @ self._Y
-        tension = -np.divide(AY, geometry.mass[:, None], out=np.zeros_like(AY),
-                             where=geometry.mass[:, None] > 0)
-        return tension - self._n0 * np.einsum("kc,kc->k", self._n0, tension)[:, None]
+    def _advected(self, geometry):
+        """``(tension, A + diag(m) D)``: (D3) and the stiffness of (D4) in the pattern
+        of ``A``, at the surface of ``geometry`` (one compiled pass)."""
+        p = self.assembler.pattern
+        tension, data = np.empty((self.mesh.n_vertices, 3)), np.empty(p.nnz)
+        advected_stiffness(geometry.L_data, p.indptr, p.indices, geometry.mass, self._Y,
+                           self._n0, self._G, tension, data)
+        return tension, data
 
     def _laplacian_data(self, geometry):
-        """``A + diag(m) D`` (D4) in the pattern of ``A``, at the surface of ``geometry``."""
-        rows = self.assembler.pattern.rows
-        advection = np.einsum("sc,sc->s", self._G, self._tension(geometry)[rows])
-        return geometry.L_data + geometry.mass[rows] * advection
-
-    def _system(self, at, base, dt, scaling):
-        """(D4) at ``at``: ``A1 - alpha A2 + alpha c I`` with ``A1`` BGN's system of
-        ``A + diag(m) D`` and unit normals, ``A2`` its normal part alone (``nu nu^T``,
-        times ``m / dt`` unscaled) and ``c`` 1 (``"mass"``) or ``m / dt``."""
-        A, b = super()._system(at, base, dt, scaling)             # A1, nu nu^T B (times c)
-        g, p, n = self.geometry_at(at), self.assembler.pattern, self.mesh.n_vertices
-        normal, b_normal = np.empty_like(A.data), np.empty((3, n))
-        bgn_system(np.zeros(p.nnz), p.indptr, p.diag_slots, g.mass, self._normals(g),
-                   np.ascontiguousarray(base), dt, self.fixed, scaling == "mass", normal,
-                   b_normal)
-        live = ~self.fixed & (g.mass > 0)
-        c = np.where(live, g.mass / dt, 1.0) if scaling == "none" else np.ones(n)
-        A.data -= self.alpha * normal
-        A.data[self._diagonal] += self.alpha * np.tile(c, 3)
-        return A, b - self.alpha * b_normal + self.alpha * c * np.asarray(base)
+        """``A + diag(m) D`` (D4) in the pattern of ``A``: BGN's system of it with unit
+        normals and ``Omega``'s identity part (:attr:`alpha`) is (D4)."""
+        return self._advected(geometry)[1]

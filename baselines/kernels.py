@@ -231,14 +231,17 @@ def row_scaled_system(L_data, indptr, diag_slots, mass, tau, fixed, A_data):
 
 
 @njit(cache=True)
-def bgn_system(L_data, indptr, diag_slots, mass, omega, X, tau, fixed, scaled, A_data, b):
+def bgn_system(L_data, indptr, diag_slots, mass, omega, X, tau, fixed, scaled, alpha, A_data,
+               b):
     """Values and right-hand side of the BGN system (B4) ``(A + P/tau) X = P X^m / tau``.
 
     Unknowns by components ``[x_1..x_n, y_1..y_n, z_1..z_n]``; row
     ``c n + i`` of the (3n, 3n) pattern of :func:`baselines.bgn.block_pattern`
     holds, in column order, the couplings ``(d n + i)`` for ``d < c``, the
     entries ``c n + j`` of row ``i`` of ``L``, and the couplings for
-    ``d > c``. ``P = diag_k(m_k omega_k omega_k^T)``.
+    ``d > c``. ``P = diag_k(m_k Omega_k)``, ``Omega_k = alpha I + (1 - alpha) omega_k
+    omega_k^T``: BGN's ``omega_k omega_k^T`` for ``alpha = 0``, DeTurck's (D4) of
+    :mod:`baselines.deturck` otherwise (there with unit normals).
 
     Parameters
     ----------
@@ -258,6 +261,8 @@ def bgn_system(L_data, indptr, diag_slots, mass, omega, X, tau, fixed, scaled, A
         Dirichlet vertices: identity rows, right-hand side ``X^m``.
     scaled : bool
         Multiply row ``(c, k)`` by ``tau / m_k`` (exact: row scaling).
+    alpha : float
+        The weight of the identity in ``Omega_k``.
     A_data : (3 (nnz + 2 n),) float64 array, output
     b : (3, n) float64 array, output
         Rows of a vertex with zero mass are written like Dirichlet rows.
@@ -280,8 +285,10 @@ def bgn_system(L_data, indptr, diag_slots, mass, omega, X, tau, fixed, scaled, A
             if fixed[i] or not mass[i] > 0.0:
                 for p in range(start, start + length + 2):
                     A_data[p] = 0.0
-                A_data[start + c + diag_slots[i] - lo] = 1.0
-                b[c, i] = X[c, i]
+                # the identity row (X^m): for alpha > 0 within an ulp, rounded as the
+                # numpy assembly of (D4) rounded it (DeTurck's states bit for bit)
+                A_data[start + c + diag_slots[i] - lo] = 1.0 - alpha + alpha
+                b[c, i] = X[c, i] - alpha * X[c, i] + alpha * X[c, i]
                 continue
             coef = 1.0 if scaled else mass[i] / tau
             s = tau / mass[i] if scaled else 1.0
@@ -292,15 +299,60 @@ def bgn_system(L_data, indptr, diag_slots, mass, omega, X, tau, fixed, scaled, A
                 if d == c:
                     q = start + c + length
                     continue
-                A_data[q] = coef * wc * omega[i, d]
+                v = coef * wc * omega[i, d]
+                A_data[q] = v - alpha * v
                 q += 1
             base = start + c
             for p in range(lo, hi):
                 A_data[base + p - lo] = L_data[p] * s
-            A_data[base + diag_slots[i] - lo] += coef * wc * wc
+            v = coef * wc * wc
+            diagonal = base + diag_slots[i] - lo
+            A_data[diagonal] = A_data[diagonal] + v - alpha * v + alpha * coef
             normal = omega[i, 0] * X[0, i] + omega[i, 1] * X[1, i] + omega[i, 2] * X[2, i]
-            b[c, i] = coef * wc * normal
+            v = coef * wc * normal
+            b[c, i] = v - alpha * v + alpha * coef * X[c, i]
     return bare
+
+
+@njit(cache=True)
+def advected_stiffness(L_data, indptr, indices, mass, Y, n0, G, tension, out):
+    """DeTurck's tension (D3) and stiffness ``A + diag(m) D`` of (D4)
+    (:mod:`baselines.deturck`), in one pass over the rows of ``L``.
+
+    ``tension_k = -P0_k (L Y)_k / m_k`` (zero where ``m_k <= 0``), ``P0_k = I -
+    n0_k n0_k^T``; ``out_p = L_p + m_k (G_p . tension_k)`` at each entry ``p`` of row ``k``.
+    The dot products are summed ``(x + z) + y``, as ``numpy.einsum`` sums three terms
+    (numpy 2.4): the numbers of the numpy assembly this pass replaced, bit for bit.
+
+    Parameters
+    ----------
+    L_data : (nnz,) float64 array
+    indptr, indices : (n + 1,), (nnz,) int arrays
+        The CSR pattern of ``L``.
+    mass : (n,) float64 array
+    Y, n0 : (n, 3) float64 arrays
+        The reference positions and unit vertex normals.
+    G : (nnz, 3) float64 array
+        :func:`baselines.deturck.reference_gradients`.
+    tension : (n, 3) float64 array, output
+    out : (nnz,) float64 array, output
+    """
+    for k in range(len(mass)):
+        lo, hi = indptr[k], indptr[k + 1]
+        a0 = a1 = a2 = 0.0
+        for p in range(lo, hi):
+            j = indices[p]
+            a0 += L_data[p] * Y[j, 0]
+            a1 += L_data[p] * Y[j, 1]
+            a2 += L_data[p] * Y[j, 2]
+        t0 = t1 = t2 = 0.0
+        if mass[k] > 0.0:
+            t0, t1, t2 = -(a0 / mass[k]), -(a1 / mass[k]), -(a2 / mass[k])
+        normal = n0[k, 0] * t0 + n0[k, 2] * t2 + n0[k, 1] * t1
+        t0, t1, t2 = t0 - n0[k, 0] * normal, t1 - n0[k, 1] * normal, t2 - n0[k, 2] * normal
+        tension[k, 0], tension[k, 1], tension[k, 2] = t0, t1, t2
+        for p in range(lo, hi):
+            out[p] = L_data[p] + mass[k] * (G[p, 0] * t0 + G[p, 2] * t2 + G[p, 1] * t1)
 
 
 @njit(cache=True)

@@ -84,6 +84,8 @@ Methods (:data:`METHODS`)
     setting: 8/45/113/279/654 iterations every solve, solutions within 3e-16).
 ``jacobi-bicgstab``
     Right-preconditioned with the diagonal of ``A`` (one more vector pass a product).
+``coupled-jacobi-bicgstab``
+    ``jacobi-bicgstab`` for a coupled ``A`` (BGN, MDR, DeTurck), else ``bicgstab``.
 ``ilu-bicgstab``
     BiCGStab right-preconditioned with an incomplete LU factorization
     (``scipy.sparse.linalg.spilu``, minimum degree on ``A + A^T``,
@@ -102,10 +104,9 @@ Methods (:data:`METHODS`)
     factor (1.0 s) for the run's 128 steps, 1.4 iterations a step (plain BiCGStab
     170-290; pyamg's AMG 40-95: ``mcfbench/README.md``, "A problem's own solver").
 ``direct``
-    Sparse LU (``scipy.sparse.linalg.splu``: SuperLU's symmetric mode, then,
-    if that misses the tolerance, COLAMD with partial pivoting;
-    :data:`LU_ORDERINGS`) factorized once per call and applied to the three
-    rows (shared case) or ``b.ravel()``; up to three refinement steps, residual as above.
+    Sparse LU (``scipy.sparse.linalg.splu``: SuperLU's symmetric mode, then COLAMD with
+    partial pivoting if that misses the tolerance, :data:`LU_ORDERINGS`) once per call for
+    the k rows or ``b.ravel()``; up to three refinement steps, residual as above.
 ``jacobi-direct``
     ``jacobi-bicgstab``, then ``direct`` from ``x0`` if that fails (:data:`ROBUST`):
     it converges wherever ``direct`` does (iterations: Jacobi's, failed included).
@@ -130,13 +131,12 @@ from mcfbench.running.factorizations import (LU_ORDERINGS, NO_FLOAT, factorize, 
 # scipy.sparse, the compiled kernels (numba) and ddfv's thread checks are imported
 # on first use: the command line reads METHODS and ROBUST for its help in 0.1 s.
 
-METHODS = ("bicgstab", "jacobi-bicgstab", "ilu-bicgstab", "kept-ilu-bicgstab", "direct",
-           "jacobi-direct")
+METHODS = ("bicgstab", "jacobi-bicgstab", "coupled-jacobi-bicgstab", "ilu-bicgstab",
+           "kept-ilu-bicgstab", "direct", "jacobi-direct")
 ROBUST = "jacobi-direct"
 """The method for meshes of unknown quality: its LU converged on all 36 bad-mesh systems
-measured (plain BiCGStab on 20, Jacobi's, tried first, on 33). BGN's first step on the
-anisotropic sphere's level 4 (96 774 unknowns): 1.23 s (367 Jacobi iterations) against
-``direct``'s 3.81 s; level 3 (23 814) 0.15 s against 0.51 s; plain BiCGStab fails."""
+(BiCGStab on 20, Jacobi's on 33). BGN's first step on the anisotropic sphere's level 4:
+1.23 s (367 Jacobi iterations) against ``direct``'s 3.81 s; plain BiCGStab fails."""
 STATUSES = ("converged", "max_iterations", "breakdown", "stagnated")
 
 _REFINEMENTS = 3         # iterative refinement steps of "direct"
@@ -326,7 +326,7 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
                 info = replace(lu, iterations=info.iterations)
             return to_block(x), replace(info, method=method)
         kind, dinv, lu = 0, NO_FLOAT, None
-        if method == "jacobi-bicgstab":
+        if method == "jacobi-bicgstab" or method == "coupled-jacobi-bicgstab" and cfull.size:
             kind = 1
             d = sp.csr_matrix(A).diagonal().astype(float)
             dinv = np.where(d != 0.0, 1.0 / np.where(d != 0.0, d, 1.0), 1.0)

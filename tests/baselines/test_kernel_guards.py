@@ -64,9 +64,10 @@ def test_vertex_normals_and_systems_with_a_bare_vertex():
     A = np.empty(3 * (nnz + 2 * n))
     b = np.empty((3, n))
     X = np.arange(12.0).reshape(3, 4)
-    assert kernels.bgn_system(g.L_data, p.indptr, p.diag_slots, g.mass, omega, X, 0.1, fixed,
-                              True, A, b) == 4
-    np.testing.assert_array_equal(b, X)
+    for alpha in (0.0, 0.3):                                 # BGN's, DeTurck's Omega
+        assert kernels.bgn_system(g.L_data, p.indptr, p.diag_slots, g.mass, omega, X, 0.1,
+                                  fixed, True, alpha, A, b) == 4
+        np.testing.assert_allclose(b, X, rtol=2e-16 if alpha else 0.0, atol=0.0)
     alpha = np.empty((4, 3))
     assert kernels.vertex_gradients(V, F, np.arange(4.0), alpha) == (4, 0)
     assert np.all(alpha == 0.0)
