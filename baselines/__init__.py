@@ -29,5 +29,6 @@ kll (:class:`baselines.kll.KLLFlow`)
 Shared: :mod:`baselines.mesh` (edge topology, CSR pattern),
 :mod:`baselines.laplacian` (the cotangent stiffness and the lumped mass),
 :mod:`baselines.vertex_flow` (the state and checks of every vertex scheme) and
-:mod:`baselines.kernels` (the compiled assembly).
+:mod:`baselines.kernels` (the compiled assembly) and
+:mod:`baselines.tangential_kernels` (the tangential motions' compiled loops).
 """

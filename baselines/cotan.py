@@ -61,7 +61,8 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from .kernels import normal_parts, vertex_normals
+from .kernels import vertex_normals
+from .tangential_kernels import normal_parts
 from .laplacian import cotangent_laplacian, lumped_mass, row_scaled_matrix
 from .redistribution import (OMEGA, PECLET, REDISTRIBUTIONS, PotentialSolver, drift_laplacian,
                              redistribution_source, surface_components, tangential_velocity,

@@ -72,7 +72,7 @@ def reference_gradients(vertices, faces, pattern):
     the hat function of its corner ``j`` is ``N_t x e_j / |N_t|^2`` (``e_j`` the
     edge opposite ``j``, counter-clockwise); the lumped gradient at ``k`` is the
     area-weighted mean over the triangles at ``k`` (that of
-    :func:`baselines.kernels.vertex_gradients` before its projection), so
+    :func:`baselines.tangential_kernels.vertex_gradients` before its projection), so
     ``grad f (x_k) = sum_j G_kj f_j``.
 
     Parameters

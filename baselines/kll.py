@@ -92,7 +92,7 @@ import scipy.sparse as sp
 from numba import njit
 
 from .vertex_flow import VertexFlow
-from .kernels import gradient_norm_weights
+from .tangential_kernels import gradient_norm_weights
 from .mdr import unit_vertex_normals
 
 ROWS = 7
@@ -101,7 +101,7 @@ ROWS = 7
 
 def curvature_weights(vertices, faces, nu):
     """``w`` of (KL4): the lumped ``int |grad_G nu|^2 phi_i``, one value per triangle
-    (kernel :func:`baselines.kernels.gradient_norm_weights`).
+    (kernel :func:`baselines.tangential_kernels.gradient_norm_weights`).
 
     Parameters
     ----------

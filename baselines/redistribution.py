@@ -129,7 +129,7 @@ import scipy.sparse as sp
 
 from kept_factor import KeptFactorSolver, pinned
 
-from .kernels import drift_weights, vertex_gradients
+from .tangential_kernels import drift_weights, vertex_gradients
 
 REDISTRIBUTIONS = (None, "area")
 PECLET = 0.1
@@ -273,7 +273,7 @@ def solve_potential(L, mass, f):
 
 
 def tangential_velocity(vertices, faces, psi):
-    """``v_T = grad psi`` at the vertices, (3, n) (:func:`baselines.kernels.vertex_gradients`).
+    """``v_T = grad psi`` at the vertices, (3, n) (:func:`baselines.tangential_kernels.vertex_gradients`).
 
     Returns
     -------
@@ -309,9 +309,9 @@ def drift_laplacian(L, psi, peclet=np.inf, X=None):
     L_psi : (n, n) scipy.sparse.csr_matrix
         Same pattern (its ``indices`` and ``indptr``, shared); off-diagonal
         ``-c_ij B(psi_i - psi_j)`` (``B`` the Bernoulli function
-        :func:`baselines.kernels.bernoulli_weight`), diagonal the negated sum
+        :func:`baselines.tangential_kernels.bernoulli_weight`), diagonal the negated sum
         of its row's off-diagonal entries (zero row sums): one compiled pass
-        (:func:`baselines.kernels.drift_weights`). Not symmetric, but where no
+        (:func:`baselines.tangential_kernels.drift_weights`). Not symmetric, but where no
         difference is clipped ``diag(e^psi) L_psi`` is (``psi`` constant: ``L``
         itself).
     drift : (3, n) float array

@@ -7,7 +7,7 @@ corrected (chi(V_i^F) in b and c).
 
 :func:`bernoulli`: the Bernoulli function of the drift weights, by ``expm1``,
 against which the compiled weights (``ddfv.kernels._bernoulli``,
-``baselines.kernels.bernoulli_weight``: a Taylor series near 0) are checked.
+``baselines.tangential_kernels.bernoulli_weight``: a Taylor series near 0) are checked.
 
 :func:`p1_stiffness`: libigl's cotangent stiffness, against which DDFV's
 F-mesh stiffness (``ddfv.tangential_motion.P1Stiffness``, summed in numpy from

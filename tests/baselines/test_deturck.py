@@ -11,7 +11,7 @@ from test_mdr import (agrees_under_rigid_motion_and_relabelling,
 from baselines.cotan import CotanFlow
 from baselines.laplacian import cotangent_laplacian
 from baselines.deturck import DeTurckFlow, reference_gradients
-from baselines.kernels import vertex_gradients
+from baselines.tangential_kernels import vertex_gradients
 from mcfbench.geometry.spheres import icosahedron, icosphere
 from mcfbench.running.integrators import BDF2, Euler
 from mcfbench.running.run import level_sweep

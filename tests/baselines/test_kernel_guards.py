@@ -4,7 +4,7 @@ triangle is reported (count and index returned to Python), never raised."""
 import numpy as np
 import pytest
 
-from baselines import kernels
+from baselines import kernels, tangential_kernels
 from baselines.bgn import BGNFlow
 from baselines.cotan import CotanFlow
 from baselines.laplacian import CotanAssembler
@@ -69,7 +69,7 @@ def test_vertex_normals_and_systems_with_a_bare_vertex():
                                   fixed, True, alpha, A, b) == 4
         np.testing.assert_allclose(b, X, rtol=2e-16 if alpha else 0.0, atol=0.0)
     alpha = np.empty((4, 3))
-    assert kernels.vertex_gradients(V, F, np.arange(4.0), alpha) == (4, 0)
+    assert tangential_kernels.vertex_gradients(V, F, np.arange(4.0), alpha) == (4, 0)
     assert np.all(alpha == 0.0)
 
 
@@ -106,9 +106,9 @@ def test_gradient_norm_weights_skip_a_zero_area_triangle():
     V, F = flattened_tetrahedron()
     u = V * [1.0, 1.0, 0.0]
     w, squared = np.empty(4), np.empty(4)
-    assert kernels.gradient_norm_weights(V, F, u, w, squared) == 1
+    assert tangential_kernels.gradient_norm_weights(V, F, u, w, squared) == 1
     assert squared[1] == 0.0 and np.allclose(squared[[0, 2, 3]], 2.0, rtol=1e-14)
     assert w.sum() == pytest.approx(2.0, rel=1e-14)
     V[2] = np.nan
-    assert kernels.gradient_norm_weights(V, F, u, w, squared) == 4
+    assert tangential_kernels.gradient_norm_weights(V, F, u, w, squared) == 4
     assert np.all(w == 0.0)

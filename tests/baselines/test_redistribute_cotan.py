@@ -7,7 +7,7 @@ from conftest import table_3_1_error, twin_sphere
 from reference import bernoulli
 
 from baselines.cotan import CotanFlow
-from baselines.kernels import bernoulli_weight, normal_parts, vertex_gradients
+from baselines.tangential_kernels import bernoulli_weight, normal_parts, vertex_gradients
 from baselines.redistribution import (POTENTIAL_RTOL, PotentialSolver,
                                       drift_laplacian, redistribution_source, solve_potential,
                                       target_shares)
