@@ -142,7 +142,7 @@ def flip_to_delaunay(V, faces, edges, edge_faces, face_edges, mollify, indptr, i
     Edges keep their index through flips (the edge ``(a, b)`` between ``(a, b, c)``
     and ``(b, a, d)`` becomes ``(c, d)``, the triangles ``(a, d, c)`` and ``(b, c,
     d)``); the stiffness (C2) and barycentric mass of the final triangulation are
-    assembled from its edge lengths (:func:`_triangle`) into the pattern.
+    assembled from its edge lengths (:func:`_face`) into the pattern.
 
     Parameters
     ----------
@@ -191,6 +191,9 @@ def flip_to_delaunay(V, faces, edges, edge_faces, face_edges, mollify, indptr, i
     lengths += epsilon
     tri[:] = faces
     sides = face_edges.copy()
+    cot, area = np.empty((m, 3)), np.empty(m)        # each corner's half cotangent, area
+    for t in range(m):
+        _face(lengths, sides, t, cot, area)
     owners = edge_faces.copy()
     ends[:] = edges
     queue = np.arange(E)                      # a ring: every edge at most once in it
@@ -201,9 +204,9 @@ def flip_to_delaunay(V, faces, edges, edge_faces, face_edges, mollify, indptr, i
         head, size = (head + 1) % E, size - 1
         queued[e] = False
         f1, f2 = owners[e, 0], owners[e, 1]
-        w = _weight(lengths, sides, f1, e) * (2.0 if f2 < 0 else 1.0)
+        w = cot[f1, _corner_of(sides, f1, e)] * (2.0 if f2 < 0 else 1.0)
         if f2 >= 0:
-            w += _weight(lengths, sides, f2, e)
+            w += cot[f2, _corner_of(sides, f2, e)]
         if not abs(w - FLIP_BELOW) > MARGIN or (f2 < 0 and w < FLIP_BELOW):
             return -1, flips, epsilon
         if w >= FLIP_BELOW:
@@ -215,12 +218,8 @@ def flip_to_delaunay(V, faces, edges, edge_faces, face_edges, mollify, indptr, i
         d = tri[f2, j]
         ad, bd = (sides[f2, (j + 1) % 3], sides[f2, (j + 2) % 3]) if tri[f2, (j + 1) % 3] == b \
             else (sides[f2, (j + 2) % 3], sides[f2, (j + 1) % 3])
-        l_cd = _unfolded(lengths[e], lengths[ac], lengths[bc], lengths[ad], lengths[bd])
-        if c == d or not (_area(l_cd, lengths[ac], lengths[ad]) > 0.0
-                          and _area(l_cd, lengths[bc], lengths[bd]) > 0.0):
-            return -1, flips, epsilon
         flips += 1
-        if flips > 20 * E:
+        if c == d or flips > 20 * E:
             return -1, flips, epsilon
         tri[f1, 0], tri[f1, 1], tri[f1, 2] = a, d, c          # (a, d, c), (b, c, d)
         sides[f1, 0], sides[f1, 1], sides[f1, 2] = e, ac, ad
@@ -229,7 +228,11 @@ def flip_to_delaunay(V, faces, edges, edge_faces, face_edges, mollify, indptr, i
         owners[ad, 0 if owners[ad, 0] == f2 else 1] = f1
         owners[bc, 0 if owners[bc, 0] == f1 else 1] = f2
         ends[e, 0], ends[e, 1] = min(c, d), max(c, d)
-        lengths[e] = l_cd
+        lengths[e] = _unfolded(lengths[e], lengths[ac], lengths[bc], lengths[ad], lengths[bd])
+        _face(lengths, sides, f1, cot, area)
+        _face(lengths, sides, f2, cot, area)
+        if not (area[f1] > 0.0 and area[f2] > 0.0):
+            return -1, flips, epsilon
         for s in (ac, ad, bd, bc):
             if not queued[s]:
                 queue[(head + size) % E] = s
@@ -250,10 +253,14 @@ def flip_to_delaunay(V, faces, edges, edge_faces, face_edges, mollify, indptr, i
     L_data[:] = 0.0
     mass[:] = 0.0
     for t in range(m):
-        s0, s1, s2 = sides[t, 0], sides[t, 1], sides[t, 2]
-        _triangle(L_data, mass, diag_slots, 1.0, tri[t, 0], tri[t, 1], tri[t, 2],
-                  lengths[s0], lengths[s1], lengths[s2], slots[s0, 0], slots[s0, 1],
-                  slots[s1, 0], slots[s1, 1], slots[s2, 0], slots[s2, 1])
+        for k in range(3):           # the edge opposite corner k: cotangent weight (C2)
+            s, w = sides[t, k], cot[t, k]
+            p, q = tri[t, (k + 1) % 3], tri[t, (k + 2) % 3]
+            L_data[slots[s, 0]] -= w
+            L_data[slots[s, 1]] -= w
+            L_data[diag_slots[p]] += w
+            L_data[diag_slots[q]] += w
+            mass[tri[t, k]] += area[t] / 3.0      # barycentric
     return 1, flips, epsilon
 
 
@@ -276,17 +283,15 @@ def _area(x, y, z):
 
 
 @njit(cache=True, inline="always")
-def _cotangent(x, y, z):
-    """Half the cotangent of the angle opposite the side ``x`` of the triangle of sides
-    ``x, y, z``: ``(y^2 + z^2 - x^2) / (8 area)`` (C2)."""
-    return (y * y + z * z - x * x) / (8.0 * _area(x, y, z))
-
-
-@njit(cache=True, inline="always")
-def _weight(lengths, sides, t, e):
-    """Triangle ``t``'s half of the weight of its edge ``e`` (:func:`_cotangent`)."""
-    k = _corner_of(sides, t, e)
-    return _cotangent(lengths[e], lengths[sides[t, (k + 1) % 3]], lengths[sides[t, (k + 2) % 3]])
+def _face(lengths, sides, t, cot, area):
+    """Triangle ``t``'s area (Heron's) and the half cotangents of its corners, ``cot[t,
+    k] = (y^2 + z^2 - x^2) / (8 area)`` for the side ``x`` opposite corner ``k`` (C2)."""
+    x, y, z = lengths[sides[t, 0]], lengths[sides[t, 1]], lengths[sides[t, 2]]
+    a = _area(x, y, z)
+    area[t] = a
+    cot[t, 0] = (y * y + z * z - x * x) / (8.0 * a)
+    cot[t, 1] = (z * z + x * x - y * y) / (8.0 * a)
+    cot[t, 2] = (x * x + y * y - z * z) / (8.0 * a)
 
 
 @njit(cache=True, inline="always")
@@ -311,29 +316,6 @@ def _slot(indptr, indices, row, col):
         else:
             hi = mid
     return lo if lo < indptr[row + 1] and indices[lo] == col else -1
-
-
-@njit(cache=True, inline="always")
-def _triangle(L_data, mass, diag_slots, sign, p0, p1, p2, l0, l1, l2, s0, t0, s1, t1, s2, t2):
-    """Add ``sign`` x the cotangent weights (C2) and the thirds of the area of the
-    triangle ``(p0, p1, p2)`` of sides ``l0, l1, l2`` (``l_k`` opposite ``p_k``, its
-    slots ``s_k, t_k``): :func:`_cotangent`, Heron's area."""
-    _edge(L_data, diag_slots, p1, p2, s0, t0, sign * _cotangent(l0, l1, l2))
-    _edge(L_data, diag_slots, p2, p0, s1, t1, sign * _cotangent(l1, l2, l0))
-    _edge(L_data, diag_slots, p0, p1, s2, t2, sign * _cotangent(l2, l0, l1))
-    third = sign * _area(l0, l1, l2) / 3.0
-    mass[p0] += third
-    mass[p1] += third
-    mass[p2] += third
-
-
-@njit(cache=True, inline="always")
-def _edge(L_data, diag_slots, p, q, s, t, w):
-    """Add the weight ``w`` of the edge ``(p, q)`` (its slots ``s``, ``t``) to ``L`` (C2)."""
-    L_data[s] -= w
-    L_data[t] -= w
-    L_data[diag_slots[p]] += w
-    L_data[diag_slots[q]] += w
 
 
 class FlipPattern:
