@@ -99,9 +99,11 @@ def intrinsic_operators(vertices, faces, mollify=MOLLIFY):
     return L.tocsr(), np.asarray(M.diagonal())
 
 
-MARGIN = 1e-9
-"""Distance from :data:`FLIP_BELOW` within which an edge weight is left to the package
-(round-off could put its weight on the other side there)."""
+MARGIN = 1e-12
+"""Distance from :data:`FLIP_BELOW` within which an edge weight is left to the package,
+times ``1 + (|h1| + |h2|)^3`` for its halves ``h1``, ``h2`` (round-off could put its
+weight on the other side there: a few ulps of each half's Heron area, whose relative
+error grows as the square of a half cotangent on a sliver)."""
 
 
 @njit(cache=True)
@@ -127,10 +129,10 @@ def flip_to_delaunay(V, faces, edges, edge_faces, face_edges, mollify, indptr, i
     Sharp and Crane 2020, Section 4.5).
 
     The package is needed (-1) when: a triangle has no area even mollified (or a
-    length is not finite); a weight the loop reads is within :data:`MARGIN` of the
-    threshold (round-off could decide it the other way); a boundary edge would
-    flip; a flip would join a vertex to itself or make a triangle of no area; more
-    than 20 E flips. Else every decision is the package's, and so is the
+    length is not finite); a weight the loop reads is within :data:`MARGIN`
+    (relative) of the threshold (round-off could decide it the other way); a
+    boundary edge would flip; a flip would join a vertex to itself or make a
+    triangle of no area; more than 20 E flips. Else every decision is the package's, and so is the
     triangulation where the order of the flips does not matter: it may only in a
     nearly cocircular quad (both diagonals' weights above the threshold), whose
     diagonal a flip beside it could leave either way; the package's order is its
@@ -204,10 +206,10 @@ def flip_to_delaunay(V, faces, edges, edge_faces, face_edges, mollify, indptr, i
         head, size = (head + 1) % E, size - 1
         queued[e] = False
         f1, f2 = owners[e, 0], owners[e, 1]
-        w = cot[f1, _corner_of(sides, f1, e)] * (2.0 if f2 < 0 else 1.0)
-        if f2 >= 0:
-            w += cot[f2, _corner_of(sides, f2, e)]
-        if not abs(w - FLIP_BELOW) > MARGIN or (f2 < 0 and w < FLIP_BELOW):
+        h1 = cot[f1, _corner_of(sides, f1, e)]
+        h2 = h1 if f2 < 0 else cot[f2, _corner_of(sides, f2, e)]
+        w, scale = h1 + h2, abs(h1) + abs(h2)
+        if not abs(w - FLIP_BELOW) > MARGIN * (1.0 + scale ** 3) or (f2 < 0 and w < FLIP_BELOW):
             return -1, flips, epsilon
         if w >= FLIP_BELOW:
             continue
