@@ -200,10 +200,10 @@ def flip_to_delaunay(V, faces, edges, edge_faces, face_edges, mollify, indptr, i
     ends[:] = edges
     queue = np.arange(E)                      # a ring: every edge at most once in it
     queued = np.ones(E, dtype=np.bool_)
-    head, size = 0, E
+    head, tail, size = 0, 0, E                # pop at head, push at tail (mod E)
     while size > 0:
         e = queue[head]
-        head, size = (head + 1) % E, size - 1
+        head, size = (head + 1 if head + 1 < E else 0), size - 1
         queued[e] = False
         f1, f2 = owners[e, 0], owners[e, 1]
         h1 = cot[f1, _corner_of(sides, f1, e)]
@@ -237,8 +237,8 @@ def flip_to_delaunay(V, faces, edges, edge_faces, face_edges, mollify, indptr, i
             return -1, flips, epsilon
         for s in (ac, ad, bd, bc):
             if not queued[s]:
-                queue[(head + size) % E] = s
-                size += 1
+                queue[tail] = s
+                tail, size = (tail + 1 if tail + 1 < E else 0), size + 1
                 queued[s] = True
     if flips == 0 and epsilon == 0.0:
         return 0, 0, 0.0
