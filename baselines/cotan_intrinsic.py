@@ -42,13 +42,12 @@ mollified, the package's operators are the mesh's cotangent stiffness and
 barycentric mass (Bobenko and Springborn: the intrinsic Delaunay triangulation
 is reached by flipping the edges of negative weight, and there are none),
 which the compiled assembly of :class:`baselines.laplacian.CotanAssembler` gives in
-a fraction of the package's time; where one round of flips of edges with no
-triangle in common reaches it, those flips are applied to the mesh's operators
-by a compiled loop over the edges (:func:`one_round_flips`), in a CSR pattern
-built once of the mesh's edges and the edges their flips make
-(:class:`FlipPattern`). A step takes them when :func:`one_round_flips` finds
-them, the package's call otherwise (baselines/README.md, "Deviations and
-interpretations").
+a fraction of the package's time; elsewhere the package's flips (and
+mollification) are done by a compiled loop on the mesh's edge lengths
+(:func:`flip_to_delaunay`), whose triangulation's operators are assembled in a
+CSR pattern that grows with the edges the flips make (:class:`FlipPattern`). A
+step takes them when :func:`flip_to_delaunay` finds them, the package's call
+otherwise (baselines/README.md, "Deviations and interpretations").
 
 The step is solved in the row-scaled form (C3), ``(I + tau diag(1/M) L) X^n
 = X^{n-1}`` (:func:`baselines.kernels.row_scaled_system`,
@@ -100,67 +99,83 @@ def intrinsic_operators(vertices, faces, mollify=MOLLIFY):
     return L.tocsr(), np.asarray(M.diagonal())
 
 
-MARGIN = 1e-9
-"""Distance from :data:`FLIP_BELOW` within which an edge weight is left to the package
-(round-off could put its weight on the other side there)."""
+MARGIN = 1e-12
+"""Distance from :data:`FLIP_BELOW` within which an edge weight is left to the package,
+times ``1 + (|h1| + |h2|)^3`` for its halves ``h1``, ``h2`` (round-off could put its
+weight on the other side there: a few ulps of each half's Heron area, whose relative
+error grows as the square of a half cotangent on a sliver)."""
 
 
 @njit(cache=True)
-def one_round_flips(V, faces, edges, edge_faces, face_edges, to_pattern, L_mesh, mass_mesh,
-                    mollify, edge_slots, diagonal_slots, indptr, diag_slots, flipped, L_data,
-                    mass):
-    """The intrinsic operators of the package where one round of flips of edges with no
-    triangle in common reaches its triangulation.
+def flip_to_delaunay(V, faces, edges, edge_faces, face_edges, mollify, indptr, indices,
+                     diag_slots, edge_slots, tri, ends, slots, L_data, mass):
+    """The intrinsic operators of the package, by its flips compiled.
 
-    The package flips an edge of the tufted cover whose weight is below
-    :data:`FLIP_BELOW`, then the edges around it whose weight fell below. An interior
-    edge of the cover has the mesh edge's weight ``w = -L_ab``, a boundary edge twice
-    it (its one angle on both sheets). The package is needed (-1) when: a triangle is
-    within twice the mollification's margin of degenerate (``la + lb - lc < 2 delta``,
-    ``delta = mollify`` x the mean edge length: the package's ``epsilon`` would not be
-    0); a weight is within :data:`MARGIN` of the threshold; a boundary edge would flip;
-    two edges to flip share a triangle; a flip's new edge is a mesh edge or another
-    flip's; after the round an edge is still below the threshold (or within
-    :data:`MARGIN` of it; a boundary edge with twice its weight). Else the flips of
-    independent edges do not interact and the package stops where none is below: its
-    triangulation is the mesh with these edges flipped (Bobenko and Springborn 2007).
+    The package (geometry-central's ``flipToDelaunay``, Sharp and Crane 2020, Section
+    4; N. Sharp, Y. Soliman, K. Crane, "Navigating Intrinsic Triangulations", ACM
+    Trans. Graph. 38(4) 2019, Section 3.2; M. Fisher, B. Springborn, P. Schroeder,
+    A. Bobenko, "An Algorithm for the Construction of Intrinsic Delaunay
+    Triangulations with Applications to Digital Geometry Processing", Computing 81
+    (2007), Algorithm 1) puts every edge of the tufted cover in a queue and, edge
+    by edge, flips one whose weight ``(cot alpha + cot beta) / 2`` is below
+    :data:`FLIP_BELOW`, giving it the length of its two triangles unfolded in the
+    plane, and queues the four edges of its quad; it stops when the queue is
+    empty, every weight at or above the threshold (Bobenko and Springborn 2007:
+    the intrinsic Delaunay triangulation). An interior edge of the cover has the
+    mesh edge's weight, a boundary edge twice it (its one angle on both sheets).
+    This is that loop on the mesh's edges, in their order, after the package's
+    mollification (``mollifyIntrinsic``: every length grows by ``epsilon = max(0,
+    max_T (l_c - l_a - l_b) + delta)``, ``delta = mollify`` x the mean edge length;
+    Sharp and Crane 2020, Section 4.5).
 
-    Each edge ``(a, b)`` between the triangles ``(a, b, c)`` and ``(b, a, d)`` becomes
-    ``(c, d)``, of the length of the planar unfolding of the two (``|c - d|`` with
-    ``c``, ``d`` laid out on either side of ``ab`` from the side lengths); the two
-    triangles' cotangent weights (C2) and thirds of their areas (barycentric mass) are
-    taken out of the mesh's and those of ``(a, d, c)`` and ``(b, c, d)`` put in
-    (:func:`_triangle`), and the entries of ``(a, b)`` set to 0 (no longer an edge).
+    The package is needed (-1) when: a triangle has no area even mollified (or a
+    length is not finite); a weight the loop reads is within :data:`MARGIN`
+    (relative) of the threshold (round-off could decide it the other way); a
+    boundary edge would flip; a flip would join a vertex to itself or make a
+    triangle of no area; more than 20 E flips. Else every decision is the package's, and so is the
+    triangulation where the order of the flips does not matter: it may only in a
+    nearly cocircular quad (both diagonals' weights above the threshold), whose
+    diagonal a flip beside it could leave either way; the package's order is its
+    own on each sheet of the cover, so this is checked, not guaranteed: along the
+    flows of the real meshes the operators are the package's to round-off (tested)
+    and the reverse order gives the same (measured; baselines/README.md,
+    "Deviations and interpretations", item 8).
+
+    Edges keep their index through flips (the edge ``(a, b)`` between ``(a, b, c)``
+    and ``(b, a, d)`` becomes ``(c, d)``, the triangles ``(a, d, c)`` and ``(b, c,
+    d)``); the stiffness (C2) and barycentric mass of the final triangulation are
+    assembled from its edge lengths (:func:`_face`) into the pattern.
 
     Parameters
     ----------
     V : (n, 3) float64 array
     faces, edges, edge_faces, face_edges : int64 arrays of :class:`baselines.mesh.EdgeMesh`
-    to_pattern : (nnz_mesh,) int64 array
-        The slot in this pattern of each slot of the mesh's.
-    L_mesh : (nnz_mesh,) float64 array
-        The mesh's cotangent stiffness (C2) at ``V`` in the mesh's pattern.
-    mass_mesh : (n,) float64 array
-        Its barycentric lumped mass.
     mollify : float
-    edge_slots, diagonal_slots : (E, 2) int64 arrays
-        Slots of each edge and of the edge its flip makes in the pattern of
-        :class:`FlipPattern` (``-1``: the edge does not flip here).
-    indptr : (n + 1,) int32 array
+    indptr, indices : (n + 1,) and (nnz,) int32 arrays
+        The pattern's CSR (column indices sorted within rows).
     diag_slots : (n,) int64 array
-        The pattern's row starts and diagonal slots.
-    flipped : (E,) bool array, output
-        The edges flipped.
+    edge_slots : (E, 2) int64 array
+        The pattern's slots of the mesh's edges.
+    tri : (m, 3) int64 array, output
+        The final triangles.
+    ends : (E, 2) int64 array, output
+        The final edges, ``ends[e, 0] < ends[e, 1]``.
+    slots : (E, 2) int64 array, output
+        Their slots in the pattern, ``-1`` where it has none.
     L_data : (nnz,) float64 array, output
-        The stiffness of the flipped triangulation (written when edges flip).
+        The stiffness of the final triangulation (written at status 1).
     mass : (n,) float64 array, output
-        Its barycentric lumped mass (written when edges flip).
+        Its barycentric lumped mass (written at status 1).
 
     Returns
     -------
-    int
-        The number of edges flipped; 0: the mesh is the package's triangulation; -1:
-        the package is needed.
+    status : int
+        1: ``L_data`` and ``mass`` written; 0: no flip and no mollification, the
+        mesh's own operators are the package's (nothing written); -1: the package
+        is needed; -2: an edge is not in the pattern (``slots``).
+    flips : int
+    epsilon : float
+        The mollification's growth of the lengths.
     """
     E, m = edges.shape[0], faces.shape[0]
     lengths = np.empty(E)
@@ -168,79 +183,87 @@ def one_round_flips(V, faces, edges, edge_faces, face_edges, to_pattern, L_mesh,
     for e in range(E):
         lengths[e] = _distance(V, edges[e, 0], edges[e, 1])
         total += lengths[e]
-    bound = 2.0 * mollify * (total / E)
+    worst, flips = -np.inf, 0
     for t in range(m):
         x, y, z = lengths[face_edges[t, 0]], lengths[face_edges[t, 1]], lengths[face_edges[t, 2]]
-        if not (x + y + z) - 2.0 * max(x, y, z) > bound:
-            return -1
+        worst = max(worst, 2.0 * max(x, y, z) - (x + y + z))
+    epsilon = max(0.0, worst + mollify * (total / E))       # mollifyIntrinsic
+    if not worst < epsilon:                                  # no area even mollified, NaN
+        return -1, flips, epsilon
+    lengths += epsilon
+    tri[:] = faces
+    sides = face_edges.copy()
+    cot, area = np.empty((m, 3)), np.empty(m)        # each corner's half cotangent, area
+    for t in range(m):
+        _face(lengths, sides, t, cot, area)
+    owners = edge_faces.copy()
+    ends[:] = edges
+    queue = np.arange(E)                      # a ring: every edge at most once in it
+    queued = np.ones(E, dtype=np.bool_)
+    head, tail, size = 0, 0, E                # pop at head, push at tail (mod E)
+    while size > 0:
+        e = queue[head]
+        head, size = (head + 1 if head + 1 < E else 0), size - 1
+        queued[e] = False
+        f1, f2 = owners[e, 0], owners[e, 1]
+        h1 = cot[f1, _corner_of(sides, f1, e)]
+        h2 = h1 if f2 < 0 else cot[f2, _corner_of(sides, f2, e)]
+        w, scale = h1 + h2, abs(h1) + abs(h2)
+        if not abs(w - FLIP_BELOW) > MARGIN * (1.0 + scale ** 3) or (f2 < 0 and w < FLIP_BELOW):
+            return -1, flips, epsilon
+        if w >= FLIP_BELOW:
+            continue
+        k = _corner_of(sides, f1, e)
+        c, a, b = tri[f1, k], tri[f1, (k + 1) % 3], tri[f1, (k + 2) % 3]
+        bc, ac = sides[f1, (k + 1) % 3], sides[f1, (k + 2) % 3]
+        j = _corner_of(sides, f2, e)
+        d = tri[f2, j]
+        ad, bd = (sides[f2, (j + 1) % 3], sides[f2, (j + 2) % 3]) if tri[f2, (j + 1) % 3] == b \
+            else (sides[f2, (j + 2) % 3], sides[f2, (j + 1) % 3])
+        flips += 1
+        if c == d or flips > 20 * E:
+            return -1, flips, epsilon
+        tri[f1, 0], tri[f1, 1], tri[f1, 2] = a, d, c          # (a, d, c), (b, c, d)
+        sides[f1, 0], sides[f1, 1], sides[f1, 2] = e, ac, ad
+        tri[f2, 0], tri[f2, 1], tri[f2, 2] = b, c, d
+        sides[f2, 0], sides[f2, 1], sides[f2, 2] = e, bd, bc
+        owners[ad, 0 if owners[ad, 0] == f2 else 1] = f1
+        owners[bc, 0 if owners[bc, 0] == f1 else 1] = f2
+        ends[e, 0], ends[e, 1] = min(c, d), max(c, d)
+        lengths[e] = _unfolded(lengths[e], lengths[ac], lengths[bc], lengths[ad], lengths[bd])
+        _face(lengths, sides, f1, cot, area)
+        _face(lengths, sides, f2, cot, area)
+        if not (area[f1] > 0.0 and area[f2] > 0.0):
+            return -1, flips, epsilon
+        for s in (ac, ad, bd, bc):
+            if not queued[s]:
+                queue[tail] = s
+                tail, size = (tail + 1 if tail + 1 < E else 0), size + 1
+                queued[s] = True
+    if flips == 0 and epsilon == 0.0:
+        return 0, 0, 0.0
+    missing = False
+    for e in range(E):
+        p, q = ends[e, 0], ends[e, 1]
+        if p == edges[e, 0] and q == edges[e, 1]:
+            slots[e, 0], slots[e, 1] = edge_slots[e, 0], edge_slots[e, 1]
+        else:
+            slots[e, 0], slots[e, 1] = _slot(indptr, indices, p, q), _slot(indptr, indices, q, p)
+            missing = missing or slots[e, 0] < 0
+    if missing:
+        return -2, flips, epsilon
     L_data[:] = 0.0
-    for p in range(len(L_mesh)):
-        L_data[to_pattern[p]] = L_mesh[p]
-    on_face = np.zeros(m, dtype=np.bool_)
-    taken = np.zeros(len(L_data), dtype=np.bool_)
-    k = 0
-    for e in range(E):
-        boundary = edge_faces[e, 1] < 0
-        cover = (2.0 if boundary else 1.0) * -L_data[edge_slots[e, 0]]
-        if abs(cover - FLIP_BELOW) <= MARGIN or (boundary and cover < FLIP_BELOW):
-            return -1
-        if not cover < FLIP_BELOW:
-            continue
-        f1, f2, new = edge_faces[e, 0], edge_faces[e, 1], diagonal_slots[e, 0]
-        if on_face[f1] or on_face[f2] or new < 0 or taken[new]:
-            return -1
-        on_face[f1] = on_face[f2] = taken[new] = flipped[e] = True
-        k += 1
-    if k == 0:
-        return 0
-    mass[:] = mass_mesh
-    for e in range(E):
-        if not flipped[e]:
-            continue
-        a, b, f1, f2 = edges[e, 0], edges[e, 1], edge_faces[e, 0], edge_faces[e, 1]
-        bc = ac = bd = ad = c = d = -1
-        for j in range(3):
-            if faces[f1, j] == a:
-                bc = face_edges[f1, j]
-            elif faces[f1, j] == b:
-                ac = face_edges[f1, j]
-            else:
-                c = faces[f1, j]
-            if faces[f2, j] == a:
-                bd = face_edges[f2, j]
-            elif faces[f2, j] == b:
-                ad = face_edges[f2, j]
-            else:
-                d = faces[f2, j]
-        l_ab, l_bc, l_ac = lengths[e], lengths[bc], lengths[ac]
-        l_ad, l_bd = lengths[ad], lengths[bd]
-        xc = (l_ab ** 2 + l_ac ** 2 - l_bc ** 2) / (2.0 * l_ab)       # c above ab, d below
-        xd = (l_ab ** 2 + l_ad ** 2 - l_bd ** 2) / (2.0 * l_ab)
-        yc = np.sqrt(max(l_ac ** 2 - xc ** 2, 0.0))
-        yd = np.sqrt(max(l_ad ** 2 - xd ** 2, 0.0))
-        l_cd = np.hypot(xc - xd, yc + yd)
-        # (its corners, the sides opposite them and their edges, -1 taken out / +1 put in)
-        _triangle(L_data, mass, diag_slots, -1.0, a, b, c, l_bc, l_ac, l_ab,
-                  edge_slots[bc, 0], edge_slots[bc, 1], edge_slots[ac, 0], edge_slots[ac, 1],
-                  edge_slots[e, 0], edge_slots[e, 1])
-        _triangle(L_data, mass, diag_slots, -1.0, b, a, d, l_ad, l_bd, l_ab,
-                  edge_slots[ad, 0], edge_slots[ad, 1], edge_slots[bd, 0], edge_slots[bd, 1],
-                  edge_slots[e, 0], edge_slots[e, 1])
-        _triangle(L_data, mass, diag_slots, 1.0, a, d, c, l_cd, l_ac, l_ad,
-                  diagonal_slots[e, 0], diagonal_slots[e, 1], edge_slots[ac, 0],
-                  edge_slots[ac, 1], edge_slots[ad, 0], edge_slots[ad, 1])
-        _triangle(L_data, mass, diag_slots, 1.0, b, c, d, l_cd, l_bd, l_bc,
-                  diagonal_slots[e, 0], diagonal_slots[e, 1], edge_slots[bd, 0],
-                  edge_slots[bd, 1], edge_slots[bc, 0], edge_slots[bc, 1])
-        L_data[edge_slots[e, 0]] = L_data[edge_slots[e, 1]] = 0.0
-    for i in range(len(mass)):
-        for p in range(indptr[i], indptr[i + 1]):
-            if p != diag_slots[i] and not -L_data[p] >= FLIP_BELOW + MARGIN:
-                return -1
-    for e in range(E):
-        if edge_faces[e, 1] < 0 and not -2.0 * L_data[edge_slots[e, 0]] >= FLIP_BELOW + MARGIN:
-            return -1
-    return k
+    mass[:] = 0.0
+    for t in range(m):
+        for k in range(3):           # the edge opposite corner k: cotangent weight (C2)
+            s, w = sides[t, k], cot[t, k]
+            p, q = tri[t, (k + 1) % 3], tri[t, (k + 2) % 3]
+            L_data[slots[s, 0]] -= w
+            L_data[slots[s, 1]] -= w
+            L_data[diag_slots[p]] += w
+            L_data[diag_slots[q]] += w
+            mass[tri[t, k]] += area[t] / 3.0      # barycentric
+    return 1, flips, epsilon
 
 
 @njit(cache=True, inline="always")
@@ -250,105 +273,124 @@ def _distance(V, p, q):
 
 
 @njit(cache=True, inline="always")
-def _triangle(L_data, mass, diag_slots, sign, p0, p1, p2, l0, l1, l2, s0, t0, s1, t1, s2, t2):
-    """Add ``sign`` x the cotangent weights (C2) and the thirds of the area of the
-    triangle ``(p0, p1, p2)`` of sides ``l0, l1, l2`` (``l_k`` opposite ``p_k``, its
-    slots ``s_k, t_k``): ``(l_j^2 + l_k^2 - l_i^2) / (8 area)`` (cotangent / 2), Heron's
-    area."""
-    x, y, z = l0, l1, l2
-    area = 0.25 * np.sqrt(max((x + y + z) * (-x + y + z) * (x - y + z) * (x + y - z), 0.0))
-    _edge(L_data, diag_slots, p1, p2, s0, t0, sign * (y * y + z * z - x * x) / (8.0 * area))
-    _edge(L_data, diag_slots, p2, p0, s1, t1, sign * (z * z + x * x - y * y) / (8.0 * area))
-    _edge(L_data, diag_slots, p0, p1, s2, t2, sign * (x * x + y * y - z * z) / (8.0 * area))
-    third = sign * area / 3.0
-    mass[p0] += third
-    mass[p1] += third
-    mass[p2] += third
+def _corner_of(sides, t, e):
+    """The corner of triangle ``t`` opposite its edge ``e``."""
+    return 0 if sides[t, 0] == e else (1 if sides[t, 1] == e else 2)
 
 
 @njit(cache=True, inline="always")
-def _edge(L_data, diag_slots, p, q, s, t, w):
-    """Add the weight ``w`` of the edge ``(p, q)`` (its slots ``s``, ``t``) to ``L`` (C2)."""
-    L_data[s] -= w
-    L_data[t] -= w
-    L_data[diag_slots[p]] += w
-    L_data[diag_slots[q]] += w
+def _area(x, y, z):
+    """Heron's area of the triangle of sides ``x, y, z``."""
+    return 0.25 * np.sqrt(max((x + y + z) * (-x + y + z) * (x - y + z) * (x + y - z), 0.0))
+
+
+@njit(cache=True, inline="always")
+def _face(lengths, sides, t, cot, area):
+    """Triangle ``t``'s area (Heron's) and the half cotangents of its corners, ``cot[t,
+    k] = (y^2 + z^2 - x^2) / (8 area)`` for the side ``x`` opposite corner ``k`` (C2)."""
+    x, y, z = lengths[sides[t, 0]], lengths[sides[t, 1]], lengths[sides[t, 2]]
+    a = _area(x, y, z)
+    area[t] = a
+    cot[t, 0] = (y * y + z * z - x * x) / (8.0 * a)
+    cot[t, 1] = (z * z + x * x - y * y) / (8.0 * a)
+    cot[t, 2] = (x * x + y * y - z * z) / (8.0 * a)
+
+
+@njit(cache=True, inline="always")
+def _unfolded(l_ab, l_ac, l_bc, l_ad, l_bd):
+    """``|c - d|`` with the triangles ``(a, b, c)`` and ``(b, a, d)`` laid out in the plane
+    on either side of ``ab``: the length of the edge the flip of ``ab`` makes."""
+    xc = (l_ab ** 2 + l_ac ** 2 - l_bc ** 2) / (2.0 * l_ab)
+    xd = (l_ab ** 2 + l_ad ** 2 - l_bd ** 2) / (2.0 * l_ab)
+    yc = np.sqrt(max(l_ac ** 2 - xc ** 2, 0.0))
+    yd = np.sqrt(max(l_ad ** 2 - xd ** 2, 0.0))
+    return np.hypot(xc - xd, yc + yd)
+
+
+@njit(cache=True, inline="always")
+def _slot(indptr, indices, row, col):
+    """The slot of ``(row, col)`` in a CSR pattern (sorted columns), ``-1`` if none."""
+    lo, hi = indptr[row], indptr[row + 1]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if indices[mid] < col:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo if lo < indptr[row + 1] and indices[lo] == col else -1
 
 
 class FlipPattern:
-    """The mesh's triangulation one round of flips away from it, compiled.
+    """The package's triangulation by compiled flips, in a CSR pattern that grows.
 
-    The CSR pattern, built once, of the mesh's edges, the diagonal and, for every
-    interior edge ``(a, b)`` between the triangles ``(a, b, c)`` and ``(b, a, d)``,
-    the edge ``(c, d)`` its flip makes (unless that is a mesh edge: then the edge
-    does not flip here). :meth:`flip` writes the intrinsic operators of a round of
-    flips into it (:func:`one_round_flips`); the entries of edges that are not in
-    the flipped triangulation hold 0 (no weight).
+    The pattern holds the mesh's edges, the diagonal and every edge a flipped
+    triangulation has had so far (:func:`flip_to_delaunay`); it grows, rebuilt, when
+    a triangulation has an edge it lacks (rarely along a flow: its edges recur), and
+    the entries of edges not in the present triangulation hold 0 (no weight).
 
     Parameters
     ----------
     mesh : baselines.mesh.EdgeMesh
-    mesh_pattern : baselines.mesh.LaplacianPattern
-        The mesh's own pattern, in which :meth:`flip` reads the mesh's stiffness.
     """
 
-    def __init__(self, mesh, mesh_pattern):
-        n, F = mesh.n_vertices, mesh.faces
-        inner = np.flatnonzero(mesh.edge_faces[:, 1] >= 0)
-        f1, f2 = mesh.edge_faces[inner, 0], mesh.edge_faces[inner, 1]
-        c = F[f1, np.argmax(mesh.face_edges[f1] == inner[:, None], axis=1)]
-        d = F[f2, np.argmax(mesh.face_edges[f2] == inner[:, None], axis=1)]
-        keys = mesh.edges[:, 0] * n + mesh.edges[:, 1]                   # sorted (EdgeMesh)
-        new = np.minimum(c, d) * n + np.maximum(c, d)
-        found = np.minimum(np.searchsorted(keys, new), len(keys) - 1)
-        flippable = (c != d) & (keys[found] != new)
-        union, where = np.unique(np.concatenate([keys, new[flippable]]), return_inverse=True)
+    def __init__(self, mesh):
+        self.mesh = mesh
+        self._mesh_keys = self._keys = mesh.edges[:, 0] * mesh.n_vertices + mesh.edges[:, 1]
+        self._grow(self._mesh_keys)
+        self.flip_count = 0
+        """The flips of the last :meth:`flip`."""
+        self.epsilon = 0.0
+        """The mollification's growth of the lengths in the last :meth:`flip`."""
+
+    def _grow(self, keys):
+        """Rebuild the pattern with the edges ``a * n + b`` (``a < b``) added."""
+        mesh, n = self.mesh, self.mesh.n_vertices
+        union = np.union1d(self._keys, keys)
+        mine = np.searchsorted(union, self._mesh_keys)
         # laplacian_pattern reads the edges, the vertex count and face_edges
         graph = dataclasses.replace(mesh, edges=np.stack([union // n, union % n], axis=1),
-                                    face_edges=where[mesh.face_edges])
+                                    face_edges=mine[mesh.face_edges])
+        self._keys = union
         self._assembler = CotanAssembler(graph)       # its CSR of the pattern, row scaling
         self.pattern = self._assembler.pattern
-        self.edge_slots = self.pattern.edge_slots[where[:len(keys)]]
-        self.diagonal_slots = np.full((mesh.n_edges, 2), -1, dtype=np.int64)
-        self.diagonal_slots[inner[flippable]] = self.pattern.edge_slots[where[len(keys):]]
-        self.to_pattern = np.empty(mesh_pattern.nnz, dtype=np.int64)
-        self.to_pattern[mesh_pattern.edge_slots] = self.edge_slots
-        self.to_pattern[mesh_pattern.diag_slots] = self.pattern.diag_slots
-        self.mesh = mesh
+        self.edge_slots = self.pattern.edge_slots[mine]
 
-    def flip(self, vertices, L_data, mass, mollify=MOLLIFY):
-        """The package's operators, when one round of flips of the mesh reaches its
-        triangulation (:func:`one_round_flips`); None when that is not known.
+    def flip(self, vertices, mollify=MOLLIFY):
+        """The package's operators, by compiled flips (:func:`flip_to_delaunay`); None
+        when the package is needed.
 
         Parameters
         ----------
         vertices : (n, 3) float array
-        L_data : (nnz,) float array
-            The mesh's cotangent stiffness (C2) at ``vertices`` in its pattern
-            (:class:`baselines.mesh.LaplacianPattern`).
-        mass : (n,) float array
-            Its barycentric lumped mass.
         mollify : float
 
         Returns
         -------
         (flip, L_data, mass) or None
-            ``flip`` (k,) the edges flipped (rows of ``mesh.edges``); empty: the mesh
-            is the package's triangulation, its operators are the mesh's own
-            (``L_data`` and ``mass`` None); else the stiffness in this pattern,
-            (nnz,), and the mass, (n,).
+            ``flip`` (k,) the edges whose ends the flips changed (rows of
+            ``mesh.edges``); ``L_data`` (nnz,) in this pattern and ``mass`` (n,)
+            the final triangulation's; both None when nothing flips (the mesh is
+            the package's triangulation, its operators are the mesh's own).
         """
-        mesh, p = self.mesh, self.pattern
-        flipped = np.zeros(mesh.n_edges, dtype=np.bool_)
-        L_out, mass_out = np.empty(p.nnz), np.empty(mesh.n_vertices)
-        k = one_round_flips(
-            np.ascontiguousarray(vertices, dtype=np.float64), mesh.faces, mesh.edges,
-            mesh.edge_faces, mesh.face_edges, self.to_pattern, L_data, mass,
-            float(mollify), self.edge_slots, self.diagonal_slots, p.indptr, p.diag_slots,
-            flipped, L_out, mass_out)
-        if k < 0:
+        mesh = self.mesh
+        V = np.ascontiguousarray(vertices, dtype=np.float64)
+        tri, ends = np.empty_like(mesh.faces), np.empty_like(mesh.edges)
+        slots = np.empty_like(mesh.edges)
+        while True:
+            p = self.pattern
+            L_out, mass_out = np.empty(p.nnz), np.empty(mesh.n_vertices)
+            status, self.flip_count, self.epsilon = flip_to_delaunay(
+                V, mesh.faces, mesh.edges, mesh.edge_faces, mesh.face_edges, float(mollify),
+                p.indptr, p.indices, p.diag_slots, self.edge_slots, tri, ends, slots, L_out,
+                mass_out)
+            if status != -2:
+                break
+            self._grow(ends[slots[:, 0] < 0] @ np.array([mesh.n_vertices, 1]))
+        if status < 0:
             return None
-        return (np.flatnonzero(flipped),) + ((L_out, mass_out) if k else (None, None))
+        if status == 0:
+            return np.empty(0, dtype=np.int64), None, None
+        return np.flatnonzero((ends != mesh.edges).any(axis=1)), L_out, mass_out
 
     def laplacian(self, L_data):
         """``L`` as CSR from the ``L_data`` of :meth:`flip`."""
@@ -390,14 +432,14 @@ class IntrinsicCotanFlow(VertexFlow):
         self.delaunay_steps = 0
         """Systems assembled with the mesh's operators (no edge to flip)."""
         self.flipped_steps = 0
-        """Systems assembled with one round of flips of the mesh (:func:`one_round_flips`)."""
+        """Systems assembled with the mesh's edges flipped (:func:`flip_to_delaunay`)."""
         super().__init__(vertices, faces, tau, mass="barycentric")
-        self.flips = FlipPattern(self.mesh, self.assembler.pattern)
+        self.flips = FlipPattern(self.mesh)
 
     def operators(self, at=None):
         """``(L, mass)`` of :func:`intrinsic_operators` at the state ``at`` (3, n)
         (default the current one), CSR and (n,): from the mesh where it is the
-        package's triangulation or one round of flips away from it
+        package's triangulation or the compiled flips reach it
         (:meth:`FlipPattern.flip`), the package's otherwise."""
         at = self._X if at is None else at
         found = self._mesh_operators(at)
@@ -410,16 +452,16 @@ class IntrinsicCotanFlow(VertexFlow):
 
     def _mesh_operators(self, at):
         """``(geometry, flipped)`` at ``at``: the mesh's :class:`baselines.laplacian.SurfaceGeometry`
-        and, when the package flips edges, the ``(L_data, mass)`` of :meth:`FlipPattern.flip`
-        (None when it flips none); None when the package is needed."""
-        g = self.geometry_at(at)
-        if g.degenerate:
-            return None
-        found = self.flips.flip(at.T, g.L_data, g.mass, self.mollify)
+        when the package flips no edge (``flipped`` None), else ``(None, (L_data, mass))`` of
+        :meth:`FlipPattern.flip`; None when the package is needed (a degenerate mesh
+        triangle is within the mollification's margin: :func:`flip_to_delaunay`)."""
+        found = self.flips.flip(at.T, self.mollify)
         if found is None:
             return None
         flip, L_data, mass = found
-        return g, (None if len(flip) == 0 else (L_data, mass))
+        if len(flip) == 0 and L_data is None:
+            return self.geometry_at(at), None
+        return None, (L_data, mass)
 
     def _system(self, at, base, dt):
         """``A = I + dt diag(1/M*) L*`` (C3) of the intrinsic operators at ``at``, CSR,

@@ -142,25 +142,32 @@ def test_the_mesh_operators_flip_exactly_where_the_package_does(weight, flips):
     kept = L[0, 1] == pytest.approx(-weight, rel=1e-6)         # L_ab = -weight
     assert kept == (weight > FLIP_BELOW)
     assert kept or L[2, 3] == pytest.approx(weight, rel=1e-6)
-    flip, _, _ = flow.flips.flip(V, flow.geometry.L_data, flow.geometry.mass)
+    flip, _, _ = flow.flips.flip(V)
     assert len(flip) == flips
     L_flow, mass_flow = flow.operators()
     np.testing.assert_allclose(L_flow.toarray(), L.toarray(), rtol=0, atol=1e-15)
     np.testing.assert_allclose(mass_flow, mass, rtol=1e-15)
 
 
-def test_a_sliver_within_the_mollification_margin_takes_the_package():
-    """A triangle whose longest side is within 2 x 1e-5 x the mean edge length of the
-    sum of the other two is left to the package (it mollifies there), with every edge
-    weight passing; 10 x further it is not."""
-    for height, from_mesh in [(1e-3, False), (1e-2, True)]:
-        # la + lb - lc = 2 sqrt(1 + h^2) - 2 ~ h^2, the mean edge length ~ 1.3
-        V = np.array([[-1.0, 0, 0], [1, 0, 0], [0, height, 0]])
-        F = np.array([[0, 1, 2]])
-        flow = IntrinsicCotanFlow(V, F, 0.01)
-        zero = np.zeros_like(flow.geometry.L_data)
-        found = flow.flips.flip(V, zero, flow.geometry.mass)
-        assert (found is not None) == from_mesh
+def test_a_sliver_within_the_mollification_margin_is_mollified_as_the_package_does():
+    """A vertex of the level-2 icosphere moved next to the midpoint of its triangle's
+    opposite side (a fraction ``s`` of its height left): at ``s = 1e-3`` the triangle is
+    within the margin (1e-5 x the mean edge length), every length grows by ``epsilon``
+    = 2.68e-6 (the package's ``mollifyIntrinsic``), at ``s = 0.1`` it is not (0); both
+    times the operators are the package's to round-off, one edge flipped."""
+    V, F = icosphere(2)
+    p, q, r = F[0]
+    for s, epsilon in [(1e-3, 2.685e-6), (0.1, 0.0)]:
+        W = V.copy()
+        W[p] = (1 - s) * (V[q] + V[r]) / 2 + s * V[p]
+        flow = IntrinsicCotanFlow(W, F, 0.01)
+        L, mass = flow.operators()
+        assert (flow.flips.flip_count, flow.flips.epsilon) == (1, pytest.approx(epsilon,
+                                                                              rel=1e-3, abs=0))
+        L_package, mass_package = intrinsic_operators(W, F)
+        np.testing.assert_allclose(L.toarray(), L_package.toarray(), rtol=0,
+                                   atol=1e-13 * abs(L_package).max())
+        np.testing.assert_allclose(mass, mass_package, rtol=1e-14)
 
 
 def test_one_flip_back_to_the_icosphere_is_the_packages_triangulation():
@@ -170,7 +177,7 @@ def test_one_flip_back_to_the_icosphere_is_the_packages_triangulation():
     round-off; so are the flow's states, step by step."""
     V, F = flipped_icosphere()
     flow = IntrinsicCotanFlow(V, F, 0.001)
-    flip, _, _ = flow.flips.flip(V, flow.geometry.L_data, flow.geometry.mass)
+    flip, _, _ = flow.flips.flip(V)
     assert len(flip) == 1 and set(flow.mesh.edges[flip[0]]) == set(F[0][:2])
     L, mass = flow.operators()
     L_package, mass_package = intrinsic_operators(V, F)
@@ -204,7 +211,7 @@ def test_along_the_catenoid_flow_every_step_takes_the_mesh_operators():
 def test_the_catenoids_flips_are_the_packages_intrinsic_delaunay_triangulation():
     """Along the registry's catenoid at level 1 (216 vertices, 60 steps) the mesh's
     rectangles' diagonals (weight 0 at ``t = 0``) turn non-Delaunay, all 192 of them every
-    other step at first: the compiled round of flips (:func:`one_round_flips`) gives the
+    other step at first: the compiled flips (:func:`flip_to_delaunay`) give the
     systems of 42 steps, each of its states' operators is intrinsic Delaunay and the
     package's to round-off, and the trajectory is that of a run that calls the package
     at every step to 1e-12."""
@@ -214,7 +221,7 @@ def test_the_catenoids_flips_are_the_packages_intrinsic_delaunay_triangulation()
     fast = IntrinsicCotanFlow(V, F, tau)
     flips = []
     for _ in range(60):
-        flip, _, _ = fast.flips.flip(fast.X.T, fast.geometry.L_data, fast.geometry.mass)
+        flip, _, _ = fast.flips.flip(fast.X.T)
         flips.append(len(flip))
         L, mass = fast.operators()
         L_package, mass_package = intrinsic_operators(fast.X.T, F)
@@ -241,21 +248,34 @@ def planar_fan():
 
 def flat_tetrahedron():
     """A tetrahedron whose edge (0, 1) has opposite angles of 145 degrees each: its flip
-    would make the edge (2, 3) it already has."""
+    makes a second edge (2, 3) beside the one it already has."""
     V = np.array([[-1.0, 0, 0], [1, 0, 0], [0, 0.3, 0.1], [0, -0.3, 0.1]])
     return V, np.array([[0, 1, 2], [1, 0, 3], [0, 2, 3], [1, 3, 2]])
 
 
-@pytest.mark.parametrize("mesh", [planar_fan, flat_tetrahedron])
-def test_flips_one_round_cannot_take_are_left_to_the_package(mesh):
-    """Two edges to flip on one triangle (the fan), or a flip onto an existing edge (the
-    tetrahedron): no compiled round (None), the flow takes the package's operators,
-    which flip them (every weight >= the threshold)."""
-    V, F = mesh()
+def test_a_flip_onto_an_existing_edge_is_the_packages():
+    """The flat tetrahedron's flip gives the vertices 2 and 3 two edges, whose weights
+    the entry (2, 3) sums, as the package's: its operators to round-off."""
+    V, F = flat_tetrahedron()
+    flow = IntrinsicCotanFlow(V, F, 0.01)
+    flip, _, _ = flow.flips.flip(V)
+    assert flow.mesh.edges[flip].tolist() == [[0, 1]] and flow.flips.flip_count == 1
+    L, mass = flow.operators()
+    L_package, mass_package = intrinsic_operators(V, F)
+    assert L_package[2, 3] == pytest.approx(-2.9487, abs=1e-4)
+    np.testing.assert_allclose(L.toarray(), L_package.toarray(), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(mass, mass_package, rtol=1e-15)
+
+
+def test_a_boundary_edge_to_flip_is_left_to_the_package():
+    """The fan's flips leave a boundary edge below the threshold, which the tufted cover
+    flips: no compiled operators (None), the flow takes the package's, every weight
+    >= the threshold."""
+    V, F = planar_fan()
     flow = IntrinsicCotanFlow(V, F, 0.01)
     weights = -flow.geometry.L_data[flow.assembler.pattern.edge_slots[:, 0]]
-    assert np.sum(weights < FLIP_BELOW) == (2 if mesh is planar_fan else 1)
-    assert flow.flips.flip(V, flow.geometry.L_data, flow.geometry.mass) is None
+    assert np.sum(weights < FLIP_BELOW) == 2
+    assert flow.flips.flip(V) is None
     L, mass = flow.operators()
     L_package, mass_package = intrinsic_operators(V, F)
     np.testing.assert_array_equal(L.toarray(), L_package.toarray())
@@ -264,3 +284,33 @@ def test_flips_one_round_cannot_take_are_left_to_the_package(mesh):
     assert -off.data[off.row != off.col].min() >= FLIP_BELOW
     flow.system()
     assert (flow.delaunay_steps, flow.flipped_steps) == (0, 0)
+
+
+def test_along_a_real_meshs_flow_the_compiled_flips_are_the_packages():
+    """The noisy sphere at level 0 (482 vertices): at ``t = 0`` 107 edges to flip, 14
+    triangles with two of them, 118 flips (some edges flip again); along 12 steps every
+    system comes from the compiled flips, each state's operators are intrinsic Delaunay
+    and the package's to round-off, and the trajectory is that of a run that calls the
+    package at every step to 1e-12."""
+    problem = get_problem("real_noisy_sphere")
+    V, F = problem_mesh(problem, 0)
+    tau = problem.tau(0, (V, F))
+    fast = IntrinsicCotanFlow(V, F, tau)
+    weights = -fast.geometry.L_data[fast.assembler.pattern.edge_slots[:, 0]]
+    sides = fast.mesh.edge_faces[weights < FLIP_BELOW].ravel()
+    assert len(sides) // 2 == 107 and np.sum(np.bincount(sides) == 2) == 14
+    for step in range(12):
+        L, mass = fast.operators()
+        assert step or fast.flips.flip_count == 118
+        L_package, mass_package = intrinsic_operators(fast.X.T, F)
+        np.testing.assert_allclose(L.toarray(), L_package.toarray(), rtol=0,
+                                   atol=5e-14 * abs(L_package).max())
+        np.testing.assert_allclose(mass, mass_package, rtol=1e-14)
+        assert_intrinsic_delaunay(L, mass, mesh_area(fast.X.T, F))
+        A, b = fast.system()
+        fast.advance(solve(A, b, b, method="direct", rtol=1e-12)[0])
+    assert (fast.delaunay_steps, fast.flipped_steps) == (0, 12)
+    slow = IntrinsicCotanFlow(V, F, tau)
+    slow._mesh_operators = lambda at: None
+    reference = simulate(slow, 12, solver=EXACT, save_every=0)
+    np.testing.assert_allclose(fast.X.T, reference.frames["vertices"][-1], rtol=0, atol=1e-12)
