@@ -64,7 +64,8 @@ def plan(section=None, schemes=None, problems=None):
     dict
         ``schemes`` (list; those of ``with_integrators`` last), ``problems``
         (name -> sorted levels, registry order), ``rtol``, ``maxiter``, ``solver``,
-        ``mesh_solver``, ``problem_solvers`` (a dict), ``selected`` (whether
+        ``mesh_solver``, ``problem_solvers`` (a dict, the planned problems' only: a
+        cut-down matrix's rules do not depend on the others'), ``selected`` (whether
         ``select`` cut the matrix down).
 
     Raises
@@ -135,7 +136,8 @@ def plan(section=None, schemes=None, problems=None):
     # another integrator only for the schemes that are run (`schemes` may list fewer)
     chosen = [*chosen, *(s for s, name in stepped.items() if name in chosen)]
     return {"schemes": list(chosen), "problems": plan_problems, "rtol": rtol,
-            "maxiter": maxiter, **methods, "problem_solvers": dict(own),
+            "maxiter": maxiter, **methods,
+            "problem_solvers": {p: m for p, m in own.items() if p in plan_problems},
             "selected": bool(select)}
 
 

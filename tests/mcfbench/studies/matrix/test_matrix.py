@@ -201,6 +201,14 @@ def test_a_problem_of_its_own_solver_gets_it_the_others_not():
         assert matrix_plan.problem_settings(plan, name)["solver"]["method"] == expected
 
 
+def test_a_cut_down_plan_carries_the_solvers_of_its_problems_only():
+    own = {"anisotropic_sphere": "kept-ilu-bicgstab", "blobby": "direct"}
+    plan = matrix_plan.plan({"problem_solvers": own,
+                             "select": {"problems": {"sphere": [1], "blobby": [1]}}})
+    assert plan["problem_solvers"] == {"blobby": "direct"}
+    assert matrix_plan.solver_method(plan, "blobby") == "direct"
+
+
 # ------------------------------------------------------------ a tiny matrix for real
 
 
