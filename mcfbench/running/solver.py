@@ -326,7 +326,7 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
                 info = replace(lu, iterations=info.iterations)
             return to_block(x), replace(info, method=method)
         kind, dinv, lu = 0, NO_FLOAT, None
-        if method == "jacobi-bicgstab" or method == "coupled-jacobi-bicgstab" and cfull.size:
+        if method == "jacobi-bicgstab" or (method == "coupled-jacobi-bicgstab" and cfull.size):
             kind = 1
             d = sp.csr_matrix(A).diagonal().astype(float)
             dinv = np.where(d != 0.0, 1.0 / np.where(d != 0.0, d, 1.0), 1.0)
