@@ -46,6 +46,17 @@ def mesh_area(V, F):
                                 axis=1).sum()
 
 
+def assert_the_packages_operators(flow, F, atol):
+    """The flow's operators at its state are the package's (stiffness to ``atol`` of its
+    largest entry, mass to 1e-14) and intrinsic Delaunay."""
+    L, mass = flow.operators()
+    L_package, mass_package = intrinsic_operators(flow.X.T, F)
+    np.testing.assert_allclose(L.toarray(), L_package.toarray(), rtol=0,
+                               atol=atol * abs(L_package).max())
+    np.testing.assert_allclose(mass, mass_package, rtol=1e-14)
+    assert_intrinsic_delaunay(L, mass, mesh_area(flow.X.T, F))
+
+
 def test_on_a_delaunay_mesh_the_operators_are_the_cotangent_ones():
     """Icosphere: ``L`` = the mesh's cotangent stiffness, the mass = its barycentric
     lumped mass (not the Voronoi one: they differ by 2e-3 at level 3)."""
@@ -223,12 +234,7 @@ def test_the_catenoids_flips_are_the_packages_intrinsic_delaunay_triangulation()
     for _ in range(60):
         flip, _, _ = fast.flips.flip(fast.X.T)
         flips.append(len(flip))
-        L, mass = fast.operators()
-        L_package, mass_package = intrinsic_operators(fast.X.T, F)
-        np.testing.assert_allclose(L.toarray(), L_package.toarray(), rtol=0,
-                                   atol=4e-15 * abs(L_package).max())
-        np.testing.assert_allclose(mass, mass_package, rtol=1e-14)
-        assert_intrinsic_delaunay(L, mass, mesh_area(fast.X.T, F))
+        assert_the_packages_operators(fast, F, 4e-15)
         A, b = fast.system()
         fast.advance(solve(A, b, b, method="direct", rtol=1e-12)[0])
     assert (fast.delaunay_steps, fast.flipped_steps) == (18, 42)
@@ -300,13 +306,8 @@ def test_along_a_real_meshs_flow_the_compiled_flips_are_the_packages():
     sides = fast.mesh.edge_faces[weights < FLIP_BELOW].ravel()
     assert len(sides) // 2 == 107 and np.sum(np.bincount(sides) == 2) == 14
     for step in range(12):
-        L, mass = fast.operators()
+        assert_the_packages_operators(fast, F, 5e-14)
         assert step or fast.flips.flip_count == 118
-        L_package, mass_package = intrinsic_operators(fast.X.T, F)
-        np.testing.assert_allclose(L.toarray(), L_package.toarray(), rtol=0,
-                                   atol=5e-14 * abs(L_package).max())
-        np.testing.assert_allclose(mass, mass_package, rtol=1e-14)
-        assert_intrinsic_delaunay(L, mass, mesh_area(fast.X.T, F))
         A, b = fast.system()
         fast.advance(solve(A, b, b, method="direct", rtol=1e-12)[0])
     assert (fast.delaunay_steps, fast.flipped_steps) == (0, 12)
