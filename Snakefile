@@ -41,6 +41,7 @@ report: "workflow/report/workflow.rst"
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/kernels.smk"
+include: "workflow/rules/runs.smk"
 include: "workflow/rules/convergence.smk"
 # Hook for the figure rules maintained separately: figures.smk defines
 # FIGURE_TARGETS (the files `rule all` builds) and its rules.

@@ -18,11 +18,13 @@ Config
     ``beyond`` value stops ``snakemake beyond``, not the matrix. In the workflow
     (:class:`WorkflowPlans`, :func:`message_only`) the message is printed without
     a traceback.
-Settings
-    Everything that determines one run record (scheme, problem, level, tau,
-    t_final, solver tolerance, the source hash of every package): passed to
-    the job, stored and hashed in the record, and recomputed by the
-    aggregation to refuse stale records (:func:`mcfbench.storage.records.read_record`).
+Runs
+    :class:`RunStore`: the specs of every study (:mod:`mcfbench.storage.run_store`,
+    each study's ``plan.run_specs``), their code digests
+    (:func:`mcfbench.running.identity.identity_digest`) and the batches of
+    :func:`mcfbench.running.batching.batches`, made while Snakemake reads the
+    workflow: the rules of ``workflow/rules/runs.smk`` and the studies' views'
+    inputs (the batch manifests) and params (the specs and their digests).
 Resources
     :func:`mem_mb`, :func:`runtime_minutes` (generous, for Slurm).
 Kernels
@@ -45,7 +47,12 @@ from mcfbench.running.schemes import SCHEMES
 from mcfbench.storage.atomic import write_json
 from mcfbench.storage.provenance import code_hash
 from mcfbench.studies.config import ConfigError, check_threads
-from mcfbench.studies.convergence.plan import PROBLEM
+
+PROBLEM = "sphere"
+"""The problem of the kernels' warm-up (:func:`warm_kernels`)."""
+
+RUN_STUDIES = ("convergence", "beyond", "matrix", "gallery")
+"""The studies whose runs are in the run store (``plan.run_specs(plans)`` of each)."""
 
 
 def check_config(config, schema_path):
@@ -225,6 +232,90 @@ class Plans:
             return self.plan(study)
         except ConfigError:
             return empty
+
+
+class RunStore:
+    """The run store's plan for the workflow: the specs of every study of
+    :data:`RUN_STUDIES` whose section is good (a bad one contributes no spec; its
+    target names the key, :meth:`Plans.checked`), gathered into batches.
+
+    Parameters
+    ----------
+    plans : Plans or WorkflowPlans
+    studies : sequence of str
+        The studies planned (default :data:`RUN_STUDIES`). The gallery's specs hash
+        its mesh files (the suite's own ones generated in memory before their rule
+        writes them: seconds), so the workflow plans them only when the gallery is
+        asked for; no other study shares its runs, so the other batches stay the same.
+    """
+
+    def __init__(self, plans, studies=RUN_STUDIES):
+        from mcfbench.running.batching import batches
+
+        self.requests = {}
+        for study in studies:
+            module = importlib.import_module(f"mcfbench.studies.{study}.plan")
+            try:
+                self.requests[study] = list(module.run_specs(plans))
+            except (ConfigError, SystemExit):       # SystemExit: WorkflowPlans' message
+                continue
+        self.batches = batches(self.requests)
+        self._batch = {spec: batch for batch in self.batches for spec in batch.specs}
+        self._digests = {}
+
+    def digest(self, spec):
+        """The code digest of a spec's run (:func:`code_digests`)."""
+        if spec not in self._digests:
+            self._digests.update(code_digests([spec]))
+        return self._digests[spec]
+
+    def entries(self, batch):
+        """The params of a batch's job: per spec its dict and code digest."""
+        return [{"spec": spec.to_dict(), "code": self.digest(spec)} for spec in batch.specs]
+
+    def manifests(self, specs):
+        """The manifests of the batches holding ``specs`` (a view's inputs), sorted."""
+        from mcfbench.storage.run_store import manifest_path
+
+        return sorted({manifest_path(self._batch[spec].name) for spec in specs})
+
+    def expected(self, specs):
+        """``[(spec dict, code digest)]`` of ``specs``: a view's params, read back
+        by :func:`expected_runs`."""
+        return [(spec.to_dict(), self.digest(spec)) for spec in specs]
+
+
+def code_digests(specs):
+    """``{spec: code digest}``: the digest of each spec's run identity
+    (:func:`mcfbench.running.identity.run_identity` of its scheme and problem), the
+    current code's; what the run store's records must carry (a view's expected runs)."""
+    from mcfbench.running.identity import identity_digest, run_identity
+
+    digests = {}
+    for name in {(spec.scheme, spec.problem) for spec in specs}:
+        digests[name] = identity_digest(run_identity(*name))
+    return {spec: digests[spec.scheme, spec.problem] for spec in specs}
+
+
+def expected_runs(params):
+    """``{RunSpec: code digest}`` of :meth:`RunStore.expected` (a view's params), for
+    :func:`mcfbench.storage.run_store.read_runs`."""
+    from mcfbench.storage.run_store import RunSpec
+
+    return {RunSpec.from_dict(dict(spec)): digest for spec, digest in params}
+
+
+def batch_resources(batch):
+    """``(mem_mb, runtime minutes)`` of a batch's job: as a matrix batch's (1 500 MB,
+    120 minutes), a gallery mesh's (2 000 MB, 60 minutes a scheme), or the
+    generous bounds of its costliest run when they are more."""
+    levels = [spec.level for spec in batch.specs]
+    if batch.problem == "gallery":
+        return 2000, 60 * len(batch.specs)
+    steps = [spec.steps if spec.tau is None else round(spec.t_final / spec.tau)
+             for spec in batch.specs]
+    return (max(1500, *(mem_mb(level) for level in levels)),
+            max(120, sum(runtime_minutes(level, n) for level, n in zip(levels, steps))))
 
 
 # -- resources of the jobs (minutes, MB) ----------------------------------------------

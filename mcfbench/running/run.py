@@ -438,27 +438,24 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
     """
     import pandas as pd
 
-    from mcfbench.geometry.metrics import volume
+    from mcfbench.geometry.frame_fields import final_state_distance
 
     def final(tau):
         result, traj = run(scheme, problem, level, tau=tau, t_final=t_final, solver=solver,
                            integrator=integrator, **options)
-        vertices, extra = surface_points(traj.frames)
-        X = (vertices[-1] if extra is None else np.concatenate([vertices[-1], extra[-1]])).T
-        return result, X, volume(vertices[-1], traj.faces)
+        return result, {**traj.frames, "faces": traj.faces}
 
-    ref_result, ref, ref_volume = final(min(taus) / reference_factor)
+    ref_result, ref = final(min(taus) / reference_factor)
     if ref_result.status != "ok":
         raise RuntimeError(f"reference run failed: {ref_result.message}")
-    weights = _final_weights(scheme, problem, level, ref, t_final, options)
+    weights = final_weights(scheme, ref, options)
     rows = []
     for tau in taus:
-        result, X, vol = final(tau)
+        result, frames = final(tau)
         ok = result.status == "ok"
-        rows.append({"tau": tau, "N": result.N,
-                     "error": float(np.sqrt(weights @ np.sum((X - ref) ** 2, axis=0)))
-                     if ok else np.nan,
-                     "volume_error": abs(vol - ref_volume) if ok else np.nan,
+        error, volume_error = final_state_distance(frames, ref, weights) if ok else \
+            (np.nan, np.nan)
+        rows.append({"tau": tau, "N": result.N, "error": error, "volume_error": volume_error,
                      **result.metrics, "status": result.status})
     table = pd.DataFrame(rows)
     table.insert(3, "eoc", eoc(table["error"].to_numpy()))
@@ -466,14 +463,15 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
     return table
 
 
-def _final_weights(scheme, problem, level, X, t_final, options):
-    """Quadrature weights of the state ``X`` (3, n_points) of the scheme's flow."""
+def final_weights(scheme, frames, options=None):
+    """The scheme's quadrature weights ``flow.l2_weights`` of the last frame of
+    ``frames`` (:mod:`mcfbench.storage.frames`' layout): (n_points,) float array
+    (DDFV: the covolumes of its F- and T-vertices), its flow made from that state
+    (``options``: the scheme's)."""
     scheme = get_scheme(scheme) if isinstance(scheme, str) else scheme
-    problem = get_problem(problem) if isinstance(problem, str) else problem
-    V, F = problem_mesh(problem, level)
-    n = len(V)
-    extra = {"T0": X[:, n:].T} if scheme.extra_points else {}
-    flow = scheme.make(X[:, :n].T, F, 1.0, **{**options, **extra})
+    vertices, extra = surface_points(frames)
+    T0 = {"T0": extra[-1]} if scheme.extra_points else {}
+    flow = scheme.make(vertices[-1], frames["faces"], 1.0, **{**(options or {}), **T0})
     return np.asarray(flow.l2_weights)
 
 

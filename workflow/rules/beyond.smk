@@ -12,24 +12,23 @@
 # (results/README.md), for any scheme of the registry mcfbench.running.schemes.SCHEMES:
 #
 # - levels: every scheme on every level with tau ~ h^2 as in Table 3.1, and
-#   the schemes of beyond.finest on one level more; the ordinary run records
-#   results/runs/{scheme}/level{k}.json of rule run_scheme (shared with the
-#   convergence study);
+#   the schemes of beyond.finest on one level more (the same specs as Table 3.1's,
+#   so the same runs in the run store);
 # - long_time: one level continued past t_final (onset of the breakdown);
 # - space: refined meshes with one tiny time step (order 2 in space);
-# - time: one mesh, tau halved repeatedly (order 1 in time;
-#   mcfbench.running.run.time_convergence);
+# - time: one mesh, tau halved repeatedly (order 1 in time): one run per tau and the
+#   reference run, the errors from their saved final states;
 # - scaling: CPU seconds per step and peak memory against the unknowns, slopes
 #   fitted on beyond.scaling.fit_levels, of every scheme of the registry (unless
-#   beyond.scaling.schemes narrows it) on beyond.scaling.levels: runs of rule
-#   run_scheme (one job for a run the levels study also makes); its own rule
+#   beyond.scaling.schemes narrows it) on beyond.scaling.levels (a run the levels
+#   study also makes is one run of the store); its own rule
 #   beyond_scaling, so that its table needs those runs only:
 #     snakemake --cores 2 results/beyond/tables/scaling.md
 #
 # Runs that break down are records like any other (status, t_failed, the T
 # monitor of every time level reached); the tables show them as such.
-# Settings, record paths and resources: mcfbench.studies.beyond through
-# mcfbench.pipeline.Plans (PLANS of workflow/rules/common.smk).
+# Specs: mcfbench.studies.beyond.plan through mcfbench.pipeline.Plans (PLANS of
+# workflow/rules/common.smk); their batch jobs: workflow/rules/runs.smk.
 
 import mcfbench.studies.beyond as _beyond_paths
 
@@ -65,60 +64,20 @@ BEYOND_TARGETS = [
 ]
 
 
-wildcard_constraints:
-    study="long_time|space",
+from mcfbench.studies.beyond import plan as _beyond
 
 
-rule beyond_run:
-    """One scheme on one sphere level with the settings of a beyond study."""
-    input:
-        kernels=ancient(KERNELS),
-    output:
-        _beyond_paths.RUN,
-    log:
-        "results/logs/beyond/{study}/{scheme}/level{level}.log",
-    benchmark:
-        "results/benchmarks/beyond/{study}/{scheme}/level{level}.tsv"
-    priority: lambda wildcards: int(wildcards.level)
-    conda:
-        "../envs/ddfv.yaml"
-    threads: THREADS
-    resources:
-        mem_mb=run_mem_mb,
-        runtime=beyond_run_runtime,
-    params:
-        settings=beyond_run_settings,
-    script:
-        "../scripts/beyond_run.py"
-
-
-rule beyond_time:
-    """Time convergence of one scheme on one mesh (mcfbench.running.run.time_convergence)."""
-    input:
-        kernels=ancient(KERNELS),
-    output:
-        _beyond_paths.TIME_RUN,
-    log:
-        "results/logs/beyond/time/{scheme}.log",
-    benchmark:
-        "results/benchmarks/beyond/time/{scheme}.tsv"
-    priority: 3
-    conda:
-        "../envs/ddfv.yaml"
-    threads: THREADS
-    resources:
-        mem_mb=500,
-        runtime=time_runtime,
-    params:
-        settings=time_settings,
-    script:
-        "../scripts/beyond_run.py"
+def beyond_specs(studies):
+    """The specs of the beyond study's ``studies`` (its plan checked: a bad value is
+    named here)."""
+    runs = _beyond.study_specs(PLANS)
+    return list(dict.fromkeys(s for study in studies for s in runs[study].values()))
 
 
 rule beyond_records:
     """Check every run record of the beyond study (a bad one stops here: the tables stay)."""
     input:
-        lambda wildcards: list(_beyond.study_records(PLANS)),
+        lambda wildcards: RUNS.manifests(beyond_specs(_beyond.TABLE_STUDIES)),
     output:
         f"{_beyond_paths.TABLES}/records.json",
     log:
@@ -133,7 +92,7 @@ rule beyond_records:
         mem_mb=500,
         runtime=5,
     params:
-        expected=lambda wildcards: _beyond.study_records(PLANS),
+        expected=lambda wildcards: RUNS.expected(beyond_specs(_beyond.TABLE_STUDIES)),
     script:
         "../scripts/check_records.py"
 
@@ -142,10 +101,7 @@ rule beyond_tables:
     """The tables of the beyond study (but the scaling study's) and the T monitor series."""
     input:
         checked=f"{_beyond_paths.TABLES}/records.json",
-        levels=lambda wildcards: list(_beyond.study_runs(PLANS)["levels"]),
-        long_time=lambda wildcards: list(_beyond.study_runs(PLANS)["long_time"]),
-        space=lambda wildcards: list(_beyond.study_runs(PLANS)["space"]),
-        time=lambda wildcards: list(_beyond.study_runs(PLANS)["time"]),
+        runs=lambda wildcards: RUNS.manifests(beyond_specs(_beyond.TABLE_STUDIES)),
     output:
         **{
             key: (
@@ -174,8 +130,8 @@ rule beyond_tables:
         mem_mb=1000,
         runtime=5,
     params:
-        expected=lambda wildcards: _beyond.study_records(PLANS),
         beyond=lambda wildcards: PLANS.plan("beyond"),
+        table=lambda wildcards: PLANS.plan("convergence"),
         paper_schemes=lambda wildcards: _beyond.paper_schemes(PLANS.plan("beyond")),
         settings={k: config[k] for k in ("tau_level_1", "t_final", "rtol")},
     script:
@@ -260,7 +216,7 @@ rule beyond_findings:
 rule beyond_scaling:
     """Cost against size: the scaling table, its points and figure from its own runs."""
     input:
-        lambda wildcards: list(_beyond.study_runs(PLANS)["scaling"]),
+        lambda wildcards: RUNS.manifests(beyond_specs(["scaling"])),
     output:
         **{
             key: (
@@ -295,8 +251,8 @@ rule beyond_scaling:
         mem_mb=1000,
         runtime=5,
     params:
-        expected=lambda wildcards: _beyond.study_runs(PLANS)["scaling"],
         beyond=lambda wildcards: PLANS.plan("beyond"),
+        table=lambda wildcards: PLANS.plan("convergence"),
         settings={"t_final": config["t_final"]},
     script:
         "../scripts/beyond_scaling.py"

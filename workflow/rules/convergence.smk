@@ -1,7 +1,16 @@
-# Convergence study: one job per (scheme, level), then Table 3.1 and the
-# convergence figure from the run records.
+# Convergence study: Table 3.1 and the convergence figure from the run store's
+# records of its specs (mcfbench.studies.convergence.plan.table_specs; their batch
+# jobs: workflow/rules/runs.smk).
 #
 #   snakemake --cores 2 convergence    # only this study (rule all adds the figures)
+
+
+from mcfbench.studies.convergence import plan as _convergence
+
+
+def convergence_specs():
+    """The specs of Table 3.1 (its plan checked: a bad value is named here)."""
+    return list(_convergence.table_specs(PLANS.plan("convergence")).values())
 
 
 rule convergence:
@@ -12,35 +21,10 @@ rule convergence:
     localrule: True
 
 
-rule run_scheme:
-    """One scheme on one sphere level: results/runs/{scheme}/level{level}.json."""
-    input:
-        kernels=ancient(KERNELS),
-    output:
-        _convergence_paths.RUN,
-    log:
-        "results/logs/runs/{scheme}/level{level}.log",
-    benchmark:
-        "results/benchmarks/runs/{scheme}/level{level}.tsv"
-    # the long runs first, so that the short ones fill the other cores
-    priority: lambda wildcards: int(wildcards.level)
-    conda:
-        "../envs/ddfv.yaml"
-    threads: THREADS
-    resources:
-        mem_mb=run_mem_mb,
-        runtime=run_runtime,
-    params:
-        # includes the source hash of ddfv, baselines, mcfbench: changed code reruns it
-        settings=run_settings,
-    script:
-        "../scripts/run_scheme.py"
-
-
 rule convergence_records:
     """Check every run record of Table 3.1 (a bad one stops here: the tables stay)."""
     input:
-        lambda wildcards: list(_convergence.table_records(PLANS)),
+        lambda wildcards: RUNS.manifests(convergence_specs()),
     output:
         f"{_convergence_paths.TABLE}.records.json",
     log:
@@ -55,7 +39,7 @@ rule convergence_records:
         mem_mb=500,
         runtime=5,
     params:
-        expected=lambda wildcards: _convergence.table_records(PLANS),
+        expected=lambda wildcards: RUNS.expected(convergence_specs()),
     script:
         "../scripts/check_records.py"
 
@@ -64,7 +48,7 @@ rule convergence_table:
     """Table 3.1 with the paper's values and the baselines side by side."""
     input:
         checked=f"{_convergence_paths.TABLE}.records.json",
-        records=lambda wildcards: list(_convergence.table_records(PLANS)),
+        runs=lambda wildcards: RUNS.manifests(convergence_specs()),
     output:
         csv=report(
             f"{_convergence_paths.TABLE}.csv",
@@ -87,7 +71,7 @@ rule convergence_table:
         mem_mb=500,
         runtime=5,
     params:
-        expected=lambda wildcards: _convergence.table_records(PLANS),
+        expected=lambda wildcards: RUNS.expected(convergence_specs()),
         schemes=lambda wildcards: PLANS.plan("convergence")["schemes"],
         levels=lambda wildcards: PLANS.plan("convergence")["levels"],
         settings=lambda wildcards: _convergence.table_settings(

@@ -9,39 +9,20 @@
 # (config key `gallery`). Without `meshes` the suite first writes its own
 # real-world-like meshes and the real meshes shipped inside pinned packages
 # (mcfbench.geometry.packaged_meshes: pyvista, nilearn; read from the installed
-# package, SHA-256 checked) as OBJ to results/gallery/meshes/. Uses MATRIX_CODE
-# and _alternatives (mcfbench.pipeline.alternatives) of workflow/rules/matrix.smk
-# (included before).
+# package, SHA-256 checked) as OBJ to results/gallery/meshes/. Uses _alternatives
+# (mcfbench.pipeline.alternatives) of workflow/rules/matrix.smk (included before).
 #
-# Outputs under results/gallery/ (the paths: mcfbench/studies/gallery/__init__.py):
-# runs/{mesh}/{scheme}.json, frames/{mesh}/{scheme}.npz (about 20 frames),
-# movies/{mesh}/{scheme}.gif, table.md, table.csv, pictures.png, pictures.pdf.
+# Its runs are specs in the run store (a mesh file's path and SHA-256 in each;
+# about 20 frames each; workflow/rules/runs.smk). Outputs under results/gallery/
+# (the paths: mcfbench/studies/gallery/__init__.py): movies/{mesh}/{scheme}.gif,
+# table.md, table.csv, pictures.png, pictures.pdf.
 
 import mcfbench.studies.gallery as _gallery
+from mcfbench.studies.gallery import plan as _gallery_plan
 
 # the plan; without meshes (no runs) when the section `gallery` or `meshes` is
 # bad: then `snakemake gallery` names the bad key (rule gallery)
 GALLERY = PLANS.while_reading("gallery", {"meshes": {}, "generated": {}, "schemes": []})
-GALLERY_SETTINGS = {
-    "study": "gallery",
-    **{k: GALLERY.get(k) for k in ("C", "steps", "solver", "rtol", "maxiter")},
-    "code": MATRIX_CODE,
-}
-# {record path: settings} of every run
-GALLERY_RUNS = {
-    _gallery.RECORD.format(mesh=mesh, scheme=scheme): {
-        **GALLERY_SETTINGS,
-        "mesh": mesh,
-        "scheme": scheme,
-    }
-    for mesh in GALLERY["meshes"]
-    for scheme in GALLERY["schemes"]
-}
-GALLERY_FRAMES = [
-    _gallery.FRAMES.format(mesh=mesh, scheme=scheme)
-    for mesh in GALLERY["meshes"]
-    for scheme in GALLERY["schemes"]
-]
 GALLERY_MOVIES = [
     _gallery.MOVIE.format(mesh=mesh, scheme=scheme)
     for mesh in GALLERY["meshes"]
@@ -54,6 +35,12 @@ GALLERY_TARGETS = [
     f"{_gallery.PICTURES}.pdf",
     *GALLERY_MOVIES,
 ]
+
+
+def gallery_runs(wildcards):
+    """The manifests of the gallery's batches (planned when the gallery is asked
+    for: workflow/rules/runs.smk)."""
+    return RUNS.manifests(RUNS.requests["gallery"])
 
 
 if GALLERY["generated"]:
@@ -77,44 +64,15 @@ if GALLERY["generated"]:
             runtime=10,
         params:
             entry=lambda wildcards: GALLERY["generated"][wildcards.mesh],
-            code=MATRIX_CODE,
+            code=PLANS.code,
         script:
             "../scripts/gallery_mesh.py"
-
-
-rule gallery_run:
-    """One scheme on one mesh file."""
-    input:
-        kernels=ancient(KERNELS),
-        mesh=lambda wildcards: GALLERY["meshes"][wildcards.mesh],
-    output:
-        record=_gallery.RECORD,
-        frames=_gallery.FRAMES,
-    log:
-        "results/logs/gallery/{mesh}/{scheme}.log",
-    benchmark:
-        "results/benchmarks/gallery/{mesh}/{scheme}.tsv"
-    wildcard_constraints:
-        mesh=_alternatives(GALLERY["meshes"]),
-        scheme=_alternatives(GALLERY["schemes"]),
-    conda:
-        "../envs/ddfv.yaml"
-    threads: 1
-    resources:
-        mem_mb=2000,
-        runtime=60,
-    params:
-        settings=lambda wildcards: GALLERY_RUNS[
-            _gallery.RECORD.format(mesh=wildcards.mesh, scheme=wildcards.scheme)
-        ],
-    script:
-        "../scripts/gallery_run.py"
 
 
 rule gallery_table:
     """Mesh x scheme: status, steps, breakdown time, mesh quality, CPU time."""
     input:
-        list(GALLERY_RUNS),
+        gallery_runs,
     output:
         md=f"{_gallery.TABLE}.md",
         csv=f"{_gallery.TABLE}.csv",
@@ -130,7 +88,6 @@ rule gallery_table:
         mem_mb=1000,
         runtime=5,
     params:
-        expected=GALLERY_RUNS,
         plan=GALLERY,
     script:
         "../scripts/gallery_table.py"
@@ -139,8 +96,7 @@ rule gallery_table:
 rule gallery_pictures:
     """Per mesh the initial surface and every scheme's last frame."""
     input:
-        records=list(GALLERY_RUNS),
-        frames=GALLERY_FRAMES,
+        gallery_runs,
     output:
         png=f"{_gallery.PICTURES}.png",
         pdf=f"{_gallery.PICTURES}.pdf",
@@ -156,7 +112,6 @@ rule gallery_pictures:
         mem_mb=2000,
         runtime=10,
     params:
-        expected=GALLERY_RUNS,
         plan=GALLERY,
     script:
         "../scripts/gallery_pictures.py"
@@ -165,8 +120,7 @@ rule gallery_pictures:
 rule gallery_movie:
     """One run's frames as an animated GIF (one camera, time and status per frame)."""
     input:
-        record=_gallery.RECORD,
-        frames=_gallery.FRAMES,
+        gallery_runs,
     output:
         gif=_gallery.MOVIE,
     log:
@@ -182,5 +136,7 @@ rule gallery_movie:
     resources:
         mem_mb=1000,
         runtime=10,
+    params:
+        plan=GALLERY,
     script:
         "../scripts/gallery_movie.py"

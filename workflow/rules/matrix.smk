@@ -10,9 +10,8 @@
 # mcfbench/studies/matrix/ (plan, job, aggregate, tables, findings, plots, page),
 # the output paths too (mcfbench/studies/matrix/__init__.py).
 #
-# Outputs under results/matrix/:
-#   runs/{problem}/{scheme}/level{level}.json    one record per run (mcfbench.storage.records)
-#   frames/{problem}/{scheme}/level{level}.npz   its first and last frame
+# Its runs are specs in the run store (results/runs/, workflow/rules/runs.smk: one
+# record and the first and last frames per run). Outputs under results/matrix/:
 #   tables/matrix.csv                            the long table (one row per metric)
 #   tables/{problem}.md, .tex                    one table per problem, schemes as rows
 #   tables/summary.md, .tex, .csv                problem x scheme
@@ -25,13 +24,12 @@ import mcfbench.studies.matrix as _matrix_paths
 from mcfbench.studies.matrix import plan as _matrix
 from mcfbench.pipeline import alternatives as _alternatives
 
-# the plan; without problems (no rules) when the section `matrix` is bad: then
+# the plan; without problems (no runs) when the section `matrix` is bad: then
 # `snakemake matrix` names the bad key (rule matrix), the other targets run
 MATRIX = PLANS.while_reading("matrix", {"schemes": [], "problems": {}})
-# a run is redone when the code that computes it changes (not the tables or plots)
-MATRIX_CODE = PLANS.code
-# {record path: settings} of every run
-MATRIX_RUNS = _matrix.planned_runs(MATRIX, MATRIX_CODE)
+# the manifests of the batches of its runs (workflow/rules/runs.smk): a run is
+# redone when its spec or the code that computes it changes, not the tables or plots
+MATRIX_RUNS = RUNS.manifests(_matrix.planned_specs(MATRIX).values())
 
 
 MATRIX_TABLES = _matrix_paths.table_files(MATRIX["problems"])
@@ -44,61 +42,10 @@ MATRIX_TARGETS = [
 ]
 
 
-# One job per batch (mcfbench.studies.matrix.plan.batches): the cheap series of a
-# problem gathered in one process until their estimated cost reaches about
-# 60 CPU s (plan.BATCH_SECONDS), a heavy series alone
-# (mcfbench.studies.matrix.job.batch_job); one rule per batch since the outputs
-# differ. Saves the start-up of a process and Snakemake's work per job of every
-# series but one per batch (about 1.7 s each);
-# a killed job redoes its own series. (Snakemake's `group:` would not do it: in
-# local execution group definitions are ignored, docs "Job Grouping".)
-for _batch in _matrix.batches(MATRIX):
-    _levels = MATRIX["problems"][_batch.problem]
-
-    rule:
-        name:
-            f"matrix_run_{_batch.name}"
-        input:
-            kernels=ancient(KERNELS),
-        output:
-            records=[
-                _matrix.record_path(_batch.problem, s, k)
-                for s in _batch.schemes
-                for k in _levels
-            ],
-            frames=[
-                _matrix.frames_path(_batch.problem, s, k)
-                for s in _batch.schemes
-                for k in _levels
-            ],
-        log:
-            [f"results/logs/matrix/{_batch.problem}/{s}.log" for s in _batch.schemes],
-        benchmark:
-            f"results/benchmarks/matrix/{_batch.problem}/batch{_batch.index}.tsv"
-        # the costliest batches first (estimated CPU s): long jobs start early and
-        # the two cores stay busy
-        priority: round(_batch.seconds)
-        conda:
-            "../envs/ddfv.yaml"
-        threads: 1
-        # one heavy series at most per batch, the others' estimate under 60 s:
-        # the bounds of a series job hold for a batch
-        resources:
-            mem_mb=1500,
-            runtime=120,
-        # the settings of the problem's runs, not of the batch's series (each
-        # run's scheme and level are its record path's): regrouping the batches
-        # (other schemes or levels) or trimming levels reruns no run already computed
-        params:
-            settings=_matrix.problem_settings(MATRIX, _batch.problem, MATRIX_CODE),
-        script:
-            "../scripts/matrix_run.py"
-
-
 rule matrix_tables:
     """The long table, one table per problem and the summary."""
     input:
-        list(MATRIX_RUNS),
+        MATRIX_RUNS,
     output:
         MATRIX_TABLES,
     log:
@@ -112,11 +59,10 @@ rule matrix_tables:
     resources:
         mem_mb=1500,
         runtime=10,
-    # the plan and the code digest, not the settings of every run (which the script
-    # makes from them): a changed matrix is named in a few lines, not hundreds
+    # the plan, not the spec of every run (which the script makes from it): a
+    # changed matrix is named in a few lines, not hundreds
     params:
         plan=MATRIX,
-        code=MATRIX_CODE,
     script:
         "../scripts/matrix_tables.py"
 
@@ -126,7 +72,7 @@ rule matrix_plots:
     the records)."""
     input:
         table=_matrix_paths.LONG_TABLE,
-        records=list(MATRIX_RUNS),
+        runs=MATRIX_RUNS,
     output:
         **{k: v for k, v in MATRIX_FIGURES.items() if not k.startswith("pictures")},
     log:
@@ -142,7 +88,6 @@ rule matrix_plots:
         runtime=10,
     params:
         plan=MATRIX,
-        code=MATRIX_CODE,
     script:
         "../scripts/matrix_plots.py"
 
@@ -155,8 +100,7 @@ rule matrix_plots:
 rule matrix_pictures:
     """The final surfaces, scheme x problem, at the coarsest level."""
     input:
-        records=[r for r, _ in _matrix.picture_runs(MATRIX).values()],
-        frames=[f for _, f in _matrix.picture_runs(MATRIX).values()],
+        RUNS.manifests(_matrix.picture_specs(MATRIX).values()),
     output:
         png=MATRIX_FIGURES["pictures_png"],
         pdf=MATRIX_FIGURES["pictures_pdf"],

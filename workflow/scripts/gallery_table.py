@@ -3,15 +3,18 @@ workflow/rules/gallery.smk; :func:`mcfbench.studies.gallery.tables.gallery_table
 
 import logging
 
+from mcfbench.pipeline import code_digests
 from mcfbench.presentation.tables import csv
 from mcfbench.storage.atomic import write_text
-from mcfbench.storage.records import read_records
+from mcfbench.storage.run_store import read_runs
+from mcfbench.studies.gallery.plan import gallery_specs
 from mcfbench.studies.gallery.tables import gallery_markdown, gallery_table
 from mcfbench.studies.matrix.tables import FLOAT_FORMAT
 
 sm = snakemake  # noqa: F821
 logging.basicConfig(filename=sm.log[0], level=logging.INFO, force=True)
-table = gallery_table(list(read_records(sm.params.expected).values()))
+specs = gallery_specs(sm.params.plan).values()
+table = gallery_table(list(read_runs(code_digests(specs)).values()))
 write_text(sm.output.csv, csv(table, FLOAT_FORMAT))
 write_text(sm.output.md, gallery_markdown(table, sm.params.plan))
 logging.info("\n%s", table.to_string())

@@ -7,8 +7,9 @@ against h from the long table, mesh quality over time from the records' series
 
 import logging
 
-from mcfbench.storage.records import read_records
-from mcfbench.studies.matrix.plan import planned_runs
+from mcfbench.pipeline import code_digests
+from mcfbench.storage.run_store import read_runs
+from mcfbench.studies.matrix.plan import planned_specs
 from mcfbench.studies.matrix.plots import error_figure, quality_figure, work_precision_figure
 from mcfbench.studies.matrix.tables import read_long_table
 
@@ -19,6 +20,6 @@ problems, schemes = list(plan["problems"]), plan["schemes"]
 table = read_long_table(sm.input.table)
 error_figure(table, [out.errors_png, out.errors_pdf], problems, schemes)
 work_precision_figure(table, [out.work_precision_png, out.work_precision_pdf], problems, schemes)
-records = read_records(planned_runs(plan, sm.params.code))
+records = read_runs(code_digests(planned_specs(plan).values()))
 quality_figure(list(records.values()), [out.quality_png, out.quality_pdf], problems, schemes)
 logging.info("wrote %s", ", ".join(out))

@@ -5,12 +5,11 @@ The study's modules:
 
 * :mod:`.plan`: the config key ``beyond`` checked against the registry and the
   Table 3.1 keys it builds on (:func:`mcfbench.studies.convergence.plan.plan`);
-  :func:`~.plan.beyond_runs`, every record of the study with its settings;
-* :mod:`.job`: one run of the study: the time study of one scheme
-  (:func:`mcfbench.running.run.time_convergence`) or one run on one level
-  (:func:`mcfbench.studies.convergence.job.job`);
+  :func:`~.plan.beyond_specs`, the spec of every run of the study (the time study's
+  too: one run per time step and the reference's);
 * :mod:`.aggregate`: the records into the tables and the T-monitor series
-  (:mod:`.tables`);
+  (:mod:`.tables`); the time study's errors from the saved final states
+  (:func:`~.aggregate.time_records`);
 * :mod:`.scaling`: cost against size, the CPU seconds per step and the peak
   memory of its runs (every scheme of the registry unless ``beyond.scaling.schemes``
   narrows it) against their unknowns with fitted slopes;
@@ -20,14 +19,8 @@ The study's modules:
 """
 
 ROOT = "results/beyond"
-"""The folder of the study's outputs (its level runs are Table 3.1's records,
-:data:`mcfbench.studies.convergence.RUN`)."""
-
-RUN = f"{ROOT}/runs/{{study}}/{{scheme}}/level{{level}}.json"
-"""One run of the long-time (``study = long_time``) or the space study."""
-
-TIME_RUN = f"{ROOT}/runs/time/{{scheme}}.json"
-"""The time study of one scheme."""
+"""The folder of the study's outputs (its runs are specs in the run store,
+:mod:`mcfbench.storage.run_store`; its level runs are Table 3.1's)."""
 
 TABLES = f"{ROOT}/tables"
 """``{name}.csv/.md/.tex`` of :data:`TABLE_NAMES`, ``t_monitor.csv``, ``beyond.json``

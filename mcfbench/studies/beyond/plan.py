@@ -1,9 +1,7 @@
 """The plan of the beyond study: the config key ``beyond`` checked against the registry
-and the Table 3.1 keys it builds on (:func:`plan`), every record of the study with
-its settings (:func:`beyond_runs`)."""
+and the Table 3.1 keys it builds on (:func:`plan`), the spec of every run of the
+study (:func:`beyond_specs`, in the run store: :mod:`mcfbench.storage.run_store`)."""
 
-from mcfbench.storage.records import FIELDS
-from mcfbench.studies.beyond import RUN, TIME_RUN
 from mcfbench.studies.config import (
     ConfigError,
     check_rtol,
@@ -11,11 +9,6 @@ from mcfbench.studies.config import (
     checked_steps,
 )
 from mcfbench.studies.convergence import plan as convergence
-
-TIME_FIELDS = {"scheme": str, "level": int, "reference_tau": float, "t_final": float,
-               "outcome": str, "message": str, "rows": list, "wall_seconds": float,
-               "peak_rss_mb": float, "settings": dict, "provenance": dict, "checksum": str}
-"""Key -> type of a time-study record (:func:`job`)."""
 
 
 def plan(config, table):
@@ -165,14 +158,6 @@ def scaling_fit_levels(scaling, scheme):
     return scaling_levels(scaling, scheme)[-len(scaling["fit_levels"]):]
 
 
-def is_finest_run(config, scheme, level):
-    """Whether (scheme, level) is a run of ``beyond.finest`` by the unchecked config
-    (the schema's types): the one record of Table 3.1's folder whose settings need
-    the beyond plan (its own ``rtol``, :func:`level_settings`)."""
-    finest = config["beyond"]["finest"]
-    return int(level) == int(finest["level"]) and scheme in finest["schemes"]
-
-
 def used_schemes(plan):
     """Every scheme the beyond study runs, in order of first appearance."""
     names = list(plan["schemes"])
@@ -195,71 +180,44 @@ def levels_of(plan, scheme):
     return plan["levels"] + ([finest["level"]] if scheme in finest["schemes"] else [])
 
 
-def level_settings(plan, table, scheme, level, code):
-    """Settings of the record of (scheme, level) in Table 3.1's folder: Table 3.1's
-    (:func:`mcfbench.studies.convergence.record_settings`), with the tolerance of
-    ``beyond.finest`` for its runs."""
+def level_spec(plan, table, scheme, level):
+    """The spec of (scheme, level) of the levels and the scaling studies: Table 3.1's
+    (:func:`mcfbench.studies.convergence.plan.sphere_spec`, the same run), with the
+    tolerance of ``beyond.finest`` for its runs."""
     finest = plan["finest"]
     rtol = finest["rtol"] if int(level) == finest["level"] and scheme in finest["schemes"] \
         else None
-    return convergence.record_settings(table, scheme, level, code, rtol=rtol)
+    return convergence.sphere_spec(table, scheme, level, rtol=rtol)
 
 
-def study_settings(plan, table, study, scheme, level, code):
-    """Settings of one run of the long-time (``study = "long_time"``) or the space
-    study (``"space"``)."""
-    if study == "long_time":
-        return convergence.record_settings(table, scheme, level, code, study=study,
-                                           t_final=plan["long_time"]["t_final"])
-    space = plan["space_study"]
-    return convergence.record_settings(table, scheme, level, code, study=study,
-                                       tau=space["tau"], t_final=space["t_final"])
-
-
-def time_settings(plan, table, scheme, code):
-    """Settings of the time study of one scheme."""
+def time_taus(plan):
+    """The time steps of the time study: ``taus`` and the reference's, the smallest over
+    ``reference_factor``."""
     study = plan["time_study"]
-    return {"study": "time", "scheme": scheme, "problem": convergence.PROBLEM,
-            "level": study["level"], "taus": study["taus"],
-            "reference_factor": study["reference_factor"], "t_final": study["t_final"],
-            "rtol": study["rtol"], "threads": table["threads"], "code": code}
+    return [*study["taus"], study["taus"][-1] / study["reference_factor"]]
 
 
-def time_steps_total(plan):
-    """Time steps of one time-study job: every ``tau`` and the reference run."""
-    study = plan["time_study"]
-    steps = sum(round(study["t_final"] / tau) for tau in study["taus"])
-    return steps + round(study["t_final"] * study["reference_factor"] / study["taus"][-1])
-
-
-def beyond_runs(plan, table, code):
-    """``{study: {record path: settings}}`` of the beyond study (``levels``,
-    ``long_time``, ``space``, ``time``, ``scaling``: a run of both ``levels`` and
-    ``scaling``, the same record, is one job)."""
-    long_level = plan["long_time"]["level"]
+def beyond_specs(plan, table):
+    """``{study: {key: spec}}`` of the beyond study: ``levels`` and ``scaling``
+    ((scheme, level): the runs of Table 3.1's settings), ``long_time`` and ``space``
+    ((scheme, level)), ``time`` ((scheme, tau), the reference's tau last)."""
+    long, space, time_ = plan["long_time"], plan["space_study"], plan["time_study"]
     return {
-        "levels": {convergence.run_record(s, lv): level_settings(plan, table, s, lv, code)
+        "levels": {(s, lv): level_spec(plan, table, s, lv)
                    for s in plan["schemes"] for lv in levels_of(plan, s)},
-        "long_time": {RUN.format(study="long_time", scheme=s, level=long_level):
-                      study_settings(plan, table, "long_time", s, long_level, code)
-                      for s in plan["long_time"]["schemes"]},
-        "space": {RUN.format(study="space", scheme=s, level=lv):
-                  study_settings(plan, table, "space", s, lv, code)
-                  for s in plan["space_study"]["schemes"]
-                  for lv in plan["space_study"]["levels"]},
-        "time": {TIME_RUN.format(scheme=s): time_settings(plan, table, s, code)
-                 for s in plan["time_study"]["schemes"]},
-        "scaling": {convergence.run_record(s, lv): level_settings(plan, table, s, lv, code)
+        "long_time": {(s, long["level"]): convergence.sphere_spec(
+            table, s, long["level"], t_final=long["t_final"]) for s in long["schemes"]},
+        "space": {(s, lv): convergence.sphere_spec(table, s, lv, tau=space["tau"],
+                                                   t_final=space["t_final"])
+                  for s in space["schemes"] for lv in space["levels"]},
+        "time": {(s, tau): convergence.sphere_spec(table, s, time_["level"], tau=tau,
+                                                   t_final=time_["t_final"],
+                                                   rtol=time_["rtol"])
+                 for s in time_["schemes"] for tau in time_taus(plan)},
+        "scaling": {(s, lv): level_spec(plan, table, s, lv)
                     for s in plan["scaling"]["schemes"]
                     for lv in scaling_levels(plan["scaling"], s)},
     }
-
-
-def record_fields(settings):
-    """The keys and types a record of ``settings`` must have (``required`` of
-    :func:`mcfbench.storage.records.read_records`): the time study's records
-    have their own (:data:`TIME_FIELDS`), every other run record :data:`FIELDS`."""
-    return TIME_FIELDS if settings.get("study") == "time" else FIELDS
 
 
 def from_config(config, plans):
@@ -267,31 +225,20 @@ def from_config(config, plans):
     return plan(config, plans.plan("convergence"))
 
 
-def study_runs(plans):
-    """:func:`beyond_runs` of the pipeline's plans."""
-    return beyond_runs(plans.plan("beyond"), plans.plan("convergence"), plans.code)
+def study_specs(plans):
+    """:func:`beyond_specs` of the pipeline's plans."""
+    return beyond_specs(plans.plan("beyond"), plans.plan("convergence"))
+
+
+def run_specs(plans):
+    """Every spec of the beyond study (the run store's: :class:`mcfbench.pipeline.RunStore`)."""
+    return list(dict.fromkeys(spec for specs in study_specs(plans).values()
+                              for spec in specs.values()))
 
 
 TABLE_STUDIES = ("levels", "long_time", "space", "time")
 """The studies of rule ``beyond_tables``; the scaling study has its own rule
 (``beyond_scaling``), so that its table needs its runs only."""
-
-
-def study_records(plans, studies=TABLE_STUDIES):
-    """``{record path: settings}`` of every run of ``studies`` of the beyond study."""
-    runs = study_runs(plans)
-    return {path: s for study in studies for path, s in runs[study].items()}
-
-
-def study_run_settings(plans, study, scheme, level):
-    """Settings of one run of the long-time or the space study."""
-    return study_settings(plans.plan("beyond"), plans.plan("convergence"), study, scheme, level,
-                          plans.code)
-
-
-def time_run_settings(plans, scheme):
-    """Settings of the time study of one scheme."""
-    return time_settings(plans.plan("beyond"), plans.plan("convergence"), scheme, plans.code)
 
 
 def every_scheme():

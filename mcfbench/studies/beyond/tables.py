@@ -211,9 +211,9 @@ def beyond_tables(inputs, records, beyond, paper_schemes):
     Parameters
     ----------
     inputs : dict
-        Study (``levels``, ``long_time``, ``space``, ``time``) -> record paths.
+        Study (``levels``, ``long_time``, ``space``, ``time``) -> the keys of its records.
     records : dict
-        Path -> record.
+        Key -> record (a time study's: :func:`mcfbench.studies.beyond.aggregate.time_records`).
     beyond : dict
         The normalised config key ``beyond`` (:func:`mcfbench.studies.beyond.plan`).
     paper_schemes : list of str
@@ -507,12 +507,12 @@ def beyond_documents(tables, beyond, settings, paper_schemes):
 
 
 def scaling_tables(records, levels, fit_levels):
-    """The scaling study from its checked records (its own runs, rule ``run_scheme``).
+    """The scaling study from its checked records (its own runs in the run store).
 
     Parameters
     ----------
     records : dict
-        Path -> record of the runs of the study.
+        Key -> record of the runs of the study.
     levels, fit_levels : dict
         Scheme -> its levels, its levels of the fits, in row order
         (:func:`mcfbench.studies.beyond.plan.scaling_levels`, ``scaling_fit_levels``).

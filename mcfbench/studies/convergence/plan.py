@@ -1,10 +1,9 @@
 """The plan of Table 3.1: the config keys (``levels``, ``schemes``, ``rtol``,
-``tau_level_1``, ``t_final``) checked across keys (:func:`plan`) and the settings
-of one run record (:func:`record_settings`, shared with the beyond study's levels)."""
+``tau_level_1``, ``t_final``) checked across keys (:func:`plan`) and its runs' specs
+(:func:`sphere_spec`, :func:`table_specs`; the beyond study's levels use the same)."""
 
 from mcfbench.running.problems import get_problem
 from mcfbench.running.schemes import joined_name
-from mcfbench.studies.convergence import RUN
 from mcfbench.studies.config import (
     ConfigError,
     check_rtol,
@@ -81,27 +80,27 @@ def problem_of(plan):
     return get_problem(PROBLEM).with_settings(tau_1=plan["tau_level_1"], t_final=plan["t_final"])
 
 
-def run_record(scheme, level):
-    """The record of (scheme, level), shared by Table 3.1 and the beyond study."""
-    return RUN.format(scheme=scheme, level=level)
+EXACT_SOLVER = "bicgstab"
+"""The paper's solver: every run of Table 3.1 and of the beyond study."""
 
 
-def record_settings(plan, scheme, level, code, *, study=None, tau=None, t_final=None,
-                    rtol=None):
-    """Everything that determines the run record of (scheme, level).
+def sphere_spec(plan, scheme, level, *, tau=None, t_final=None, rtol=None):
+    """The :class:`~mcfbench.storage.run_store.RunSpec` of ``scheme`` on the sphere of
+    ``level`` with Table 3.1's settings (``plan``): its time step of the level, its
+    ``t_final``, BiCGStab at its ``rtol`` with the solver's default ``maxiter``, its
+    ``threads``. ``tau``, ``t_final`` and ``rtol`` override them (the beyond study's
+    runs); a matrix run with the same settings is the same spec."""
+    from mcfbench.running.batch import spec_of
+    from mcfbench.running.solver import Solver
 
-    ``study``, ``tau``, ``t_final`` and ``rtol`` override Table 3.1's settings
-    (the studies beyond it); without them the settings, and so the hash, are
-    those of Table 3.1. ``code``: :func:`mcfbench.storage.provenance.code_hash`.
-    """
-    level = int(level)
     problem = problem_of(plan)
-    settings = {"scheme": scheme, "problem": problem.name, "level": level,
-                "tau": problem.tau(level) if tau is None else float(tau),
-                "t_final": problem.t_final if t_final is None else float(t_final),
-                "rtol": plan["rtol"] if rtol is None else rtol,
-                "threads": plan["threads"], "code": code}
-    return settings if study is None else {"study": study, **settings}
+    return spec_of(scheme, PROBLEM, level,
+                   solver={"method": EXACT_SOLVER,
+                           "rtol": plan["rtol"] if rtol is None else rtol,
+                           "maxiter": Solver.maxiter},
+                   tau=problem.tau(int(level)) if tau is None else tau,
+                   t_final=problem.t_final if t_final is None else t_final,
+                   threads=plan["threads"])
 
 
 def table_settings(plan):
@@ -114,23 +113,14 @@ def from_config(config, plans):
     return plan(config)
 
 
-def sphere_run_settings(plans, scheme, level):
-    """Settings of the record ``results/runs/{scheme}/level{level}.json``: Table
-    3.1's, or for a run of ``beyond.finest`` the beyond study's (its tolerance;
-    the only record of that folder that needs the beyond plan)."""
-    from mcfbench.studies.beyond import plan as beyond
-
-    if beyond.is_finest_run(plans.config, scheme, level):
-        return beyond.level_settings(plans.plan("beyond"), plans.plan("convergence"), scheme,
-                                     level, plans.code)
-    return record_settings(plans.plan("convergence"), scheme, level, plans.code)
+def table_specs(plan):
+    """``{(scheme, level): spec}`` of Table 3.1, schemes in config order."""
+    return {(s, lv): sphere_spec(plan, s, lv) for s in plan["schemes"] for lv in plan["levels"]}
 
 
-def table_records(plans):
-    """``{record path: settings}`` of Table 3.1, schemes in config order."""
-    table = plans.plan("convergence")
-    return {run_record(s, lv): sphere_run_settings(plans, s, lv)
-            for s in table["schemes"] for lv in table["levels"]}
+def run_specs(plans):
+    """The specs of Table 3.1 (the run store's: :class:`mcfbench.pipeline.RunStore`)."""
+    return table_specs(plans.plan("convergence")).values()
 
 
 def level_steps(plan, level):

@@ -1,11 +1,10 @@
 """The gallery: every scheme on every mesh file of a folder (default: the suite's generated
 real-world-like meshes and the real meshes shipped inside pinned packages,
-:data:`mcfbench.geometry.packaged_meshes.PACKAGED_MESHES`), one run job per (mesh, scheme).
+:data:`mcfbench.geometry.packaged_meshes.PACKAGED_MESHES`), one run per (mesh, scheme) in the run store.
 
 The study's modules (``workflow/rules/gallery.smk`` calls them): :mod:`.plan`
 (the config keys ``gallery`` and ``meshes``, the suite's own meshes),
-:mod:`.job` (one scheme on one mesh file, and the OBJ files of the suite's
-meshes), :mod:`.tables` (mesh x scheme) and :mod:`.plots` (the picture grid,
+:mod:`.job` (the OBJ files of the suite's meshes), :mod:`.tables` (mesh x scheme) and :mod:`.plots` (the picture grid,
 one animation per run)."""
 
 ROOT = "results/gallery"
@@ -14,12 +13,6 @@ ROOT = "results/gallery"
 
 MESH = f"{ROOT}/meshes/{{mesh}}"
 """One of the suite's own meshes written as OBJ (when no ``meshes`` folder is given)."""
-
-RECORD = f"{ROOT}/runs/{{mesh}}/{{scheme}}.json"
-"""One run's record."""
-
-FRAMES = f"{ROOT}/frames/{{mesh}}/{{scheme}}.npz"
-"""One run's frames (about :data:`mcfbench.studies.gallery.plan.MOVIE_FRAMES`)."""
 
 MOVIE = f"{ROOT}/movies/{{mesh}}/{{scheme}}.gif"
 """One run's animation."""

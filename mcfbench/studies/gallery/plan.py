@@ -114,6 +114,41 @@ def generated_meshes():
     return {**own, **packaged}
 
 
+def mesh_digest(plan, name):
+    """SHA-256 of the mesh file ``name`` of the plan: of the file, or, for one of the
+    suite's own meshes not written yet, of the text its rule will write
+    (:func:`mcfbench.studies.gallery.job.generated_mesh_text`)."""
+    from mcfbench.storage.run_store import mesh_sha256
+
+    path = Path(plan["meshes"][name])
+    if path.is_file() or name not in plan["generated"]:
+        return mesh_sha256(path)
+    import hashlib
+
+    from mcfbench.studies.gallery.job import generated_mesh_text
+
+    return hashlib.sha256(generated_mesh_text(plan["generated"][name]).encode()).hexdigest()
+
+
+def gallery_specs(plan):
+    """``{(mesh, scheme): spec}`` of the gallery: every scheme on every mesh file,
+    ``tau = C (mean edge length)^2``, ``steps`` steps, about :data:`MOVIE_FRAMES`
+    frames (:func:`mcfbench.running.batch.mesh_spec`)."""
+    from mcfbench.running.batch import mesh_spec
+
+    solver = {k: plan[k] for k in ("rtol", "maxiter")} | {"method": plan["solver"]}
+    digests = {name: mesh_digest(plan, name) for name in plan["meshes"]}
+    return {(name, scheme): mesh_spec(scheme, path, digests[name], tau_edge=plan["C"],
+                                      steps=plan["steps"], solver=solver,
+                                      frames=MOVIE_FRAMES)
+            for name, path in plan["meshes"].items() for scheme in plan["schemes"]}
+
+
+def run_specs(plans):
+    """The specs of the gallery (the run store's: :class:`mcfbench.pipeline.RunStore`)."""
+    return gallery_specs(plans.plan("gallery")).values()
+
+
 def from_config(config, plans):
     """:func:`plan` of the config (:meth:`mcfbench.pipeline.Plans.plan`)."""
     return plan(config.get("gallery"), config.get("meshes"))

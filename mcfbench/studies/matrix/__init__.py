@@ -7,9 +7,9 @@ paper's) on the problems with a refinement series, the robust method
 meshes (``tau_rule = "mesh"``). The study's modules
 (``workflow/rules/matrix.smk`` calls them):
 
-* :mod:`.plan`: the config key ``matrix`` checked against the registries, the
-  settings of one run and the paths of its record and frames;
-* :mod:`.job`: one run with its record and first and last frames;
+* :mod:`.plan`: the config key ``matrix`` checked against the registries and the
+  spec of every run (its record and first and last frames in the run store,
+  :mod:`mcfbench.storage.run_store`; computed by :mod:`mcfbench.running.batch`);
 * :mod:`.aggregate`: the records into the tables (:mod:`.tables`);
 * :mod:`.findings`: ``findings.md`` from the summary table only, in words;
 * :mod:`.plots`: the figures; :mod:`.page`: the results page (``index.html``).
@@ -22,12 +22,6 @@ real-world-like.
 
 ROOT = "results/matrix"
 """The folder of the study's outputs."""
-
-RECORD = "{root}/runs/{problem}/{scheme}/level{level}.json"
-"""One run's record (:mod:`mcfbench.storage.records`)."""
-
-FRAMES = "{root}/frames/{problem}/{scheme}/level{level}.npz"
-"""One run's first and last frames (:func:`mcfbench.storage.frames.save_frames`)."""
 
 TABLES = f"{ROOT}/tables"
 """The tables' folder (:func:`table_files`)."""

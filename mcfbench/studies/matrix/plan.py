@@ -1,14 +1,9 @@
 """The plan of the benchmark matrix: the config key ``matrix`` checked against the
-registries (:func:`plan`), the settings of one run (:func:`run_settings`), the
-paths of its record and frames (:data:`mcfbench.studies.matrix.RECORD`) and the
-Snakemake jobs that run the series, several cheap ones in one process
-(:func:`batches`)."""
-
-import re
-from dataclasses import dataclass
+registries (:func:`plan`) and the spec of every run (:func:`planned_specs`, in the run
+store: :mod:`mcfbench.storage.run_store`)."""
 
 from mcfbench.studies.config import ConfigError
-from mcfbench.studies.matrix import FRAMES, RECORD, ROOT, is_mesh_problem
+from mcfbench.studies.matrix import is_mesh_problem
 
 EXACT_SOLVER = "bicgstab"
 """Solver of the problems with a refinement series: the paper's comparison."""
@@ -194,195 +189,35 @@ def solver_method(plan, problem):
     return own or (plan["mesh_solver"] if is_mesh_problem(problem) else plan["solver"])
 
 
-def record_path(problem, scheme, level, root=ROOT):
-    return RECORD.format(root=root, problem=problem, scheme=scheme, level=level)
+def run_spec(plan, scheme, problem, level):
+    """The spec of one run: the problem's own time rule (:func:`mcfbench.running.batch.spec_of`),
+    its solver (:func:`solver_method`, the plan's ``rtol`` and ``maxiter``), one
+    thread, the first and the last frame."""
+    from mcfbench.running.batch import spec_of
+
+    return spec_of(scheme, problem, level,
+                   solver={"method": solver_method(plan, problem), "rtol": plan["rtol"],
+                           "maxiter": plan["maxiter"]})
 
 
-def frames_path(problem, scheme, level, root=ROOT):
-    return FRAMES.format(root=root, problem=problem, scheme=scheme, level=level)
-
-
-def problem_settings(plan, problem, code=""):
-    """What determines every record on ``problem`` but the scheme and the level: the
-    params of its Snakemake jobs (:func:`batches`; each run's scheme and level are
-    those of its record path), so that adding or removing levels or schemes, which
-    regroups the batches, does not rerun the runs already computed."""
-    return {"study": "matrix", "problem": problem,
-            "solver": {"method": solver_method(plan, problem), "rtol": plan["rtol"],
-                       "maxiter": plan["maxiter"]},
-            "code": code}
-
-
-def series_settings(plan, scheme, problem, code=""):
-    """What determines every record of one scheme's series on ``problem`` but the
-    level (:func:`problem_settings` and the scheme)."""
-    return {**problem_settings(plan, problem, code), "scheme": scheme}
-
-
-def run_settings(plan, scheme, problem, level, code=""):
-    """Everything that determines the record of one run of the matrix."""
-    return {**series_settings(plan, scheme, problem, code), "level": int(level)}
-
-
-_RECORD_PATH = re.compile(r"/runs/[^/]+/([^/]+)/level(\d+)\.json$")
-"""The scheme and the level in a record path (:data:`mcfbench.studies.matrix.RECORD`)."""
-
-
-def _record_parts(record):
-    """``(scheme, level)`` of a record path (:func:`record_path`)."""
-    match = _RECORD_PATH.search(str(record))
-    if match is None:
-        raise ValueError(f"{record}: not a matrix record path "
-                         f"(.../runs/<problem>/<scheme>/level<k>.json)")
-    return match.group(1), int(match.group(2))
-
-
-def level_of(record):
-    """The level of a run from its record path (:func:`record_path`)."""
-    return _record_parts(record)[1]
-
-
-def scheme_of(record):
-    """The scheme of a run from its record path (:func:`record_path`)."""
-    return _record_parts(record)[0]
-
-
-def planned_runs(plan, code="", root=ROOT):
-    """``{record path: settings}`` of every run, problems then schemes then levels."""
-    return {record_path(p, s, level, root): run_settings(plan, s, p, level, code)
+def planned_specs(plan):
+    """``{(problem, scheme, level): spec}`` of every run, problems then schemes then
+    levels."""
+    return {(p, s, level): run_spec(plan, s, p, level)
             for p, levels in plan["problems"].items() for s in plan["schemes"]
             for level in levels}
 
 
-RUN_SECONDS = 0.3
-"""Estimated CPU seconds of a run besides its time steps (:func:`series_seconds`):
-its mesh, its share of the scheme's warm-up, the metrics, the record and frames
-written (measured 2026-11-26: a cut-down matrix of 198 runs in 8 batch jobs took
-64 CPU s besides the kernels' compilation and the tables and figures: 18 s the
-runs' timed flows, the other 46 s (the processes' start-up and Snakemake's work
-included) 0.23 s a run)."""
-
-BATCH_SECONDS = 60.0
-"""Estimated CPU seconds of work a Snakemake job of the matrix gathers at least
-(:func:`batches`). A job costs about 1.7 s besides its runs (the process's
-start-up, the harness's imports, Snakemake's work; and 0.14 s a series, 0.02 s
-a run: fitted to the 127 jobs of the full matrix of 2026-11-26, f699a17, their
-benchmark wall times against their records' times). The jobs of that matrix
-replayed on 2 cores (``benchmarks/matrix_batches.py``, the records' CPU seconds,
-costliest estimate first) end the runs after 1 083 s with a 10 s budget (169
-jobs), 1 009 s with 30 s (82), 984 s with 60 s (53) and 977 s with 90 s (44),
-the two cores within 2 s of each other in each: 60 s takes most of the gain and
-keeps a killed job's loss and a process's memory small."""
-
-MATRIX_FACTORS = {"ddfv": 3.7, "ddfv, redistributing": 0.51, "vertex": 2.6,
-                  "vertex, redistributing": 0.14, "bgn": 7.1, "kll": 2.6}
-"""Kind of scheme (:func:`mcfbench.running.cost.cost_class`) -> the measured CPU
-seconds of a matrix series over the cost model's estimate (:func:`series_seconds`):
-the median over the series of the full matrix of 2026-11-26 (f699a17) above 0.3 s
-(149, 56, 142, 20, 23, 16 series; ``benchmarks/matrix_batches.py``). The model
-was fitted to steps of the sphere (:data:`mcfbench.running.cost.COSTS`); the
-matrix's series take more solver iterations a step (larger steps, real meshes,
-the anisotropic sphere) and the redistributing ones mostly stop early. Within a
-kind, a series is still within a factor 2.5 of its measured time in the median,
-a factor 7-15 in one case out of ten; the factor brings the heavy series out (1 for
-a kind not measured)."""
-
-
-def series_seconds(plan, scheme, problem):
-    """Estimated CPU seconds of one scheme's series on ``problem``: per level,
-    :data:`RUN_SECONDS` and the time steps' CPU seconds of the cost model
-    (:func:`mcfbench.running.cost.estimate`; the problem's first level is built
-    once per process to know its size) times the matrix's factor of the scheme's
-    kind (:data:`MATRIX_FACTORS`). The order of magnitude only: it tells the heavy
-    series from the cheap ones."""
-    from mcfbench.running.cost import cost_class, estimate, size
-    from mcfbench.running.problems import get_problem
-    from mcfbench.running.schemes import get_scheme
-
-    entry, problem = get_scheme(scheme), get_problem(problem)
-    factor = MATRIX_FACTORS.get(cost_class(entry), 1.0)
-    return sum(RUN_SECONDS + factor * estimate(entry, *size(entry, problem, level)).seconds
-               for level in plan["problems"][problem.name])
-
-
-@dataclass(frozen=True)
-class Batch:
-    """The series that one Snakemake job of the matrix runs in one process.
-
-    Attributes
-    ----------
-    problem : str
-    index : int
-        Its place among the problem's batches, from 1 (the rule's name:
-        :attr:`name`).
-    schemes : tuple of str
-        Plan order.
-    seconds : float
-        Their estimated CPU seconds (:func:`series_seconds`).
-    """
-
-    problem: str
-    index: int
-    schemes: tuple
-    seconds: float
-
-    @property
-    def name(self):
-        return f"{self.problem}_batch{self.index}"
-
-
-def batches(plan):
-    """The series of the plan gathered into Snakemake jobs: each problem's schemes
-    in plan order (:func:`pack` of their :func:`series_seconds` by
-    :data:`BATCH_SECONDS`), problems in plan order. Deterministic; every series in
-    exactly one batch, a heavy one alone.
-
-    Returns
-    -------
-    list of Batch
-    """
-    gathered = []
-    for problem in plan["problems"]:
-        seconds = {s: series_seconds(plan, s, problem) for s in plan["schemes"]}
-        gathered += [Batch(problem, k, tuple(group), sum(seconds[s] for s in group))
-                     for k, group in enumerate(pack(seconds, BATCH_SECONDS), start=1)]
-    return gathered
-
-
-def pack(costs, budget):
-    """Consecutive groups of the keys of ``costs`` (in its order), each closed when its
-    costs reach ``budget``; a key costing ``budget`` or more is alone.
-
-    Parameters
-    ----------
-    costs : dict
-        Name -> estimated cost.
-    budget : float
-
-    Returns
-    -------
-    list of list
-        Every key in exactly one group, in order but for the heavy ones, each alone
-        where it comes.
-    """
-    groups, group, total = [], [], 0.0
-    for name, cost in costs.items():
-        if cost >= budget:
-            groups.append([name])
-            continue
-        group.append(name)
-        total += cost
-        if total >= budget:
-            groups.append(group)
-            group, total = [], 0.0
-    return groups + [group] if group else groups
-
-
-def picture_runs(plan, root=ROOT):
-    """``{(problem, scheme): (record path, frames path)}`` of the picture grid:
-    the coarsest level of each problem."""
-    return {(p, s): (record_path(p, s, min(levels), root), frames_path(p, s, min(levels), root))
+def picture_specs(plan):
+    """``{(problem, scheme): spec}`` of the picture grid: the coarsest level of each
+    problem."""
+    return {(p, s): run_spec(plan, s, p, min(levels))
             for p, levels in plan["problems"].items() for s in plan["schemes"]}
+
+
+def run_specs(plans):
+    """The specs of the matrix (the run store's: :class:`mcfbench.pipeline.RunStore`)."""
+    return planned_specs(plans.plan("matrix")).values()
 
 
 def from_config(config, plans):

@@ -257,12 +257,20 @@ def scheme_comparison(conv):
 
 
 def run_records(results, conv):
-    """``{(scheme, level): record or None}`` for every row of the table, and
-    the disagreements between a record and its table row (a stale table)."""
+    """``{(scheme, level): record or None}`` for every row of the table (the records of
+    its provenance sidecar's ``inputs``, in the run store), and the disagreements
+    between a record and its table row (a stale table)."""
     records, stale = {}, []
-    for r in conv.itertuples():
-        path = Path(results) / "runs" / r.scheme / f"level{r.level}.json"
+    sidecar = read_json(Path(results) / "tables" / "convergence.csv.json") or {}
+    paths = {}                       # the table's records in the run store, by its sidecar
+    for name in sidecar.get("inputs") or {}:
+        path = Path(results).parent / name
         record = read_json(path)
+        if record is not None:
+            paths[record.get("scheme"), record.get("level")] = path
+    for r in conv.itertuples():
+        path = paths.get((r.scheme, int(r.level)))
+        record = None if path is None else read_json(path)
         records[r.scheme, int(r.level)] = record
         if record is None:
             continue
