@@ -132,7 +132,8 @@ def test_importing_presentation_loads_no_solver_driver_or_numba():
 
 
 def test_storage_loads_nothing_of_the_other_layers():
-    modules = ["mcfbench.storage.records", "mcfbench.storage.atomic", "mcfbench.storage.provenance"]
+    modules = ["mcfbench.storage.records", "mcfbench.storage.atomic", "mcfbench.storage.provenance",
+               "mcfbench.storage.run_store"]
     assert _loaded(modules, "m.startswith(('mcfbench.running', 'mcfbench.geometry', "
                             "'mcfbench.presentation', 'mcfbench.studies', 'numba', 'ddfv', "
                             "'baselines'))") == ""
@@ -145,7 +146,7 @@ def test_no_harness_module_is_over_600_lines():
 
 
 # every study module defines these (the study protocol); no other name may repeat
-PROTOCOL = {"plan", "job", "aggregate", "findings", "from_config"}
+PROTOCOL = {"plan", "run_specs", "aggregate", "findings", "from_config"}
 
 
 def test_no_class_or_public_function_is_defined_twice():

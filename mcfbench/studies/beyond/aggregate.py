@@ -19,7 +19,7 @@ def read_study(specs, digests, log):
             {record_path(s): records[s] for s in unique})
 
 
-def time_records(specs, records, plan):
+def time_records(specs, records, plan, root=None):
     """The time study of every scheme from its runs: one record per scheme in the shape
     of :func:`mcfbench.studies.beyond.tables.time_table`'s input (``scheme``, ``level``,
     ``t_final``, ``reference_tau``, ``outcome``, ``message``, ``rows``). Each row's
@@ -34,13 +34,17 @@ def time_records(specs, records, plan):
         ``(scheme, tau) -> spec`` and ``-> record`` of the time study.
     plan : dict
         The beyond plan (its ``time_study``).
+    root : str, optional
+        The run store (default :data:`mcfbench.storage.run_store.STORE`).
     """
     import numpy as np
 
     from mcfbench.geometry.frame_fields import final_state_distance
     from mcfbench.storage.frames import load_frames
-    from mcfbench.storage.run_store import frames_path
+    from mcfbench.storage.run_store import STORE, frames_path
     from mcfbench.studies.beyond.plan import time_taus
+
+    root = STORE if root is None else root
 
     study = plan["time_study"]
     *taus, reference_tau = time_taus(plan)
@@ -55,13 +59,13 @@ def time_records(specs, records, plan):
                         "message": f"reference run failed: {reference['message']}",
                         "rows": []})
             continue
-        ref = load_frames(frames_path(specs[scheme, reference_tau]))
+        ref = load_frames(frames_path(specs[scheme, reference_tau], root))
         rows = []
         for tau in taus:
             r = records[scheme, tau]
             ok = r["status"] == "ok"
             error, volume_error = final_state_distance(
-                load_frames(frames_path(specs[scheme, tau])), ref, ref["l2_weights"]) \
+                load_frames(frames_path(specs[scheme, tau], root)), ref, ref["l2_weights"]) \
                 if ok else (np.nan, np.nan)
             rows.append({"tau": tau, "N": r["N"], "error": error, "volume_error": volume_error,
                          **{m: r[m] for m in r["metric_names"]}, "status": r["status"]})

@@ -189,7 +189,7 @@ def solver_method(plan, problem):
     return own or (plan["mesh_solver"] if is_mesh_problem(problem) else plan["solver"])
 
 
-def run_spec(plan, scheme, problem, level):
+def matrix_spec(plan, scheme, problem, level):
     """The spec of one run: the problem's own time rule (:func:`mcfbench.running.batch.spec_of`),
     its solver (:func:`solver_method`, the plan's ``rtol`` and ``maxiter``), one
     thread, the first and the last frame."""
@@ -203,7 +203,7 @@ def run_spec(plan, scheme, problem, level):
 def planned_specs(plan):
     """``{(problem, scheme, level): spec}`` of every run, problems then schemes then
     levels."""
-    return {(p, s, level): run_spec(plan, s, p, level)
+    return {(p, s, level): matrix_spec(plan, s, p, level)
             for p, levels in plan["problems"].items() for s in plan["schemes"]
             for level in levels}
 
@@ -211,7 +211,7 @@ def planned_specs(plan):
 def picture_specs(plan):
     """``{(problem, scheme): spec}`` of the picture grid: the coarsest level of each
     problem."""
-    return {(p, s): run_spec(plan, s, p, min(levels))
+    return {(p, s): matrix_spec(plan, s, p, min(levels))
             for p, levels in plan["problems"].items() for s in plan["schemes"]}
 
 

@@ -32,14 +32,15 @@ from mcfbench.storage.provenance import config_hash
 from mcfbench.storage.records import RecordError, read_record, read_records
 from mcfbench.studies.beyond.findings import beyond_findings
 from mcfbench.studies.beyond.findings import findings as verdicts
-from mcfbench.studies.beyond.job import time_job
+from mcfbench.running.batch import compute, spec_of
+from mcfbench.storage.run_store import record_path, store_settings
+from mcfbench.studies.beyond.aggregate import time_records
 from mcfbench.studies.beyond.plan import (
+    TABLE_STUDIES,
     levels_of,
-    record_fields,
     scaling_fit_levels,
     scaling_levels,
-    study_records,
-    study_runs,
+    study_specs,
     used_schemes,
 )
 from mcfbench.studies.beyond.tables import (
@@ -52,8 +53,7 @@ from mcfbench.studies.beyond.tables import (
     time_order,
 )
 from mcfbench.studies.config import ConfigError
-from mcfbench.studies.convergence.job import job as run_job
-from mcfbench.studies.convergence.plan import level_steps, problem_of, sphere_run_settings
+from mcfbench.studies.convergence.plan import level_steps, problem_of, sphere_spec
 from mcfbench.studies.convergence.tables import convergence_documents, eoc_column, level_table
 
 REPO = Path(__file__).resolve().parents[4]
@@ -93,12 +93,13 @@ def record(scheme, level, *, status="ok", l2=None, monitor=None, tau=None, t_fin
 
 @pytest.fixture(scope="module")
 def failing_record(tmp_path_factory):
-    """A real run that breaks down at once (maxiter = 1), written by the run job."""
-    out = tmp_path_factory.mktemp("runs") / "ddfv" / "level2.json"
-    settings = {"scheme": "ddfv", "problem": "sphere", "level": 2, "tau": 0.01,
-                "t_final": 0.08, "rtol": 1e-9, "maxiter": 1, "code": {}}
-    run_job(settings, out, setup_logging(out.with_suffix(".log")))
-    return out, settings
+    """A real run that breaks down at once (maxiter = 1, its robust continuation too),
+    written by the run store's job."""
+    root = str(tmp_path_factory.mktemp("runs"))
+    spec = spec_of("ddfv", "sphere", 2, solver={"method": "bicgstab", "rtol": 1e-9,
+                                                "maxiter": 1})
+    compute(spec, "c0de", root)
+    return Path(record_path(spec, root)), store_settings(spec, "c0de")
 
 
 def test_run_that_breaks_down_is_a_record_with_status_and_no_l2(failing_record):
@@ -381,27 +382,35 @@ def test_space_table_agrees_with_space_convergence(tmp_path):
     log = setup_logging(tmp_path / "runs.log")
     records = {}
     for level in (1, 2):
-        settings = {"scheme": "ddfv", "problem": "sphere", "level": level, "tau": 0.01,
-                    "t_final": 0.08, "rtol": 1e-9, "code": {}}
-        run_job(settings, tmp_path / f"level{level}.json", log)
-        records["ddfv", level] = read_record(tmp_path / f"level{level}.json", settings)
+        spec = spec_of("ddfv", "sphere", level, tau=0.01,
+                       solver={"method": "bicgstab", "rtol": 1e-9, "maxiter": 1000})
+        records["ddfv", level] = compute(spec, "c", str(tmp_path), log)
     table = space_table(records, ["ddfv"], [1, 2])
     reference = space_convergence("ddfv", "sphere", [1, 2], 0.01)
     np.testing.assert_allclose(table["l2_error"], reference["l2_error"], rtol=1e-12)
     np.testing.assert_allclose(table["eoc"], reference["eoc_l2_error"], rtol=1e-12)
 
 
-def test_time_study_runs_for_a_vertex_scheme(tmp_path):
-    settings = {"study": "time", "scheme": "cotan", "problem": "sphere", "level": 1,
-                "taus": [0.02, 0.01], "reference_factor": 2, "t_final": 0.04, "rtol": 1e-9,
-                "code": {}}
-    path = tmp_path / "cotan.json"
-    log = setup_logging(tmp_path / "time.log")
-    time_job(settings, path, log)
-    rec = read_records({path: settings}, log, required=record_fields)[path]
+def test_time_study_from_the_stored_final_states_is_time_convergence(tmp_path):
+    """The time study's runs are plain specs; its errors, from their saved final states
+    and the reference's saved weights, are time_convergence's."""
+    from mcfbench.running.run import time_convergence
+
+    plan = {"time_study": {"level": 1, "taus": [0.02, 0.01], "reference_factor": 2,
+                           "t_final": 0.04, "schemes": ["cotan"]}}
+    specs = {("cotan", tau): spec_of("cotan", "sphere", 1, tau=tau, t_final=0.04,
+                                     solver={"method": "bicgstab", "rtol": 1e-9,
+                                             "maxiter": 1000})
+             for tau in (0.02, 0.01, 0.005)}
+    records = {key: compute(spec, "c", str(tmp_path)) for key, spec in specs.items()}
+    (rec,) = time_records(specs, records, plan, str(tmp_path))
     assert rec["outcome"] == "ok" and [r["status"] for r in rec["rows"]] == ["ok", "ok"]
-    assert rec["wall_seconds"] > 0 and rec["peak_rss_mb"] > 0
     assert rec["rows"][1]["error"] < rec["rows"][0]["error"]
+    reference = time_convergence("cotan", "sphere", 1, [0.02, 0.01], reference_factor=2,
+                                 t_final=0.04)
+    np.testing.assert_array_equal([r["error"] for r in rec["rows"]], reference["error"])
+    np.testing.assert_array_equal([r["volume_error"] for r in rec["rows"]],
+                                  reference["volume_error"])
 
 
 # -- the config key `beyond` ----------------------------------------------------
@@ -428,27 +437,29 @@ def test_default_config_passes_the_schema_and_the_checks():
     # the scaling study: every scheme of the registry with the Euler step
     assert {k: v for k, v in settings["scaling"].items() if k != "up_to"} == {
         "schemes": list(SCHEMES), "levels": [2, 3, 4, 5, 6], "fit_levels": [4, 5, 6]}
-    assert not [p for p in study_runs(Plans(config, SCHEMAS))["levels"] if "level7" in p]
+    assert not [k for k in study_specs(Plans(config, SCHEMAS))["levels"] if k[1] == 7]
 
 
 def test_finest_level_adds_its_runs_only():
     config = json.loads(json.dumps(CONFIG))
     config["beyond"]["finest"]["schemes"] = ["ddfv-chord"]
     pipeline = Plans(config, SCHEMAS)
-    runs = study_runs(pipeline)["levels"]
-    default = study_runs(Plans(json.loads(json.dumps(CONFIG)), SCHEMAS))["levels"]
-    assert set(runs) - set(default) == {"results/runs/ddfv-chord/level7.json"}
-    assert all(runs[p] == settings for p, settings in default.items())
-    assert runs["results/runs/ddfv-chord/level7.json"] == \
-        sphere_run_settings(pipeline, "ddfv-chord", 7)
-    # the finest level's own tolerance; every other run keeps the top-level one
-    assert runs["results/runs/ddfv-chord/level7.json"]["rtol"] == 1e-11
-    assert {s["rtol"] for p, s in runs.items() if "level7" not in p} == {1e-9}
+    runs = study_specs(pipeline)["levels"]
+    default = study_specs(Plans(json.loads(json.dumps(CONFIG)), SCHEMAS))["levels"]
+    assert set(runs) - set(default) == {("ddfv-chord", 7)}
+    assert all(runs[k] == spec for k, spec in default.items())
+    # the finest level's own tolerance; every other run keeps the top-level one, and
+    # is Table 3.1's run
+    assert runs["ddfv-chord", 7].solver_settings()["rtol"] == 1e-11
+    assert {s.solver_settings()["rtol"] for k, s in runs.items() if k[1] != 7} == {1e-9}
+    assert runs["ddfv", 3] == sphere_spec(pipeline.plan("convergence"), "ddfv", 3)
     # the time study's own tolerance (config: its BDF3 errors reach 1e-7); default the
     # top-level one
-    assert {s["rtol"] for s in study_runs(pipeline)["time"].values()} == {1e-12}
+    assert {s.solver_settings()["rtol"] for s in study_specs(pipeline)["time"].values()} \
+        == {1e-12}
     del config["beyond"]["time_study"]["rtol"]
-    assert {s["rtol"] for s in study_runs(Plans(config, SCHEMAS))["time"].values()} == {1e-9}
+    assert {s.solver_settings()["rtol"]
+            for s in study_specs(Plans(config, SCHEMAS))["time"].values()} == {1e-9}
     assert levels_of(pipeline.plan("beyond"), "ddfv-chord") == [1, 2, 3, 4, 5, 6, 7]
     assert levels_of(pipeline.plan("beyond"), "ddfv") == [1, 2, 3, 4, 5, 6]
     problem = problem_of(pipeline.plan("convergence"))
@@ -585,27 +596,27 @@ def test_dry_run_of_beyond_and_a_bad_value(tmp_path):
              for k, args in runs.items()}
     out = {k: p.communicate(timeout=300)[0] for k, p in procs.items()}
     assert procs["good"].returncode == 0, out["good"][-3000:]
-    for job in ("beyond_run", "beyond_time", "beyond_tables", "beyond_figures",
-                "beyond_findings", "beyond_scaling", "results/runs/ddfv-chord/level6.json",
-                "results/runs/kll/level6.json",             # the scaling study: every scheme
-                "results/beyond/runs/long_time/ddfv/level5.json",
-                "results/beyond/runs/time/cotan.json"):   # the time study: every scheme
+    pipeline = Plans(json.loads(json.dumps(CONFIG)), SCHEMAS)
+    runs = study_specs(pipeline)
+    for job in ("runs_sphere_", "beyond_tables", "beyond_figures", "beyond_findings",
+                "beyond_scaling"):
         assert job in out["good"], job
     assert procs["bad"].returncode != 0
     assert "config key 'beyond.time_study.schemes': unknown scheme(s) ['fem']" in out["bad"], \
         out["bad"][-2000:]
-    # the level-7 run: only with beyond.finest, one job more, sized for Slurm
-    level7 = "results/runs/ddfv-chord/level7.json"
-    assert level7 not in out["good"]
+    # the level-7 run: only with beyond.finest, in a batch alone (a heavy run), sized
+    # for Slurm
     assert procs["finest"].returncode == 0, out["finest"][-3000:]
-    job = out["finest"].split(f"output: {level7}")[1].split("\n\n")[0]
-    pipeline = Plans(json.loads(json.dumps(CONFIG)), SCHEMAS)
+    batches = {line.split()[0] for line in out["finest"].splitlines()
+               if line.startswith("runs_")} - {line.split()[0] for line in
+                                               out["good"].splitlines()
+                                               if line.startswith("runs_")}
+    assert len(batches) == 1, batches
+    job = out["finest"].split(f"rule {batches.pop()}:")[1].split("\n\n")[0]
     runtime = runtime_minutes(7, level_steps(pipeline.plan("convergence"), 7))
-    assert f"runtime={runtime}, mem_mb={mem_mb(7)}," in job, job
-    assert jobs(out["finest"], "run_scheme") == jobs(out["good"], "run_scheme") + 1
-    # a run of both the L2/EOC table and the scaling study is one job
-    runs = study_runs(pipeline)
-    assert jobs(out["good"], "run_scheme") == len(set(runs["levels"]) | set(runs["scaling"])) \
+    assert f"runtime={max(120, runtime)}, mem_mb={max(1500, mem_mb(7))}," in job, job
+    # a run of both the L2/EOC table and the scaling study is one run
+    assert len(set(runs["levels"].values()) | set(runs["scaling"].values())) \
         < len(runs["levels"]) + len(runs["scaling"])
     assert procs["bad_finest"].returncode != 0
     assert "config key 'beyond.finest.level': 6 is not above" in out["bad_finest"]
@@ -737,35 +748,34 @@ def test_scaling_fits_exact_power_laws_exactly():
 
 def test_scaling_study_runs_every_scheme_of_the_registry_unless_narrowed():
     """beyond.scaling.schemes: "all" (the default) is every Euler scheme of the registry
-    on every level of beyond.scaling.levels, as records of rule run_scheme whose
-    settings are those of the L2/EOC table where both run (one job); a list narrows
+    on every level of beyond.scaling.levels, as specs of the run store, those of the
+    L2/EOC table where both run (one run); a list narrows
     it (an integrator's rows only when listed). The records the other tables read
     do not change."""
     default = Plans(json.loads(json.dumps(CONFIG)), SCHEMAS)
-    runs = study_runs(default)
+    runs = study_specs(default)
     slow = {"cotan-intrinsic", "ddfv-chord-bgn-carried", "ddfv-chord-mdr-carried"}
     assert default.plan("beyond")["scaling"]["up_to"] == {s: 5 for s in slow}
-    assert set(runs["scaling"]) == {f"results/runs/{s}/level{lv}.json" for s in SCHEMES
+    assert set(runs["scaling"]) == {(s, lv) for s in SCHEMES
                                     for lv in (2, 3, 4, 5, 6) if not (s in slow and lv == 6)}
     shared = set(runs["scaling"]) & set(runs["levels"])
-    assert shared == {f"results/runs/{s}/level{lv}.json"
-                      for s in ("ddfv", "ddfv-chord", "ddfv-eliminate", "cotan")
+    assert shared == {(s, lv) for s in ("ddfv", "ddfv-chord", "ddfv-eliminate", "cotan")
                       for lv in (2, 3, 4, 5, 6)}
-    assert all(runs["scaling"][p] == runs["levels"][p] for p in shared)
-    assert all(runs["scaling"][f"results/runs/{s}/level{lv}.json"] ==
-               sphere_run_settings(default, s, lv) for s in ("bgn", "kll") for lv in (2, 6))
+    assert all(runs["scaling"][k] == runs["levels"][k] for k in shared)
+    assert all(runs["scaling"][s, lv] == sphere_spec(default.plan("convergence"), s, lv)
+               for s in ("bgn", "kll") for lv in (2, 6))
     config = json.loads(json.dumps(CONFIG))
     config["beyond"]["scaling"] = {"schemes": ["kll", "cotan@bdf2"], "levels": [3, 2],
                                    "fit_levels": [2, 3]}
     narrowed = Plans(config, SCHEMAS)
     assert narrowed.plan("beyond")["scaling"] == {
         "schemes": ["kll", "cotan@bdf2"], "levels": [2, 3], "fit_levels": [2, 3], "up_to": {}}
-    assert sorted(study_runs(narrowed)["scaling"]) == [
-        "results/runs/cotan@bdf2/level2.json", "results/runs/cotan@bdf2/level3.json",
-        "results/runs/kll/level2.json", "results/runs/kll/level3.json"]
+    assert sorted(study_specs(narrowed)["scaling"]) == [
+        ("cotan@bdf2", 2), ("cotan@bdf2", 3), ("kll", 2), ("kll", 3)]
     # the tables' records (rule beyond_tables) are those of the other studies only
-    assert study_records(narrowed) == study_records(default)
-    assert "results/runs/kll/level6.json" not in study_records(default)
+    tables = {study: study_specs(default)[study] for study in TABLE_STUDIES}
+    assert {study: study_specs(narrowed)[study] for study in TABLE_STUDIES} == tables
+    assert ("kll", 6) not in tables["levels"]
     del config["beyond"]["scaling"]["schemes"]                     # absent: "all"
     assert Plans(config, SCHEMAS).plan("beyond")["scaling"]["schemes"] == list(SCHEMES)
     # beyond.scaling.up_to: a scheme stops below the finest level, fitted on as many
@@ -777,8 +787,8 @@ def test_scaling_study_runs_every_scheme_of_the_registry_unless_narrowed():
     assert scaling_levels(scaling, "cotan-intrinsic") == [2, 3, 4, 5]
     assert scaling_fit_levels(scaling, "cotan-intrinsic") == [3, 4, 5]
     assert scaling_fit_levels(scaling, "cotan") == [4, 5, 6]
-    assert set(study_runs(capped)["scaling"]) - set(runs["scaling"]) == {
-        f"results/runs/{s}/level6.json" for s in slow - {"cotan-intrinsic"}}
+    assert set(study_specs(capped)["scaling"]) - set(runs["scaling"]) == {
+        (s, 6) for s in slow - {"cotan-intrinsic"}}
 
 
 def plan_levels(scaling):

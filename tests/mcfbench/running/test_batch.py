@@ -1,0 +1,65 @@
+"""Runs of the run store (mcfbench.running.batch): a spec's run is the study's run,
+a batch computes what the store lacks and reads the rest."""
+
+import json
+import os
+
+import numpy as np
+import pytest
+
+from mcfbench.running.batch import run_batch, spec_of
+from mcfbench.running.run import run
+from mcfbench.storage import run_store
+from mcfbench.storage.frames import load_frames
+
+pytestmark = pytest.mark.usefixtures("timed_once")
+
+SOLVER = {"method": "bicgstab", "rtol": 1e-9, "maxiter": 1000}
+
+
+def test_a_level_rule_spec_resolves_the_time_step_and_a_mesh_rule_keeps_its_inputs():
+    spec = spec_of("cotan", "sphere", 3, solver=SOLVER)
+    assert (spec.tau, spec.t_final, spec.tau_edge, spec.steps) == (0.0025, 0.08, None, None)
+    from mcfbench.running.problems import PROBLEMS
+
+    name = next(n for n, p in PROBLEMS.items() if p.tau_rule == "mesh")
+    mesh = spec_of("cotan", name, 1, solver=SOLVER)
+    assert mesh.tau is None and mesh.t_final is None and mesh.steps > 0 and mesh.tau_edge > 0
+
+
+def test_a_batch_computes_what_the_store_lacks_and_reads_the_rest(tmp_path):
+    root = str(tmp_path / "runs")
+    specs = [spec_of(s, "sphere", 1, solver=SOLVER) for s in ("cotan", "ddfv")]
+    entries = [{"spec": s.to_dict(), "code": "c0de"} for s in specs]
+    first = run_batch(entries[:1], tmp_path / "a.json", root=root)
+    assert [r["computed"] for r in first["runs"]] == [True]
+    record = run_store.record_path(specs[0], root)
+    stamp = os.stat(record).st_mtime_ns, open(record).read()
+    second = run_batch(entries, tmp_path / "b.json", root=root)
+    assert [r["computed"] for r in second["runs"]] == [False, True]
+    assert (os.stat(record).st_mtime_ns, open(record).read()) == stamp     # untouched
+    assert json.loads((tmp_path / "b.json").read_text())["runs"][1]["key"] == specs[1].key
+    # another code digest: computed again
+    third = run_batch([{**entries[0], "code": "new"}], tmp_path / "c.json", root=root)
+    assert [r["computed"] for r in third["runs"]] == [True]
+    assert run_store.read_run(specs[0], "new", root)["settings"]["code"] == "new"
+
+
+def test_a_stored_run_is_the_studies_run_with_its_final_weights(tmp_path):
+    """The record's numbers are run()'s (Table 3.1's job ran run(); the matrix's
+    framed_run with the robust continuation, unused on the sphere); the frames carry
+    the final state's quadrature weights."""
+    root = str(tmp_path)
+    spec = spec_of("ddfv", "sphere", 2, solver=SOLVER)
+    run_batch([{"spec": spec.to_dict(), "code": "c"}], tmp_path / "m.json", root=root)
+    record = run_store.read_run(spec, "c", root)
+    result, traj = run("ddfv", "sphere", 2)
+    for key in ("l2_error", "iterations", "nV", "N", "status", "t_min_barycentric"):
+        assert record[key] == result.to_dict()[key], key
+    frames = load_frames(run_store.frames_path(spec, root))
+    assert record["robust_status"] == "" and record["metric_names"] == ["l2_error"]
+    np.testing.assert_array_equal(frames["vertices"][-1], traj.frames["vertices"][-1])
+    weights = frames["l2_weights"]
+    assert weights.shape == (482,) and np.all(weights > 0)
+    radius = np.sqrt(1 - 4 * 0.08)
+    assert weights.sum() == pytest.approx(4 * np.pi * radius ** 2, rel=0.02)

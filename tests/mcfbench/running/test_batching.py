@@ -1,0 +1,37 @@
+"""The run store's batches (mcfbench.running.batching)."""
+
+from mcfbench.running.batch import spec_of
+from mcfbench.running.batching import BATCH_SECONDS, batches, pack
+
+SOLVER = {"method": "bicgstab", "rtol": 1e-9, "maxiter": 1000}
+
+
+def sphere(scheme, level):
+    return spec_of(scheme, "sphere", level, solver=SOLVER)
+
+
+def test_a_run_two_studies_ask_for_is_in_exactly_one_batch():
+    requests = {"convergence": [sphere(s, k) for s in ("ddfv", "cotan") for k in (1, 2)],
+                "matrix": [sphere(s, k) for s in ("cotan", "bgn") for k in (1, 2)]}
+    found = batches(requests, cost=lambda spec: 1.0)
+    specs = [s for b in found for s in b.specs]
+    assert len(specs) == len(set(specs)) == 6
+    by_name = {b.name: b for b in found}
+    assert set(by_name) == {"sphere_convergence_batch1", "sphere_convergence-matrix_batch1",
+                            "sphere_matrix_batch1"}
+    assert by_name["sphere_convergence-matrix_batch1"].specs == (sphere("cotan", 1),
+                                                                 sphere("cotan", 2))
+    # the batches of a study hold only runs it asked for
+    assert all("matrix" in b.studies for b in found if sphere("bgn", 1) in b.specs)
+
+
+def test_heavy_series_alone_cheap_ones_packed():
+    specs = [sphere(s, 1) for s in ("ddfv", "cotan", "bgn", "mdr")]
+    cost = {specs[0]: 2 * BATCH_SECONDS, specs[1]: 1.0, specs[2]: 1.0, specs[3]: 1.0}
+    found = batches({"matrix": specs}, cost=cost.get)
+    assert [b.specs for b in found] == [(specs[0],), tuple(specs[1:])]
+    assert [b.seconds for b in found] == [2 * BATCH_SECONDS, 3.0]
+
+
+def test_pack_closes_a_group_at_the_budget():
+    assert pack({"a": 30, "b": 30, "c": 70, "d": 10}, 60) == [["a", "b"], ["c"], ["d"]]
