@@ -101,13 +101,9 @@ def run_provenance(arrays, source=None):
 
 
 def sibling_record(frames_path):
-    """The record of a matrix or gallery frames file (``.../frames/...npz`` ->
-    ``.../runs/...json``), or None when there is none."""
-    parts = Path(frames_path).with_suffix(".json").parts
-    if "frames" not in parts:
-        return None
-    index = len(parts) - 1 - parts[::-1].index("frames")
-    record = Path(*parts[:index], "runs", *parts[index + 1:])
+    """The record of a run store's frames file (``{key}.npz`` -> ``{key}.json`` beside
+    it, :mod:`mcfbench.storage.run_store`), or None when there is none."""
+    record = Path(frames_path).with_suffix(".json")
     return record if record.is_file() else None
 
 

@@ -146,7 +146,7 @@ def test_no_harness_module_is_over_600_lines():
 
 
 # every study module defines these (the study protocol); no other name may repeat
-PROTOCOL = {"plan", "run_specs", "aggregate", "findings", "from_config"}
+PROTOCOL = {"plan", "run_specs", "job", "aggregate", "findings", "from_config"}
 
 
 def test_no_class_or_public_function_is_defined_twice():

@@ -53,10 +53,10 @@ def page(tmp_path_factory):
     """``(matrix folder, plan)`` of a tiny matrix with its tables, findings,
     figures and ``index.html``."""
     from mcfbench.running.problems import PROBLEMS
-    from mcfbench.storage.records import read_record, read_records
+    from mcfbench.running.batch import compute
+    from mcfbench.storage.run_store import frames_path, read_run, read_runs
     from mcfbench.studies.matrix import aggregate as matrix_aggregate
     from mcfbench.studies.matrix import findings as matrix_findings
-    from mcfbench.studies.matrix import job as matrix_job
     from mcfbench.studies.matrix import plan as matrix_plan
     from mcfbench.studies.matrix.plots import (
         error_figure,
@@ -69,19 +69,20 @@ def page(tmp_path_factory):
     levels = {"sphere": [1, 2], "catenoid": [1]}
     plan = matrix_plan.plan({"schemes": ["cotan", "ddfv"],
                              "problems": {p: levels.get(p, []) for p in PROBLEMS}})
-    runs = matrix_plan.planned_runs(plan, code="test", root=str(root))
-    for path, s in runs.items():
-        matrix_job.job(s, path, matrix_plan.frames_path(s["problem"], s["scheme"], s["level"], str(root)))
-    table, _ = matrix_aggregate.aggregate(runs, plan, root / "tables")
+    store = str(root / "runs")
+    runs = dict.fromkeys(matrix_plan.planned_specs(plan).values(), "test")
+    for spec in runs:
+        compute(spec, "test", store)
+    table, _ = matrix_aggregate.aggregate(runs, plan, root / "tables", store)
     matrix_findings.findings(root / "tables" / "summary.csv", root / "tables" / "matrix.csv",
                              root / "findings.md", plan)
     problems, schemes, figures = list(plan["problems"]), plan["schemes"], root / "figures"
     error_figure(table, [figures / "errors.png"], problems, schemes)
     work_precision_figure(table, [figures / "work_precision.png"], problems, schemes)
-    quality_figure(list(read_records(runs).values()), [figures / "quality.png"], problems,
-                   schemes)
-    entries = {key: (read_record(r), load_frames(f))
-               for key, (r, f) in matrix_plan.picture_runs(plan, str(root)).items()}
+    quality_figure(list(read_runs(runs, root=store).values()), [figures / "quality.png"],
+                   problems, schemes)
+    entries = {key: (read_run(spec, "test", store), load_frames(frames_path(spec, store)))
+               for key, spec in matrix_plan.picture_specs(plan).items()}
     picture_grid(entries, [figures / "pictures.png"], problems, schemes)
     size = write_matrix_page(root, root / "index.html", plan)
     assert size == (root / "index.html").stat().st_size

@@ -4,18 +4,15 @@ with the published values.
 The study's modules (``workflow/rules/convergence.smk`` calls them):
 
 * :mod:`.plan`: the config keys of Table 3.1 (``levels``, ``schemes``, ``rtol``,
-  ``tau_level_1``, ``t_final``) checked across keys; :func:`~.plan.record_settings`, the
-  settings of one run record (shared with the beyond study's levels);
-* :mod:`.job`: one scheme on one level, its record;
+  ``tau_level_1``, ``t_final``) checked across keys; :func:`~.plan.sphere_spec`, the
+  spec of one run in the run store (the beyond study's levels and the matrix's sphere
+  ask for the same);
 * :mod:`.aggregate`: the records into Table 3.1 (CSV, Markdown, LaTeX,
   provenance; :mod:`.tables`).
 
 :func:`~.job.sphere_table` is the same table computed in one process (the command
 line's ``sphere-table``).
 """
-
-RUN = "results/runs/{scheme}/level{level}.json"
-"""One scheme on one level: its run record (shared with the beyond study's levels)."""
 
 TABLE = "results/tables/convergence"
 """Table 3.1: ``.csv``, ``.md``, ``.tex``, its provenance ``.csv.json`` and the check of

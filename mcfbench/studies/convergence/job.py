@@ -1,36 +1,5 @@
-"""One scheme on one level of Table 3.1 (:func:`job`, its run record), and the whole
-table computed in one process (:func:`sphere_table`, the command line's ``sphere-table``)."""
-
-import math
-
-from mcfbench.running.problems import get_problem
-
-
-def job(settings, output, log):
-    """One scheme on one level of the problem with ``settings``: its run record.
-
-    Returns
-    -------
-    mcfbench.storage.records.RunResult
-    """
-    from mcfbench.running.run import run
-    from mcfbench.running.solver import Solver
-    from mcfbench.storage.records import write_record
-
-    problem = get_problem(settings["problem"]).with_settings(t_final=settings["t_final"])
-    log.info("%s level %d: tau %g, t_final %g, rtol %g", settings["scheme"], settings["level"],
-             settings["tau"], settings["t_final"], settings["rtol"])
-    result, _ = run(settings["scheme"], problem, settings["level"], tau=settings["tau"],
-                    t_final=settings["t_final"], solver=Solver.of_settings(settings),
-                    threads=settings.get("threads", 1))
-    record = write_record(output, result, settings)
-    log.info("%s level %d: status %s, L2 error %.4e, %d iterations, %.3f s wall, "
-             "%.0f MB peak memory -> %s", result.scheme, result.level, result.status,
-             result.metrics.get("l2_error", math.nan), result.iterations, result.wall_seconds,
-             record["peak_rss_mb"], output)
-    if result.status != "ok":
-        log.warning("%s", result.message)
-    return result
+"""Table 3.1 computed in one process (:func:`sphere_table`, the command line's
+``sphere-table``; the pipeline's runs are specs in the run store)."""
 
 
 def sphere_table(levels, scheme="ddfv", **options):

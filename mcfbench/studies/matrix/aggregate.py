@@ -5,7 +5,7 @@ from pathlib import Path
 
 from mcfbench.presentation.formats import tex_escape
 from mcfbench.presentation.tables import Table, csv, latex, markdown
-from mcfbench.storage.run_store import read_runs
+from mcfbench.storage.run_store import STORE, read_runs
 from mcfbench.studies.matrix.plan import solver_method
 from mcfbench.studies.matrix.tables import (
     FLOAT_FORMAT,
@@ -70,10 +70,11 @@ def write_tables(table, out_dir, plan):
     return summary
 
 
-def aggregate(expected, plan, out_dir):
+def aggregate(expected, plan, out_dir, root=STORE):
     """The records of every planned run (``expected``: spec -> code digest; a bad or
-    stale record refused, :func:`mcfbench.storage.run_store.read_runs`) into the long
-    table and its views (:func:`write_tables`); returns ``(table, summary)``."""
-    table = long_table(list(read_runs(expected).values()), plan["schemes"],
+    stale record refused, :func:`mcfbench.storage.run_store.read_runs`; ``root``: the
+    run store) into the long table and its views (:func:`write_tables`); returns
+    ``(table, summary)``."""
+    table = long_table(list(read_runs(expected, root=root).values()), plan["schemes"],
                        list(plan["problems"]))
     return table, write_tables(table, out_dir, plan)

@@ -68,15 +68,14 @@ def test_status_turns_red_from_the_defect_on(tmp_path):
     assert red[0] == red[1] == 0 and red[2] > 50 and red[3] > red[2]   # + the message
 
 
-def test_export_of_a_matrix_frames_file_shows_the_status_of_its_record(tmp_path, capsys):
-    """A matrix or gallery frames file has no status of its own: the GIF takes the
-    record's (``.../frames/X/Y.npz`` -> ``.../runs/X/Y.json``), as the ``.pvd`` export
-    does; the failed step is ``t_failed / tau`` (10 here), red from there on."""
+def test_export_of_a_store_frames_file_shows_the_status_of_its_record(tmp_path, capsys):
+    """A run store's frames file has no status of its own: the GIF takes the record's
+    beside it (``{key}.npz`` -> ``{key}.json``), as the ``.pvd`` export does; the
+    failed step is ``t_failed / tau`` (10 here), red from there on."""
     run = _shrinking_run()
-    frames = tmp_path / "frames" / "sphere" / "cotan" / "level1.npz"
-    record = tmp_path / "runs" / "sphere" / "cotan" / "level1.json"
+    frames = tmp_path / "runs" / "sphere" / "cotan" / "level1" / "0123456789abcdef.npz"
+    record = frames.with_suffix(".json")
     frames.parent.mkdir(parents=True)
-    record.parent.mkdir(parents=True)
     np.savez(frames, **{key: run[key] for key in ("vertices", "faces", "t", "steps")})
     record.write_text(json.dumps({"scheme": "cotan", "status": "inverted", "tau": 0.01,
                                   "message": "inverted at step 10 (t = 0.1): triangle 3",
@@ -112,25 +111,31 @@ def test_gallery_run_keeps_frames_for_its_movie(tmp_path):
     one frame each; a mesh the reader refuses gives a one-frame notice."""
     import igl
 
-    from mcfbench.studies.gallery import job as gallery_job
+    from mcfbench.running.batch import compute, mesh_spec
+    from mcfbench.storage.run_store import frames_path, mesh_sha256, record_path
     from mcfbench.studies.gallery import plots as gallery_plots
 
     V, F = icosphere(1)
     mesh = tmp_path / "s.obj"
     igl.write_triangle_mesh(str(mesh), V, F)
-    settings = {"study": "gallery", "C": 0.1, "steps": 8, "solver": "direct", "rtol": 1e-9,
-                "maxiter": 1000, "mesh": "s.obj", "scheme": "cotan"}
-    record, frames = tmp_path / "runs/s.obj/cotan.json", tmp_path / "frames/s.obj/cotan.npz"
-    assert gallery_job.job(mesh, "cotan", settings, record, frames).status == "ok"
+    solver = {"method": "direct", "rtol": 1e-9, "maxiter": 1000}
+    root = str(tmp_path / "runs")
+
+    def gallery_run(path):
+        spec = mesh_spec("cotan", str(path), mesh_sha256(path), tau_edge=0.1, steps=8,
+                         solver=solver, frames=20)
+        return compute(spec, "c", root), record_path(spec, root), frames_path(spec, root)
+
+    result, record, frames = gallery_run(mesh)
+    assert result["status"] == "ok" and result["mesh"] == "s.obj"
     assert np.load(frames)["steps"].tolist() == list(range(9))
     gallery_plots.run_movie(record, frames, tmp_path / "cotan.gif")
     assert Image.open(tmp_path / "cotan.gif").n_frames == 9
 
     bad = tmp_path / "bad.obj"
     bad.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n")
-    record, frames = tmp_path / "runs/bad.obj/cotan.json", tmp_path / "frames/bad.obj/cotan.npz"
-    assert gallery_job.job(bad, "cotan", {**settings, "mesh": "bad.obj"}, record,
-                           frames).status == "unsupported"
+    result, record, frames = gallery_run(bad)
+    assert result["status"] == "unsupported"
     gallery_plots.run_movie(record, frames, tmp_path / "bad.gif")
     _, shown = _frames(tmp_path / "bad.gif")
     assert len(shown) == 1                                  # the status, in red

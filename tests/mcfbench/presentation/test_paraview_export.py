@@ -2,6 +2,7 @@
 mcfbench.presentation.paraview_export), read back with meshio."""
 
 import json
+from pathlib import Path
 
 import igl
 import meshio
@@ -92,18 +93,19 @@ def test_ddfv_run_writes_t_vertices_and_the_t_monitor(tmp_path, capsys, split_cu
     assert collection.provenance["run"]["status"] == "t_escaped"
 
 
-def test_matrix_frames_file_exports_with_its_record(tmp_path):
-    """A matrix run's frames file (first and last frames): the collection takes the
+def test_store_frames_file_exports_with_its_record(tmp_path):
+    """A run store's frames file (first and last frames): the collection takes the
     provenance of the record next to it."""
+    from mcfbench.running.batch import compute
     from mcfbench.storage.paraview import frame_file
-    from mcfbench.studies.matrix import job as matrix_job
+    from mcfbench.storage.run_store import frames_path, record_path
     from mcfbench.studies.matrix import plan as matrix_plan
 
     plan = matrix_plan.plan({"schemes": ["cotan"], "problems": {"sphere": [1]}})
-    settings = matrix_plan.run_settings(plan, "cotan", "sphere", 1)
-    record = tmp_path / matrix_plan.record_path("sphere", "cotan", 1, "m")
-    frames = tmp_path / matrix_plan.frames_path("sphere", "cotan", 1, "m")
-    matrix_job.job(settings, record, frames)
+    spec = matrix_plan.matrix_spec(plan, "cotan", "sphere", 1)
+    compute(spec, "c", str(tmp_path / "m"))
+    record = Path(record_path(spec, str(tmp_path / "m")))
+    frames = Path(frames_path(spec, str(tmp_path / "m")))
     pvd = tmp_path / "sphere.pvd"
     assert main(["export", str(frames), str(pvd)]) == 0
     collection = read_pvd(pvd)

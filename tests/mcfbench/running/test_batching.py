@@ -1,5 +1,7 @@
 """The run store's batches (mcfbench.running.batching)."""
 
+import pytest
+
 from mcfbench.running.batch import spec_of
 from mcfbench.running.batching import BATCH_SECONDS, batches, pack
 
@@ -35,3 +37,26 @@ def test_heavy_series_alone_cheap_ones_packed():
 
 def test_pack_closes_a_group_at_the_budget():
     assert pack({"a": 30, "b": 30, "c": 70, "d": 10}, 60) == [["a", "b"], ["c"], ["d"]]
+
+
+def test_spec_seconds_scale_the_cost_model_by_the_kind_of_scheme(monkeypatch):
+    """spec_seconds: RUN_SECONDS a run and the model's steps times the measured factor
+    of the scheme's kind (MATRIX_FACTORS: BGN's series take 7.1 x its model, the
+    redistributing vertex schemes 0.14 x); a matrix's heavy series alone."""
+    from mcfbench.running import batching
+
+    specs = {s: [spec_of(s, "catenoid", k, solver=SOLVER) for k in (1, 2, 3)]
+             for s in ("bgn", "cotan-redistribute")}
+    calibrated = {s: sum(map(batching.spec_seconds, v)) for s, v in specs.items()}
+    monkeypatch.setattr(batching, "MATRIX_FACTORS", {})
+    model = {s: sum(map(batching.spec_seconds, v)) for s, v in specs.items()}
+    runs = 3 * batching.RUN_SECONDS
+    assert (calibrated["bgn"] - runs) / (model["bgn"] - runs) == pytest.approx(7.1)
+    assert (calibrated["cotan-redistribute"] - runs) / \
+        (model["cotan-redistribute"] - runs) == pytest.approx(0.14)
+    monkeypatch.undo()
+    # catenoid levels 1-3 of BGN: its kind's factor on the model's 13 s: alone
+    found = batches({"matrix": [*specs["bgn"], *specs["cotan-redistribute"],
+                                sphere("cotan", 1)]})
+    assert [b.specs for b in found if b.problem == "catenoid"][0] == tuple(specs["bgn"])
+    assert calibrated["bgn"] >= BATCH_SECONDS

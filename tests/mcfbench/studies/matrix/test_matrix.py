@@ -17,7 +17,9 @@ import pytest
 from mcfbench.running.problems import PROBLEMS
 from mcfbench.running.schemes import SCHEMES
 from mcfbench.storage.frames import load_frames
-from mcfbench.storage.records import FIELDS, read_record, read_records, write_record
+from mcfbench.running.batch import compute
+from mcfbench.storage.records import FIELDS, read_record, write_record
+from mcfbench.storage.run_store import frames_path, read_run, read_runs, record_path
 from mcfbench.storage.statuses import STATUSES
 from mcfbench.studies.config import ConfigError
 from mcfbench.studies.gallery import job as gallery_job
@@ -25,11 +27,18 @@ from mcfbench.studies.gallery import plan as gallery_plan
 from mcfbench.studies.gallery import tables as gallery_tables
 from mcfbench.studies.matrix import aggregate as matrix_aggregate
 from mcfbench.studies.matrix import findings as matrix_findings
-from mcfbench.studies.matrix import job as matrix_job
 from mcfbench.studies.matrix import plan as matrix_plan
 from mcfbench.studies.matrix import tables as matrix_tables
 
 REPO = Path(__file__).resolve().parents[4]
+
+
+def computed(specs, root):
+    """Every spec run into the run store ``root`` (the batch job's
+    :func:`mcfbench.running.batch.compute`, code digest ``"test"``): ``{spec: "test"}``."""
+    for spec in specs:
+        compute(spec, "test", str(root))
+    return dict.fromkeys(specs, "test")
 
 
 # ------------------------------------------------------------ config
@@ -72,7 +81,7 @@ def test_select_runs_exactly_the_named_schemes_problems_and_levels():
     assert plan["schemes"] == ["cotan", "bgn@bdf2"]          # no cotan@bdf2 added
     assert plan["problems"] == {"sphere": [1, 2], "torus": [2]}   # registry order
     assert plan["selected"] and not matrix_plan.plan(full)["selected"]
-    runs = matrix_plan.planned_runs(plan)
+    runs = matrix_plan.planned_specs(plan)
     assert len(runs) == 2 * 3
     # either key alone keeps the full matrix's other one
     only_sphere = matrix_plan.plan({**full, "select": {"problems": {"sphere": [1]}}})
@@ -82,106 +91,20 @@ def test_select_runs_exactly_the_named_schemes_problems_and_levels():
         matrix_plan.plan(full)["problems"]
 
 
-def test_run_settings_do_not_depend_on_the_other_levels():
-    """A Snakemake job's params are its series' settings without the level, so that
-    trimming levels reruns none already computed."""
+def test_a_run_is_its_spec_whatever_else_the_plan_holds():
+    """A run's spec depends neither on the other levels nor on the other schemes, and
+    the matrix's sphere run is Table 3.1's (one run in the store for both studies)."""
+    from mcfbench.studies.convergence import plan as convergence
+
     wide = matrix_plan.plan({"select": {"problems": {"sphere": [1, 2, 3]}}})
-    narrow = matrix_plan.plan({"select": {"problems": {"sphere": [1]}}})
-    path = matrix_plan.record_path("sphere", "cotan", 1)
-    assert matrix_plan.planned_runs(wide)[path] == matrix_plan.planned_runs(narrow)[path]
-    assert matrix_plan.level_of(path) == 1
-    assert matrix_plan.scheme_of(path) == "cotan"
-    assert matrix_plan.scheme_of(matrix_plan.record_path("torus", "cotan@bdf2", 2)) == \
-        "cotan@bdf2"
-    with pytest.raises(ValueError, match="not a matrix record path"):
-        matrix_plan.scheme_of("results/matrix/frames/sphere/cotan/level1.npz")
-    assert matrix_plan.run_settings(wide, "cotan", "sphere", 3) == \
-        {**matrix_plan.series_settings(narrow, "cotan", "sphere"), "level": 3}
-    # a batch job's params: the same whatever the schemes and levels (its batch's)
-    fewer = matrix_plan.plan({"select": {"schemes": ["bgn"], "problems": {"sphere": [2]}}})
-    assert matrix_plan.problem_settings(fewer, "sphere") == \
-        matrix_plan.problem_settings(wide, "sphere")
-    assert matrix_plan.series_settings(wide, "cotan", "sphere") == \
-        {**matrix_plan.problem_settings(wide, "sphere"), "scheme": "cotan"}
-
-
-def test_pack_closes_a_group_at_the_budget_and_leaves_a_heavy_one_alone():
-    costs = {"a": 3.0, "b": 12.0, "c": 4.0, "d": 5.0, "e": 10.0, "f": 1.0}
-    assert matrix_plan.pack(costs, 10.0) == [["b"], ["a", "c", "d"], ["e"], ["f"]]
-    assert matrix_plan.pack({"a": 1.0, "b": 2.0}, 10.0) == [["a", "b"]]
-    assert matrix_plan.pack({}, 10.0) == []
-
-
-def test_batches_hold_every_series_once_the_heavy_ones_alone():
-    """The matrix's Snakemake jobs (plan.batches): deterministic, every planned run in
-    exactly one, a series estimated at BATCH_SECONDS or more alone, the others
-    gathered until their estimate reaches it (the last of a problem may hold less)."""
-    plan = matrix_plan.plan({"select": {
-        "schemes": ["cotan", "bgn", "ddfv", "ddfv-chord-redistribute-carried"],
-        "problems": {"catenoid": [1, 2, 3], "sphere": [1, 2], "real_nut": [0]}}})
-    batches = matrix_plan.batches(plan)
-    assert batches == matrix_plan.batches(plan)
-    assert [b.problem for b in batches] == sorted(
-        (b.problem for b in batches), key=list(plan["problems"]).index)
-    series = [(b.problem, s) for b in batches for s in b.schemes]
-    assert sorted(series) == sorted((p, s) for p in plan["problems"] for s in plan["schemes"])
-    records = [matrix_plan.record_path(b.problem, s, k) for b in batches for s in b.schemes
-               for k in plan["problems"][b.problem]]
-    assert sorted(records) == sorted(matrix_plan.planned_runs(plan))
-    seconds = {(p, s): matrix_plan.series_seconds(plan, s, p) for p, s in series}
-    heavy = {key for key, t in seconds.items() if t >= matrix_plan.BATCH_SECONDS}
-    # catenoid levels 1-3 of BGN: its kind's factor 7.1 on the model's 13 s; the
-    # sphere's levels 1-2 a second at most
-    assert ("catenoid", "bgn") in heavy
-    assert ("sphere", "cotan") not in heavy
-    for b in batches:
-        assert b.seconds == pytest.approx(sum(seconds[b.problem, s] for s in b.schemes))
-        assert len(b.schemes) == 1 or not heavy & {(b.problem, s) for s in b.schemes}
-        last = b is [c for c in batches if c.problem == b.problem][-1]
-        assert last or b.seconds >= matrix_plan.BATCH_SECONDS
-    assert {b.name for b in batches if b.problem == "sphere"} == {"sphere_batch1"}
-    assert len({b.name for b in batches}) == len(batches)
-
-
-def test_series_seconds_scale_the_cost_model_by_the_kind_of_scheme(monkeypatch):
-    """plan.series_seconds: RUN_SECONDS a run and the model's steps times the measured
-    factor of the scheme's kind (MATRIX_FACTORS: BGN's series take 7.1 x its model,
-    the redistributing vertex schemes 0.14 x)."""
-    plan = matrix_plan.plan({"select": {"schemes": ["bgn", "cotan-redistribute"],
-                                        "problems": {"catenoid": [1, 2, 3]}}})
-    calibrated = {s: matrix_plan.series_seconds(plan, s, "catenoid") for s in plan["schemes"]}
-    monkeypatch.setattr(matrix_plan, "MATRIX_FACTORS", {})
-    model = {s: matrix_plan.series_seconds(plan, s, "catenoid") for s in plan["schemes"]}
-    runs = 3 * matrix_plan.RUN_SECONDS
-    assert (calibrated["bgn"] - runs) / (model["bgn"] - runs) == pytest.approx(7.1)
-    assert (calibrated["cotan-redistribute"] - runs) / (model["cotan-redistribute"] - runs) \
-        == pytest.approx(0.14)
-    # measured on 2026-11-26: cotan-redistribute 12.6 s, BGN 12.9 s; the model alone
-    # put the first 11 x above the second, calibrated 4.4 x below: a factor per kind
-    # is the order of magnitude only
-    measured = 12.6 / 12.9
-    off = {name: abs(np.log(e["cotan-redistribute"] / e["bgn"] / measured))
-           for name, e in (("model", model), ("calibrated", calibrated))}
-    assert off["calibrated"] < off["model"], off
-
-
-@pytest.mark.parametrize("section, key", [
-    ({"schemes": ["ddfv", "nope"]}, "matrix.schemes"),
-    ({"problems": {"spere": [1]}}, "matrix.problems"),
-    ({"problems": {"sphere": [0]}}, "matrix.problems.sphere"),
-    ({"solver": "gmres"}, "matrix.solver"),
-    ({"problem_solvers": {"spere": "bicgstab"}}, "matrix.problem_solvers"),
-    ({"problem_solvers": {"sphere": "ilu"}}, "matrix.problem_solvers.sphere"),
-    ({"problem_solvers": ["sphere"]}, "matrix.problem_solvers"),
-    ({"select": {"schemes": ["fem"]}}, "matrix.select.schemes"),
-    ({"select": {"problems": {"spere": [1]}}}, "matrix.select.problems"),
-    ({"select": {"problems": {"sphere": []}}}, "matrix.select.problems.sphere"),
-    ({"select": {"problems": ["sphere"]}}, "matrix.select.problems"),
-    ({"select": {"levels": [1]}}, "matrix.select"),
-])
-def test_plan_names_the_bad_key(section, key):
-    with pytest.raises(ConfigError, match=key.replace(".", r"\.")):
-        matrix_plan.plan(section)
+    narrow = matrix_plan.plan({"select": {"schemes": ["cotan"], "problems": {"sphere": [1]}}})
+    key = ("sphere", "cotan", 1)
+    assert matrix_plan.planned_specs(wide)[key] == matrix_plan.planned_specs(narrow)[key]
+    table = convergence.plan({"schemes": ["cotan", "ddfv"], "levels": [1, 2, 3], "rtol": 1e-9,
+                              "tau_level_1": 0.04, "t_final": 0.08, "threads": 1})
+    for (scheme, level), spec in convergence.table_specs(table).items():
+        assert matrix_plan.planned_specs(wide)["sphere", scheme, level] == spec
+        assert spec.key == matrix_plan.planned_specs(wide)["sphere", scheme, level].key
 
 
 def test_mesh_problems_get_the_robust_solver():
@@ -198,7 +121,9 @@ def test_a_problem_of_its_own_solver_gets_it_the_others_not():
     for name in PROBLEMS:
         expected = own.get(name, matrix_plan.solver_method(default, name))
         assert matrix_plan.solver_method(plan, name) == expected
-        assert matrix_plan.problem_settings(plan, name)["solver"]["method"] == expected
+        level = min(PROBLEMS[name].levels)
+        assert matrix_plan.matrix_spec(plan, "cotan", name, level).solver_settings()[
+            "method"] == expected
 
 
 def test_a_cut_down_plan_carries_the_solvers_of_its_problems_only():
@@ -214,23 +139,20 @@ def test_a_cut_down_plan_carries_the_solvers_of_its_problems_only():
 
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
-    """ddfv and cotan on sphere and catenoid, level 1, through run_job."""
+    """ddfv and cotan on sphere and catenoid, level 1, through the run store's job."""
     root = tmp_path_factory.mktemp("matrix")
     plan = matrix_plan.plan({"schemes": ["ddfv", "cotan"],
                                     "problems": {p: ([1] if p in ("sphere", "catenoid") else [])
                                                  for p in PROBLEMS}})
-    runs = matrix_plan.planned_runs(plan, code="test", root=str(root))
-    for path, settings in runs.items():
-        frames = path.replace("/runs/", "/frames/").removesuffix(".json") + ".npz"
-        matrix_job.job(settings, path, frames)
-    table, summary = matrix_aggregate.aggregate(runs, plan, root / "tables")
+    runs = computed(matrix_plan.planned_specs(plan).values(), root / "runs")
+    table, summary = matrix_aggregate.aggregate(runs, plan, root / "tables", str(root / "runs"))
     return root, plan, runs, table, summary
 
 
 def test_tiny_records_and_frames(tiny):
     root, plan, runs, table, _ = tiny
-    for path, settings in runs.items():
-        record = read_record(path, settings=settings)
+    for spec, digest in runs.items():
+        record = read_run(spec, digest, str(root / "runs"))
         assert record["status"] in STATUSES
         if record["problem"] == "sphere":
             assert record["status"] == "ok", record["message"]
@@ -239,8 +161,7 @@ def test_tiny_records_and_frames(tiny):
             assert record["t_failed"] == pytest.approx(record["steps_done"] * record["tau"],
                                                        abs=2 * record["tau"])
         assert record["metric_names"]
-        frames = load_frames(path.replace("/runs/", "/frames/")
-                                    .removesuffix(".json") + ".npz")
+        frames = load_frames(frames_path(spec, str(root / "runs")))
         assert len(frames["steps"]) == 2 and frames["steps"][0] == 0
         assert frames["steps"][-1] == record["steps_done"]
     assert not list(root.rglob("*.tmp"))
@@ -295,9 +216,11 @@ def test_tiny_plots(tiny):
     problems, schemes = list(plan["problems"]), plan["schemes"]
     figs = root / "figures"
     error_figure(table, [figs / "errors.png"], problems, schemes)
-    quality_figure(list(read_records(runs).values()), [figs / "quality.png"], problems, schemes)
-    entries = {key: (read_record(r), load_frames(f))
-               for key, (r, f) in matrix_plan.picture_runs(plan, str(root)).items()}
+    store = str(root / "runs")
+    quality_figure(list(read_runs(runs, root=store).values()), [figs / "quality.png"],
+                   problems, schemes)
+    entries = {key: (read_run(spec, "test", store), load_frames(frames_path(spec, store)))
+               for key, spec in matrix_plan.picture_specs(plan).items()}
     picture_grid(entries, [figs / "pictures.png"], problems, schemes)
     drawn = work_precision_figure(table, [figs / "work_precision.png"], problems, schemes)
     for problem, lines in drawn.items():          # every point is a run's (CPU s, |error|)
@@ -391,16 +314,14 @@ def test_solver_failure_is_rerun_with_the_robust_solver(tmp_path):
     solve is the sparse LU's), which finishes, and the findings call it a solver verdict."""
     plan = matrix_plan.plan({"schemes": ["cotan", "bgn"], "maxiter": 1,
                              "problems": {p: ([1, 2] if p == "sphere" else []) for p in PROBLEMS}})
-    runs = matrix_plan.planned_runs(plan, code="test", root=str(tmp_path))
-    for path, settings in runs.items():
-        matrix_job.job(settings, path, path.replace(".json", ".npz"))
-    for path, settings in runs.items():
-        record = read_record(path, settings=settings)
+    runs = computed(matrix_plan.planned_specs(plan).values(), tmp_path)
+    for spec in runs:
+        record = read_run(spec, "test", str(tmp_path))
         assert record["status"] == "solver_failed" and "iteration limit 1" in record["message"]
         assert record["robust_status"] == "ok" and record["robust_solver"] == "jacobi-direct"
         assert record["robust_message"] == "" and record["robust_steps_done"] == record["N"]
         assert record["robust_metrics"]["l2_error"] < 2e-2
-    table, summary = matrix_aggregate.aggregate(runs, plan, tmp_path / "tables")
+    table, summary = matrix_aggregate.aggregate(runs, plan, tmp_path / "tables", str(tmp_path))
     assert (table["robust_status"] == "ok").all() and np.isfinite(table["robust_value"]).all()
     cotan = summary[summary["scheme"] == "cotan"].iloc[0]
     assert cotan["runs_ok"] == 0 and cotan["runs_robust_ok"] == 2
@@ -421,9 +342,8 @@ def test_solver_failure_is_rerun_with_the_robust_solver(tmp_path):
 def test_a_run_that_ended_otherwise_is_not_rerun(tmp_path):
     plan = matrix_plan.plan({"schemes": ["cotan"], "problems": {p: ([1] if p == "sphere" else [])
                                                                   for p in PROBLEMS}})
-    path, settings = next(iter(matrix_plan.planned_runs(plan, code="test", root=str(tmp_path)).items()))
-    matrix_job.job(settings, path, path.replace(".json", ".npz"))
-    record = read_record(path, settings=settings)
+    (spec,) = computed(matrix_plan.planned_specs(plan).values(), tmp_path)
+    record = read_run(spec, "test", str(tmp_path))
     assert record["status"] == "ok" and record["robust_status"] == ""
     assert "robust_metrics" not in record
 
@@ -465,6 +385,8 @@ def test_findings_tell_solver_verdicts_from_scheme_verdicts():
 @pytest.mark.e2e
 def test_snakemake_dry_run(tmp_path):
     """Both targets resolve to the planned jobs, in a copy of the repository."""
+    from mcfbench.running.batching import batches
+
     work = tmp_path / "work"
     work.mkdir()
     for name in ("Snakefile", "workflow", "config", "ddfv", "baselines", "mcfbench"):
@@ -483,12 +405,13 @@ def test_snakemake_dry_run(tmp_path):
         __import__("yaml").safe_load((REPO / "config" / "config.yaml").read_text())["matrix"])
     counts = dict(line.split()[:2] for line in out.stdout.splitlines()
                   if len(line.split()) == 2 and line.split()[1].isdigit())
-    batches = matrix_plan.batches(plan)                 # one job per batch
-    assert {f"matrix_run_{b.name}" for b in batches} == \
-        {rule for rule in counts if rule.startswith("matrix_run_")}
-    assert all(int(counts[f"matrix_run_{b.name}"]) == 1 for b in batches)
+    specs = list(matrix_plan.planned_specs(plan).values())
+    found = batches({"matrix": specs})              # the batches of the matrix's own runs
+    assert {f"runs_{b.name}" for b in found if b.studies == ("matrix",)} <= set(counts)
+    assert all(int(n) == 1 for rule, n in counts.items() if rule.startswith("runs_"))
     assert int(counts["matrix_page"]) == 1  # results/matrix/index.html
-    assert int(counts["gallery_run"]) == len(SCHEMES)  # one mesh file, every scheme
+    # one mesh file: one batch of every scheme on it
+    assert int(counts["runs_gallery_gallery_batch1"]) == 1
     assert "gallery_mesh" not in counts  # a folder given: no generated meshes
 
 
@@ -505,15 +428,13 @@ def test_gallery_runs_every_scheme_on_every_file(tmp_path):
     plan = gallery_plan.plan({"schemes": ["ddfv", "cotan"], "steps": 3}, str(meshes))
     assert list(plan["meshes"]) == ["ball.obj", "broken.off"]
     assert plan["C"] == 0.1 and plan["solver"] == matrix_plan.robust_method()
-    records = []
-    for mesh, path in plan["meshes"].items():
-        for scheme in plan["schemes"]:
-            settings = {"study": "gallery", "mesh": mesh, "scheme": scheme,
-                        **{k: plan[k] for k in ("C", "steps", "solver", "rtol", "maxiter")}}
-            out = tmp_path / "runs" / mesh / f"{scheme}.json"
-            gallery_job.job(path, scheme, settings, out, out.with_suffix(".npz"))
-            records.append(read_record(out, settings=settings))
-    table = gallery_tables.gallery_table(records)
+    specs = gallery_plan.gallery_specs(plan)
+    assert {spec.mesh_sha256 for spec in specs.values()} == {
+        __import__("hashlib").sha256(Path(path).read_bytes()).hexdigest()
+        for path in plan["meshes"].values()}
+    runs = computed(specs.values(), tmp_path / "runs")
+    table = gallery_tables.gallery_table(list(read_runs(runs, root=str(tmp_path / "runs"))
+                                              .values()))
     ball = table[table["mesh"] == "ball.obj"]
     assert ball["status"].tolist() == ["ok", "ok"] and ball["steps_done"].tolist() == [3, 3]
     h = ball["h"].iloc[0]
@@ -654,64 +575,6 @@ def test_noise_level_timings_are_marked_and_not_ranked():
     one_fast = {**fast, "costs": {"cotan": 0.0045, "ddfv": 0.5}}
     assert "**cotan** is the cheapest, 0.0045 s (noise level) (then ddfv 0.5 s)." in \
         "\n".join(matrix_findings.work_precision_section([one_fast]))
-
-
-def test_series_job_writes_every_level_and_logs_to_one_file(tmp_path):
-    """One Snakemake job per (problem, scheme): every level's record and frames,
-    the same records as one job per run, one log for the series."""
-    plan = matrix_plan.plan({"schemes": ["cotan"], "problems": {p: ([1, 2] if p == "sphere" else [])
-                                                                for p in PROBLEMS}})
-    runs = matrix_plan.planned_runs(plan, code="test", root=str(tmp_path))
-    records = list(runs)
-    frames = [r.replace("/runs/", "/frames/").removesuffix(".json") + ".npz" for r in records]
-    log = tmp_path / "series.log"
-    series = matrix_plan.series_settings(plan, "cotan", "sphere", code="test")
-    results = matrix_job.series_job(series, records, frames, log)
-    assert [read_record(r)["settings"] for r in records] == list(runs.values())
-    assert [r.level for r in results] == [1, 2] and all(r.status == "ok" for r in results)
-    one = tmp_path / "one.json"
-    matrix_job.job(runs[records[1]], one, tmp_path / "one.npz")
-    assert read_record(records[1])["l2_error"] == read_record(one)["l2_error"]
-    text = log.read_text()
-    assert "sphere level 1" in text and "sphere level 2" in text
-
-
-def test_batch_job_runs_each_series_with_its_own_log(tmp_path, monkeypatch):
-    """One Snakemake job, several series: every run's record as the series job's,
-    with the scheme and the level of its path, one log per series; each series'
-    first run warmed up before it is timed, in a process that ran another scheme
-    first too."""
-    from mcfbench.running import run as run_module
-
-    timed, timed_run = [], run_module._timed_run
-
-    def spy(scheme, problem, mesh, tau, steps, **kwargs):
-        timed.append((scheme.name, steps))
-        return timed_run(scheme, problem, mesh, tau, steps, **kwargs)
-
-    monkeypatch.setattr(run_module, "_warmed", set())       # as a fresh process
-    monkeypatch.setattr(run_module, "_timed_run", spy)
-    plan = matrix_plan.plan({"select": {"schemes": ["cotan", "bgn"],
-                                        "problems": {"sphere": [1]}}})
-    runs = matrix_plan.planned_runs(plan, code="test", root=str(tmp_path))
-    records = list(runs)
-    frames = [r.replace("/runs/", "/frames/").removesuffix(".json") + ".npz" for r in records]
-    logs = [tmp_path / "cotan.log", tmp_path / "bgn.log"]
-    settings = matrix_plan.problem_settings(plan, "sphere", code="test")
-    with pytest.raises(ValueError, match=r"1 log files for the 2 series \['cotan', 'bgn'\]"):
-        matrix_job.batch_job(settings, records, frames, logs[:1])
-    results = matrix_job.batch_job(settings, records, frames, logs)
-    assert [[(r.scheme, r.level) for r in series] for series in results] == \
-        [[("cotan", 1)], [("bgn", 1)]]
-    assert [read_record(r)["settings"] for r in records] == list(runs.values())
-    assert all(Path(f).stat().st_size > 0 for f in frames)
-    for log, other in (logs, logs[::-1]):
-        assert f"{log.stem} on sphere level 1" in log.read_text()
-        assert f"{other.stem} on sphere" not in log.read_text()
-    # the warm-up's steps, then level 1's (2 steps; timed again while under 10 ms)
-    assert [call for k, call in enumerate(timed) if k == 0 or timed[k - 1] != call] == \
-        [("cotan", run_module.WARM_UP_STEPS), ("cotan", 2),
-         ("bgn", run_module.WARM_UP_STEPS), ("bgn", 2)]
 
 
 def test_the_main_metric_is_decided_once_in_the_long_table():

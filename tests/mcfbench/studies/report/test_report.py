@@ -134,12 +134,15 @@ def results(tmp_path):
     table.to_csv(root / "tables" / "convergence.csv", index=False)
     config = {"rule": "convergence_table", "levels": list(LEVELS), "schemes": ["ddfv", "cotan"],
               "tau_level_1": 0.04, "t_final": 0.08, "rtol": 1e-9}
-    (root / "tables" / "convergence.csv.json").write_text(
-        json.dumps({**PROVENANCE, "config": config}))
-    for _, row in table.iterrows():
-        path = root / "runs" / row["scheme"] / f"level{row['level']}.json"
+    inputs = {}
+    for _, row in table.iterrows():      # in the run store, named by the table's sidecar
+        path = root / "runs" / "sphere" / row["scheme"] / f"level{row['level']}" / \
+            f"{row['level']:016x}.json"
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(record_of(row)))
+        inputs[path.relative_to(tmp_path).as_posix()] = {}
+    (root / "tables" / "convergence.csv.json").write_text(
+        json.dumps({**PROVENANCE, "config": config, "inputs": inputs}))
     write_png(root / "figures" / "convergence.png", 1)
     (root / "runs" / "figures").mkdir(parents=True)
     for i, name in enumerate(FIGURES):
@@ -273,7 +276,7 @@ def test_changed_table_value_changes_the_report(results):
 
 def test_changed_run_record_changes_the_report(results):
     _, md_before, _, _ = build(results)
-    path = results / "runs" / "ddfv" / "level3.json"
+    path = results / "runs" / "sphere" / "ddfv" / "level3" / f"{3:016x}.json"
     record = json.loads(path.read_text())
     record["provenance"]["host"] = "otherhost"
     record["provenance"]["git_commit"] = "f" * 40
