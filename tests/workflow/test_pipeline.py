@@ -28,10 +28,11 @@ import pytest
 import yaml
 
 from mcfbench.pipeline import Plans
-from mcfbench.running.solver import Solver
 from mcfbench.storage.provenance import BLAS_THREAD_VARIABLES
 from mcfbench.storage.records import checksum
-from mcfbench.studies.convergence.plan import sphere_run_settings
+from mcfbench.running.identity import identity_digest, run_identity
+from mcfbench.storage.run_store import record_path
+from mcfbench.studies.convergence.plan import table_specs
 
 pytestmark = pytest.mark.e2e
 
@@ -45,7 +46,6 @@ OUTPUTS = [
     "results/tables/convergence.csv", "results/tables/convergence.md",
     "results/tables/convergence.tex", "results/tables/convergence.csv.json",
     "results/figures/convergence.png", "results/figures/convergence.pdf",
-    *(f"results/runs/{s}/level{k}.json" for s in ("ddfv", "cotan") for k in (1, 2)),
 ]
 IGNORE = shutil.ignore_patterns(".snakemake", "__pycache__", "*.pyc")
 TIMEOUT = 300
@@ -90,9 +90,18 @@ def table(workdir):
     return pd.read_csv(workdir / TABLE)
 
 
+def store_record(work, scheme, level):
+    """The run store's record of (scheme, level) of Table 3.1 (one file in its folder)."""
+    (path,) = (work / "results" / "runs" / "sphere" / scheme / f"level{level}").glob("*.json")
+    return path
+
+
 def test_all_outputs_exist(workdir):
     missing = [p for p in OUTPUTS if not (workdir / p).is_file()]
     assert not missing
+    for scheme in ("ddfv", "cotan"):
+        for level in (1, 2):
+            assert store_record(workdir, scheme, level).with_suffix(".npz").is_file()
     assert not list((workdir / "results" / "runs").rglob("*.tmp"))
 
 
@@ -132,12 +141,13 @@ def test_provenance(workdir, table):
     assert sidecar["config"]["levels"] == [1, 2] and sidecar["config_hash"]
     assert "scheme_modules" not in sidecar["config"]
     assert len(sidecar["inputs"]) == 4
-    record = json.loads((workdir / "results/runs/cotan/level2.json").read_text())
+    record = json.loads(store_record(workdir, "cotan", 2).read_text())
     # set once by the Snakefile, inherited by every job
     assert record["provenance"]["blas_threads"] == dict.fromkeys(BLAS_THREAD_VARIABLES, "1")
     assert record["l2_error"] == table.set_index(["scheme", "level"]).loc[
         ("cotan", 2), "l2_error"]
-    assert record["settings"]["code"].keys() == {"ddfv", "baselines", "kept_factor", "mcfbench"}
+    assert record["settings"]["code"] == identity_digest(run_identity("cotan", "sphere"))
+    assert store_record(workdir, "cotan", 2).stem == record["settings"]["key"]
     assert len(record["series"]["t_min_barycentric"]) == record["N"] + 1
     assert record["wall_seconds"] > 0 and record["peak_rss_mb"] > 10   # the job's peak, MB
     assert record["checksum"] == checksum(record)
@@ -150,24 +160,26 @@ def test_second_run_has_nothing_to_do(workdir, env):
 
 
 def test_bad_run_records_stop_the_aggregation(workdir, env, tmp_path):
+    """The store is a cache: a record damaged, edited or stale (another spec key or code
+    digest) is refused by the view that reads it, naming the file."""
     work = tmp_path / "work"
     shutil.copytree(workdir, work, symlinks=True)
-    runs = work / "results" / "runs"
-    (runs / "cotan" / "level2.json").write_text('{"scheme": "cotan", "level": 2,')
-    record = json.loads((runs / "ddfv" / "level1.json").read_text())
+    damaged, edited, stale = (store_record(work, s, k) for s, k in
+                              (("cotan", 2), ("ddfv", 1), ("ddfv", 2)))
+    damaged.write_text('{"scheme": "cotan", "level": 2,')
+    record = json.loads(edited.read_text())
     record["iterations"] = 9                     # edited by hand
-    (runs / "ddfv" / "level1.json").write_text(json.dumps(record))
-    record = json.loads((runs / "ddfv" / "level2.json").read_text())
-    record["settings"]["rtol"] = 1e-6            # other settings, consistent checksum:
-    record["provenance"]["config_hash"] = "0123456789abcdef"   # a stale record
+    edited.write_text(json.dumps(record))
+    record = json.loads(stale.read_text())
+    record["settings"]["code"] = "0123456789abcdef"   # other code, consistent checksum
     record["checksum"] = checksum(record)
-    (runs / "ddfv" / "level2.json").write_text(json.dumps(record))
+    stale.write_text(json.dumps(record))
     before = (work / TABLE).read_text()
-    code, out = snakemake(work, env, *RUN)
+    code, out = snakemake(work, env, "-R", "convergence_records", *RUN)
     assert code != 0
-    assert "results/runs/cotan/level2.json: not valid JSON" in out
-    assert "results/runs/ddfv/level1.json: checksum does not match the content" in out
-    assert "results/runs/ddfv/level2.json: its settings are not the current ones" in out
+    assert f"{damaged.relative_to(work)}: not valid JSON" in out
+    assert f"{edited.relative_to(work)}: checksum does not match the content" in out
+    assert f"{stale.relative_to(work)}: a stale record" in out
     assert "3 invalid run record(s)" in out
     assert "Error in rule convergence_records" in out
     # the check is its own job: the tables of the previous good run stay
@@ -189,7 +201,7 @@ def test_killed_run_resumes_to_the_same_tables(workdir, env, tmp_path):
                             start_new_session=True)
     runs = work / "results" / "runs"
     deadline = time.monotonic() + TIMEOUT
-    while not any(runs.glob("*/level*.json")) and time.monotonic() < deadline:
+    while not any(runs.rglob("level*/*.json")) and time.monotonic() < deadline:
         time.sleep(0.05)                 # killed after the first record, mid-pipeline
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait()
@@ -267,9 +279,8 @@ def test_a_bad_beyond_value_stops_only_the_beyond_study(tmp_path, env):
         for how in bad:
             assert procs[target, how].returncode == 0, out[target, how][-2000:]
             assert "beyond" not in out[target, how].split("Building DAG of jobs")[1]
-    # the matrix plans its own series jobs, no run of Table 3.1
-    assert "matrix_run_sphere" in out["matrix", "file"]
-    assert "run_scheme" not in out["matrix", "file"]
+    # the matrix plans the batches of its runs (those Table 3.1 asks for too among them)
+    assert "rule runs_sphere_matrix_batch" in out["matrix", "file"]
     assert not (work / "results").exists()
 
 
@@ -291,7 +302,8 @@ def test_a_bad_matrix_or_gallery_value_stops_only_its_target(tmp_path, env):
                         "config key 'gallery.C': -1 is less than or equal to the minimum of 0")
     for target in ("beyond_tables", "convergence"):     # (`beyond` adds the report)
         assert procs[target].returncode == 0, out[target][-2000:]
-        assert "run_scheme" in out[target] and "matrix_run" not in out[target]
+        batches = [line for line in out[target].splitlines() if line.startswith("rule runs_")]
+        assert batches and not [b for b in batches if "matrix" in b]
     assert not (work / "results").exists()
 
 
@@ -307,35 +319,48 @@ def planned_jobs(out):
 
 def test_a_one_line_selection_plans_only_the_named_runs(tmp_path, env):
     """`matrix.select` on the command line: the named schemes on the named problems
-    at the named levels, nothing of config.yaml's full matrix (dry run)."""
+    at the named levels, nothing of config.yaml's full matrix (dry run): batches of the
+    sphere only, whose runs are the four named (those the other studies ask for too
+    in batches of their own)."""
+    from mcfbench.pipeline import RunStore
+
     work = copy_workflow(tmp_path / "work")
     code, out = snakemake(work, env, "-n", "--cores", "2", "matrix", "--config", SELECT)
     assert code == 0, out[-3000:]
-    jobs = planned_jobs(out)
-    assert {r: n for r, n in jobs.items() if r.startswith("matrix_run")} == \
-        {"matrix_run_sphere_batch1": 1}          # two cheap series: one job
-    records = set(re.findall(r"results/matrix/runs/\S+?\.json", out))
-    assert records == {f"results/matrix/runs/sphere/{s}/level{k}.json"
-                       for s in ("cotan", "bgn") for k in (1, 2)}
+    jobs = {r for r in planned_jobs(out) if r.startswith("runs_")}
+    config = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+    config["matrix"] = {**config["matrix"], **yaml.safe_load(SELECT.split("=", 1)[1])}
+    store = RunStore(Plans(config, SCHEMAS))
+    asked = store.requests["matrix"]
+    assert {f"runs_{b.name}" for b in store.batches if set(b.specs) & set(asked)} == jobs
+    assert all(set(b.specs) <= set(asked) for b in store.batches if f"runs_{b.name}" in jobs)
+    assert {(s.scheme, s.level) for s in asked} == {(s, k) for s in ("cotan", "bgn")
+                                                    for k in (1, 2)}
+    assert all(job.startswith("runs_sphere_") for job in jobs)
     assert not (work / "results").exists()
 
 
 def test_trimming_the_levels_reruns_no_run(tmp_path, env):
-    """A batch job's params depend neither on its series nor on their levels: after
-    cotan and bgn on sphere 1-2 (one job), asking for level 1 alone, one scheme
-    alone (other batches, other rules) or the same again plans no run, only the
-    tables, and names why in a few short lines."""
+    """Which batch a run falls in does not decide whether it is computed: after cotan
+    and bgn on sphere 1-2, asking for level 1 alone, one scheme alone (other batches,
+    other rules) or the same again rewrites no record; a batch that runs finds its runs
+    in the store."""
     work = copy_workflow(tmp_path / "work")
     both = "matrix={select: {schemes: [cotan, bgn], problems: {sphere: [1, 2]}}}"
     code, out = snakemake(work, env, "--cores", "2", "matrix", "--config", both)
     assert code == 0, out[-3000:]
+    records = sorted((work / "results" / "runs" / "sphere").rglob("*.json"))
+    assert len(records) == 4
+    stamps = [(r.stat().st_mtime_ns, r.read_text()) for r in records]
     for schemes, levels in (("[cotan, bgn]", "[1]"), ("[bgn]", "[1, 2]"),
                             ("[cotan]", "[2]"), ("[cotan, bgn]", "[1, 2]")):
-        code, out = snakemake(work, env, "-n", "--cores", "2", "matrix", "--config",
+        code, out = snakemake(work, env, "--cores", "2", "matrix", "--config",
                               both.replace("[1, 2]", levels).replace("[cotan, bgn]", schemes))
         assert code == 0, out[-3000:]
-        assert "matrix_run" not in out, out[-3000:]
         assert max(map(len, out.splitlines())) < 1000
+    assert [(r.stat().st_mtime_ns, r.read_text()) for r in records] == stamps
+    assert sorted((work / "results" / "runs" / "sphere").rglob("*.json")) == records
+    code, out = snakemake(work, env, "-n", "--cores", "2", "matrix", "--config", both)
     assert "Nothing to be done" in out
 
 
@@ -346,12 +371,14 @@ def test_threads_setting_reaches_the_rules_and_the_records(tmp_path, env):
          "threads=2", "levels=[1,2]", "schemes=[ddfv]"],
         cwd=work, env=env, capture_output=True, text=True, timeout=TIMEOUT)
     assert out.returncode == 0, out.stderr[-2000:]
-    jobs = out.stdout.split("rule run_scheme:")[1:]
-    assert len(jobs) == 2 and all("threads: 2" in job.split("\n\n")[0] for job in jobs)
+    jobs = out.stdout.split("rule runs_sphere_")[1:]
+    assert jobs and all("threads: 2" in job.split("\n\n")[0] for job in jobs)
     config = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
-    settings = sphere_run_settings(Plans({**config, "threads": 2}, SCHEMAS), "ddfv", 1)
-    assert settings["threads"] == 2 and Solver.of_settings(settings).threads == 2
-    assert sphere_run_settings(Plans(config, SCHEMAS), "ddfv", 1)["threads"] == 1
+    spec = table_specs(Plans({**config, "threads": 2}, SCHEMAS).plan("convergence"))["ddfv", 1]
+    assert spec.threads == 2
+    assert table_specs(Plans(config, SCHEMAS).plan("convergence"))["ddfv", 1].threads == 1
+    assert record_path(spec) != record_path(
+        table_specs(Plans(config, SCHEMAS).plan("convergence"))["ddfv", 1])
 
 
 _ONE_STEP = ("import json; from mcfbench.running.run import run; "
@@ -382,8 +409,8 @@ def test_run_jobs_wait_for_one_kernel_compilation(tmp_path, env):
                          cwd=work, env=env, capture_output=True, text=True, timeout=TIMEOUT)
     assert out.returncode == 0, out.stdout[-2000:]
     assert out.stdout.count("rule compile_kernels:") == 1
-    jobs = [job.split("\n\n")[0] for job in out.stdout.split("rule run_scheme:")[1:]]
-    assert len(jobs) == 10
+    jobs = [job.split("\n\n")[0] for job in out.stdout.split("rule runs_")[1:]]
+    assert jobs
     assert all(re.search(r"input: results/logs/kernels/[0-9a-f]{16}\.json", job)
                for job in jobs), jobs[0]
 
@@ -403,11 +430,11 @@ def test_a_code_change_compiles_and_reruns_in_one_invocation(tmp_path, env):
                          capture_output=True, text=True, timeout=TIMEOUT)
     assert dry.returncode == 0, dry.stdout[-2000:]
     assert dry.stdout.count("rule compile_kernels:") == 1
-    assert dry.stdout.count("rule run_scheme:") == 1      # before: compile_kernels alone
+    assert dry.stdout.count("rule runs_") == 1      # before: compile_kernels alone
 
 
 SCRIPTS = REPO / "workflow" / "scripts"
-OWN_SCRIPTS = ["compile_kernels", "run_scheme", "beyond_run", "figure", "convergence_table",
+OWN_SCRIPTS = ["compile_kernels", "run_batch", "figure", "convergence_table",
                "plot_convergence",
                "beyond_tables", "beyond_plots", "beyond_findings", "beyond_scaling", "report",
                "report_pdf",
@@ -426,13 +453,13 @@ def test_scripts_are_thin_adapters_of_the_harness(name):
     local = {p.stem for p in SCRIPTS.glob("*.py")}
     assert not [m for m in imports if m.split(".")[0] in local], imports
     assert any(m.startswith("mcfbench") for m in imports)
-    if name in ("run_scheme", "beyond_run", "figure"):    # jobs that run flows
+    if name in ("run_batch", "figure"):    # jobs that run flows
         assert "tune_malloc()" in text
 
 
 def test_rules_use_the_registry_and_one_code_digest():
     rules = "".join((REPO / "workflow" / "rules" / f"{name}.smk").read_text()
-                    for name in ("common", "convergence", "beyond", "figures", "report"))
+                    for name in ("common", "runs", "convergence", "beyond", "figures", "report"))
     for gone in ("scheme_modules", "code_digest", "_package_dir", "DDFV_MODULE",
                  "importlib", "def _"):
         assert gone not in rules, gone

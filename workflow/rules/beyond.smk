@@ -64,16 +64,6 @@ BEYOND_TARGETS = [
 ]
 
 
-from mcfbench.studies.beyond import plan as _beyond
-
-
-def beyond_specs(studies):
-    """The specs of the beyond study's ``studies`` (its plan checked: a bad value is
-    named here)."""
-    runs = _beyond.study_specs(PLANS)
-    return list(dict.fromkeys(s for study in studies for s in runs[study].values()))
-
-
 rule beyond_records:
     """Check every run record of the beyond study (a bad one stops here: the tables stay)."""
     input:

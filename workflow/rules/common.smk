@@ -7,6 +7,8 @@
 
 from mcfbench.pipeline import RunStore, WorkflowPlans
 import mcfbench.studies.convergence as _convergence_paths
+from mcfbench.studies.beyond import plan as _beyond
+from mcfbench.studies.convergence import plan as _convergence
 
 PLANS = WorkflowPlans(config, f"{workflow.basedir}/workflow/schemas")
 # the config key `threads` (every run job), checked here
@@ -21,3 +23,25 @@ TABLES = [
 ]
 CONVERGENCE_FIGURES = [f"{_convergence_paths.FIGURE}.{ext}" for ext in ("png", "pdf")]
 CONVERGENCE_TARGETS = TABLES + CONVERGENCE_FIGURES
+
+
+# The specs of the studies' views (RUNS: the run store's plan, workflow/rules/runs.smk;
+# called when a view joins the job graph)
+
+
+def convergence_specs():
+    """The specs of Table 3.1 (its plan checked: a bad value is named here)."""
+    return list(_convergence.table_specs(PLANS.plan("convergence")).values())
+
+
+def beyond_specs(studies):
+    """The specs of the beyond study's ``studies`` (its plan checked: a bad value is
+    named here)."""
+    runs = _beyond.study_specs(PLANS)
+    return list(dict.fromkeys(s for study in studies for s in runs[study].values()))
+
+
+def gallery_runs(wildcards):
+    """The manifests of the gallery's batches (planned when the gallery is asked
+    for: workflow/rules/runs.smk)."""
+    return RUNS.manifests(RUNS.requests["gallery"])

@@ -5,14 +5,6 @@
 #   snakemake --cores 2 convergence    # only this study (rule all adds the figures)
 
 
-from mcfbench.studies.convergence import plan as _convergence
-
-
-def convergence_specs():
-    """The specs of Table 3.1 (its plan checked: a bad value is named here)."""
-    return list(_convergence.table_specs(PLANS.plan("convergence")).values())
-
-
 rule convergence:
     """Target: Table 3.1 (CSV, Markdown, LaTeX, provenance) and the convergence figure."""
     input:

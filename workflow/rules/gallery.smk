@@ -37,12 +37,6 @@ GALLERY_TARGETS = [
 ]
 
 
-def gallery_runs(wildcards):
-    """The manifests of the gallery's batches (planned when the gallery is asked
-    for: workflow/rules/runs.smk)."""
-    return RUNS.manifests(RUNS.requests["gallery"])
-
-
 if GALLERY["generated"]:
 
     rule gallery_mesh:

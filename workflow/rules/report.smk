@@ -82,7 +82,7 @@ rule reproduction_report:
         unpack(
             lambda wildcards: {
                 **REPORT_INPUTS,
-                "records": list(_convergence.table_records(PLANS)),
+                "records": RUNS.manifests(convergence_specs()),
                 "beyond": (
                     BEYOND_RESULTS
                     if "beyond"

@@ -1,0 +1,139 @@
+"""The run store in the pipeline (workflow/rules/runs.smk): a run two studies ask for
+is computed once, which batch a run falls in does not decide whether it is recomputed,
+and an edit reruns exactly the runs whose code it changed.
+
+Each test runs Snakemake for real in a temporary copy of the workflow, on the sphere
+at levels 1-2. The two edit tests copy the packages too (``PYTHONPATH`` puts the copy
+first) and give the copy a per-scheme run identity (:data:`PER_SCHEME_IDENTITY`: the
+scheme's flow module and the harness's ``running`` layer), the interface of
+``mcfbench.running.identity`` that the import-closure identity implements; the interim
+identity of this tree hashes whole packages, ``studies`` included.
+"""
+
+import json
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+
+from test_pipeline import copy_workflow, env, snakemake  # noqa: F401  (env: a fixture)
+
+pytestmark = pytest.mark.e2e
+
+REPO = Path(__file__).resolve().parents[2]
+IGNORE = shutil.ignore_patterns(".snakemake", "__pycache__", "*.pyc")
+SPHERE = "problems: {sphere: [1, 2]}"
+THREE = f"matrix={{select: {{schemes: [cotan, bgn, ddfv-chord-carried], {SPHERE}}}}}"
+
+PER_SCHEME_IDENTITY = '''"""A run's code identity, per scheme (the tests' stand-in of the import closure)."""
+
+import hashlib
+from pathlib import Path
+
+from mcfbench.storage.provenance import config_hash
+
+
+def run_identity(scheme, problem):
+    from mcfbench.running.schemes import get_scheme
+
+    module = get_scheme(scheme).flow.partition(":")[0]
+    root = Path(__file__).resolve().parents[2]
+    files = [root / (module.replace(".", "/") + ".py"),
+             *sorted((root / "mcfbench" / "running").glob("*.py"))]
+    return {"files": {f.relative_to(root).as_posix():
+                      hashlib.sha256(f.read_bytes()).hexdigest()[:16] for f in files}}
+
+
+def identity_digest(identity):
+    return config_hash(identity)
+'''
+
+
+def records(work):
+    """``{record path: (mtime, text)}`` of every record of the work's run store."""
+    return {p.relative_to(work): (p.stat().st_mtime_ns, p.read_text())
+            for p in (work / "results" / "runs").rglob("level*/*.json")}
+
+
+def schemes_of(work, paths):
+    return sorted({json.loads((work / p).read_text())["scheme"] for p in paths})
+
+
+def test_the_convergence_study_then_the_matrix_compute_the_shared_runs_once(tmp_path, env):
+    work = copy_workflow(tmp_path / "work")
+    code, out = snakemake(work, env, "--cores", "2", "convergence", "--config",
+                          "levels=[1,2]")
+    assert code == 0, out[-3000:]
+    table = records(work)
+    assert len(table) == 4 and schemes_of(work, table) == ["cotan", "ddfv"]
+    code, out = snakemake(work, env, "--cores", "2", "matrix", "--config",
+                          f"matrix={{select: {{schemes: [ddfv, cotan, bgn], {SPHERE}}}}}")
+    assert code == 0, out[-3000:]
+    after = records(work)
+    assert {p: after[p] for p in table} == table        # Table 3.1's runs, untouched
+    assert len(after) == 6 and schemes_of(work, set(after) - set(table)) == ["bgn"]
+    computed = [r for m in (work / "results" / "runs" / "batches").glob("*.json")
+                for r in json.loads(m.read_text())["runs"] if r["computed"]]
+    assert len(computed) == 6                  # every run computed once, over both targets
+    # the matrix's sphere rows are Table 3.1's numbers
+    import pandas as pd
+
+    conv = pd.read_csv(work / "results" / "tables" / "convergence.csv").set_index(
+        ["scheme", "level"])
+    long = pd.read_csv(work / "results" / "matrix" / "tables" / "matrix.csv")
+    for row in long[long["metric"] == "l2_error"].itertuples():
+        if row.scheme in ("ddfv", "cotan"):
+            assert row.value == pytest.approx(conv.loc[(row.scheme, row.level), "l2_error"],
+                                              rel=1e-9)   # the CSVs: 10 digits
+
+
+def test_a_cut_down_matrix_then_the_full_one_leaves_its_records_alone(tmp_path, env):
+    work = copy_workflow(tmp_path / "work")
+    cut = "matrix={select: {schemes: [cotan], problems: {sphere: [1]}}}"
+    code, out = snakemake(work, env, "--cores", "2", "matrix", "--config", cut)
+    assert code == 0, out[-3000:]
+    before = records(work)
+    assert len(before) == 1
+    code, out = snakemake(work, env, "--cores", "2", "matrix", "--config", THREE)
+    assert code == 0, out[-3000:]
+    after = records(work)
+    assert len(after) == 6 and {p: after[p] for p in before} == before
+
+
+@pytest.fixture(scope="module")
+def edited(tmp_path_factory, env):
+    """A copy of the repository (workflow and packages) with the per-scheme identity,
+    after the three-scheme matrix; its environment."""
+    work = copy_workflow(tmp_path_factory.mktemp("edits") / "work")
+    for name in ("ddfv", "baselines", "kept_factor", "mcfbench"):
+        shutil.copytree(REPO / name, work / name, ignore=IGNORE)
+    (work / "mcfbench" / "running" / "identity.py").write_text(PER_SCHEME_IDENTITY)
+    env = {**env, "PYTHONPATH": os.pathsep.join([str(work), env["PYTHONPATH"]])}
+    code, out = snakemake(work, env, "--cores", "2", "matrix", "--config", THREE)
+    assert code == 0, out[-3000:]
+    return work, env
+
+
+def test_editing_a_presentation_module_reruns_no_run(edited):
+    work, env = edited
+    before = records(work)
+    with open(work / "mcfbench" / "studies" / "matrix" / "findings.py", "a") as source:
+        source.write("\n# a change of the findings' wording\n")
+    code, out = snakemake(work, env, "--cores", "2", "matrix", "--config", THREE)
+    assert code == 0, out[-3000:]
+    assert "rule runs_" not in out
+    assert records(work) == before
+
+
+def test_editing_bgn_rewrites_only_bgns_records(edited):
+    work, env = edited
+    before = records(work)
+    with open(work / "baselines" / "bgn.py", "a") as source:
+        source.write("\n# a change of the scheme's source\n")
+    code, out = snakemake(work, env, "--cores", "2", "matrix", "--config", THREE)
+    assert code == 0, out[-3000:]
+    after = records(work)
+    changed = sorted(p for p in before if after[p] != before[p])
+    assert schemes_of(work, changed) == ["bgn"] and len(changed) == 2
+    assert after.keys() == before.keys()
