@@ -4,23 +4,23 @@ finished matrix's records and benchmark files (issue 32).
 Three parts, each printed:
 
 1. *Outside the runs*: per batch job of the matrix as it ran
-   (:func:`~mcfbench.studies.matrix.plan.batches`, as this code packs them; for
-   a matrix of older code, ``--ran-budget``:
-   :func:`~mcfbench.studies.matrix.plan.pack` of the cost model's estimates
-   without :data:`~mcfbench.studies.matrix.plan.MATRIX_FACTORS`, as before
+   (:func:`~mcfbench.running.batching.batches` of the matrix's specs alone, as this
+   code packs them; for a matrix of older code, ``--ran-budget``:
+   :func:`~mcfbench.running.batching.pack` of the cost model's estimates
+   without :data:`~mcfbench.running.batching.MATRIX_FACTORS`, as before
    them, by that budget: 10 s up to f699a17), its wall seconds (Snakemake's
    ``benchmark:`` file; its ``cpu_time`` is sampled and stops growing between
    samples, so the wall time is used) less its runs' wall seconds (each
    record's ``wall_seconds`` times its ``timing_repeats``, and its robust
    re-run's); the sum, the median, and a least-squares fit
-   ``a + b series + c runs`` (:data:`~mcfbench.studies.matrix.plan.BATCH_SECONDS`).
+   ``a + b series + c runs`` (:data:`~mcfbench.running.batching.BATCH_SECONDS`).
 2. *The cost model against the records*: per kind of scheme
    (:func:`mcfbench.running.cost.cost_class`), the median over the series
    (above 0.3 s) of the measured CPU seconds over the model's
-   (:data:`~mcfbench.studies.matrix.plan.MATRIX_FACTORS`).
+   (:data:`~mcfbench.running.batching.MATRIX_FACTORS`).
 3. *Batches replayed*: for each budget, the jobs that
-   :func:`~mcfbench.studies.matrix.plan.pack` makes of the current estimates
-   (:func:`~mcfbench.studies.matrix.plan.series_seconds`), each lasting its
+   :func:`~mcfbench.running.batching.pack` makes of the current estimates
+   (:func:`~mcfbench.running.batching.spec_seconds` of a series' runs), each lasting its
    records' CPU seconds and the fitted cost of part 1, started costliest
    estimate first on 2 cores (as Snakemake's priorities do): the job count, the
    time both cores are done and their difference.
@@ -55,15 +55,22 @@ def main():
     from mcfbench.running.cost import cost_class, estimate, size
     from mcfbench.running.problems import get_problem
     from mcfbench.running.schemes import get_scheme
+    from mcfbench.running import batching
+    from mcfbench.storage.run_store import record_path
     from mcfbench.studies.matrix import plan as matrix_plan
 
     root = args.checkout / "results"
     config = yaml.safe_load((args.checkout / "config/config.yaml").read_text())
     plan = matrix_plan.plan(config["matrix"])
 
+    specs = matrix_plan.planned_specs(plan)
+
     def record(problem, scheme, level):
-        return json.loads(Path(matrix_plan.record_path(problem, scheme, level,
-                                                       root=root / "matrix")).read_text())
+        """The run store's record, or one of the matrix's own folder (before the store)."""
+        path = Path(record_path(specs[problem, scheme, level], root=root / "runs"))
+        if not path.is_file():
+            path = root / "matrix" / "runs" / problem / scheme / f"level{level}.json"
+        return json.loads(path.read_text())
 
     series = {}          # (problem, scheme) -> (model s, measured CPU s, runs wall s, runs)
     for problem, levels in plan["problems"].items():
@@ -79,17 +86,18 @@ def main():
 
     # 1. outside the runs, per batch job of the matrix as it ran
     if args.ran_budget is None:
-        ran = [(b.problem, b.index, b.schemes) for b in matrix_plan.batches(plan)]
+        ran = [(b.problem, f"runs/{b.name}", list(dict.fromkeys(s.scheme for s in b.specs)))
+               for b in batching.batches({"matrix": list(specs.values())})]
     else:
         ran = []
         for problem, levels in plan["problems"].items():
-            old = {s: series[problem, s][0] + matrix_plan.RUN_SECONDS * len(levels)
+            old = {s: series[problem, s][0] + batching.RUN_SECONDS * len(levels)
                    for s in plan["schemes"]}
-            ran += [(problem, index, group) for index, group
-                    in enumerate(matrix_plan.pack(old, args.ran_budget), start=1)]
+            ran += [(problem, f"matrix/{problem}/batch{index}", group) for index, group
+                    in enumerate(batching.pack(old, args.ran_budget), start=1)]
     rows = []
-    for problem, index, group in ran:
-        tsv = root / "benchmarks/matrix" / problem / f"batch{index}.tsv"
+    for problem, name, group in ran:
+        tsv = root / "benchmarks" / f"{name}.tsv"
         with open(tsv) as handle:
             job_wall = float(next(csv.DictReader(handle, delimiter="\t"))["s"])
         parts = [series[problem, s] for s in group]
@@ -109,16 +117,17 @@ def main():
     print("2. measured / model CPU seconds of a series (median; MATRIX_FACTORS beside):")
     for kind, values in ratios.items():
         print(f"   {kind:24s} {len(values):4d} series {statistics.median(values):6.2f} "
-              f"({matrix_plan.MATRIX_FACTORS.get(kind, 1.0)})")
+              f"({batching.MATRIX_FACTORS.get(kind, 1.0)})")
 
     # 3. the batches replayed with the current estimates
-    estimates = {key: matrix_plan.series_seconds(plan, key[1], key[0]) for key in series}
+    estimates = {(p, s): sum(batching.spec_seconds(specs[p, s, k])
+                             for k in plan["problems"][p]) for p, s in series}
     print("3. budget   jobs   runs end   cores apart")
     for budget in args.budgets:
         jobs = []
         for problem in plan["problems"]:
             costs = {s: estimates[problem, s] for s in plan["schemes"]}
-            for group in matrix_plan.pack(costs, budget):
+            for group in batching.pack(costs, budget):
                 parts = [series[problem, s] for s in group]
                 length = sum(p[1] for p in parts) + fit @ [1.0, len(parts),
                                                            sum(p[3] for p in parts)]
