@@ -9,10 +9,9 @@ Config
     :func:`check_config` checks the whole config while Snakemake reads the
     workflow. Each study checks its own section (its schema, then its
     ``plan``) through :class:`Plans` (one generic entry, :meth:`Plans.plan`):
-    those of Table 3.1 and of the beyond
-    study only when a rule that needs them is in the job graph, those of the
-    matrix and the gallery while Snakemake reads their rule files (their rules
-    are made from them; a bad section leaves them without rules). A bad value
+    every study's while Snakemake reads the workflow, for the run store's batches
+    (:class:`RunStore`; a bad section contributes no run and the study's views
+    no rule's input is made of it). A bad value
     stops only the study's own target, with a
     :class:`~mcfbench.studies.config.ConfigError` naming the key: a bad
     ``beyond`` value stops ``snakemake beyond``, not the matrix. In the workflow
@@ -152,19 +151,11 @@ def alternatives(names):
     return "|".join(re.escape(n) for n in sorted(names, key=len, reverse=True))
 
 
-def scheme_pattern():
-    """The wildcard constraint of a scheme: a registry name (longest first),
-    optionally ``@<integrator>`` (:func:`mcfbench.running.schemes.get_scheme`)."""
-    from mcfbench.running.integrators import INTEGRATORS
-
-    return f"(?:{alternatives(SCHEMES)})(?:@(?:{alternatives(INTEGRATORS)}))?"
-
-
 class Plans:
     """The plans of the studies for one config, each made (and its config section
-    checked) on first use: those of Table 3.1 and of the beyond study when a rule
-    that needs them joins the job graph, those of the matrix and the gallery while
-    Snakemake reads their rule files (:meth:`while_reading`).
+    checked) on first use: while Snakemake reads the workflow, for the run store's
+    batches (:class:`RunStore`) and the rules made from a plan (:meth:`while_reading`);
+    a bad section is named when the study's target is asked for (:meth:`checked`).
 
     A study is a folder of :mod:`mcfbench.studies` whose ``plan`` module has
     ``from_config(config, plans)``; its section of the config (when the study has

@@ -11,10 +11,11 @@ a path back: whoever needs the scheme reads the spec.
 
 A record in the store carries in its ``settings`` the spec, its ``key`` and the
 ``code`` digest of the code that computed it (the run's code identity,
-:func:`mcfbench.running.identity.identity_digest`): :func:`stored` tells whether a
-record is there for a spec and a digest (the batch job then skips the run),
-:func:`read_runs` reads the records of the current specs and refuses a stale one
-(another key or code digest) with a message naming it.
+:func:`mcfbench.running.identity.identity_digest`), hashed into its provenance as
+every record's settings are: :func:`stored` tells whether a record is there for a
+spec and a digest (the batch job then skips the run), :func:`read_runs` reads the
+records of the current specs and refuses a stale one (another key or code digest:
+other settings) with a message naming it.
 """
 
 import hashlib
@@ -23,7 +24,7 @@ import math
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
-from mcfbench.storage.records import FIELDS, RECOMPUTE, RecordError, read_record
+from mcfbench.storage.records import RecordError, read_record, read_records
 
 STORE = "results/runs"
 """The one run store."""
@@ -186,38 +187,24 @@ def read_run(spec, digest, root=STORE):
     Raises
     ------
     RecordError
-        Unreadable, edited or invalid (:func:`mcfbench.storage.records.read_record`),
-        or stale: its spec key or code digest is not the current one; the message
-        names the file.
+        Unreadable, edited or invalid, or stale: its settings (the spec, its key,
+        the code digest) are not the current ones
+        (:func:`mcfbench.storage.records.read_record`); the message names the file.
     """
-    path = record_path(spec, root)
-    record = read_record(path, required=FIELDS)
-    settings = record["settings"]
-    if settings.get("key") != spec.key or settings.get("code") != digest:
-        raise RecordError(f"{path}: a stale record: spec key {settings.get('key')!r} and "
-                          f"code digest {settings.get('code')!r}, expected {spec.key!r} and "
-                          f"{digest!r}; {RECOMPUTE}")
-    return record
+    return read_record(record_path(spec, root), store_settings(spec, digest))
 
 
 def read_runs(specs, log=None, root=STORE):
     """The records of ``specs`` (``{spec: code digest}``), all read before any is
-    refused: ``{spec: record}`` in the order of ``specs``.
+    refused (:func:`mcfbench.storage.records.read_records`): ``{spec: record}`` in the
+    order of ``specs``.
 
     Raises
     ------
     RecordError
         Listing every invalid or stale record, each message naming its file.
     """
-    records, errors = {}, []
-    for spec, digest in specs.items():
-        try:
-            records[spec] = read_run(spec, digest, root)
-        except RecordError as err:
-            errors.append(str(err))
-            if log is not None:
-                log.error("invalid run record: %s", err)
-    if errors:
-        raise RecordError(f"aggregation stopped: {len(errors)} invalid run record(s):\n"
-                          + "\n".join(errors))
-    return records
+    paths = {spec: record_path(spec, root) for spec in specs}
+    records = read_records({paths[spec]: store_settings(spec, digest)
+                            for spec, digest in specs.items()}, log)
+    return {spec: records[paths[spec]] for spec in specs}

@@ -171,7 +171,8 @@ def test_bad_run_records_stop_the_aggregation(workdir, env, tmp_path):
     record["iterations"] = 9                     # edited by hand
     edited.write_text(json.dumps(record))
     record = json.loads(stale.read_text())
-    record["settings"]["code"] = "0123456789abcdef"   # other code, consistent checksum
+    record["settings"]["code"] = "0123456789abcdef"   # other code, consistent checksum:
+    record["provenance"]["config_hash"] = "0123456789abcdef"   # a stale record
     record["checksum"] = checksum(record)
     stale.write_text(json.dumps(record))
     before = (work / TABLE).read_text()
@@ -179,7 +180,7 @@ def test_bad_run_records_stop_the_aggregation(workdir, env, tmp_path):
     assert code != 0
     assert f"{damaged.relative_to(work)}: not valid JSON" in out
     assert f"{edited.relative_to(work)}: checksum does not match the content" in out
-    assert f"{stale.relative_to(work)}: a stale record" in out
+    assert f"{stale.relative_to(work)}: its settings are not the current ones" in out
     assert "3 invalid run record(s)" in out
     assert "Error in rule convergence_records" in out
     # the check is its own job: the tables of the previous good run stay

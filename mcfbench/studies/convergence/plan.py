@@ -121,9 +121,3 @@ def table_specs(plan):
 def run_specs(plans):
     """The specs of Table 3.1 (the run store's: :class:`mcfbench.pipeline.RunStore`)."""
     return table_specs(plans.plan("convergence")).values()
-
-
-def level_steps(plan, level):
-    """Time steps of a run of ``level`` with Table 3.1's time step."""
-    problem = problem_of(plan)
-    return problem.time_steps(problem.tau(int(level)))

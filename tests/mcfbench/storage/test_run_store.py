@@ -77,9 +77,8 @@ def test_stored_and_read_only_with_the_same_key_and_code_digest(tmp_path):
     assert run_store.stored(spec, "c0de", root)
     assert not run_store.stored(spec, "other", root)
     assert run_store.read_run(spec, "c0de", root)["iterations"] == 3
-    with pytest.raises(RecordError, match=r"level2/\w{16}\.json: a stale record: spec key "
-                                          r"'\w{16}' and code digest 'c0de', expected "
-                                          r"'\w{16}' and 'other'"):
+    with pytest.raises(RecordError, match=r"level2/\w{16}\.json: its settings are not the "
+                                          r"current ones .* the record is stale"):
         run_store.read_run(spec, "other", root)
 
 
@@ -93,7 +92,8 @@ def test_read_runs_names_every_bad_or_stale_record(tmp_path):
     record["iterations"] = 9
     open(run_store.record_path(edited, root), "w").write(json.dumps(record))
     record = json.loads(open(run_store.record_path(stale, root)).read())
-    record["settings"]["code"] = "old"
+    record["settings"]["code"] = "old"                 # computed by other code
+    record["provenance"]["config_hash"] = "0123456789abcdef"
     record["checksum"] = checksum(record)
     open(run_store.record_path(stale, root), "w").write(json.dumps(record))
     with pytest.raises(RecordError) as err:
@@ -101,6 +101,6 @@ def test_read_runs_names_every_bad_or_stale_record(tmp_path):
     text = str(err.value)
     assert "3 invalid run record(s)" in text
     assert f"level2/{edited.key}.json: checksum does not match" in text
-    assert f"level3/{stale.key}.json: a stale record" in text
+    assert f"level3/{stale.key}.json: its settings are not the current ones" in text
     assert f"level4/{missing.key}.json: cannot read record" in text
     assert list(run_store.read_runs({good: "c0de"}, root=root)) == [good]

@@ -53,7 +53,7 @@ from mcfbench.studies.beyond.tables import (
     time_order,
 )
 from mcfbench.studies.config import ConfigError
-from mcfbench.studies.convergence.plan import level_steps, problem_of, sphere_spec
+from mcfbench.studies.convergence.plan import problem_of, sphere_spec
 from mcfbench.studies.convergence.tables import convergence_documents, eoc_column, level_table
 
 REPO = Path(__file__).resolve().parents[4]
@@ -466,7 +466,7 @@ def test_finest_level_adds_its_runs_only():
     assert problem.time_steps(problem.tau(7)) == 8192
     # the job's Slurm resources cover the single-core estimate of an earlier session
     # (about 630 MB and 860 s) twice over
-    runtime = runtime_minutes(7, level_steps(pipeline.plan("convergence"), 7))
+    runtime = runtime_minutes(7, problem.time_steps(problem.tau(7)))
     assert mem_mb(7) >= 2 * 630 and runtime * 60 >= 2 * 860
 
 
@@ -613,7 +613,8 @@ def test_dry_run_of_beyond_and_a_bad_value(tmp_path):
                                                if line.startswith("runs_")}
     assert len(batches) == 1, batches
     job = out["finest"].split(f"rule {batches.pop()}:")[1].split("\n\n")[0]
-    runtime = runtime_minutes(7, level_steps(pipeline.plan("convergence"), 7))
+    problem = problem_of(pipeline.plan("convergence"))
+    runtime = runtime_minutes(7, problem.time_steps(problem.tau(7)))
     assert f"runtime={max(120, runtime)}, mem_mb={max(1500, mem_mb(7))}," in job, job
     # a run of both the L2/EOC table and the scaling study is one run
     assert len(set(runs["levels"].values()) | set(runs["scaling"].values())) \
