@@ -181,12 +181,21 @@ class Plans:
 
     @property
     def kernels(self):
-        """The output of the kernels' compile job, named by the code it compiled:
-        ``results/logs/kernels/<digest of the code hash>.json``. A code change is a
+        """The output of the kernels' compile job, named by the code it compiles:
+        ``results/logs/kernels/<digest>.json``, the digest of the code identities of
+        every scheme of the registry on every problem
+        (:func:`mcfbench.running.identity.run_identity`). A change of a run's code is a
         new file, so the run jobs that take it as input wait for the new compilation
         and run in the same invocation (with the code in the job's params instead,
-        Snakemake reran only the compile job and reported the target done)."""
-        digest = hashlib.sha256(json.dumps(self.code, sort_keys=True).encode()).hexdigest()
+        Snakemake reran only the compile job and reported the target done); a change
+        of no run's code (a table, a plot, the report) compiles nothing and reruns no
+        batch."""
+        from mcfbench.running.identity import identity_digest, run_identity
+        from mcfbench.running.problems import PROBLEMS
+
+        digests = sorted({identity_digest(run_identity(s, p)) for s in SCHEMES
+                          for p in PROBLEMS})
+        digest = hashlib.sha256(json.dumps(digests).encode()).hexdigest()
         return f"results/logs/kernels/{digest[:16]}.json"
 
     def plan(self, study):

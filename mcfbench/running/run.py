@@ -80,7 +80,7 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
         the monitors, the metric observers and the driver's checks are exactly
         those of the run at that step, so that the result is that of the whole run
         with ``robust`` from ``t = 0`` up to the solvers' tolerances (the robust
-        re-run of the matrix, :func:`mcfbench.studies.matrix.job.job`).
+        re-run of every run of the run store, :func:`mcfbench.running.batch.run_spec`).
         Not when the run used ``robust``'s method already.
     **options
         Options of the scheme's flow class (override the registry's).

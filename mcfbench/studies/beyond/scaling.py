@@ -2,8 +2,9 @@
 of one time step and the peak memory against the number of unknowns, with the
 power laws ``c n^p`` fitted in log-log on the finest levels.
 
-The points are the finished runs of the levels table (one job, hence one fresh
-process, per scheme and level: rule ``run_scheme``), nothing is run again:
+The points are the finished runs of the levels table (runs of the run store: a
+batch job runs several in one process, so a run's ``peak_rss_mb`` is the process's
+peak so far, that of the batch's earlier runs included), nothing is run again:
 
 * ``n``: the unknowns of the run (``RunResult.nV``: DDFV's F- plus T-vertices,
   the mesh vertices otherwise);

@@ -5,7 +5,7 @@ order on which problem, which breaks down where, and the recommendation.
 A verdict is the scheme's, not its linear solver's: a run that ended with a
 ``solver_*`` status and that the scheme's robust solver
 (:attr:`mcfbench.running.schemes.Scheme.robust_solver`, recorded as ``robust_solver``)
-finished when continued (:func:`mcfbench.studies.matrix.job`) counts as finished, with the
+finished when continued (:func:`mcfbench.running.batch.run_spec`) counts as finished, with the
 robust run's value, and its text says that the failure was the solver's
 (:func:`scheme_view`)."""
 

@@ -67,7 +67,7 @@ plots, the page and the findings take these rows, :func:`main_runs`).
 (:func:`quality_over_time`; ``min_angle`` is its worst over the run).
 ``robust_*``: the re-run of a run that ended with a ``solver_*`` status with
 the robust solver, continued from its last accepted state
-(:func:`mcfbench.studies.matrix.job.job`; ``robust_status`` empty without a
+(:func:`mcfbench.running.batch.robust_fields`; ``robust_status`` empty without a
 re-run)."""
 
 
