@@ -38,7 +38,7 @@ import functools
 import importlib
 import json
 
-from mcfbench.storage.code_identity import REPOSITORY_PACKAGES, code_identity
+from mcfbench.storage import code_identity as code
 from mcfbench.storage.provenance import config_hash
 
 HARNESS = ("mcfbench.running.run",)
@@ -103,13 +103,13 @@ def problem_data(problem):
 
 def _packages(roots):
     """The repository's packages and the outside ones ``roots`` lie in."""
-    outside = sorted({r.split(".")[0] for r in roots} - set(REPOSITORY_PACKAGES))
-    return (*REPOSITORY_PACKAGES, *outside)
+    outside = sorted({r.split(".")[0] for r in roots} - set(code.REPOSITORY_PACKAGES))
+    return (*code.REPOSITORY_PACKAGES, *outside)
 
 
 @functools.cache
 def _identity(roots, data):
-    return code_identity(roots, _packages(roots), STOP, data)
+    return code.code_identity(roots, _packages(roots), STOP, data)
 
 
 @functools.cache
@@ -153,3 +153,10 @@ def registry_identity():
             union["unresolved"].update(identity["unresolved"])
             union["python"] = identity["python"]
     return identity_digest({**union, "unresolved": sorted(union["unresolved"])})
+
+
+def clear_caches():
+    """Forget every identity, file and version read (a test that changes them)."""
+    _identity.cache_clear()
+    _digest.cache_clear()
+    code.clear_caches()

@@ -45,6 +45,8 @@ import sys
 from importlib import metadata
 from pathlib import Path
 
+from mcfbench.storage.provenance import distribution_headers, requirement_name
+
 REPOSITORY_PACKAGES = ("ddfv", "baselines", "kept_factor", "mcfbench")
 """The repository's top-level packages: the ones whose modules are hashed."""
 
@@ -136,7 +138,6 @@ def _with_packages(name):
     return [".".join(parts[:k]) for k in range(1, len(parts) + 1)]
 
 
-@functools.cache
 def closure(roots, packages=REPOSITORY_PACKAGES, stop=frozenset()):
     """The import closure of the modules ``roots`` (a tuple of module names).
 
@@ -164,14 +165,21 @@ def closure(roots, packages=REPOSITORY_PACKAGES, stop=frozenset()):
     ValueError
         A root that is not a module of ``packages``.
     """
-    for root in roots:
-        if module_file(root, packages) is None:
-            raise ValueError(f"{root!r} is not a module of the packages {', '.join(packages)}")
-    modules, outside, todo = set(), set(), list(roots)
+    parts = [_root_closure(root, packages, stop) for root in roots]
+    return (frozenset().union(*(m for m, _ in parts)),
+            frozenset().union(*(o for _, o in parts)))
+
+
+@functools.cache
+def _root_closure(root, packages, stop):
+    """:func:`closure` of one root (the closure of several is their union)."""
+    if module_file(root, packages) is None:
+        raise ValueError(f"{root!r} is not a module of the packages {', '.join(packages)}")
+    modules, outside, todo = set(), set(), [root]
     while todo:
         name = todo.pop()
         for part in _with_packages(name):
-            if part in modules or (part in stop and part not in roots):
+            if part in modules or (part in stop and part != root):
                 continue
             if module_file(part, packages) is None:
                 top = part.split(".")[0]
@@ -185,6 +193,7 @@ def closure(roots, packages=REPOSITORY_PACKAGES, stop=frozenset()):
     return frozenset(modules), frozenset(outside)
 
 
+@functools.cache
 def module_path(name, packages=REPOSITORY_PACKAGES):
     """The path of module ``name``'s file below its package's folder
     (``baselines/bgn.py``): the same in every copy of the repository."""
@@ -233,7 +242,8 @@ def _providers():
 
 @functools.cache
 def distribution_version(name):
-    """The installed version of distribution ``name`` (None if not installed)."""
+    """The installed version of distribution ``name`` (a normalised name: lower
+    case, ``-`` for ``_``; None if not installed)."""
     try:
         return metadata.version(name)
     except metadata.PackageNotFoundError:
@@ -244,25 +254,21 @@ def distribution_version(name):
 def _requirements(name):
     """The distributions ``name`` requires (its extras' left out)."""
     try:
-        required = metadata.requires(name) or []
+        headers = distribution_headers(metadata.distribution(name))
     except metadata.PackageNotFoundError:
         return ()
-    names = []
-    for requirement in required:
-        spec, _, marker = requirement.partition(";")
-        if "extra" in marker:
-            continue
-        names.append(re.split(r"[<>=!~\[( ]", spec.strip(), maxsplit=1)[0])
-    return tuple(names)
+    return tuple(requirement_name(r) for r in headers.get_all("Requires-Dist") or []
+                 if "extra" not in r.partition(";")[2])
 
 
 def _key(distribution):
     return distribution.lower().replace("_", "-")
 
 
+@functools.cache
 def distribution_versions(tops):
     """``({distribution: version}, [unresolved])`` of the top-level import names
-    ``tops``: the distributions providing them and, recursively, those they
+    ``tops`` (a frozenset): the distributions providing them and, recursively, those they
     require (installed ones), by their normalised names; the names no installed
     distribution provides, sorted."""
     providers = _providers()
@@ -274,13 +280,13 @@ def distribution_versions(tops):
         else:
             unresolved.append(top)
     while todo:
-        name = todo.pop()
-        if _key(name) in versions:
+        name = _key(todo.pop())
+        if name in versions:
             continue
         version = distribution_version(name)
         if version is None:
             continue
-        versions[_key(name)] = version
+        versions[name] = version
         todo += _requirements(name)
     return dict(sorted(versions.items())), unresolved
 
@@ -307,13 +313,16 @@ def code_identity(roots, packages=REPOSITORY_PACKAGES, stop=frozenset(), data=()
     """
     modules, outside = closure(tuple(sorted(set(roots))), tuple(packages), frozenset(stop))
     versions, unresolved = distribution_versions(outside)
-    return {"modules": module_hashes(modules, tuple(packages)), "distributions": versions,
-            "unresolved": unresolved, "data": data_hashes(data),
+    return {"modules": module_hashes(modules, tuple(packages)), "distributions": dict(versions),
+            "unresolved": list(unresolved), "data": data_hashes(data),
             "python": ".".join(map(str, sys.version_info[:3]))}
+
+
+_CACHES = (package_folder, module_file, references, _root_closure, module_path, file_hash,
+           _providers, distribution_version, _requirements, distribution_versions)
 
 
 def clear_caches():
     """Forget every file, closure and version read (a test that edits files)."""
-    for cached in (package_folder, module_file, references, closure, file_hash, _providers,
-                   distribution_version, _requirements):
+    for cached in _CACHES:
         cached.cache_clear()

@@ -88,7 +88,7 @@ def dependency_versions():
     (recursively, the extras included), sorted by name.
 
     Each distribution's metadata headers are parsed once (not the description
-    that follows them: :func:`_headers`), and a requirement that is not
+    that follows them: :func:`distribution_headers`), and a requirement that is not
     installed is looked up once: 0.02 s of CPU instead of 0.12 s, paid by
     every job when it writes its first record."""
     seen, missing, todo = {}, set(), [DISTRIBUTION]
@@ -98,16 +98,16 @@ def dependency_versions():
         if key in seen or key in missing:
             continue
         try:
-            meta = _headers(metadata.distribution(name))
+            meta = distribution_headers(metadata.distribution(name))
         except metadata.PackageNotFoundError:
             missing.add(key)
             continue
         seen[key] = meta["Version"]
-        todo += [_requirement_name(r) for r in meta.get_all("Requires-Dist") or []]
+        todo += [requirement_name(r) for r in meta.get_all("Requires-Dist") or []]
     return dict(sorted(seen.items()))
 
 
-def _headers(dist):
+def distribution_headers(dist):
     """The header fields of a distribution's core metadata (``METADATA``, or
     ``PKG-INFO``), an :class:`email.message.Message`: the part before the first
     empty line (after it comes the description, the longest part to parse)."""
@@ -117,7 +117,7 @@ def _headers(dist):
     return email.message_from_string(text.split("\n\n", 1)[0])
 
 
-def _requirement_name(requirement):
+def requirement_name(requirement):
     name = requirement.split(";")[0]
     for stop in "<>=!~[ (":
         name = name.split(stop)[0]
