@@ -155,7 +155,7 @@ def registry_identity():
     return identity_digest({**union, "unresolved": sorted(union["unresolved"])})
 
 
-def clear_caches():
+def forget_identities():
     """Forget every identity, file and version read (a test that changes them)."""
     _identity.cache_clear()
     _digest.cache_clear()

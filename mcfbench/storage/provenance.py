@@ -31,35 +31,17 @@ def package_dir(name):
     return Path(spec.origin).parent if spec is not None and spec.origin else None
 
 
-# harness modules that present results (tables, plots, report, command line,
-# file handling) but do not change what a run computes: left out of the code
-# hash that decides when the pipeline redoes a run
-COMPUTING_LAYERS = ("geometry", "running", "studies")
-"""The harness's layers whose code determines what a run computes (the code hash):
-not ``presentation`` and ``storage`` (how results are shown and stored), nor the
-command line and the Snakemake glue at the top."""
-
-
 @functools.cache
-def source_hash(name, only=None):
-    """Short SHA-256 of the Python sources of package ``name`` (paths and contents);
-    with ``only``, of the files in those subpackages only."""
+def source_hash(name):
+    """Short SHA-256 of the Python sources of package ``name`` (paths and contents):
+    what a result file's provenance names; what decides that a run is redone is
+    its code identity (:mod:`mcfbench.running.identity`)."""
     digest = hashlib.sha256()
     root = package_dir(name)
     for path in sorted(root.rglob("*.py")):
-        if only is not None and path.relative_to(root).parts[0] not in only:
-            continue
         digest.update(path.relative_to(root).as_posix().encode() + b"\0")
         digest.update(path.read_bytes() + b"\0")
     return digest.hexdigest()[:16]
-
-
-def code_hash():
-    """``{package: hash}`` of the code that determines what a run computes: the
-    scheme packages and the harness's :data:`COMPUTING_LAYERS`, so that a change of
-    a table, a plot or the report redoes no run."""
-    return {name: source_hash(name, COMPUTING_LAYERS if name == "mcfbench" else None)
-            for name in SOURCE_PACKAGES if package_dir(name) is not None}
 
 
 @functools.cache
@@ -157,7 +139,6 @@ def provenance(config=None):
         "version": version,
         "source_hash": {name: source_hash(name) for name in SOURCE_PACKAGES
                         if package_dir(name) is not None},
-        "code_hash": code_hash(),
         "git_commit": commit,
         "git_dirty": dirty,
         "packages": dependency_versions(),

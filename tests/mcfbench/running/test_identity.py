@@ -28,9 +28,9 @@ BGN_FAMILY = {"bgn", "mdr", "deturck", "kll"}
 @pytest.fixture
 def fresh():
     """Identities recomputed before and after (a test that patches what they read)."""
-    identity.clear_caches()
+    identity.forget_identities()
     yield
-    identity.clear_caches()
+    identity.forget_identities()
 
 
 def _modules(scheme, problem="sphere"):
@@ -100,7 +100,7 @@ def test_a_changed_data_file_changes_its_real_mesh_problem_s_identity_only(fresh
     assert problem_data(get_problem("sphere")) == ()
     before = {p: identity_digest(run_identity("cotan", p)) for p in PROBLEMS}
     real = ci.file_hash
-    identity.clear_caches()
+    identity.forget_identities()
     with monkeypatch.context() as patch:
         patch.setattr(ci, "file_hash",
                       lambda path: "changed" if str(path).endswith("/nut.json") else real(path))
@@ -112,7 +112,7 @@ def test_a_changed_dependency_version_changes_the_identity_of_who_imports_it(fre
                                                                             monkeypatch):
     before = {s: identity_digest(run_identity(s, "sphere")) for s in SCHEMES}
     real = ci.distribution_version
-    identity.clear_caches()
+    identity.forget_identities()
     with monkeypatch.context() as patch:
         patch.setattr(ci, "distribution_version",
                       lambda name: "9.9.9" if name == "robust-laplacian" else real(name))
