@@ -307,12 +307,16 @@ def code_identity(roots, packages=REPOSITORY_PACKAGES, stop=frozenset(), data=()
     -------
     dict
         ``modules`` (path -> SHA-256, :func:`module_hashes`), ``distributions``
-        (distribution -> version, :func:`distribution_versions`), ``unresolved``
+        (distribution -> version, :func:`distribution_versions`, of the outside
+        names imported and of the packages given outside the repository's),
+        ``unresolved``
         (imported names no installed distribution provides), ``data`` (path ->
         SHA-256), ``python`` (its version).
     """
     modules, outside = closure(tuple(sorted(set(roots))), tuple(packages), frozenset(stop))
-    versions, unresolved = distribution_versions(outside)
+    # an outside package given is hashed, and its distribution's version counts too
+    given = {m.split(".")[0] for m in modules} - set(REPOSITORY_PACKAGES)
+    versions, unresolved = distribution_versions(outside | given)
     return {"modules": module_hashes(modules, tuple(packages)), "distributions": dict(versions),
             "unresolved": list(unresolved), "data": data_hashes(data),
             "python": ".".join(map(str, sys.version_info[:3]))}

@@ -117,7 +117,8 @@ def test_third_party_imports_count_by_their_distributions_versions(pkgx, monkeyp
 
     identity = ci.code_identity(["pkgx.root"], ("pkgx",))
     assert identity["distributions"]["numpy"] == numpy.__version__
-    assert identity["unresolved"] == ["no_such_distribution_anywhere"]
+    # pkgx, a package given, is hashed and would count by its version: not installed
+    assert identity["unresolved"] == ["no_such_distribution_anywhere", "pkgx"]
     real = ci.distribution_version
     with monkeypatch.context() as patch:
         patch.setattr(ci, "distribution_version",
@@ -146,3 +147,13 @@ def test_data_files_by_their_bytes(tmp_path, pkgx):
     assert ci.code_identity(["pkgx.rel"], ("pkgx",), data=[data])["data"] != first
     with pytest.raises(FileNotFoundError, match="missing.obj"):
         ci.data_hashes([tmp_path / "missing.obj"])
+
+
+def test_an_installed_outside_package_given_counts_by_its_files_and_version():
+    """A package outside the repository (here tqdm) given to follow: its modules are
+    hashed and its distribution's version is in the identity."""
+    from importlib import metadata
+
+    identity = ci.code_identity(["tqdm.std"], ("tqdm",))
+    assert {"tqdm/__init__.py", "tqdm/std.py"} <= set(identity["modules"])
+    assert identity["distributions"]["tqdm"] == metadata.version("tqdm")
