@@ -89,6 +89,7 @@ def test_the_registries_are_not_followed_from_the_harness():
     assert not any(m.startswith("baselines") for m in modules)
     unstopped, _ = ci.closure(HARNESS, ci.REPOSITORY_PACKAGES)
     assert {"mcfbench.running.schemes", "ddfv.variants"} <= unstopped
+    assert not any("mcfbench/running/schemes.py" in _modules(s) for s in VARIANTS)
 
 
 def test_a_changed_data_file_changes_its_real_mesh_problem_s_identity_only(fresh,
