@@ -137,22 +137,24 @@ def identity_digest(identity):
 
 
 def registry_identity():
-    """The code identity of every run the registries can make: the union of
-    :func:`run_identity` over every scheme (Euler) and problem, as one digest
-    (the code a pipeline's kernels' compilation and its studies' runs depend on
-    until each run is keyed by its own)."""
+    """The code identity of every run the registries can make, as one digest: the
+    closure of the harness, every scheme's and every problem's roots (the union of
+    their :func:`run_identity`), with every problem's data files. The code a
+    pipeline's kernels' compilation and its studies' runs depend on until each run
+    is keyed by its own."""
+    from mcfbench.running.integrators import INTEGRATORS
     from mcfbench.running.problems import PROBLEMS
     from mcfbench.running.schemes import SCHEMES
 
-    union = {"modules": {}, "distributions": {}, "unresolved": set(), "data": {}}
+    roots = {*HARNESS, *(c.__module__ for c in INTEGRATORS.values())}
+    data = set()
     for scheme in SCHEMES:
-        for problem in PROBLEMS:
-            identity = run_identity(scheme, problem)
-            for part in ("modules", "distributions", "data"):
-                union[part].update(identity[part])
-            union["unresolved"].update(identity["unresolved"])
-            union["python"] = identity["python"]
-    return identity_digest({**union, "unresolved": sorted(union["unresolved"])})
+        roots.update(scheme_roots(scheme))
+    for problem in PROBLEMS.values():
+        roots.update(problem_roots(problem))
+        data.update(problem_data(problem))
+    roots = tuple(sorted(roots))
+    return identity_digest(_identity(roots, tuple(sorted(data))))
 
 
 def forget_identities():

@@ -157,3 +157,20 @@ def test_one_changed_line_of_bgn_changes_the_identity_of_bgn_s_family_only(tmp_p
     before = {s: identity_digest(run_identity(s, "sphere")) for s in VARIANTS}
     changed = {s for s in VARIANTS if out["digests"][s] != before[s]}
     assert changed == {s for s in VARIANTS if s.partition("@")[0] in BGN_FAMILY}
+
+
+def test_the_registry_s_identity_is_the_union_of_every_run_s(fresh, monkeypatch):
+    """A change that reaches one run only (nut's reference file) changes the
+    registry's digest too; one that reaches none (a presentation module) does not."""
+    before = identity.registry_identity()
+    real = ci.file_hash
+    identity.forget_identities()
+    with monkeypatch.context() as patch:
+        patch.setattr(ci, "file_hash", lambda path: "changed" if str(path).endswith(
+            ("/nut.json", "/presentation/formats.py")) else real(path))
+        changed = identity.registry_identity()
+        patch.setattr(ci, "file_hash", lambda path: "changed" if str(path).endswith(
+            "/presentation/formats.py") else real(path))
+        identity.forget_identities()
+        unchanged = identity.registry_identity()
+    assert changed != before and unchanged == before
