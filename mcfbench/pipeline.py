@@ -40,10 +40,10 @@ from contextlib import contextmanager
 from functools import wraps
 from pathlib import Path
 
+from mcfbench.running.identity import registry_identity
 from mcfbench.running.problems import get_problem
 from mcfbench.running.schemes import SCHEMES
 from mcfbench.storage.atomic import write_json
-from mcfbench.storage.provenance import code_hash
 from mcfbench.studies.config import ConfigError, check_threads
 from mcfbench.studies.convergence.plan import PROBLEM
 
@@ -176,7 +176,8 @@ class Plans:
     def __init__(self, config, schemas):
         self.config = config
         self.schemas = Path(schemas)
-        self.code = code_hash()
+        # the code of every run the registries make (not the studies' presentation)
+        self.code = registry_identity()
         # threads of every run job and of the kernels' job: checked at once
         self.threads = check_threads(config)
         self._plans = {}
@@ -184,7 +185,7 @@ class Plans:
     @property
     def kernels(self):
         """The output of the kernels' compile job, named by the code it compiled:
-        ``results/logs/kernels/<digest of the code hash>.json``. A code change is a
+        ``results/logs/kernels/<digest of the code>.json`` (:attr:`code`). A code change is a
         new file, so the run jobs that take it as input wait for the new compilation
         and run in the same invocation (with the code in the job's params instead,
         Snakemake reran only the compile job and reported the target done)."""

@@ -52,11 +52,8 @@ class Monitor:
         self.quality["min_angle"].append(q["min_angle"])
         self.quality["max_aspect"].append(q["max_aspect_ratio"])
         self.quality["flipped"].append(q["flipped_triangles"])
-        # the scheme's own covolumes (DDFV: the F-vertices' come first); the module
-        # imports pandas, on first use (the warm-up's)
-        from mcfbench.geometry.quality import covolume_ratio
-
-        self.quality["covolume_ratio"].append(covolume_ratio(
+        # the scheme's own covolumes (DDFV: the F-vertices' come first)
+        self.quality["covolume_ratio"].append(metrics.covolume_ratio(
             np.asarray(flow.l2_weights)[:len(V)], flow.faces))
 
 

@@ -72,7 +72,7 @@ class RunResult:
     series : dict of lists
         ``t``, ``t_min_barycentric`` (every level), ``quality_t``,
         ``min_angle``, ``max_aspect``, ``flipped``, ``covolume_ratio``
-        (sampled levels; :func:`mcfbench.geometry.quality.covolume_ratio` of the
+        (sampled levels; :func:`mcfbench.geometry.metrics.covolume_ratio` of the
         scheme's own covolumes, absent from records written before it).
     timing_repeats : int
         How many executions of the run ``cpu_seconds`` and ``wall_seconds`` are

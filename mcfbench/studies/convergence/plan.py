@@ -92,7 +92,7 @@ def record_settings(plan, scheme, level, code, *, study=None, tau=None, t_final=
 
     ``study``, ``tau``, ``t_final`` and ``rtol`` override Table 3.1's settings
     (the studies beyond it); without them the settings, and so the hash, are
-    those of Table 3.1. ``code``: :func:`mcfbench.storage.provenance.code_hash`.
+    those of Table 3.1. ``code``: :func:`mcfbench.running.identity.registry_identity`.
     """
     level = int(level)
     problem = problem_of(plan)

@@ -58,7 +58,7 @@ def test_run_records_quality_and_the_t_monitor():
     # the covolume ratio at every sample: at t = 0 that of the icosphere's lumped mass
     # (cotan) and of the F-covolumes chi of the paper's T-vertices (DDFV, not the same)
     from mcfbench.geometry.metrics import lumped_mass
-    from mcfbench.geometry.quality import covolume_ratio
+    from mcfbench.geometry.metrics import covolume_ratio
 
     V, F = icosphere(1)
     for r in (result, cotan):
