@@ -123,13 +123,15 @@ def test_a_changed_dependency_version_changes_the_identity_of_who_imports_it(fre
 
 def test_the_identities_of_a_full_matrix_cost_well_under_a_second(fresh):
     """Every scheme (Euler and BDF2) on every problem, from a cold cache: the
-    files read once, each run's identity then a lookup."""
+    files read once, each run's identity then a lookup (measured 0.45-0.65 CPU s
+    under load 15; the bound is a guard against a closure recomputed per run,
+    which costs minutes, not a benchmark: CPU time, three times the measured)."""
     import time
 
     start = time.process_time()
     digests = {(s, p): identity_digest(run_identity(s, p)) for s in VARIANTS for p in PROBLEMS}
     assert len(digests) == 2 * len(SCHEMES) * len(PROBLEMS)
-    assert time.process_time() - start < 1.0
+    assert time.process_time() - start < 2.0
 
 
 def test_one_changed_line_of_bgn_changes_the_identity_of_bgn_s_family_only(tmp_path):
