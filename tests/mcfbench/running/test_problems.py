@@ -95,7 +95,7 @@ TINY = '''"""A unit sphere at level 1-2 with its radius as the metric (a drop-in
 
 import numpy as np
 
-from mcfbench.running.problems import Problem
+from mcfbench.running.problem import Problem
 
 
 def surface(subdivisions=1):
@@ -130,7 +130,7 @@ def test_a_problem_is_one_file_found_by_the_registry(tmp_path, monkeypatch):
     """One new module, no other file edited: the registry finds the problem, its
     surface, its observer and its main metric; the matrix plans it and a run measures it."""
     from mcfbench.geometry import surfaces
-    from mcfbench.running import problems
+    from mcfbench.running import observers, problems
     from mcfbench.running.run import run
     from mcfbench.studies.matrix import plan as matrix_plan
     from mcfbench.studies.matrix.tables import main_metric
@@ -141,7 +141,7 @@ def test_a_problem_is_one_file_found_by_the_registry(tmp_path, monkeypatch):
     (package / "tiny_sphere.py").write_text(TINY)
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.setattr(problems, "PROBLEMS", dict(problems.PROBLEMS))
-    monkeypatch.setattr(problems, "METRICS", dict(problems.METRICS))
+    monkeypatch.setattr(observers, "METRICS", dict(observers.METRICS))
     monkeypatch.setattr(surfaces, "SURFACES", dict(surfaces.SURFACES))
 
     assert problems.discover_problems([str(package)], "dropin_problems") == ["tiny_sphere"]
@@ -156,5 +156,5 @@ def test_a_problem_is_one_file_found_by_the_registry(tmp_path, monkeypatch):
     # one step of tau = 0.04 from the unit sphere: R = sqrt(1 - 4 tau) = 0.916..., up to h^2
     assert result.status == "ok" and result.steps_done == 1
     assert abs(result.metrics["mean_radius"] - np.sqrt(1 - 4 * 0.04)) < 0.03
-    with pytest.raises(ValueError, match="already in the registry"):
+    with pytest.raises(ValueError, match="'tiny_sphere' is declared twice: by dropin_problems.tiny_sphere and by dropin_problems.tiny_sphere"):
         problems.discover_problems([str(package)], "dropin_problems")
