@@ -113,7 +113,9 @@ class Scheme:
     source: dict | None = field(default=None, compare=False)
 
     def __post_init__(self):
-        if not self.name or any(c in self.name for c in "/@ "):
+        base, at, integrator = self.name.partition("@")   # NAME@INTEGRATOR: get_scheme's
+        if not base or any(c in base for c in "/ ") or \
+                (at and integrator in ("euler", "") or at and integrator != self.integrator):
             raise ValueError(f"scheme {self.name!r}: a name is a non-empty word without "
                              "'/', '@' or spaces (a folder of the results; '@' joins an "
                              "integrator)")
