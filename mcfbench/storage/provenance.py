@@ -34,9 +34,10 @@ def package_dir(name):
 # harness modules that present results (tables, plots, report, command line,
 # file handling) but do not change what a run computes: left out of the code
 # hash that decides when the pipeline redoes a run
-COMPUTING_LAYERS = ("geometry", "running", "studies")
-"""The harness's layers whose code determines what a run computes (the code hash):
-not ``presentation`` and ``storage`` (how results are shown and stored), nor the
+COMPUTING_LAYERS = ("geometry", "running", "schemes", "problems", "studies")
+"""The harness's layers whose code determines what a run computes (the code hash),
+the declarations of the schemes and problems the registries scan included: not
+``presentation`` and ``storage`` (how results are shown and stored), nor the
 command line and the Snakemake glue at the top."""
 
 

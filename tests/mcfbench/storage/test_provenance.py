@@ -55,7 +55,8 @@ def test_config_hash_ignores_key_order():
 
 
 def test_code_hash_follows_the_computing_layers_only(tmp_path, monkeypatch):
-    """A change in presentation or storage redoes no run; one in running does."""
+    """A change in presentation or storage redoes no run; one in running, a scheme's or a
+    problem's declaration does."""
     import shutil
 
     from mcfbench.storage import provenance
@@ -68,9 +69,13 @@ def test_code_hash_follows_the_computing_layers_only(tmp_path, monkeypatch):
         with open(changed, "a") as f:
             f.write("# changed\n")
     assert provenance.source_hash.__wrapped__("mcfbench", provenance.COMPUTING_LAYERS) == before
-    with open(copy / "running" / "run.py", "a") as f:
-        f.write("# changed\n")
-    assert provenance.source_hash.__wrapped__("mcfbench", provenance.COMPUTING_LAYERS) != before
+    for changed in (copy / "running" / "run.py", copy / "schemes" / "bgn.py",
+                    copy / "problems" / "sphere.py"):
+        with open(changed, "a") as f:
+            f.write("# changed\n")
+        after = provenance.source_hash.__wrapped__("mcfbench", provenance.COMPUTING_LAYERS)
+        assert after != before
+        before = after
 
 
 def test_git_is_asked_once_per_process_and_path(monkeypatch, tmp_path):
