@@ -158,3 +158,32 @@ def test_a_problem_is_one_file_found_by_the_registry(tmp_path, monkeypatch):
     assert abs(result.metrics["mean_radius"] - np.sqrt(1 - 4 * 0.04)) < 0.03
     with pytest.raises(ValueError, match="'tiny_sphere' is declared twice: by dropin_problems.tiny_sphere and by dropin_problems.tiny_sphere"):
         problems.discover_problems([str(package)], "dropin_problems")
+
+
+def test_a_problems_kind_says_what_it_tests():
+    """``kind`` decides what the matrix's REAL_WORLD_SURFACES and tau_rule decided before:
+    the same 12 real-world-like generated or committed meshes' problems."""
+    from mcfbench.studies.matrix import is_real_mesh, is_real_world
+
+    kinds = {name: p.kind for name, p in PROBLEMS.items()}
+    assert [n for n, k in kinds.items() if k == "reference"] == ["torus", "dumbbell"]
+    assert [n for n, k in kinds.items() if k == "real_world"] == [
+        "perturbed_sphere", "remeshed_sphere", "anisotropic_sphere", "flat_patch", "blobby",
+        "marching_torus"]
+    assert {n for n, k in kinds.items() if k == "real_mesh"} == \
+        {n for n in PROBLEMS if n.startswith("real_")}
+    assert all(is_real_world(p) == (p.kind in ("real_world", "real_mesh"))
+               and is_real_mesh(p) == (p.kind == "real_mesh") for p in PROBLEMS.values())
+    assert all(p.kind != "exact" for p in PROBLEMS.values() if p.tau_rule == "mesh")
+    assert Problem.user_mesh("my mesh", steps=3).kind == "real_world"
+
+
+def test_a_problem_records_the_data_files_it_reads():
+    for name, problem in PROBLEMS.items():
+        if problem.kind != "real_mesh":
+            assert problem.data_files == (), name
+            continue
+        mesh = name.removeprefix("real_")
+        assert all(f.is_file() for f in problem.data_files)
+        assert [f.name for f in problem.data_files] == [
+            mesh_manifest()[mesh]["file"], "manifest.json", f"{mesh}.json", f"{mesh}.npz"]
