@@ -18,8 +18,6 @@ import hashlib
 import json
 from pathlib import Path
 
-from mcfbench.geometry.mesh_files import read_mesh
-from mcfbench.geometry.subdivision import loop_limit_level
 
 MESH_DIR = Path(__file__).resolve().parents[1] / "data" / "meshes"
 """The folder of the committed meshes, their manifest and README."""
@@ -58,6 +56,8 @@ def committed_mesh_file(name):
 def read_committed_mesh(name):
     """``(V, F)`` of the committed mesh ``name`` through :func:`read_mesh`
     (a ``(n, 3)`` float64 and an ``(m, 3)`` int64 array, a valid surface)."""
+    from mcfbench.geometry.mesh_files import read_mesh  # libigl: on first use, not the registry's
+
     V, F, _ = read_mesh(committed_mesh_file(name))
     return V, F
 
@@ -66,4 +66,6 @@ def real_mesh(mesh="nut", level=0):
     """Level ``level`` of the Loop-limit refinement series of the committed mesh
     named ``mesh`` (default the smallest, ``nut``;
     :func:`mcfbench.geometry.subdivision.loop_limit_level`): ``(V, F)``."""
+    from mcfbench.geometry.subdivision import loop_limit_level
+
     return loop_limit_level(*read_committed_mesh(mesh), level)

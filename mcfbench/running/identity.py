@@ -5,13 +5,15 @@ import closure (:mod:`mcfbench.storage.code_identity`: static, lazy imports,
 ``"module:Class"`` strings and constant ``import_module`` names followed) of
 
 * the scheme: its flow class's module (the registry entry's ``"module:Class"``;
-  an outside package's flow is followed and hashed as the repository's are),
-  and for ``NAME@INTEGRATOR`` the integrator's module;
+  an outside package's flow is followed and hashed as the repository's are, and
+  its ``source``: distribution, version, files' SHA-256), for ``NAME@INTEGRATOR``
+  the integrator's module, and the entry's values that change the numbers (its
+  flow, options and integrator: :func:`scheme_values`; not its label or style);
 * the problem: the module that defines it (``Problem.module`` where the problem
   has one, else the module of its ``params`` function) and the registry module
   that defines :class:`~mcfbench.running.problems.Problem` and the metrics, with
-  the data files it reads (``Problem.data_files`` where it has them; a committed
-  real mesh's mesh file and its reference ``.json`` and ``.npz``);
+  the data files it reads (``Problem.data_files``: a committed real mesh's mesh
+  file and its reference ``.json`` and ``.npz``);
 * the harness that steps, checks and measures a run: the closure of
   :mod:`mcfbench.running.run` (driver, solver, integrators, invariants,
   monitors, metrics, records, frames and the surface generators);
@@ -21,14 +23,13 @@ what those require) and the Python version.
 
 **The stop rule.** The listings are not computing code: the scheme registry
 (:mod:`mcfbench.running.schemes`: every scheme's ``"module:Class"``), the problem
-registry (:mod:`mcfbench.running.problems`: every problem) and the problems'
-discovery folder (:mod:`mcfbench.problems`) are neither followed nor hashed where
+registry (:mod:`mcfbench.running.problems`: every problem) and the discovery
+folders (:mod:`mcfbench.problems`, :mod:`mcfbench.schemes`) are neither followed nor hashed where
 another module imports them (:data:`STOP`), so the harness's ``run`` does not
 reach every scheme through the registry, and a new entry in a listing changes no
-other run's identity. What a registry entry sets that changes the numbers (a
-scheme's options and integrator, a problem's parameters) belongs to the run's
-spec, not to its code identity. A problem's defining module is a root, so the
-problem registry is followed from there (today it defines every built-in problem).
+other run's identity. What a scheme's entry sets that changes the numbers (its
+flow, options and integrator) is part of the identity as values; a problem's
+defining module (its parameters, time rule, metrics) is a root.
 
 Everything is cached per process: the identities of every run of the full matrix
 cost a fraction of a second.
@@ -44,11 +45,12 @@ from mcfbench.storage.provenance import config_hash
 HARNESS = ("mcfbench.running.run",)
 """The roots of the harness code every run shares."""
 
-STOP = frozenset({"mcfbench.running.schemes", "mcfbench.running.problems", "mcfbench.problems"})
+STOP = frozenset({"mcfbench.running.schemes", "mcfbench.running.problems", "mcfbench.problems",
+                  "mcfbench.schemes"})
 """The listings: not followed where they are imported (module docstring)."""
 
-PROBLEM_DEFINITIONS = ("mcfbench.running.problems",)
-"""The module defining ``Problem`` and the metrics: a root of every problem."""
+PROBLEM_DEFINITIONS = ("mcfbench.running.problem", "mcfbench.running.observers")
+"""The modules defining ``Problem`` and the metric observers: roots of every problem."""
 
 
 def _module_of(qualified):
@@ -69,6 +71,19 @@ def scheme_roots(scheme):
     return tuple(roots)
 
 
+def scheme_values(scheme):
+    """What the registry entry of ``scheme`` sets that changes a run's numbers: its
+    flow, options and integrator, and an installed package's ``source``
+    (distribution, version, SHA-256 of its files); not its label, style or
+    description."""
+    from mcfbench.running.schemes import get_scheme
+
+    entry = get_scheme(scheme)
+    values = {"flow": entry.flow, "options": entry.options, "integrator": entry.integrator}
+    source = getattr(entry, "source", None)
+    return {**values, "source": source} if source else values
+
+
 def problem_roots(problem):
     """The modules defining ``problem`` (a :class:`~mcfbench.running.problems.Problem`):
     its ``module`` (a name or a module) where it has one, else its ``params``
@@ -84,21 +99,9 @@ def problem_roots(problem):
 
 
 def problem_data(problem):
-    """The data files ``problem`` reads: its ``data_files`` where it has them, else
-    for a committed real mesh (``surface == "real_mesh"``) the mesh file and its
-    reference answers and surface (:mod:`mcfbench.running.real_mesh_problems`);
-    none for a generated surface."""
-    files = getattr(problem, "data_files", None)
-    if files is not None:
-        return tuple(files)
-    if problem.surface != "real_mesh":
-        return ()
-    from mcfbench.geometry.committed_meshes import MESH_DIR, mesh_manifest
-    from mcfbench.running.real_mesh_problems import reference_path, surface_path
-
-    name = problem.params(problem.levels[0])["mesh"]
-    files = [MESH_DIR / mesh_manifest()[name]["file"], reference_path(name)]
-    return tuple(files + [p for p in (surface_path(name),) if p.is_file()])
+    """The data files ``problem`` reads (``Problem.data_files``: a committed real
+    mesh's mesh file and reference answers; none for a generated surface)."""
+    return tuple(getattr(problem, "data_files", ()))
 
 
 def _packages(roots):
@@ -118,8 +121,9 @@ def _digest(scheme, problem):
 
     definition = get_problem(problem)
     roots = tuple(sorted({*HARNESS, *scheme_roots(scheme), *problem_roots(definition)}))
-    identity = _identity(roots, problem_data(definition))
-    return json.dumps(identity, sort_keys=True)
+    identity = {**_identity(roots, problem_data(definition)),
+                "scheme": scheme_values(scheme)}
+    return json.dumps(identity, sort_keys=True, default=str)
 
 
 def run_identity(scheme, problem):
@@ -127,7 +131,8 @@ def run_identity(scheme, problem):
     included) on ``problem`` (a registry name): a JSON-serialisable dict, its
     ``modules`` (path -> SHA-256), ``distributions`` (name -> version),
     ``unresolved``, ``data`` (path -> SHA-256) and ``python``
-    (:func:`mcfbench.storage.code_identity.code_identity`); a fresh copy per call."""
+    (:func:`mcfbench.storage.code_identity.code_identity`) and ``scheme``
+    (:func:`scheme_values`); a fresh copy per call."""
     return json.loads(_digest(scheme, problem))
 
 
@@ -154,7 +159,8 @@ def registry_identity():
         roots.update(problem_roots(problem))
         data.update(problem_data(problem))
     roots = tuple(sorted(roots))
-    return identity_digest(_identity(roots, tuple(sorted(data))))
+    values = {name: scheme_values(name) for name in SCHEMES}
+    return identity_digest({**_identity(roots, tuple(sorted(data))), "schemes": values})
 
 
 def forget_identities():

@@ -35,20 +35,6 @@ FLOAT_FORMAT = "%.10g"
 """The floats of the matrix's and the gallery's CSV tables: ten significant digits."""
 
 
-# metric observer (Problem.metrics) -> preferred main metrics, best first
-MAIN_METRICS = {
-    "sphere_l2": ("l2_error",),
-    "catenoid": ("neck_error", "max_radial_error"),
-    "height": ("max_height", "l2_height"),
-    "shape": ("volume", "area"),
-    "still": ("max_displacement", "max_height"),
-    "decay": ("decay_rate_error",),
-    "angenent": ("distance_error", "area_error"),
-    "enneper": ("height_error", "area_error"),
-    "reference_volume": ("volume_error", "pinch_time_error"),
-}
-
-
 # metrics whose exact value is zero besides the ones named "*error*"
 ZERO_METRICS = ("max_height", "l2_height", "max_displacement")
 
@@ -79,9 +65,9 @@ def is_error(metric):
 def main_metric(problem, available=()):
     """The metric of ``problem`` shown in the summary, the plots and the findings.
 
-    ``problem.main_metric`` if the problem names one, else the first of
-    :data:`MAIN_METRICS` of its observers found in ``available``, else the
-    first error among ``available``, else the first of ``available``.
+    ``problem.main_metric`` (the problem module's) if ``available`` has it (or is
+    empty), else the first error among ``available``, else the first of
+    ``available``.
     """
     from mcfbench.running.problems import get_problem
 
@@ -90,10 +76,6 @@ def main_metric(problem, available=()):
     named = getattr(problem, "main_metric", None)
     if named and (not available or named in available):
         return named
-    for observer in problem.metrics:
-        for name in MAIN_METRICS.get(observer, ()):
-            if name in available:
-                return name
     errors = [m for m in available if is_error(m)]
     return (errors or available or [""])[0]
 

@@ -773,8 +773,7 @@ def test_figures_fit_a_laptop_column_with_text_of_8_pt_at_least(monkeypatch, tmp
     monkeypatch.setattr(plots, "save_figure", lambda fig, *paths: figures.append(fig))
     records = []
     for problem, entry in PROBLEMS.items():
-        metric = matrix_tables.main_metric(problem, [
-            m for o in entry.metrics for m in matrix_tables.MAIN_METRICS.get(o, ())] or ["area"])
+        metric = entry.main_metric
         for scheme, c in (("cotan", 1.0), ("ddfv", 2.0)):
             for k in (1, 2):
                 broke = scheme == "ddfv" and k == 2
