@@ -14,6 +14,7 @@ from mcfbench.geometry.axisymmetric import (
 )
 from mcfbench.geometry.extrapolation import extinction_time, observed_orders
 from mcfbench.geometry.shapes import dumbbell_profile
+from mcfbench.running.problems import get_problem
 from mcfbench.geometry.meridian_surgery import area_radius, bulb_through_pinch, capped_bulb
 
 RHO_LEVELS = 0.2 * 2.0 ** (-0.5 * np.arange(9))
@@ -90,7 +91,12 @@ def test_the_bulbs_extinction_converges_at_second_order_and_the_cut_radius_hardl
     T = {key: extinction_time(r["t_levels"], RHO_LEVELS)[0] for key, r in runs.items()}
     series = [T[(n, 0.04)] for n in (101, 201, 401)]
     assert observed_orders(series)[0] == pytest.approx(2.0, abs=0.3)
-    assert 0.2553 < series[-1] < 0.2555
+    # towards the dumbbell problem's reference (meshes of 1 601-12 801 nodes, cut at
+    # 0.0025): each mesh a quarter of the previous one's distance from it
+    reference = get_problem("dumbbell").reference["extinction_time"]
+    distances = [abs(t - reference) for t in series]
+    assert distances[-1] < 1e-5
+    assert 3.0 < distances[-2] / distances[-1] < 5.0
     mesh_error = abs(series[-1] - series[-2])
     assert abs(T[(401, 0.04)] - T[(401, 0.02)]) < 0.3 * mesh_error
     # one bulb's volume decreases after the cut, as the flow's dV/dt = -int H < 0
