@@ -61,6 +61,14 @@ class Trajectory:
         occurrence): ``status``, ``step``, ``time``, ``detail``.
     wall_seconds, cpu_seconds : float
         Time of the stepping, observers included.
+    events : list of dict
+        What happened to the surface without ending the run, and what ended it
+        ``extinct``: one ``{"event": "extinct", "step", "time", "component",
+        "kind", "area", "volume", "extinction_time"}`` per component that vanished
+        round (:mod:`mcfbench.geometry.collapse`): ``time`` the state's, ``kind``
+        ``"point"`` or ``"circle"``, ``area`` and ``volume`` the component's then,
+        ``extinction_time`` the state's time plus the time the round component
+        had left.
     continue_with : callable or None
         For a run that ended with a solver failure (a ``solver_*`` status; not one
         turned into ``degenerated`` by a collapsed mesh), ``continue_with(solver,
@@ -85,11 +93,19 @@ class Trajectory:
     defects: list = field(default_factory=list)
     wall_seconds: float = 0.0
     cpu_seconds: float = 0.0
+    events: list = field(default_factory=list)
     continue_with: object = field(default=None, repr=False, compare=False)
 
     @property
     def ok(self):
         return self.status == "ok"
+
+    @property
+    def extinction_time(self):
+        """The time the last component vanished (:attr:`events`'s
+        ``extinction_time``) of a run that ended ``extinct``, NaN otherwise."""
+        return float(self.events[-1]["extinction_time"]) if self.status == "extinct" \
+            and self.events else float("nan")
 
     @property
     def t_failed(self):
@@ -154,7 +170,10 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
         before the next solve, for a component that shrank to a point or a
         line or has non-finite coordinates
         (:class:`mcfbench.geometry.collapse.CollapseCheck`): status
-        ``degenerated`` naming the component. It ends the run in both
+        ``degenerated`` naming the component; or that vanished round (a point,
+        or a circle: the flow's extinction, with less than two time steps left),
+        status ``extinct`` naming the component and its extinction time (an
+        event of :attr:`Trajectory.events`). Either ends the run in both
         ``on_defect`` modes (there is no surface left to step).
     invariants : bool
         Check every state of the mesh (``flow.vertices``, ``flow.faces``)
@@ -199,12 +218,13 @@ class _Stepping:
         self.save_every, self.observers, self.on_defect = save_every, observers, on_defect
         self.until = until
         self.frames, self.steps_kept, self.iterations, self.defects = [], [], [], []
+        self.events = []
         self.seen = set()
         # one compiled measuring pass per state serves both checks
         self.measures = StateMeasures(flow.vertices, flow.faces) \
             if collapse or invariants else None
-        self.collapsed = CollapseCheck(flow.vertices, flow.faces, measures=self.measures) \
-            if collapse else None
+        self.collapsed = CollapseCheck(flow.vertices, flow.faces, measures=self.measures,
+                                       tau=flow.tau) if collapse else None
         self.invariant = FlowInvariants(flow.vertices, flow.faces, measures=self.measures) \
             if invariants else None
         self.wall = self.cpu = 0.0
@@ -232,11 +252,14 @@ class _Stepping:
         # for both checks
         V = flow.vertices if self.measures is not None else None
         measured = self.measures(V) if V is not None else None
-        detail = self.collapsed(V, measured) if self.collapsed is not None else None
-        if detail is not None:
-            self.defects.append({"status": "degenerated", "step": flow.n,
-                                 "time": flow.n * flow.tau, "detail": detail})
-            raise FlowBreakdown("degenerated", flow.n, flow.n * flow.tau, detail)
+        found = self.collapsed(V, measured, flow.n * flow.tau) \
+            if self.collapsed is not None else None
+        if found is not None:
+            if found.status == "extinct":
+                self.vanished(found)
+            self.defects.append({"status": found.status, "step": flow.n,
+                                 "time": flow.n * flow.tau, "detail": found.detail})
+            raise FlowBreakdown(found.status, flow.n, flow.n * flow.tau, found.detail)
         found = flow.defects()
         if self.invariant is not None:
             found = [*found, *self.invariant(V, flow.n, measured)]
@@ -248,6 +271,16 @@ class _Stepping:
                                  "time": flow.n * flow.tau, "detail": detail})
             if self.on_defect == "stop":
                 raise FlowBreakdown(status, flow.n, flow.n * flow.tau, detail)
+
+    def vanished(self, found):
+        """Record the components of an ``extinct`` :class:`~mcfbench.geometry.collapse.Collapse`
+        as events of the run."""
+        flow = self.flow
+        for c, kind, area, volume, time in zip(found.components, found.kinds, found.areas,
+                                               found.volumes, found.times):
+            self.events.append({"event": "extinct", "step": flow.n, "time": flow.n * flow.tau,
+                                "component": int(c), "kind": kind, "area": area,
+                                "volume": volume, "extinction_time": time})
 
     def observe(self):
         for observer in self.observers:
@@ -332,5 +365,5 @@ class _Stepping:
             t=np.array(self.steps_kept) * flow.tau, faces=np.asarray(flow.faces),
             iterations=np.array(self.iterations, dtype=int), status=status, message=message,
             failed_step=failed, steps_done=len(self.iterations), defects=defects,
-            wall_seconds=self.wall, cpu_seconds=self.cpu,
+            wall_seconds=self.wall, cpu_seconds=self.cpu, events=list(self.events),
             continue_with=self.continue_with if self.solver_failed else None)
