@@ -268,15 +268,41 @@ class CollapseCheck:
         self.tau = None if tau is None else float(tau)
         self.count, self.labels = self.measures.count, self.measures.labels
         self._sizes = np.bincount(self.labels, minlength=self.count)
-        self._first = np.unique(self.labels, return_index=True)[1]
+        #: the first point of every component
+        self.first = np.unique(self.labels, return_index=True)[1]
         self.chi = euler_characteristics(self.measures.faces, self.labels, self.count)
         self.closed = closed_components(self.measures.faces, self.labels, self.count)
         measured = self.measures(V)
-        self.area0, self.diameter0 = measured.component_area.copy(), measured.diameter.copy()
+        self.renamed(measured.component_area.copy(), measured.diameter.copy(),
+                     np.arange(self.count), np.arange(len(V)), self.count)
+
+    def renamed(self, area0, diameter0, ids, vertex_ids, total):
+        """The components' initial sizes and their names in the sentences: a check of
+        the components that remain of a larger mesh (the driver's, after a component
+        vanished) keeps their sizes and names in that mesh.
+
+        Parameters
+        ----------
+        area0, diameter0 : (count,) float arrays
+            Initial area and diameter of every component.
+        ids : (count,) int array
+            Its number in the larger mesh.
+        vertex_ids : (n,) int array
+            Every point's number in the larger mesh.
+        total : int
+            The larger mesh's number of components.
+        """
+        self.area0, self.diameter0 = np.asarray(area0, float), np.asarray(diameter0, float)
+        self.ids, self.vertex_ids, self.total = np.asarray(ids), np.asarray(vertex_ids), total
         # one component of positive size (every surface of the registry): its ratios
         # in Python floats, as numpy divides them, without numpy's per-call overhead
         self._one = (float(self.area0[0]), float(self.diameter0[0])) if self.count == 1 \
             and self.area0[0] > 0 and self.diameter0[0] > 0 else None
+
+    def name(self, c):
+        """``"component 1 of 2 (162 vertices, e.g. vertex 162)"``."""
+        return (f"component {int(self.ids[c])} of {self.total} ({self._sizes[c]} vertices, "
+                f"e.g. vertex {int(self.vertex_ids[self.first[c]])})")
 
     def __call__(self, vertices, measured=None, t=0.0):
         """What collapsed or vanished in the state ``vertices`` at time ``t``, a
@@ -298,7 +324,8 @@ class CollapseCheck:
                 c = int(self.labels[bad[0]])
                 return Collapse("degenerated", (
                     f"non-finite coordinates at {len(bad)} vertex(es), e.g. vertex "
-                    f"{int(bad[0])} of component {c} of {self.count}"), (c,))
+                    f"{int(self.vertex_ids[bad[0]])} of component {int(self.ids[c])} of "
+                    f"{self.total}"), (c,))
         with np.errstate(divide="ignore", invalid="ignore"):
             a_ratio, d_ratio = area / self.area0, diameter / self.diameter0
         collapsed = (a_ratio < self.area_tol) | (d_ratio < self.diameter_tol)
@@ -319,18 +346,16 @@ class CollapseCheck:
             more = f" ({int(collapsed.sum())} components collapsed)" \
                 if collapsed.sum() > 1 else ""
             return Collapse("degenerated", (
-                f"component {c} of {self.count} ({self._sizes[c]} vertices, e.g. vertex "
-                f"{int(self._first[c])}) shrank to {shape}: area {area[c]:.3g} "
+                f"{self.name(c)} shrank to {shape}: area {area[c]:.3g} "
                 f"({a_ratio[c]:.3g} x its initial {self.area0[c]:.3g}), diameter "
                 f"{diameter[c]:.3g} ({d_ratio[c]:.3g} x its initial {self.diameter0[c]:.3g})"
                 + more), (c,), (shape[2:],), (float(area[c]),), (float(volume[c]),),
                 (math.nan,))
         if not extinct:
             return None
-        times = tuple(float(t) + left[c] for c in extinct)
+        times = tuple(float(t) + float(left[c]) for c in extinct)
         detail = "; ".join(
-            f"component {c} of {self.count} ({self._sizes[c]} vertices, e.g. vertex "
-            f"{int(self._first[c])}) vanished round, to a {kinds[c]}: area {area[c]:.3g} "
+            f"{self.name(c)} vanished round, to a {kinds[c]}: area {area[c]:.3g} "
             f"({a_ratio[c]:.3g} x its initial {self.area0[c]:.3g}), volume {volume[c]:.3g}, "
             f"diameter {diameter[c]:.3g}; extinct at t = {time:.6g} (t = {float(t):.6g} "
             f"and the {left[c]:.3g} a round {kinds[c]} of its size has left)"

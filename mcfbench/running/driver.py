@@ -69,6 +69,9 @@ class Trajectory:
         ``"point"`` or ``"circle"``, ``area`` and ``volume`` the component's then,
         ``extinction_time`` the state's time plus the time the round component
         had left.
+    flow : mcfbench.running.flow.SchemeFlow
+        The flow at the run's end: the one stepped, or the one rebuilt on the
+        components that remained (``rebuild``).
     continue_with : callable or None
         For a run that ended with a solver failure (a ``solver_*`` status; not one
         turned into ``degenerated`` by a collapsed mesh), ``continue_with(solver,
@@ -94,6 +97,7 @@ class Trajectory:
     wall_seconds: float = 0.0
     cpu_seconds: float = 0.0
     events: list = field(default_factory=list)
+    flow: object = field(default=None, repr=False, compare=False)
     continue_with: object = field(default=None, repr=False, compare=False)
 
     @property
@@ -129,7 +133,7 @@ class _NoBar:
 
 def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrapolate",
              save_every=1, observers=(), on_defect="stop", until=None, progress=False,
-             collapse=True, invariants=True):
+             collapse=True, invariants=True, rebuild=None):
     """Step ``flow`` ``steps`` times.
 
     Parameters
@@ -184,6 +188,15 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
         solver failure on a mesh whose smallest angle collapsed ends the run
         as ``degenerated`` (the mesh's verdict), naming the angle and since
         when. Off only for toy flows that are not mean curvature flows.
+    rebuild : callable, optional
+        ``rebuild(flow, keep) -> flow``: the flow on the mesh vertices ``keep``
+        ((n,) bool, whole components) at the same time level, or ``ValueError``
+        saying why it cannot be (:func:`mcfbench.running.continuation.sub_flow`).
+        When a component vanishes round and others remain, the run goes on with
+        them (an ``extinct`` event of :attr:`Trajectory.events`; the frames keep the
+        initial mesh's layout, the vanished points where they vanished, and the
+        integrator starts afresh); without ``rebuild``, or when it cannot, the run
+        ends ``degenerated`` saying why (the event's ``why_not``).
 
     Returns
     -------
@@ -198,7 +211,8 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
         raise ValueError(f"unknown on_defect {on_defect!r}; choose one of {', '.join(ON_DEFECT)}")
     stepping = _Stepping(flow, int(steps), get_integrator(integrator, warm_start=warm_start),
                          save_every=save_every, observers=observers, on_defect=on_defect,
-                         until=until, collapse=collapse, invariants=invariants)
+                         until=until, collapse=collapse, invariants=invariants,
+                         rebuild=rebuild)
     # a copy per run: what a solver keeps between solves (the kept ILU factor) is the
     # run's own, built inside its timed steps, never carried in from a warm-up or an
     # earlier run (a timed repeat pays for its factor as the first execution did)
@@ -213,12 +227,18 @@ class _Stepping:
     failure with another one."""
 
     def __init__(self, flow, steps, stepper, *, save_every, observers, on_defect, until,
-                 collapse, invariants):
+                 collapse, invariants, rebuild=None):
         self.flow, self.steps, self.stepper = flow, steps, stepper
         self.save_every, self.observers, self.on_defect = save_every, observers, on_defect
         self.until = until
         self.frames, self.steps_kept, self.iterations, self.defects = [], [], [], []
         self.events = []
+        self.rebuild, self.faces = rebuild, np.asarray(flow.faces)
+        # the initial mesh's points and triangles still in the flow (all until a
+        # component vanishes and the run goes on without it), and the last full frame
+        self.kept_vertices = np.arange(len(flow.vertices))
+        self.kept_faces = np.arange(len(self.faces))
+        self.full = None
         self.seen = set()
         # one compiled measuring pass per state serves both checks
         self.measures = StateMeasures(flow.vertices, flow.faces) \
@@ -242,7 +262,7 @@ class _Stepping:
 
     def save(self):
         self.steps_kept.append(self.flow.n)
-        self.frames.append(self.flow.frame())
+        self.frames.append(self.full_frame())
 
     def check(self):
         """Record the defects of the current state; raise in stop mode (always for a
@@ -257,6 +277,8 @@ class _Stepping:
         if found is not None:
             if found.status == "extinct":
                 self.vanished(found)
+                if len(found.components) < self.collapsed.count and self.go_on(found):
+                    return self.check()
             self.defects.append({"status": found.status, "step": flow.n,
                                  "time": flow.n * flow.tau, "detail": found.detail})
             raise FlowBreakdown(found.status, flow.n, flow.n * flow.tau, found.detail)
@@ -274,13 +296,62 @@ class _Stepping:
 
     def vanished(self, found):
         """Record the components of an ``extinct`` :class:`~mcfbench.geometry.collapse.Collapse`
-        as events of the run."""
+        as events of the run (the components numbered as in the initial mesh)."""
         flow = self.flow
         for c, kind, area, volume, time in zip(found.components, found.kinds, found.areas,
                                                found.volumes, found.times):
             self.events.append({"event": "extinct", "step": flow.n, "time": flow.n * flow.tau,
-                                "component": int(c), "kind": kind, "area": area,
-                                "volume": volume, "extinction_time": time})
+                                "component": int(self.collapsed.ids[c]), "kind": kind,
+                                "area": area, "volume": volume, "extinction_time": time})
+
+    def go_on(self, found):
+        """Drop the vanished components of ``found`` and go on with the flow rebuilt on
+        the rest (``rebuild``, :mod:`mcfbench.running.continuation`); True when it
+        did. Else the last event says why not, and the run ends ``degenerated``."""
+        check, flow = self.collapsed, self.flow
+        keep = ~np.isin(check.labels, found.components)
+        try:
+            if self.rebuild is None:
+                raise ValueError("no continuation given (simulate's rebuild)")
+            new = self.rebuild(flow, keep)
+        except ValueError as err:
+            self.events[-1]["continued"] = False
+            self.events[-1]["why_not"] = str(err)
+            found = found._replace(status="degenerated", detail=(
+                f"{found.detail}; the run cannot go on without it: {err}"))
+            self.defects.append({"status": "degenerated", "step": flow.n,
+                                 "time": flow.n * flow.tau, "detail": found.detail})
+            raise FlowBreakdown("degenerated", flow.n, flow.n * flow.tau, found.detail) \
+                from None
+        self.full = self.full_frame()          # the vanished vertices stay where they were
+        kept_faces = keep[np.asarray(flow.faces)].all(axis=1)
+        self.kept_vertices = self.kept_vertices[keep]
+        self.kept_faces = self.kept_faces[kept_faces]
+        self.flow = new
+        self.stepper = get_integrator(self.stepper.name, warm_start=self.stepper.warm_start)
+        self.measures = StateMeasures(new.vertices, new.faces)
+        collapsed = CollapseCheck(new.vertices, new.faces, measures=self.measures, tau=new.tau,
+                                  area_tol=check.area_tol, diameter_tol=check.diameter_tol)
+        # the remaining components keep their initial size and names
+        old = check.labels[keep][collapsed.first]
+        collapsed.renamed(check.area0[old], check.diameter0[old], check.ids[old],
+                          self.kept_vertices, check.total)
+        self.collapsed = collapsed
+        if self.invariant is not None:
+            self.invariant = FlowInvariants(new.vertices, new.faces, measures=self.measures)
+        return True
+
+    def full_frame(self):
+        """The current frame in the initial mesh's layout: the vanished components'
+        points where they were when they vanished."""
+        frame = self.flow.frame()
+        if self.full is None:
+            return frame
+        full = {key: value.copy() for key, value in self.full.items()}
+        full["vertices"][self.kept_vertices] = frame["vertices"]
+        if "extra_points" in full:
+            full["extra_points"][self.kept_faces] = frame["extra_points"]
+        return full
 
     def observe(self):
         for observer in self.observers:
@@ -307,8 +378,8 @@ class _Stepping:
 
     def go(self, solver, progress=False):
         """Step with ``solver`` until the run's end, a breakdown or ``until``; the
-        :class:`Trajectory` of the whole run so far."""
-        flow = self.flow
+        :class:`Trajectory` of the whole run so far (its flow may be rebuilt on the
+        remaining components: read ``self.flow``)."""
         wall, cpu = time.perf_counter(), time.process_time()
         if progress and self.broken is None:
             from tqdm import tqdm  # on first use: not paid at start-up without a bar
@@ -327,11 +398,11 @@ class _Stepping:
                 finally:
                     bar.update()
                 self.observe()
-                if self.save_every and flow.n % self.save_every == 0:
+                if self.save_every and self.flow.n % self.save_every == 0:
                     self.save()
-                if self.until is not None and self.until(flow):
+                if self.until is not None and self.until(self.flow):
                     break
-        self.end_frame = self.steps_kept[-1] != flow.n
+        self.end_frame = self.steps_kept[-1] != self.flow.n
         if self.end_frame:
             self.save()
         self.wall += time.perf_counter() - wall
@@ -362,8 +433,8 @@ class _Stepping:
                    for key in self.frames[0]}
         return Trajectory(
             frames=stacked, steps=np.array(self.steps_kept),
-            t=np.array(self.steps_kept) * flow.tau, faces=np.asarray(flow.faces),
+            t=np.array(self.steps_kept) * flow.tau, faces=self.faces,
             iterations=np.array(self.iterations, dtype=int), status=status, message=message,
             failed_step=failed, steps_done=len(self.iterations), defects=defects,
             wall_seconds=self.wall, cpu_seconds=self.cpu, events=list(self.events),
-            continue_with=self.continue_with if self.solver_failed else None)
+            flow=flow, continue_with=self.continue_with if self.solver_failed else None)
