@@ -212,7 +212,7 @@ def tube_fit(points):
 
     Examples
     --------
-    >>> u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 16), np.linspace(0, 2 * np.pi, 8))
+    >>> u, v = np.meshgrid(np.arange(16) * np.pi / 8, np.arange(8) * np.pi / 4)
     >>> P = np.stack([(2 + 0.1 * np.cos(v)) * np.cos(u), (2 + 0.1 * np.cos(v)) * np.sin(u),
     ...               0.1 * np.sin(v)], axis=-1).reshape(-1, 3)
     >>> [round(x, 3) for x in tube_fit(P)]
