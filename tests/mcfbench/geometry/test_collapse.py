@@ -11,6 +11,7 @@ from mcfbench.cli import main
 from mcfbench.geometry import metrics
 from mcfbench.geometry.collapse import (AREA_TOL, ROUND_POINT, ROUND_TUBE, WATCH,
                                         CollapseCheck, tube_fit)
+from mcfbench.geometry.committed_meshes import read_committed_mesh
 from mcfbench.geometry.shapes import cylinder, torus
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate
@@ -217,3 +218,19 @@ def test_command_line_names_the_collapse(tmp_path, capsys):
     assert code == 1 and "error: degenerated at step 4 (t = 0.518082): component 0 of 1" \
         in capsys.readouterr().err
     assert str(np.load(out)["status"]) == "degenerated"
+
+
+@pytest.mark.parametrize("name, scheme, kind, step", [
+    ("rounded_cube", "bgn", "point", 109), ("nut", "cotan", "circle", 25)])
+def test_real_closed_meshes_shrink_to_their_extinction(name, scheme, kind, step):
+    """Two committed CAD meshes run long at tau = 0.1 h^2 (the new user's
+    ``--tau-edge 0.1``): the rounded cube (genus 0) shrinks round to a point (cotan folds
+    it first, ``inverted`` at step 79), the octagonal nut (genus 1) to the circle of its
+    ring (its tube round; before: ``degenerated``, a line)."""
+    V, F = read_committed_mesh(name)
+    tau = 0.1 * igl.edge_lengths(V, F).mean() ** 2
+    traj = simulate(SCHEMES[scheme].make(V, F, tau), 400, save_every=0)
+    assert traj.status == "extinct" and traj.failed_step == step, traj.message
+    [event] = traj.events
+    assert event["kind"] == kind and f"vanished round, to a {kind}" in traj.message
+    assert 0 < event["extinction_time"] - event["time"] < 2 * tau

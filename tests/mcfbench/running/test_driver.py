@@ -8,8 +8,10 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate
 from mcfbench.running.flow import SchemeFlow
+from mcfbench.running.schemes import SCHEMES
 from mcfbench.running.solver import Solver
 
 
@@ -185,3 +187,13 @@ def test_every_run_builds_its_own_kept_factor(monkeypatch):
     again = simulate(Decay(V0, FACES, 0.1), 3, solver=solver)
     assert factored == [(4, 4), (4, 4)] and solver._kept == {}
     assert np.array_equal(first.frames["vertices"], again.frames["vertices"])
+
+
+def test_a_run_that_ends_ok_has_no_extinction():
+    V, F = icosphere(1)
+    traj = simulate(SCHEMES["cotan"].make(V, F, 0.01), 5, save_every=0)
+    assert traj.ok and traj.events == [] and np.isnan(traj.extinction_time)
+    assert traj.flow.n == 5 and np.array_equal(traj.faces, F)
+    ended = simulate(SCHEMES["cotan"].make(V, F, 0.01), 40, save_every=0)
+    assert ended.status == "extinct" and ended.extinction_time == \
+        ended.events[-1]["extinction_time"] > ended.t_failed

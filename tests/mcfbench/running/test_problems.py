@@ -158,3 +158,14 @@ def test_a_problem_is_one_file_found_by_the_registry(tmp_path, monkeypatch):
     assert abs(result.metrics["mean_radius"] - np.sqrt(1 - 4 * 0.04)) < 0.03
     with pytest.raises(ValueError, match="already in the registry"):
         problems.discover_problems([str(package)], "dropin_problems")
+
+
+def test_to_extinction_lets_a_run_pass_t_max():
+    sphere = get_problem("sphere")
+    with pytest.raises(ValueError, match="set the problem's to_extinction"):
+        sphere.time_steps(0.01, 0.3)
+    with pytest.raises(ValueError, match="past the extinction time"):
+        sphere.time_steps(0.01, 0.25)
+    assert sphere.time_steps(0.01, 0.24) == 24
+    assert sphere.with_settings(to_extinction=True).time_steps(0.01, 0.3) == 30
+    assert not any(p.to_extinction for p in PROBLEMS.values())
