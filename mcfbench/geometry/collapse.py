@@ -44,8 +44,9 @@ under the velocity ``H n`` (``H`` the sum of the principal curvatures):
 A closed component is tested once its area fell below :data:`WATCH` of its initial
 one (its volume is measured then, in numpy, only for such states). It is
 *extinct* when it is round and either collapsed (the tolerances above) or has
-less than :data:`EXTINCTION_STEPS` time steps left (``tau`` given): stepping on
-would take the semi-implicit schemes into the round-off states above. Its
+less than :data:`EXTINCTION_STEPS` time steps left (``tau`` given, and a step to
+follow): stepping on would take the semi-implicit schemes into the round-off
+states above. Its
 *extinction time* is the state's time plus the time it has left (the exact
 flow's, from the round component's area and volume): within a few steps of
 the end the schemes lag the exact radius by ``O(tau)`` per step (the implicit
@@ -304,11 +305,13 @@ class CollapseCheck:
         return (f"component {int(self.ids[c])} of {self.total} ({self._sizes[c]} vertices, "
                 f"e.g. vertex {int(self.vertex_ids[self.first[c]])})")
 
-    def __call__(self, vertices, measured=None, t=0.0):
+    def __call__(self, vertices, measured=None, t=0.0, final=False):
         """What collapsed or vanished in the state ``vertices`` at time ``t``, a
         :class:`Collapse`, or ``None``; ``measured``: the state's
         :class:`~mcfbench.geometry.measures.Measured` when the caller has it (the
-        driver, for both of its checks), else measured here."""
+        driver, for both of its checks), else measured here; ``final``: no step
+        follows (the run's last state), so a round component is extinct only once
+        it collapsed, whatever its time left."""
         V = np.asarray(vertices, dtype=float)
         if measured is None:
             measured = self.measures(V)
@@ -338,7 +341,8 @@ class CollapseCheck:
         for c in watched:
             kinds[c], left[c] = self._round(V, int(c), area[c], volume[c])
         extinct = [int(c) for c in watched if kinds[c] is not None and (
-            collapsed[c] or (self.tau is not None and left[c] < EXTINCTION_STEPS * self.tau))]
+            collapsed[c] or (self.tau is not None and not final
+                             and left[c] < EXTINCTION_STEPS * self.tau))]
         broken = [int(c) for c in np.flatnonzero(collapsed) if kinds[c] is None]
         if broken:
             c = min(broken, key=lambda k: a_ratio[k])

@@ -266,22 +266,22 @@ class _Stepping:
 
     def check(self):
         """Record the defects of the current state; raise in stop mode (always for a
-        collapse)."""
+        collapse or an extinction). A component that vanished round is an extinction
+        only of a state that passes the other checks (an invalid state is never counted
+        as the flow's end), and at the run's last state only once it collapsed (its time
+        left matters only before a next step)."""
         flow = self.flow
         # the mesh vertices once (DDFV's are a gather of its F-vertices), measured once
         # for both checks
         V = flow.vertices if self.measures is not None else None
         measured = self.measures(V) if V is not None else None
-        found = self.collapsed(V, measured, flow.n * flow.tau) \
+        vanished = self.collapsed(V, measured, flow.n * flow.tau,
+                                  final=flow.n >= self.steps) \
             if self.collapsed is not None else None
-        if found is not None:
-            if found.status == "extinct":
-                self.vanished(found)
-                if len(found.components) < self.collapsed.count and self.go_on(found):
-                    return self.check()
-            self.defects.append({"status": found.status, "step": flow.n,
-                                 "time": flow.n * flow.tau, "detail": found.detail})
-            raise FlowBreakdown(found.status, flow.n, flow.n * flow.tau, found.detail)
+        if vanished is not None and vanished.status != "extinct":
+            self.defects.append({"status": vanished.status, "step": flow.n,
+                                 "time": flow.n * flow.tau, "detail": vanished.detail})
+            raise FlowBreakdown(vanished.status, flow.n, flow.n * flow.tau, vanished.detail)
         found = flow.defects()
         if self.invariant is not None:
             found = [*found, *self.invariant(V, flow.n, measured)]
@@ -293,6 +293,13 @@ class _Stepping:
                                  "time": flow.n * flow.tau, "detail": detail})
             if self.on_defect == "stop":
                 raise FlowBreakdown(status, flow.n, flow.n * flow.tau, detail)
+        if vanished is not None:
+            self.vanished(vanished)
+            if len(vanished.components) < self.collapsed.count and self.go_on(vanished):
+                return self.check()
+            self.defects.append({"status": "extinct", "step": flow.n,
+                                 "time": flow.n * flow.tau, "detail": vanished.detail})
+            raise FlowBreakdown("extinct", flow.n, flow.n * flow.tau, vanished.detail)
 
     def vanished(self, found):
         """Record the components of an ``extinct`` :class:`~mcfbench.geometry.collapse.Collapse`

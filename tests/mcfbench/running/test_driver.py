@@ -197,3 +197,18 @@ def test_a_run_that_ends_ok_has_no_extinction():
     ended = simulate(SCHEMES["cotan"].make(V, F, 0.01), 40, save_every=0)
     assert ended.status == "extinct" and ended.extinction_time == \
         ended.events[-1]["extinction_time"] > ended.t_failed
+
+
+def test_an_invalid_state_is_never_the_flows_end():
+    """The icosphere under x' = -x, tau = 0.5: round, its area 0.198 of the initial one at
+    step 2 with A / (16 pi) = 0.046 < 2 tau left: ``extinct`` there, unless the state has
+    a defect of its own, which is the run's status (stop and record modes alike)."""
+    V, F = icosphere(1)
+    assert simulate(Decay(V, F, 0.5), 6).status == "extinct"
+    stopped = simulate(Decay(V, F, 0.5, defect_at=2), 6)
+    assert stopped.status == "t_escaped" and stopped.events == [] and stopped.steps_done == 2
+    recorded = simulate(Decay(V, F, 0.5, defect_at=2), 6, on_defect="record")
+    assert recorded.status == "t_escaped" and recorded.steps_done == 2
+    assert [d["status"] for d in recorded.defects] == ["t_escaped", "extinct"]
+    # its last state: extinct only once collapsed, whatever its time left
+    assert simulate(Decay(V, F, 0.5), 2).status == "ok"
