@@ -132,8 +132,9 @@ class Collapse(NamedTuple):
         return self.detail
 
 
-def euler_characteristics(faces, labels, count):
-    """``chi = V - E + F`` of every connected component.
+def component_topology(faces, labels, count):
+    """The Euler characteristic ``chi = V - E + F`` of every connected component, and
+    whether it is closed (every edge of it shared by two triangles).
 
     Parameters
     ----------
@@ -144,33 +145,17 @@ def euler_characteristics(faces, labels, count):
 
     Returns
     -------
-    (count,) int array
+    chi : (count,) int array
         2 for a sphere, 0 for a torus, ``2 - 2 g - b`` in general.
-    """
-    F = np.asarray(faces, dtype=np.int64)
-    edges = np.unique(np.sort(F[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1), axis=0)
-    return (np.bincount(labels, minlength=count)
-            - np.bincount(labels[edges[:, 0]], minlength=count)
-            + np.bincount(labels[F[:, 0]], minlength=count))
-
-
-def closed_components(faces, labels, count):
-    """Whether every component is closed (every edge of it shared by two triangles).
-
-    Parameters
-    ----------
-    faces : (m, 3) int array
-    labels : (n,) int array
-    count : int
-
-    Returns
-    -------
-    (count,) bool array
+    closed : (count,) bool array
     """
     F = np.asarray(faces, dtype=np.int64)
     edges, seen = np.unique(np.sort(F[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1),
                             axis=0, return_counts=True)
-    return np.bincount(labels[edges[seen == 1, 0]], minlength=count) == 0
+    chi = (np.bincount(labels, minlength=count)
+           - np.bincount(labels[edges[:, 0]], minlength=count)
+           + np.bincount(labels[F[:, 0]], minlength=count))
+    return chi, np.bincount(labels[edges[seen == 1, 0]], minlength=count) == 0
 
 
 def component_volumes(vertices, faces, face_label, count):
@@ -271,8 +256,8 @@ class CollapseCheck:
         self._sizes = np.bincount(self.labels, minlength=self.count)
         #: the first point of every component
         self.first = np.unique(self.labels, return_index=True)[1]
-        self.chi = euler_characteristics(self.measures.faces, self.labels, self.count)
-        self.closed = closed_components(self.measures.faces, self.labels, self.count)
+        self.chi, self.closed = component_topology(self.measures.faces, self.labels,
+                                                   self.count)
         measured = self.measures(V)
         self.renamed(measured.component_area.copy(), measured.diameter.copy(),
                      np.arange(self.count), np.arange(len(V)), self.count)
