@@ -357,7 +357,9 @@ def _run(args):
 
         write_movie(arrays, args.movie, title=f"{scheme.label} on {args.mesh.name}")
         print(f"wrote {args.movie}: {len(traj.t)} frames")
-    if traj.status != "ok":
+    if traj.status == "extinct":         # the flow's own end, not an error
+        print(f"the flow ended: {traj.message}")
+    elif traj.status != "ok":
         print(f"error: {traj.message} (frames up to step {traj.steps[-1]} kept)",
               file=sys.stderr)
         return 1

@@ -60,7 +60,13 @@ class Problem:
     exact : str
         What the exact (or reference) answer is, for tables and the report.
     t_max : float or None
-        Runs must end before this time (the sphere's extinction ``R^2/4``).
+        Runs must end before this time (the sphere's extinction ``R^2/4``), unless
+        ``to_extinction``.
+    to_extinction : bool
+        Runs may go past ``t_max`` to the flow's end: they end ``extinct`` when the
+        surface vanishes round (:mod:`mcfbench.geometry.collapse`), e.g.
+        ``get_problem("sphere").with_settings(to_extinction=True, t_final=0.3)``.
+        Off in every registry entry: their metrics are measured at ``t_final``.
     reference : dict
         Reference values of a problem without a closed-form answer, from the
         axisymmetric meridian solver on fine meshes with Richardson
@@ -102,6 +108,7 @@ class Problem:
     steps: int | None = None
     exact: str = ""
     t_max: float | None = None
+    to_extinction: bool = False
     reference: dict = field(default_factory=dict, compare=False)
     description: str = field(default="", compare=False)
     main_metric: str | None = field(default=None, compare=False)
@@ -138,15 +145,17 @@ class Problem:
         Raises
         ------
         ValueError
-            ``t_final`` not a whole multiple of ``tau``, or not before ``t_max``.
+            ``t_final`` not a whole multiple of ``tau``, or not before ``t_max`` (unless
+            ``to_extinction``).
         """
         if self.tau_rule == "mesh" and t_final is None:
             return int(self.steps)
         t_final = self.t_final if t_final is None else t_final
         steps = time_steps(t_final, tau)
-        if self.t_max is not None and steps * tau >= self.t_max:
+        if self.t_max is not None and steps * tau >= self.t_max and not self.to_extinction:
             raise ValueError(f"t_final = {steps * tau:g} is past the extinction time "
-                             f"{self.t_max:g} of the {self.name} ({self.exact})")
+                             f"{self.t_max:g} of the {self.name} ({self.exact}); to run to "
+                             "the extinction, set the problem's to_extinction")
         return steps
 
     @classmethod

@@ -17,6 +17,7 @@ import numpy as np
 
 from mcfbench.geometry.exact import eoc
 from mcfbench.presentation.formats import formatted
+from mcfbench.storage.statuses import reached
 
 TIMING_BASE = (
     "Timings compare schemes fairly only on the same footing: the same solver and "
@@ -241,8 +242,11 @@ def summary_table(table, problems=None, schemes=None):
         Columns ``problem, scheme, metric, error, levels, runs, runs_ok,
         eoc, eoc_levels, finest_level, finest_value, eocs, values, status,
         failed_level, t_failed, min_angle, t_min_barycentric,
-        cpu_seconds`` (CPU of the finest finished level). ``status`` is
-        ``ok`` or that of the coarsest run that did not finish. The scheme's
+        cpu_seconds`` (CPU of the finest finished level). ``runs_ok`` counts
+        the runs that reached their end, the flow's extinction included
+        (:data:`mcfbench.storage.statuses.REACHED`); ``status`` is that of the
+        coarsest run that did not, else ``extinct`` when a run ended so, else
+        ``ok``. The scheme's
         own verdict, with the robust solver's re-run in place of a run whose
         failure it removes (:func:`solver_only`): ``runs_robust_ok``,
         ``robust_eoc``, ``robust_eoc_levels``, ``robust_finest_level``,
@@ -260,8 +264,8 @@ def summary_table(table, problems=None, schemes=None):
             runs = part[part["scheme"] == scheme].sort_values("level")
             if not len(runs):
                 continue
-            ok = runs[runs["status"] == "ok"]
-            failed = runs[runs["status"] != "ok"]
+            done = runs["status"].map(reached).astype(bool)    # ok, or the flow's extinction
+            ok, failed = runs[done], runs[~done]
             # a value is measured when finite: a finished run's, or one taken before
             # a later breakdown (the volume before a pinch)
             finished = runs[np.isfinite(runs["value"])]
@@ -278,7 +282,8 @@ def summary_table(table, problems=None, schemes=None):
                 f"{int(last_eoc['level']) - 1}-{int(last_eoc['level'])}",
                 "finest_level": np.nan if finest is None else int(finest["level"]),
                 "finest_value": np.nan if finest is None else finest["value"],
-                "status": "ok" if first_fail is None else first_fail["status"],
+                "status": first_fail["status"] if first_fail is not None else
+                "extinct" if (runs["status"] == "extinct").any() else "ok",
                 "failed_level": np.nan if first_fail is None else int(first_fail["level"]),
                 "t_failed": np.nan if first_fail is None else first_fail["t_failed"],
                 "min_angle": runs["min_angle"].min(),
@@ -297,7 +302,7 @@ def _robust_values(runs):
         return np.array([])
     fixed = [solver_only(r) for _, r in runs.iterrows()]
     return np.where(fixed, runs["robust_value"],
-                    np.where(runs["status"] == "ok", runs["value"], np.nan))
+                    np.where(runs["status"].map(reached).astype(bool), runs["value"], np.nan))
 
 
 def _robust_summary(runs, metric):
@@ -312,7 +317,7 @@ def _robust_summary(runs, metric):
     finite = np.flatnonzero(np.isfinite(values))
     with_eoc = np.flatnonzero(np.isfinite(eocs))
     return {
-        "runs_robust_ok": int((runs["status"] == "ok").sum()) + fixed,
+        "runs_robust_ok": int(runs["status"].map(reached).sum()) + fixed,
         "robust_eoc": eocs[with_eoc[-1]] if len(with_eoc) else np.nan,
         "robust_eoc_levels": f"{int(levels[with_eoc[-1]]) - 1}-{int(levels[with_eoc[-1]])}"
         if len(with_eoc) else "",
@@ -448,10 +453,11 @@ def problem_table(table, problem, schemes=None, labels=None):
                 row[f"L{level}"] = "–"
                 continue
             r = runs.loc[level]
-            row[f"L{level}"] = formatted(r["value"], ".3e") if r["status"] == "ok" else r["status"]
+            row[f"L{level}"] = formatted(r["value"], ".3e") if reached(r["status"]) and \
+                np.isfinite(r["value"]) else r["status"]
         row["EOC"] = ", ".join(formatted(v, ".2f") for v in runs["eoc"].iloc[1:]) \
             if is_error(metric) and len(runs) > 1 else "–"
-        failed = runs[runs["status"] != "ok"]
+        failed = runs[runs["status"] != "ok"]         # an extinction is named too
         row["status"] = "ok" if not len(failed) else "; ".join(
             breakdown_text(r.status, r.t_failed, lv) for lv, r in failed.iterrows())
         finest = runs.iloc[-1]

@@ -187,3 +187,14 @@ def test_a_problem_records_the_data_files_it_reads():
         assert all(f.is_file() for f in problem.data_files)
         assert [f.name for f in problem.data_files] == [
             mesh_manifest()[mesh]["file"], f"{mesh}.json", f"{mesh}.npz"]
+
+
+def test_to_extinction_lets_a_run_pass_t_max():
+    sphere = get_problem("sphere")
+    with pytest.raises(ValueError, match="set the problem's to_extinction"):
+        sphere.time_steps(0.01, 0.3)
+    with pytest.raises(ValueError, match="past the extinction time"):
+        sphere.time_steps(0.01, 0.25)
+    assert sphere.time_steps(0.01, 0.24) == 24
+    assert sphere.with_settings(to_extinction=True).time_steps(0.01, 0.3) == 30
+    assert not any(p.to_extinction for p in PROBLEMS.values())

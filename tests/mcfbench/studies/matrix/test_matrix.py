@@ -818,3 +818,24 @@ def test_the_real_meshes_get_a_survival_count_and_a_breakdown_there_disqualifies
     assert "- **a**: 2 of 2, median error 2.000e-02." in section
     assert "- **b**: 1 of 2, median error 1.500e-02; broke down on real_spot." in section
     assert "**Recommendation: a**" in text and "b (broke down on real_spot)" in text
+
+
+def test_an_extinct_run_reached_its_end():
+    """Issue #44, item 3: a run on a real mesh that ends ``extinct`` (the surface
+    vanished round, the flow's end; no error measured at the final time) counts as
+    reached in the summary and the findings; a ``degenerated`` one at the same time (a
+    collapse that is not round) stays a breakdown."""
+    errors = [1.0e-2, 2.5e-3, float("nan")]
+    records = [_record(scheme, "real_nut", k + 1, e, status=end if k == 2 else "ok",
+                       t_failed=0.25 if k == 2 else np.nan, metric="area_error")
+               for scheme, end in (("a", "extinct"), ("b", "degenerated"))
+               for k, e in enumerate(errors)]
+    table = matrix_tables.long_table(records)
+    summary = matrix_tables.summary_table(table)
+    a, b = (summary[summary["scheme"] == s].iloc[0] for s in "ab")
+    assert a["runs_ok"] == 3 and a["status"] == "extinct" and a["runs_robust_ok"] == 3
+    assert b["runs_ok"] == 2 and b["status"] == "degenerated" and b["failed_level"] == 3
+    assert b["runs_robust_ok"] == 2
+    text = matrix_findings.matrix_findings(table, summary)
+    assert "- **a**: 1 of 1, median error 2.500e-03." in text
+    assert "- **b**: 0 of 1; broke down on real_nut." in text
