@@ -41,6 +41,7 @@ TANGENTIAL = {
                     "2014; the journal version)",
     "bgn": "BGN's equidistribution (Barrett, Garcke, Nuernberg 2008)",
     "mdr": "minimal deformation rate (Hu, Li 2022)",
+    "dual-mdr": "MDR's with a tangential dual multiplier, energy-stable (Gao, Li, Tang 2026)",
     "deturck": "DeTurck (Elliott, Fritz 2017)",
     "conformal": "conformalized MCF (Kazhdan, Solomon, Ben-Chen 2012)",
     "intrinsic-delaunay": "intrinsic Delaunay operators (Sharp, Crane 2020)",
@@ -224,6 +225,11 @@ SCHEMES = {s.name: s for s in (
            "minimal deformation rate (Hu, Li 2022): the velocity of least int |grad v|^2 with "
            "normal part -H, the multiplier eliminated into BGN's system with unit normals",
            matrix="scaled-spd", tangential="mdr"),
+    Scheme("dual-mdr", "dual-MDR", "baselines.dual_mdr:DualMDRFlow", {"scaling": "mass"},
+           {"color": "teal", "marker": "o", "linestyle": "--"},
+           "dual-MDR (Gao, Li, Tang 2026): MDR's tangential motion with a tangential dual "
+           "multiplier R that makes the area decrease at every step, (X, R) in one block "
+           "triangular system", matrix="nonsymmetric", tangential="dual-mdr"),
     Scheme("deturck", "DeTurck", "baselines.deturck:DeTurckFlow", {"alpha": 0.1},
            {"color": "tab:brown", "marker": "H", "linestyle": "--"},
            "the DeTurck trick (Elliott, Fritz 2017): reparametrised by the harmonic map heat "
