@@ -68,33 +68,12 @@ it is the solver's initial guess. ``X`` is a view of the first three rows.
 import numpy as np
 import scipy.sparse as sp
 
+from .kernels import dual_mdr_system
 from .laplacian import with_values
 from .mdr import UnitNormalBGN
 
 ROWS = 6
 """The state ``(X, R)``: 3 + 3 rows."""
-
-
-def projection_products(a, b):
-    """``P_a P_b = (I - a a^T)(I - b b^T)`` for pairs of unit vectors.
-
-    Parameters
-    ----------
-    a, b : (k, 3) float arrays
-
-    Returns
-    -------
-    (k, 3, 3) float array
-
-    Examples
-    --------
-    >>> e = np.eye(3)
-    >>> projection_products(e[:1], e[:1])[0].tolist()
-    [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-    """
-    ab = np.einsum("kc,kc->k", a, b)
-    return (np.eye(3) - a[:, :, None] * a[:, None, :] - b[:, :, None] * b[:, None, :]
-            + ab[:, None, None] * a[:, :, None] * b[:, None, :])
 
 
 class DualMDRFlow(UnitNormalBGN):
@@ -128,24 +107,24 @@ class DualMDRFlow(UnitNormalBGN):
         self._build_pattern()
 
     def _build_pattern(self):
-        """The CSR pattern of (DM5)-(DM6), built once: the (3n, 3n) pattern of (B4)
-        (:func:`baselines.bgn.block_pattern`), ``D A`` in the three blocks ``(c, 3 + c)``
-        and ``P D A P`` in the nine blocks ``(3 + c, 3 + d)``, each in the pattern of
-        ``L``. ``self._order[s]`` is the position in the raw values (those of (B4), of
-        ``D A``, of ``P D A P``, concatenated in that order) of CSR slot ``s``."""
+        """The CSR pattern of (DM5)-(DM6), built once: row ``c n + k`` the pattern of row
+        ``c n + k`` of (B4) (:func:`baselines.bgn.block_pattern`), then ``D A`` at the
+        columns ``3 n + c n + j``; row ``3 n + c n + k`` the nine blocks ``P D A P`` in the
+        pattern of ``L`` (columns ``3 n + d n + j``). Columns ascend in every row: the
+        layout :func:`baselines.kernels.dual_mdr_system` writes."""
         p, n = self.assembler.pattern, self.mesh.n_vertices
         rows_b = np.repeat(np.arange(3 * n), np.diff(self._indptr))
-        rows = [rows_b, *(c * n + p.rows for c in range(3)),
-                *((3 + c) * n + p.rows for c in range(3) for d in range(3))]
-        cols = [self._indices.astype(np.int64),
-                *((3 + c) * n + p.indices for c in range(3)),
-                *((3 + d) * n + p.indices.astype(np.int64) for c in range(3)
-                  for d in range(3))]
-        rows, cols = np.concatenate(rows), np.concatenate(cols)
-        ids = sp.csr_matrix((np.arange(1, len(rows) + 1, dtype=np.float64), (rows, cols)),
-                            shape=(ROWS * n, ROWS * n))
-        self._order = ids.data.astype(np.int64) - 1
-        self._pattern6 = ids
+        rows = np.concatenate([rows_b, *(c * n + p.rows for c in range(3)),
+                               *((3 + c) * n + p.rows for c in range(3) for d in range(3))])
+        cols = np.concatenate([self._indices.astype(np.int64),
+                               *((3 + c) * n + p.indices.astype(np.int64) for c in range(3)),
+                               *((3 + d) * n + p.indices.astype(np.int64) for c in range(3)
+                                 for d in range(3))])
+        order = np.lexsort((cols, rows))
+        indptr = np.searchsorted(rows[order], np.arange(ROWS * n + 1))
+        self._indptr6 = indptr.astype(np.int64)
+        self._pattern6 = sp.csr_matrix((np.zeros(len(order)), cols[order].astype(np.int32),
+                                        indptr.astype(np.int32)), shape=(ROWS * n, ROWS * n))
 
     def _adopt(self, U):
         """Make ``U`` (6, n) the state; ``X`` is a view of its first rows."""
@@ -202,16 +181,13 @@ class DualMDRFlow(UnitNormalBGN):
         else:
             scale = live.astype(float)
             normal = np.where(live, g.mass / dt, 0.0)
-        DA = g.L_data * scale[p.rows]                                    # D A, pattern of L
-        PDAP = DA[:, None, None] * projection_products(nu[p.rows], nu[p.indices])
-        PDAP[p.diag_slots] += normal[:, None, None] * nu[:, :, None] * nu[:, None, :]
-        PDAP[p.diag_slots[~live]] = np.eye(3)                           # identity rows
-        raw = np.concatenate([bgn.data, np.tile(DA, 3),
-                              PDAP.transpose(1, 2, 0).ravel()])
+        data = np.empty(self._indptr6[-1])
+        dual_mdr_system(g.L_data, p.indptr, p.indices, p.diag_slots, scale, normal, nu, live,
+                        bgn.data, self._indptr, self._indptr6, data)
         b = np.empty((ROWS, n))
         b[:3] = b_bgn
         b[3:] = -(self._tangential_laplacian(g, nu, B) * scale[:, None]).T
-        return with_values(self._pattern6, raw[self._order]), b
+        return with_values(self._pattern6, data), b
 
     def advance(self, U):
         """Accept ``U`` (6, n) as the state ``n + 1``."""
