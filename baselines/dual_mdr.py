@@ -81,12 +81,9 @@ class DualMDRFlow(UnitNormalBGN):
 
     Parameters
     ----------
-    vertices : (n, 3) float array
-        Initial surface ``X^0``.
-    faces : (m, 3) int array
-        Consistently oriented triangles of a manifold surface, closed or with
-        boundary; boundary vertices keep their position (Dirichlet).
-    tau : float
+    vertices, faces, tau
+        As :class:`baselines.mdr.MDRFlow`'s: ``(n, 3)``, ``(m, 3)``, closed or with a
+        boundary held fixed (Dirichlet).
     scaling : {"mass", "none"}
         Rows as (DM5)-(DM6) (``"mass"``) or times ``m_k / dt`` (``"none"``: (DM5) is
         then (B4)'s symmetric form plus ``A R``).
@@ -152,10 +149,8 @@ class DualMDRFlow(UnitNormalBGN):
         at, base : (6, n) float arrays, optional
             ``X*`` and ``B`` in their first three rows (their ``R`` rows are not used);
             default the current state.
-        dt : float, optional
-            Default ``tau``.
-        scaling : {"mass", "none"}, optional
-            Default: the flow's.
+        dt, scaling : optional
+            As :meth:`baselines.bgn.BGNFlow.system`'s.
 
         Returns
         -------
