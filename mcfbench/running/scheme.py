@@ -29,6 +29,7 @@ TANGENTIAL = {
                     "2014; the journal version)",
     "bgn": "BGN's equidistribution (Barrett, Garcke, Nuernberg 2008)",
     "mdr": "minimal deformation rate (Hu, Li 2022)",
+    "dual-mdr": "MDR's with a tangential dual multiplier, energy-stable (Gao, Li, Tang 2026)",
     "deturck": "DeTurck (Elliott, Fritz 2017)",
     "conformal": "conformalized MCF (Kazhdan, Solomon, Ben-Chen 2012)",
     "intrinsic-delaunay": "intrinsic Delaunay operators (Sharp, Crane 2020)",

@@ -21,8 +21,8 @@ from mcfbench.running.schemes import SCHEMES
 from mcfbench.storage import code_identity as ci
 
 VARIANTS = [*SCHEMES, *(f"{s}@bdf2" for s in SCHEMES)]
-BGN_FAMILY = {"bgn", "mdr", "deturck", "kll"}
-"""The baselines that import baselines/bgn.py (mdr; deturck and kll through mdr)."""
+BGN_FAMILY = {"bgn", "mdr", "dual-mdr", "deturck", "kll"}
+"""The baselines that import baselines/bgn.py (mdr; dual-mdr, deturck and kll through mdr)."""
 
 
 @pytest.fixture
