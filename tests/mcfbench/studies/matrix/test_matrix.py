@@ -21,8 +21,6 @@ from mcfbench.storage.records import FIELDS, read_record, read_records, write_re
 from mcfbench.storage.statuses import STATUSES
 from mcfbench.studies.config import ConfigError
 from mcfbench.studies.gallery import job as gallery_job
-from mcfbench.studies.gallery import plan as gallery_plan
-from mcfbench.studies.gallery import tables as gallery_tables
 from mcfbench.studies.matrix import aggregate as matrix_aggregate
 from mcfbench.studies.matrix import findings as matrix_findings
 from mcfbench.studies.matrix import job as matrix_job
@@ -490,39 +488,6 @@ def test_snakemake_dry_run(tmp_path):
     assert int(counts["matrix_page"]) == 1  # results/matrix/index.html
     assert int(counts["gallery_run"]) == len(SCHEMES)  # one mesh file, every scheme
     assert "gallery_mesh" not in counts  # a folder given: no generated meshes
-
-
-# ------------------------------------------------------------ the gallery
-
-
-def test_gallery_runs_every_scheme_on_every_file(tmp_path):
-    from mcfbench.geometry.surfaces import make_surface
-
-    meshes = tmp_path / "meshes"
-    gallery_job.write_obj(meshes / "ball.obj", *make_surface("sphere", level=2))
-    (meshes / "broken.off").write_text("OFF\n3 1 0\n0 0 0\n1 0 0\n")
-    (meshes / "notes.txt").write_text("not a mesh")
-    plan = gallery_plan.plan({"schemes": ["ddfv", "cotan"], "steps": 3}, str(meshes))
-    assert list(plan["meshes"]) == ["ball.obj", "broken.off"]
-    assert plan["C"] == 0.1 and plan["solver"] == matrix_plan.robust_method()
-    records = []
-    for mesh, path in plan["meshes"].items():
-        for scheme in plan["schemes"]:
-            settings = {"study": "gallery", "mesh": mesh, "scheme": scheme,
-                        **{k: plan[k] for k in ("C", "steps", "solver", "rtol", "maxiter")}}
-            out = tmp_path / "runs" / mesh / f"{scheme}.json"
-            gallery_job.job(path, scheme, settings, out, out.with_suffix(".npz"))
-            records.append(read_record(out, settings=settings))
-    table = gallery_tables.gallery_table(records)
-    ball = table[table["mesh"] == "ball.obj"]
-    assert ball["status"].tolist() == ["ok", "ok"] and ball["steps_done"].tolist() == [3, 3]
-    h = ball["h"].iloc[0]
-    assert ball["tau"].iloc[0] == pytest.approx(0.1 * h * h)
-    assert (table[table["mesh"] == "broken.off"]["status"] == "unsupported").all()
-    text = gallery_tables.gallery_markdown(table, plan)
-    assert "same footing" in text and "| ball.obj | ddfv | ok | 3/3 |" in text
-    with pytest.raises(ConfigError, match="'meshes'"):
-        gallery_plan.plan({}, str(tmp_path / "missing"))
 
 
 def test_cheapest_to_reach_reads_the_long_table():
