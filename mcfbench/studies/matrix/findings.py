@@ -181,7 +181,7 @@ def matrix_findings(table, summary=None, labels=None, mesh_problems=(),
              f"the two finest finished levels in [{ORDER_BAND[0]}, {ORDER_BAND[1]}]; an "
              f"error with EOC below {CONVERGING_EOC} is not decreasing; an EOC from two "
              "levels only settles no order and disqualifies no scheme; no EOC is computed "
-             f"into an error within the stated accuracy of a problem's reference ({BELOW_ACCURACY}). "
+             "into an error within the stated accuracy of a problem's reference (n/a). "
              "Values are numbers as in the tables (a relative error too, not a percentage).", "",
              *scope]
     lines += verdict_section(recommend(summary, problems, schemes, mesh_problems), schemes,
@@ -337,8 +337,8 @@ def tangential_lines(table, summary, problems, schemes):
 
 
 def _count(n, noun):
-    """``"1 problem"``, ``"3 problems"``."""
-    return f"{n} {noun}{'' if n == 1 else 's'}"
+    """``"1 problem"``, ``"3 problems"``, ``"2 meshes"``."""
+    return f"{n} {noun}" + ("" if n == 1 else "es" if noun.endswith("sh") else "s")
 
 
 def verdict_section(rec, schemes, verdict):
@@ -359,13 +359,13 @@ def verdict_section(rec, schemes, verdict):
         wins = sum(rec["winners"].get(q) == best for q in exact)
         text = (f"**Recommendation: {best}**. {len(ranked)} of the {n} schemes converge as "
                 f"required on the {_count(p, 'problem')} with an exact error"
-                + (f" and break down on none of the {m} real-world-like meshes" if m else "")
+                + (f" and break down on none of the real-world-like meshes ({m})" if m else "")
                 + f"; of these, {best} has the smallest finest-level errors: {score[best]:.3g} x "
                 f"the smallest of any scheme, geometric mean over those problems"
                 + (f" (then {ahead})" if ahead else "") + f". It is the most accurate on "
                 f"{wins} of them" + (
                     f"; the second table below lists the {_count(len(rec['exceptions']), 'problem')}"
-                    " where another scheme is more accurate or its order is not ~2."
+                    " where another scheme is more accurate or it shows no order ~2."
                     if rec["exceptions"] else "."))
         if rec["tied"]:
             text += (f" {best} and {', '.join(rec['tied'])} are practically tied (scores "
@@ -375,9 +375,9 @@ def verdict_section(rec, schemes, verdict):
                 "on every problem with an exact error without breaking down on a "
                 "real-world-like mesh.")
     if m:
-        text += (f" On the {m} real-world-like meshes {len(broke)} of the {n} schemes break "
-                 "down at least once" + (f" (most often {broke[0][0]}, on {len(broke[0][1])})"
-                                         if broke else "") + ".")
+        text += (f" On the {_count(m, 'real-world-like mesh')} " + (
+            f"{len(broke)} of the {n} schemes break down at least once (most often "
+            f"{broke[0][0]}, on {len(broke[0][1])})." if broke else "no scheme breaks down."))
     lines += [text, "",
               f"Problems with an exact error: {', '.join(exact)}. Real-world-like meshes (a "
               f"breakdown disqualifies): {', '.join(meshes) or 'none run'}. Without an exact "
@@ -395,7 +395,7 @@ def verdict_section(rec, schemes, verdict):
         [(s, formatted(score[s], ".3g"), f"{len(rec['breakdowns'][s])} of {m}" if m else "–",
           standing[s]) for s in order], align="lrrl")), ""]
     if rec["exceptions"]:
-        lines += [f"Where {best} is not the most accurate, or its order is not ~2:", "",
+        lines += [f"Where {best} is not the most accurate, or shows no order ~2:", "",
                   markdown(Table(
                       ["problem", f"EOC of {best}", "finest error / smallest",
                        "most accurate", "note"],

@@ -807,5 +807,6 @@ def test_the_real_meshes_get_a_survival_count_and_a_breakdown_there_disqualifies
     assert "**Recommendation: a**" in text
     assert "| a | 1.15 | 0 of 2 | recommended |" in text
     assert "| b | 1 | 1 of 2 | left out: broke down on real_spot |" in text
-    assert "1 of the 2 schemes break down at least once (most often b, on 1)" in text
+    assert "On the 2 real-world-like meshes 1 of the 2 schemes break down at least once " \
+        "(most often b, on 1)." in text
     assert "| real_nut | 2.00 | 1.33 | b | – |" in text          # b more accurate there
