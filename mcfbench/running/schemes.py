@@ -99,6 +99,11 @@ class Scheme:
     tangential : str
         Its tangential strategy, a key of :data:`TANGENTIAL` (DDFV: its
         ``tangential`` option, ``"none"`` without one).
+    integrates_itself : bool
+        Its flow class steps itself in time (its ``integrates_itself``, e.g.
+        :mod:`baselines.bgn_bdf`): no ``<name>@<integrator>`` of it
+        (:func:`get_scheme`), said here so that a name resolves without importing
+        the flow.
     """
 
     name: str
@@ -113,6 +118,7 @@ class Scheme:
     robust_solver: str = "jacobi-direct"
     integrator: str = "euler"
     tangential: str = "none"
+    integrates_itself: bool = False
 
     def __post_init__(self):
         if self.matrix not in MATRICES:
@@ -219,6 +225,14 @@ SCHEMES = {s.name: s for s in (
            {"color": "C7", "marker": "P", "linestyle": ":"},
            "Barrett, Garcke, Nuernberg (2008): mass-lumped vertex normals, tangential "
            "motion that equidistributes the mesh", matrix="scaled-spd", tangential="bgn"),
+    *(Scheme(f"bgn-bdf{k}", f"BGN/BDF{k}", "baselines.bgn_bdf:BGNBDFFlow",
+             {"order": k, "scaling": "mass"},
+             {"color": "C7", "marker": marker, "linestyle": "-."},
+             f"BGN with BDF{k} in time as Jiang, Su and Zhang (2024) build it: the normals "
+             f"and inner products on a predictor surface from BGN/BDF1..{k - 1} solves, "
+             f"{k} solves a step", matrix="scaled-spd", tangential="bgn",
+             integrates_itself=True)
+      for k, marker in ((2, "1"), (3, "2"))),
     Scheme("mdr", "MDR", "baselines.mdr:MDRFlow", {"scaling": "mass"},
            {"color": "tab:cyan", "marker": "d", "linestyle": "-"},
            "minimal deformation rate (Hu, Li 2022): the velocity of least int |grad v|^2 with "
@@ -278,6 +292,8 @@ def get_scheme(name, registry=None):
     if integrator not in INTEGRATORS:
         raise ValueError(f"unknown integrator {integrator!r} in scheme {name!r}; choose one "
                          f"of {', '.join(INTEGRATORS)}")
+    if entry.integrates_itself:
+        raise ValueError(f"scheme {base!r} integrates in time itself: no {name!r}")
     return replace(entry, name=name, integrator=integrator,
                    label=f"{entry.label}, {INTEGRATORS[integrator].label}",
                    style={**entry.style, "markerfacecolor": "none"})

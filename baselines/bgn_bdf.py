@@ -1,0 +1,164 @@
+"""BGN with BDF-k in time on predictor surfaces (Jiang, Su and Zhang).
+
+W. Jiang, C. Su, G. Zhang, "Stable BDF time discretization of BGN-based parametric
+finite element methods for geometric flows", SIAM J. Sci. Comput. 46(5) (2024)
+A2874-A2898, arXiv 2402.03641 ("BGN/BDFk"). BGN's equations (B1)-(B2) of
+:mod:`baselines.bgn` with the difference quotient of (B1) replaced by the BDF-k
+difference (Hairer, Norsett, Wanner, Solving ODEs I, Section III.1)::
+
+    delta_k X^{m+1} = sum_{j=1}^k (1/j) nabla^j X^{m+1}
+                    = alpha_0 (X^{m+1} - B_k),                                   (J1)
+    k = 1: alpha_0 = 1,     B_1 = X^m
+    k = 2: alpha_0 = 3/2,   B_2 = X^m + (X^m - X^{m-1}) / 3
+    k = 3: alpha_0 = 11/6,  B_3 = X^m + (7 (X^m - X^{m-1}) - 2 (X^{m-1} - X^{m-2})) / 11
+
+and the normals ``omega`` (B3), the lumped inner products and the stiffness all
+taken on a predictor surface ``Gamma~^{m+1}`` (vertices ``X~^{m+1}``) instead of
+``Gamma^m``::
+
+    < delta_k X^{m+1} / tau, chi omega~ >_h~ - < kappa^{m+1}, chi >_h~ = 0       (J2)
+    < kappa^{m+1} omega~, eta >_h~ + < grad_s X^{m+1}, grad_s eta >_~ = 0       (J3)
+
+Eliminating ``kappa`` as in (B4) gives BGN's system at ``Gamma~^{m+1}`` with the
+step ``dt = tau / alpha_0`` and the base ``B_k`` in place of ``tau`` and ``X^m``::
+
+    (A~ + P~ / dt) X^{m+1} = P~ B_k / dt                                         (J4)
+
+which is :meth:`baselines.bgn.BGNFlow.system` ``(at=X~^{m+1}, base=B_k, dt)``, the
+same assembly (kernels, row scaling, Dirichlet rows).
+
+The predictor (the authors build ``Gamma~^{m+1}`` "from lower-order BGN/BDF steps",
+arXiv 2402.03641 v2, abstract and Section 2; read here as the recursion)::
+
+    X~_1 = the BGN step (B4) from Gamma^m (operators on Gamma^m)
+    X~_j = the solution of (J4) with k = j on the predictor X~_{j-1}, j = 2, ..., k-1
+    X^{m+1} = the solution of (J4) with k on the predictor X~_{k-1}              (J5)
+
+A BDF-(j-1) step from the exact history has local error O(tau^j) when its own
+evaluation surface is O(tau^(j-1)) accurate, so ``X~_{k-1}`` is O(tau^k) close to
+``X(t^{m+1})``: the operators' error in (J4) is then of the order of the scheme,
+as with the extrapolation ``X* = sum_{j<k} nabla^j X^m`` of the harness's generic
+BDF (``bgn@bdf2``, ``bgn@bdf3``; :mod:`mcfbench.running.integrators`, (I2)-(I3)),
+which is (J4) with the extrapolated predictor, exactly. What differs is the
+tangential position of the predictor's vertices: BGN's tangential motion is set anew
+at every step by (B2) on the surface where the normals are taken; the extrapolation
+amplifies a step-to-step alternation of it three- (k = 2) or sevenfold (k = 3),
+whereas a BGN/BDF solve puts ``X~`` where BGN's own equidistribution puts it.
+Cost: ``k`` linear systems per step (``k`` assemblies, ``k`` solves).
+
+Start: ``X^1, ..., X^{k-1}`` must be O(tau^k) accurate (HNW I, Section III.4).
+``k = 2``: ``X^1`` is one BGN step (local error O(tau^2)). ``k = 3``: ``X^1 = 2 Z -
+W``, the Richardson extrapolation (HNW I, Section II.4) of one BGN step ``W`` and two
+BGN half steps ``Z`` (local error O(tau^3), three solves), then ``X^2`` by (J5) with
+``k = 2`` (the harness's BDF3 start, :mod:`mcfbench.running.integrators`).
+
+Energy: BGN's Euler step decreases the area (test (B1) with ``chi = kappa^{m+1}``,
+(B2) with ``eta = X^{m+1} - X^m``: ``|Gamma^{m+1}| <= |Gamma^m|``, BGN 2008,
+Theorem 2.3). (J2)-(J3) test to ``<grad X^{m+1}, grad delta_k X^{m+1}>_~ <= 0`` on
+``Gamma~``, which bounds no area: no energy law for k >= 2 (the authors claim none;
+measured in ``baselines/README.md``).
+"""
+
+import numpy as np
+
+from .bgn import BGNFlow
+
+ORDERS = (2, 3)
+
+BDF = {1: ((), 1, 1.0), 2: ((1,), 3, 2.0 / 3.0), 3: ((7, -2), 11, 6.0 / 11.0)}
+"""``k -> (p, q, dt / tau)`` of (J1): ``B_k = X^m + sum_i p_i d_i / q``, ``d_i =
+X^{m+1-i} - X^{m-i}``, ``dt / tau = 1 / alpha_0`` (BDF-k, HNW I, Section III.1)."""
+
+
+def bdf_base(k, X, past, tau):
+    """``(B_k, dt)`` of (J1) from ``X = X^m`` and ``past = (X^{m-1}, X^{m-2}, ...)``.
+
+    Parameters
+    ----------
+    k : {1, 2, 3}
+    X : (3, n) float array
+    past : tuple of (3, n) float arrays
+        At least ``k - 1`` of them, newest first.
+    tau : float
+
+    Returns
+    -------
+    base : (3, n) float array
+        Equal to ``X`` exactly where every level is (fixed vertices).
+    dt : float
+    """
+    p, q, share = BDF[k]
+    shift = np.zeros_like(X)
+    newer = X
+    for p_i, older in zip(p, past):
+        shift += p_i * (newer - older)
+        newer = older
+    return X + shift / q, share * tau
+
+
+class BGNBDFFlow(BGNFlow):
+    """BGN/BDF-``order`` (J1)-(J5): BGN's scheme stepped by BDF-k on predictor surfaces.
+
+    It integrates in time itself (``integrates_itself``): the harness's Euler
+    integrator hands its solver to :meth:`step` (``mcfbench.running.integrators``,
+    ``Euler._own_step``), which solves ``order`` systems of BGN's form (J4) a step.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+    tau : float
+    order : {2, 3}
+        ``k`` of BDF-k.
+    scaling : {"mass", "none"}
+        Row scaling of (J4), as :class:`baselines.bgn.BGNFlow`'s.
+    """
+
+    integrates_itself = True
+
+    def __init__(self, vertices, faces, tau, *, order=2, scaling="mass"):
+        if order not in ORDERS:
+            raise ValueError(f"BGN/BDF-k is implemented for k in {ORDERS}, not {order!r}")
+        super().__init__(vertices, faces, tau, scaling=scaling)
+        self.order = int(order)
+        self._past = ()              # X^{m-1}, X^{m-2}: newest first
+
+    def step(self, solve_system):
+        """Advance one time step (J5), the start-up steps included.
+
+        Parameters
+        ----------
+        solve_system : callable
+            ``solve_system((at, base, dt), x0) -> x`` (3, n): the solution of
+            :meth:`system` ``(at, base, dt)`` from the initial guess ``x0``. When it
+            raises, the flow stays at ``n``.
+        """
+        X, past = self.state, self._past
+        if not past and self.order == 3:
+            x = self._richardson_start(solve_system)
+        else:
+            x = self._predicted_step(min(len(past) + 1, self.order), X, past, solve_system)
+        self._past = (X, *past)[:self.order - 1]
+        self.advance(x)
+
+    def _predicted_step(self, k, X, past, solve_system):
+        """``X^{m+1}`` of (J5): BGN/BDF-1, ..., BGN/BDF-k, each on the previous one's
+        solution."""
+        at = None                                  # BGN/BDF-1: the operators on Gamma^m
+        guess = 2.0 * X - past[0] if past else X.copy()
+        for j in range(1, k + 1):
+            base, dt = bdf_base(j, X, past, self.tau)
+            guess = solve_system((at, base, dt), guess)
+            at = guess
+        return guess
+
+    def _richardson_start(self, solve_system):
+        """``X^1 = 2 Z - W`` (the ``k = 3`` start): ``W`` one BGN step, ``Z`` two half
+        steps; fixed vertices keep ``X^0`` exactly."""
+        X, tau = self.state, self.tau
+        W = solve_system((None, X, tau), X.copy())
+        Y = solve_system((None, X, tau / 2), X.copy())
+        Z = solve_system((Y, Y, tau / 2), 2.0 * Y - X)
+        x = np.multiply(Z, 2.0)
+        x -= W
+        return x
