@@ -46,17 +46,34 @@ amplifies a step-to-step alternation of it three- (k = 2) or sevenfold (k = 3),
 whereas a BGN/BDF solve puts ``X~`` where BGN's own equidistribution puts it.
 Cost: ``k`` linear systems per step (``k`` assemblies, ``k`` solves).
 
-Start: ``X^1, ..., X^{k-1}`` must be O(tau^k) accurate (HNW I, Section III.4).
-``k = 2``: ``X^1`` is one BGN step (local error O(tau^2)). ``k = 3``: ``X^1 = 2 Z -
-W``, the Richardson extrapolation (HNW I, Section II.4) of one BGN step ``W`` and two
-BGN half steps ``Z`` (local error O(tau^3), three solves), then ``X^2`` by (J5) with
-``k = 2`` (the harness's BDF3 start, :mod:`mcfbench.running.integrators`).
+Start (an interpretation: not in what we could read of the paper): ``X^j``, ``j <
+k``, is the step (J5) of order ``j`` (``start="bgn"``, the registry's): ``X^1`` one BGN
+step, ``X^2`` (``k = 3``) one BGN/BDF2 step. A stable k-step method keeps order k when
+its starting values are O(tau^k) accurate (HNW I, Section III.4); BGN's ``X^1`` is
+O(tau^2) only, so BGN/BDF3's order is 2 in the limit, its error that of its first
+step where nothing else dominates (level-1 sphere to ``t = 0.04``: EOC 2.04, 2.00,
+2.01 from tau 0.01). ``start="richardson"``: ``X^1 = 2 Z - W``, the Richardson
+extrapolation (HNW I, Section II.4) of one BGN step ``W`` and two half steps ``Z``
+(the harness's BDF3 start), O(tau^3) where BGN moves no vertex tangentially (the
+level-1 icosphere, by symmetry: EOC 3.06, 3.02, 3.01, 3.01). Where it does (level
+>= 2), every O(tau^3) start we tried leaves an error that falls with first order or
+not at all: this one, the same extrapolating only the normal part of ``Z - W``, from
+the tangentially relaxed ``X^0`` (the tangential part of ``W - X^0`` added first),
+and ``ceil(tau^(-1/2))`` BGN/BDF2 substeps (level-2 sphere to ``t = 0.04``, final
+volume: Richardson moves by 2.0e-5, 1.8e-5, 1.0e-5, 5.1e-6, 2.6e-6 per halving of tau
+from 0.0025, the substeps' drifts away from BGN/BDF2's limit; level-3 time study:
+Richardson volume errors 3.1e-4, 2.1e-5, 4.9e-5, 3.8e-5, 2.2e-5); cause not found
+(our reading: BGN's tangential positions are set anew at every step by the surface
+the operators are taken on, and a start that is not BGN's own step puts ``X^1``'s
+where the later steps would not, a jump the BDF differences divide by tau).
 
 Energy: BGN's Euler step decreases the area (test (B1) with ``chi = kappa^{m+1}``,
 (B2) with ``eta = X^{m+1} - X^m``: ``|Gamma^{m+1}| <= |Gamma^m|``, BGN 2008,
 Theorem 2.3). (J2)-(J3) test to ``<grad X^{m+1}, grad delta_k X^{m+1}>_~ <= 0`` on
-``Gamma~``, which bounds no area: no energy law for k >= 2 (the authors claim none;
-measured in ``baselines/README.md``).
+``Gamma~``, which bounds no area (BGN's bound needs the integral on ``Gamma^m`` and
+the difference ``X^{m+1} - X^m``): no energy law for k >= 2, none claimed in the
+abstract we could read; the area is checked at every step by the harness
+(``area_grew``) and measured in ``baselines/README.md``.
 """
 
 import numpy as np
@@ -64,6 +81,7 @@ import numpy as np
 from .bgn import BGNFlow
 
 ORDERS = (2, 3)
+STARTS = ("bgn", "richardson")
 
 BDF = {1: ((), 1, 1.0), 2: ((1,), 3, 2.0 / 3.0), 3: ((7, -2), 11, 6.0 / 11.0)}
 """``k -> (p, q, dt / tau)`` of (J1): ``B_k = X^m + sum_i p_i d_i / q``, ``d_i =
@@ -110,15 +128,21 @@ class BGNBDFFlow(BGNFlow):
     tau : float
     order : {2, 3}
         ``k`` of BDF-k.
+    start : {"bgn", "richardson"}
+        ``X^1`` of ``k = 3``: one BGN step, or the Richardson extrapolation of BGN
+        steps (module docstring, "Start").
     scaling : {"mass", "none"}
         Row scaling of (J4), as :class:`baselines.bgn.BGNFlow`'s.
     """
 
     integrates_itself = True
 
-    def __init__(self, vertices, faces, tau, *, order=2, scaling="mass"):
+    def __init__(self, vertices, faces, tau, *, order=2, start="bgn", scaling="mass"):
         if order not in ORDERS:
             raise ValueError(f"BGN/BDF-k is implemented for k in {ORDERS}, not {order!r}")
+        if start not in STARTS:
+            raise ValueError(f"unknown start {start!r}; choose one of {', '.join(STARTS)}")
+        self.start = start
         super().__init__(vertices, faces, tau, scaling=scaling)
         self.order = int(order)
         self._past = ()              # X^{m-1}, X^{m-2}: newest first
@@ -134,27 +158,28 @@ class BGNBDFFlow(BGNFlow):
             raises, the flow stays at ``n``.
         """
         X, past = self.state, self._past
-        if not past and self.order == 3:
+        if self.start == "richardson" and self.order == 3 and not past:
             x = self._richardson_start(solve_system)
         else:
-            x = self._predicted_step(min(len(past) + 1, self.order), X, past, solve_system)
+            x = self._predicted_step(min(len(past) + 1, self.order), X, past, self.tau,
+                                     solve_system)
         self._past = (X, *past)[:self.order - 1]
         self.advance(x)
 
-    def _predicted_step(self, k, X, past, solve_system):
-        """``X^{m+1}`` of (J5): BGN/BDF-1, ..., BGN/BDF-k, each on the previous one's
-        solution."""
-        at = None                                  # BGN/BDF-1: the operators on Gamma^m
+    def _predicted_step(self, k, X, past, tau, solve_system):
+        """The solution of (J5) from ``X`` (the state or an earlier substep) and
+        ``past``: BGN/BDF-1, ..., BGN/BDF-k, each on the previous one's solution."""
+        at = None if X is self.state else X        # BGN/BDF-1: the operators on X
         guess = 2.0 * X - past[0] if past else X.copy()
         for j in range(1, k + 1):
-            base, dt = bdf_base(j, X, past, self.tau)
+            base, dt = bdf_base(j, X, past, tau)
             guess = solve_system((at, base, dt), guess)
             at = guess
         return guess
 
     def _richardson_start(self, solve_system):
-        """``X^1 = 2 Z - W`` (the ``k = 3`` start): ``W`` one BGN step, ``Z`` two half
-        steps; fixed vertices keep ``X^0`` exactly."""
+        """``X^1 = 2 Z - W`` (``start="richardson"``): ``W`` one BGN step, ``Z`` two
+        half steps; fixed vertices keep ``X^0`` exactly."""
         X, tau = self.state, self.tau
         W = solve_system((None, X, tau), X.copy())
         Y = solve_system((None, X, tau / 2), X.copy())
