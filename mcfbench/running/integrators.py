@@ -111,6 +111,10 @@ operators at the extrapolated state, Kovacs, Li, Lubich, Numer. Math. 143 (2019)
     threefold, which matters for schemes whose tangential motion is not smooth
     in time (BGN, ``baselines/README.md``).
 
+A flow that integrates in time itself (``integrates_itself``: BGN/BDF-k on predictor
+surfaces, :mod:`baselines.bgn_bdf`) is stepped by the Euler integrator's
+:meth:`Euler._own_step` alone: it solves its own systems with the run's solver.
+
 Every integrator solves one linear system per step (the BDF3 start-up: three
 at the first step) with the initial guess ``2 X^n - X^{n-1}`` (``X^0`` at the
 first step; BDF3, from the third step: its ``X*``; ``warm_start="previous"``:
