@@ -176,18 +176,17 @@ class BGNBDFFlow(BGNFlow):
         if self.start == "richardson" and self.order == 3 and not past:
             x = self._richardson_start(solve_system)
         else:
-            x = self._predicted_step(min(len(past) + 1, self.order), X, past, self.tau,
-                                     solve_system)
+            x = self._predicted_step(min(len(past) + 1, self.order), solve_system)
         self._past = (X, *past)[:self.order - 1]
         self.advance(x)
 
-    def _predicted_step(self, k, X, past, tau, solve_system):
-        """The solution of (J5) from ``X`` (the state or an earlier substep) and
-        ``past``: BGN/BDF-1, ..., BGN/BDF-k, each on the previous one's solution."""
-        at = None if X is self.state else X        # BGN/BDF-1: the operators on X
+    def _predicted_step(self, k, solve_system):
+        """``X^{m+1}`` of (J5) with ``k``: BGN/BDF-1, ..., BGN/BDF-k, each on the
+        previous one's solution (the first on ``Gamma^m``)."""
+        X, past, at = self.state, self._past, None
         guess = 2.0 * X - past[0] if past else X.copy()
         for j in range(1, k + 1):
-            base, dt = bdf_base(j, X, past, tau)
+            base, dt = bdf_base(j, X, past, self.tau)
             guess = solve_system((at, base, dt), guess)
             if j < k and not surface_area(guess, self.faces) > VANISHED * self.mass.sum():
                 return guess                       # the surface vanishes in this step
