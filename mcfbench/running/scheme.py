@@ -88,6 +88,11 @@ class Scheme:
     tangential : str
         Its tangential strategy, a key of :data:`TANGENTIAL` (DDFV: its
         ``tangential`` option, ``"none"`` without one).
+    integrates_itself : bool
+        Its flow class steps itself in time (its ``integrates_itself``, e.g.
+        :mod:`baselines.bgn_bdf`): no ``<name>@<integrator>`` of it
+        (:func:`mcfbench.running.schemes.get_scheme`), said here so that a name
+        resolves without importing the flow.
     module : str
         The module that declared it (set by the registry's discovery,
         :mod:`mcfbench.running.discovery`).
@@ -110,6 +115,7 @@ class Scheme:
     robust_solver: str = "jacobi-direct"
     integrator: str = "euler"
     tangential: str = "none"
+    integrates_itself: bool = False
     module: str = field(default="", compare=False)
     source: dict | None = field(default=None, compare=False)
 

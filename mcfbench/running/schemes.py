@@ -72,6 +72,8 @@ def get_scheme(name, registry=None):
     if integrator not in INTEGRATORS:
         raise ValueError(f"unknown integrator {integrator!r} in scheme {name!r}; choose one "
                          f"of {', '.join(INTEGRATORS)}")
+    if entry.integrates_itself:
+        raise ValueError(f"scheme {base!r} integrates in time itself: no {name!r}")
     return replace(entry, name=name, integrator=integrator,
                    label=f"{entry.label}, {INTEGRATORS[integrator].label}",
                    style={**entry.style, "markerfacecolor": "none"})

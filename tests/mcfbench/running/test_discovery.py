@@ -70,11 +70,12 @@ def test_a_folder_is_scanned_by_order_then_name(tmp_path, monkeypatch):
 
 
 def test_the_builtins_come_in_their_documented_order():
-    """mcfbench/schemes/__init__.py: ddfv 10, cotan 20, cmcf 30, bgn 40, mdr 50,
-    dual_mdr 55, deturck 60, kll 70; the problems' modules 1-13, then the real meshes (100)."""
+    """mcfbench/schemes/__init__.py: ddfv 10, cotan 20, cmcf 30, bgn 40, bgn_bdf 45,
+    mdr 50, dual_mdr 55, deturck 60, kll 70; the problems' modules 1-13, then the real meshes (100)."""
     modules = list(dict.fromkeys(s.module for s in SCHEMES.values()))
     assert modules == [f"mcfbench.schemes.{m}" for m in
-                       ("ddfv", "cotan", "cmcf", "bgn", "mdr", "dual_mdr", "deturck", "kll")]
+                       ("ddfv", "cotan", "cmcf", "bgn", "bgn_bdf", "mdr", "dual_mdr", "deturck",
+                        "kll")]
     assert list(SCHEMES)[:2] == ["ddfv", "ddfv-chord"] and list(SCHEMES)[-1] == "kll"
     names = list(problems.PROBLEMS)
     assert names[:7] == ["sphere", "catenoid", "hemisphere", "torus", "dumbbell", "angenent",
