@@ -171,15 +171,16 @@ def step_cost(calls, positions, faces):
     return nbytes, flops
 
 
-def measure(name, level, steps):
-    """One run of ``name`` on the sphere at ``level``: ``(ms per step: the median of the
-    timed steps, iterations per timed step, bytes per step, flops per step, vertices)``."""
+def measure(name, level, steps, mesh=None):
+    """One run of ``name`` on the sphere at ``level`` (or on ``mesh``, ``(V, F)``, with
+    the sphere's time step of ``level``): ``(ms per step: the median of the timed steps,
+    iterations per timed step, bytes per step, flops per step, vertices)``."""
     from mcfbench.geometry.spheres import icosphere
     from mcfbench.running.driver import simulate
     from mcfbench.running.problems import get_problem
     from mcfbench.running.schemes import get_scheme
 
-    V, F = icosphere(level)
+    V, F = icosphere(level) if mesh is None else mesh
     flow = get_scheme(name).make(V, F, get_problem("sphere").tau(level))
     solver = CountingSolver()
     clock = []
