@@ -213,6 +213,40 @@ def eliminated_kernel(indptr, indices, data, X, B, N, dt, out):
         out[2, i] = B[2, i] - dt * (h2 - hN * N[2, i])
 
 
+@numba.njit("void(int32[::1], int32[::1], float64[::1], float64[:, :], float64[:, :], "
+            "float64, float64[::1])", **_OPTIONS)
+def squared_normal_speed_kernel(indptr, indices, data, X, N, dt, out):
+    """``out = (h . N)^2`` with ``h = (X - A X) / dt``, the ``h . V = H^2`` of the
+    redistribution's source (R3) (:meth:`ddfv.flow.Flow._potential_of`), in one pass
+    over the rows of ``A`` (the products summed in storage order, as scipy's; the dot
+    product with ``N`` in the order of the components: numpy's ``einsum`` may sum it
+    otherwise, by an ulp).
+
+    Parameters
+    ----------
+    indptr, indices, data : int32, int32, float64 arrays
+        ``A`` (n, n) in CSR (the assembler's: its column indices are in range by
+        construction and not checked here).
+    X, N : (3, n) float64 arrays
+        The state of the operators ``X*`` and the unit vertex normals.
+    dt : float
+    out : (n,) float64 array, output
+    """
+    n = X.shape[1]
+    if indptr.shape[0] != n + 1 or N.shape[1] != n or out.shape[0] != n:
+        raise ValueError("the matrix, state, normals and output do not fit")
+    for i in range(n):
+        y0 = y1 = y2 = 0.0                                      # (A X)_i
+        for p in range(indptr[i], indptr[i + 1]):
+            j, a = indices[p], data[p]
+            y0 += a * X[0, j]
+            y1 += a * X[1, j]
+            y2 += a * X[2, j]
+        hN = (((X[0, i] - y0) / dt) * N[0, i] + ((X[1, i] - y1) / dt) * N[1, i]) \
+            + ((X[2, i] - y2) / dt) * N[2, i]
+        out[i] = hN * hN
+
+
 def moved_t_vertices(F, T, faces, lam, carry):
     """(n_t, 3) :func:`t_vertices_kernel` of any arrays: ``F`` (n_f, 3), ``T`` (n_t,
     3), ``faces`` (n_t, 3) int, ``lam`` (n_t, 3), ``carry`` bool (views are not copied;
