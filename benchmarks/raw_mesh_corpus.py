@@ -33,7 +33,6 @@ import tempfile
 from pathlib import Path
 
 import igl
-import meshio
 import numpy as np
 
 from mcfbench.geometry.committed_meshes import RAW_DIR, read_committed_mesh
@@ -192,11 +191,17 @@ def _import(name, root):
 
 
 def _ply_bytes(V, F, single=False):
-    with tempfile.TemporaryDirectory() as tmp:
-        out = Path(tmp) / "mesh.ply"
-        meshio.write(out, meshio.Mesh(np.asarray(V, np.float32 if single else np.float64),
-                                      [("triangle", np.asarray(F, np.int32))]), binary=True)
-        return out.read_bytes()
+    """Binary little-endian PLY of ``(V, F)``: vertices float32 (``single``) or
+    float64, faces as a uchar count and int32 corners; no timestamp (meshio
+    writes one), so the same mesh gives the same bytes."""
+    kind, dtype = ("float", "<f4") if single else ("double", "<f8")
+    header = ("ply\nformat binary_little_endian 1.0\n"
+              f"element vertex {len(V)}\n"
+              + "".join(f"property {kind} {axis}\n" for axis in "xyz")
+              + f"element face {len(F)}\nproperty list uchar int vertex_indices\nend_header\n")
+    faces = np.zeros(len(F), dtype=[("n", "u1"), ("v", "<i4", (3,))])
+    faces["n"], faces["v"] = 3, F
+    return header.encode() + np.asarray(V, dtype).tobytes() + faces.tobytes()
 
 
 def _generate(name):
