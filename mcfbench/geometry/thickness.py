@@ -15,7 +15,8 @@ across the inside compared with ``2 h``), measured by one ray per triangle:
   when the enclosed signed volume is positive; otherwise the normals are
   reversed first, so an inward-oriented file is measured from its inside);
   ``inf`` when the ray leaves the surface (open surfaces, a ray through a
-  hole). libigl's AABB tree casts the rays (``igl.AABB.intersect_ray_first``).
+  hole). libigl's AABB tree casts the rays (``igl.AABB.intersect_ray_first``,
+  in single precision: a distance to about ``1e-6`` of the mesh's size).
 * ``thin_share`` = area of the triangles with ``thickness < 2 h`` over the
   total area;
 * a mesh **has thin features** when ``thin_share > THIN_SHARE`` (2 % of its
@@ -86,8 +87,10 @@ def triangle_thickness(vertices, faces):
     normal /= np.linalg.norm(normal, axis=1)[:, None]
     if volume(V, F) < 0:
         normal = -normal
-    # start a hair inside the triangle's plane, so the ray does not meet its own triangle
-    eps = 1e-9 * float(np.ptp(V, axis=0).max())
+    # start a hair inside the triangle's plane, so the ray does not meet its own
+    # triangle: libigl intersects in single precision, so the hair is 1e-6 of the
+    # mesh's size (16 float32 roundings), and the distances are as accurate
+    eps = 1e-6 * float(np.ptp(V, axis=0).max())
     tree = igl.AABB()
     tree.init(V, F)
     hit, t, _ = tree.intersect_ray_first(V, F, centroid - eps * normal, -normal)
