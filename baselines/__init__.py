@@ -15,6 +15,9 @@ cmcf (:class:`baselines.cmcf.CMCFFlow`)
     Conformalized mean curvature flow (Kazhdan, Solomon, Ben-Chen 2012).
 bgn (:class:`baselines.bgn.BGNFlow`)
     Barrett, Garcke, Nuernberg (2008), mass-lumped vertex normals.
+bgn-bdf2, bgn-bdf3 (:class:`baselines.bgn_bdf.BGNBDFFlow`)
+    BGN with BDF-k on predictor surfaces (Jiang, Su, Zhang 2024); it integrates
+    in time itself (several solves a step).
 mdr (:class:`baselines.mdr.MDRFlow`)
     The minimal deformation rate velocity of Hu and Li (2022), eliminated
     into BGN's system with unit normals.

@@ -315,6 +315,73 @@ def bgn_system(L_data, indptr, diag_slots, mass, omega, X, tau, fixed, scaled, a
 
 
 @njit(cache=True)
+def dual_mdr_system(L_data, indptr, indices, diag_slots, scale, normal, nu, live, bgn_data,
+                    bgn_indptr, indptr6, data):
+    """Values of the dual-MDR system (DM5)-(DM6) (:mod:`baselines.dual_mdr`), in the
+    pattern of :meth:`baselines.dual_mdr.DualMDRFlow._build_pattern`.
+
+    Row ``c n + k`` (``X``): the values of row ``c n + k`` of BGN's (B4) (``bgn_data``,
+    :func:`bgn_system`'s), then ``scale_k L_kj`` (``D A``) at the columns ``3 n + c n + j``.
+    Row ``3 n + c n + k`` (``R``): for ``d = 0, 1, 2`` the entries ``j`` of row ``k`` of
+    ``L``, ``scale_k L_kj (P_k P_j)_cd`` (``P D A P``, ``P_k = I - nu_k nu_k^T``) plus
+    ``normal_k nu_kc nu_kd`` on the diagonal (``N``); a vertex not ``live`` an identity row.
+
+    Parameters
+    ----------
+    L_data : (nnz,) float64 array
+        Cotangent stiffness ``A`` (one coordinate).
+    indptr : (n + 1,) int32 array
+    indices : (nnz,) int32 array
+    diag_slots : (n,) int64 array
+        The pattern of ``L``.
+    scale : (n,) float64 array
+        ``dt / m_k`` (row scaling ``"mass"``) or 1; 0 where not ``live``.
+    normal : (n,) float64 array
+        The weight of ``nu_k nu_k^T`` in the ``R`` rows: 1 or ``m_k / dt``.
+    nu : (n, 3) float64 array
+        Unit vertex normals.
+    live : (n,) bool array
+        Neither fixed nor of zero mass.
+    bgn_data : (3 (nnz + 2 n),) float64 array
+    bgn_indptr : (3 n + 1,) int32 array
+        BGN's matrix (:func:`baselines.bgn.block_pattern`).
+    indptr6 : (6 n + 1,) int64 array
+        Row pointers of the (6n, 6n) pattern.
+    data : (indptr6[-1],) float64 array, output
+    """
+    n = len(scale)
+    for c in range(3):
+        for k in range(n):
+            lo, hi = indptr[k], indptr[k + 1]
+            q = indptr6[c * n + k]
+            for s in range(bgn_indptr[c * n + k], bgn_indptr[c * n + k + 1]):
+                data[q] = bgn_data[s]
+                q += 1
+            for p in range(lo, hi):
+                data[q] = L_data[p] * scale[k]
+                q += 1
+            q = indptr6[(3 + c) * n + k]
+            a0, a1, a2 = nu[k, 0], nu[k, 1], nu[k, 2]
+            ac = nu[k, c]
+            for d in range(3):
+                ad = nu[k, d]
+                for p in range(lo, hi):
+                    if not live[k]:
+                        data[q] = 1.0 if (p == diag_slots[k] and c == d) else 0.0
+                        q += 1
+                        continue
+                    j = indices[p]
+                    bc, bd = nu[j, c], nu[j, d]
+                    ab = a0 * nu[j, 0] + a1 * nu[j, 1] + a2 * nu[j, 2]
+                    pp = (1.0 if c == d else 0.0) - ac * ad - bc * bd + ab * ac * bd
+                    v = scale[k] * L_data[p] * pp
+                    if p == diag_slots[k]:
+                        v += normal[k] * ac * ad
+                    data[q] = v
+                    q += 1
+
+
+@njit(cache=True)
 def advected_stiffness(L_data, indptr, indices, mass, Y, n0, G, tension, out):
     """DeTurck's tension (D3) and stiffness ``A + diag(m) D`` of (D4)
     (:mod:`baselines.deturck`), in one pass over the rows of ``L``.

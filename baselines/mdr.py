@@ -88,6 +88,13 @@ class UnitNormalBGN(BGNFlow):
         a vertex whose triangles all vanished."""
         return unit_vertex_normals(self.faces, geometry.area_vectors, self.mesh.n_vertices)
 
+    def _tangential_laplacian(self, geometry, nu, base):
+        """(n, 3) ``P_k (A B)_k``, ``P_k = I - nu_k nu_k^T``: the tangential part of the
+        stiffness ``A`` of ``geometry`` applied to ``base`` (3, n), at every vertex (MDR's
+        (M5), dual-MDR's (DM6))."""
+        AB = self.assembler.laplacian(geometry.L_data) @ np.ascontiguousarray(base).T
+        return AB - nu * np.einsum("kc,kc->k", nu, AB)[:, None]
+
 
 class MDRFlow(UnitNormalBGN):
     """Mean curvature flow with the MDR tangential velocity, (M5), of one surface.
@@ -119,8 +126,7 @@ class MDRFlow(UnitNormalBGN):
         A, b = super()._system(at, base, dt, scaling)
         g = self.geometry_at(at)
         nu = self._normals(g)
-        AB = self.assembler.laplacian(g.L_data) @ np.ascontiguousarray(base).T     # (n, 3)
-        tangential = AB - nu * np.einsum("kc,kc->k", nu, AB)[:, None]
+        tangential = self._tangential_laplacian(g, nu, base)
         live = ~self.fixed & (g.mass > 0)
         scale = np.divide(dt, g.mass, out=np.zeros_like(g.mass), where=live) \
             if scaling == "mass" else live.astype(float)

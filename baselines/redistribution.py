@@ -129,7 +129,7 @@ import scipy.sparse as sp
 
 from kept_factor import KeptFactorSolver, pinned
 
-from .tangential_kernels import drift_weights, vertex_gradients
+from .tangential_kernels import drift_weights, squared_curvature_normals, vertex_gradients
 
 REDISTRIBUTIONS = (None, "area")
 PECLET = 0.1
@@ -187,10 +187,13 @@ def redistribution_source(L, mass, X, fixed, omega, shares=None):
     -------
     (n,) float array
     """
-    LX = np.asarray(L @ np.asarray(X).T)                # h_i = -(L X)_i / m_i, zero where
-    safe = np.where(mass > 0.0, mass, np.inf)           # m_i = 0
-    hV = np.einsum("ij,ij->i", LX, LX) / (safe * safe)  # |h_i|^2
-    hV[fixed] = 0.0
+    L = sp.csr_matrix(L)
+    hV = np.empty(len(mass))                            # |h_i|^2, h_i = -(L X)_i / m_i,
+    squared_curvature_normals(L.indptr, L.indices,      # zero where m_i = 0 or fixed
+                              np.asarray(L.data, dtype=np.float64),
+                              np.asarray(X, dtype=np.float64),
+                              np.asarray(mass, dtype=np.float64),
+                              np.asarray(fixed, dtype=np.bool_), hV)
     area = mass.sum()
     f = hV - (mass * hV).sum() / area
     if omega:

@@ -216,6 +216,32 @@ def drift_weights(indptr, indices, L_data, psi, peclet, X, out, DX):
 
 
 @njit(cache=True)
+def squared_curvature_normals(indptr, indices, data, X, mass, fixed, out):
+    """``out_i = |(L X)_i|^2 / m_i^2``, the ``|h_i|^2`` of the redistribution's source
+    (R2) (:func:`baselines.redistribution.redistribution_source`), in one pass over the
+    rows of ``L`` (each row's products summed in storage order, as scipy's product);
+    zero at fixed vertices and where ``m_i <= 0``.
+
+    Parameters
+    ----------
+    indptr, indices, data : CSR arrays of ``L`` (n, n)
+    X : (3, n) float64 array
+    mass : (n,) float64 array
+    fixed : (n,) bool array
+    out : (n,) float64 array, output
+    """
+    for i in range(mass.shape[0]):
+        y0 = y1 = y2 = 0.0
+        for p in range(indptr[i], indptr[i + 1]):
+            j, a = indices[p], data[p]
+            y0 += a * X[0, j]
+            y1 += a * X[1, j]
+            y2 += a * X[2, j]
+        m = mass[i]
+        out[i] = 0.0 if fixed[i] or not m > 0.0 else ((y0 * y0 + y1 * y1) + y2 * y2) / (m * m)
+
+
+@njit(cache=True)
 def normal_parts(omega, D, mass, fixed, g):
     """``g_i = N_i N_i . D_i / m_i`` (the normal part (R5) of the drift of
     :mod:`baselines.redistribution`), ``N_i = omega_i / |omega_i|``; zero at fixed

@@ -44,6 +44,11 @@ CG iterations (levels 1 to ``--level``). Usage::
     python benchmarks/bench_potential.py --solvers [--level 5] [--steps 64]
     python benchmarks/bench_potential.py --profile [--level 5] [--steps 64] [--repeats 3]
     python benchmarks/bench_potential.py --tolerances 1e-7 1e-4 1e-3 [--level 5]
+    python benchmarks/bench_potential.py --check [5 7] [--repeats 3] [--steps N]
+
+``--check``: the drift check of issue 46, this tree alone: plain and redistributing
+steps interleaved at each level (level 5 the whole run, level 7 its first 64 steps
+unless ``--steps``), absolute CPU ms per step, the ratio and "ok" or "DRIFT: above 2".
 """
 
 import os
@@ -341,6 +346,33 @@ def choose_solver(level, steps):
           "refinement: passes); vs direct: largest |x - x_direct| / |x_direct|.")
 
 
+def check(pairs, levels, steps, repeats):
+    """This tree's ratios, redistributing step over plain step, at each of ``levels``
+    (``steps``: level -> the steps of each run, None for the whole run), the pairs
+    interleaved, medians of ``repeats``; printed with the absolute CPU ms and the
+    verdict against :data:`TARGET` (issue 46: "drift" when a change makes a ratio pass
+    it). Returns the ratios, ``{(redistributing, level): ratio}``."""
+    names = [name for pair in pairs for name in pair]
+    for name in names:                                     # warm-up: compilation, caches
+        step_cost(get_scheme(name), 1, None)
+    ratios = {}
+    print(f"{'level':>5s} {'plain':>20s} {'ms/step':>8s} {'redistributing':>32s} "
+          f"{'ms/step':>8s} {'ratio':>6s}  verdict")
+    for level in levels:
+        cost = {name: [] for name in names}
+        for repeat in range(repeats):
+            for name in (names if repeat % 2 == 0 else names[::-1]):
+                cost[name].append(step_cost(get_scheme(name), level, steps.get(level))[0])
+        for plain, redistributing in pairs:
+            a, b = median(cost[plain]), median(cost[redistributing])
+            ratios[(redistributing, level)] = b / a
+            print(f"{level:5d} {plain:>20s} {a:8.2f} {redistributing:>32s} {b:8.2f} "
+                  f"{b / a:6.2f}  {'ok' if b / a <= TARGET else f'DRIFT: above {TARGET:g}'}")
+    runs = ", ".join(f"level {lv}: {steps.get(lv) or 'all'}" for lv in levels)
+    print(f"steps per run: {runs}; CPU ms per step, medians of {repeats}; {machine_line()}")
+    return ratios
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--level", type=int, default=5)
@@ -356,6 +388,9 @@ def main(argv=None):
                              "1 to --level instead")
     parser.add_argument("--profile", action="store_true",
                         help="time the parts of a step instead (this tree, --steps, default 64)")
+    parser.add_argument("--check", type=int, nargs="*", default=None,
+                        help="instead, this tree's ratios at these levels (default 5 7; "
+                             "level 7 and above: the first 64 steps) against the target 2")
     parser.add_argument("--before", default=BEFORE,
                         help=f"the commit of the 'before' packages (default {BEFORE})")
     args = parser.parse_args(argv)
@@ -366,6 +401,11 @@ def main(argv=None):
         choose_solver(args.level, 64 if args.steps is None else args.steps)
         return
     pairs = [tuple(p.split(":")) for p in args.pairs]
+    if args.check is not None:
+        levels = args.check or [5, 7]
+        check(pairs, levels, {lv: (64 if lv >= 7 else None) if args.steps is None
+                              else args.steps for lv in levels}, args.repeats)
+        return
     if args.tolerances:
         tolerances([pair[1] for pair in pairs], list(range(1, args.level + 1)), args.tolerances)
         return

@@ -412,11 +412,14 @@ class Flow:
         """(n,) ``psi`` of (R3) at the state ``at``; ``A`` the scheme's step matrix at
         ``at`` with step ``dt`` (its discrete Laplacian gives ``h``, as in (3.6)), ``N``
         the vertex normals of ``geometry`` (3, n) when the caller has them."""
+        from .tangential_kernels import squared_normal_speed_kernel
+
         clock = time.perf_counter()
         mesh = self._mesh
         N = vertex_normals(mesh, geometry) if N is None else N
-        h = (at - (A @ at.T).T) / dt                             # h*, zero at fixed F
-        hV = np.einsum("ij,ij->j", h, N) ** 2                    # h.V = H^2 (V = H N)
+        hV = np.empty(A.shape[0])                                # h.V = H^2 (V = H N),
+        squared_normal_speed_kernel(A.indptr, A.indices, A.data,  # h* = (at - A at) / dt
+                                    np.asarray(at, dtype=np.float64), N, float(dt), hV)
         if self._area_0 is None:                                 # the first step's state
             self._area_0 = float(covolumes[:mesh.n_f].sum())
         rate = self.omega * 4.0 * np.pi / self._area_0           # scale-covariant omega

@@ -120,7 +120,7 @@ from types import SimpleNamespace
 import numpy as np
 import scipy.sparse as sp
 
-from kept_factor import KeptFactorSolver, pinned
+from kept_factor import KeptFactorSolver, factorise, family_blocks, pinned
 
 from .assembly import flux_coefficients
 
@@ -254,16 +254,29 @@ class TangentialPotential(KeptFactorSolver):
     and the largest aspect ratio to the 4th decimal (``ddfv/README.md``, item
     22 of its deviations).
 
+    The kept factorisation is that of the two diagonal blocks, F-F and T-T
+    (:func:`kept_factor.family_blocks`), where ``A`` is symmetric: the F-T coupling
+    of the diamonds makes the whole matrix's Cholesky factor several times denser
+    than the blocks' (level 5 of the sphere, 30 722 unknowns, a sequence of 100
+    steps' systems at rtol 1e-4, CPU: the whole matrix's factor 323 ms and 6.1 ms
+    a solve at 0.91 CG iterations, the blocks' 166 ms and 3.9 ms at 1.02
+    iterations); the blocks are symmetric positive definite where ``A`` is, so CG
+    converges to the same solution, to the same tolerance.
+
     Parameters
     ----------
     mesh : DiamondMesh
     rtol : float
         Relative residual of each solve (default :data:`POTENTIAL_RTOL`).
     max_iterations : int
+    blocks : bool
+        Factorise the two families' diagonal blocks (default) rather than ``A``
+        (a direct solve on a fresh factor: :func:`tangential_potential`).
     """
 
-    def __init__(self, mesh, rtol=None, max_iterations=4):
-        super().__init__(POTENTIAL_RTOL if rtol is None else rtol, max_iterations)
+    def __init__(self, mesh, rtol=None, max_iterations=4, blocks=True):
+        super().__init__(POTENTIAL_RTOL if rtol is None else rtol, max_iterations,
+                         factorise=family_blocks(mesh.n_f) if blocks else factorise)
         self.mesh = mesh
         self._keep = np.ones(mesh.n_unknowns)
         self._keep[[0, mesh.n_f]] = 0.0
@@ -295,7 +308,8 @@ class TangentialPotential(KeptFactorSolver):
 
 
 def tangential_potential(K, source, mesh, chi):
-    """``psi`` of (R3) in one call (see :class:`TangentialPotential`).
+    """``psi`` of (R3) in one call (see :class:`TangentialPotential`), by the Cholesky
+    factorisation of the whole matrix (or its LU): a direct solve.
 
     Parameters
     ----------
@@ -311,7 +325,7 @@ def tangential_potential(K, source, mesh, chi):
     -------
     (n,) float array
     """
-    return TangentialPotential(mesh)(K, source, chi)
+    return TangentialPotential(mesh, blocks=False)(K, source, chi)
 
 
 def diamond_gradients(mesh, geom, psi):

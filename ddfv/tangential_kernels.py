@@ -177,6 +177,20 @@ def t_vertices_kernel(F, T, faces, lam, carry, out):
         raise IndexError("face index out of range")
 
 
+@numba.njit("UniTuple(float64, 3)(int32[::1], int32[::1], float64[::1], float64[:, :], "
+            "int64)", **_OPTIONS, inline="always")
+def _row_product(indptr, indices, data, X, i):
+    """``(A X)_i`` of a (3, n) ``X``, each row's products summed in storage order from 0
+    (as scipy's product sums them)."""
+    y0 = y1 = y2 = 0.0
+    for p in range(indptr[i], indptr[i + 1]):
+        j, a = indices[p], data[p]
+        y0 += a * X[0, j]
+        y1 += a * X[1, j]
+        y2 += a * X[2, j]
+    return y0, y1, y2
+
+
 @numba.njit("void(int32[::1], int32[::1], float64[::1], float64[:, :], float64[:, :], "
             "float64[:, :], float64, float64[:, ::1])", **_OPTIONS)
 def eliminated_kernel(indptr, indices, data, X, B, N, dt, out):
@@ -200,17 +214,41 @@ def eliminated_kernel(indptr, indices, data, X, B, N, dt, out):
     if indptr.shape[0] != n + 1 or B.shape[1] != n or N.shape[1] != n or out.shape[1] != n:
         raise ValueError("the matrix, states, normals and output do not fit")
     for i in range(n):
-        y0 = y1 = y2 = 0.0                                      # (A X)_i
-        for p in range(indptr[i], indptr[i + 1]):
-            j, a = indices[p], data[p]
-            y0 += a * X[0, j]
-            y1 += a * X[1, j]
-            y2 += a * X[2, j]
+        y0, y1, y2 = _row_product(indptr, indices, data, X, i)  # (A X)_i
         h0, h1, h2 = (X[0, i] - y0) / dt, (X[1, i] - y1) / dt, (X[2, i] - y2) / dt
         hN = (h0 * N[0, i] + h1 * N[1, i]) + h2 * N[2, i]
         out[0, i] = B[0, i] - dt * (h0 - hN * N[0, i])
         out[1, i] = B[1, i] - dt * (h1 - hN * N[1, i])
         out[2, i] = B[2, i] - dt * (h2 - hN * N[2, i])
+
+
+@numba.njit("void(int32[::1], int32[::1], float64[::1], float64[:, :], float64[:, :], "
+            "float64, float64[::1])", **_OPTIONS)
+def squared_normal_speed_kernel(indptr, indices, data, X, N, dt, out):
+    """``out = (h . N)^2`` with ``h = (X - A X) / dt``, the ``h . V = H^2`` of the
+    redistribution's source (R3) (:meth:`ddfv.flow.Flow._potential_of`), in one pass
+    over the rows of ``A`` (the products summed in storage order, as scipy's; the dot
+    product with ``N`` in the order of the components: numpy's ``einsum`` may sum it
+    otherwise, by an ulp).
+
+    Parameters
+    ----------
+    indptr, indices, data : int32, int32, float64 arrays
+        ``A`` (n, n) in CSR (the assembler's: its column indices are in range by
+        construction and not checked here).
+    X, N : (3, n) float64 arrays
+        The state of the operators ``X*`` and the unit vertex normals.
+    dt : float
+    out : (n,) float64 array, output
+    """
+    n = X.shape[1]
+    if indptr.shape[0] != n + 1 or N.shape[1] != n or out.shape[0] != n:
+        raise ValueError("the matrix, state, normals and output do not fit")
+    for i in range(n):
+        y0, y1, y2 = _row_product(indptr, indices, data, X, i)  # (A X)_i
+        hN = (((X[0, i] - y0) / dt) * N[0, i] + ((X[1, i] - y1) / dt) * N[1, i]) \
+            + ((X[2, i] - y2) / dt) * N[2, i]
+        out[i] = hN * hN
 
 
 def moved_t_vertices(F, T, faces, lam, carry):

@@ -4,6 +4,6 @@ Imports numpy, scipy and cholespy only; ``ddfv`` and ``baselines`` import it
 (they may not import each other), see :mod:`kept_factor.nearby_systems`.
 """
 
-from .nearby_systems import KeptFactorSolver, cholesky_solve, factorise, pinned
+from .nearby_systems import KeptFactorSolver, cholesky_solve, factorise, family_blocks, pinned
 
-__all__ = ["KeptFactorSolver", "cholesky_solve", "factorise", "pinned"]
+__all__ = ["KeptFactorSolver", "cholesky_solve", "factorise", "family_blocks", "pinned"]

@@ -357,7 +357,9 @@ def _run(args):
 
         write_movie(arrays, args.movie, title=f"{scheme.label} on {args.mesh.name}")
         print(f"wrote {args.movie}: {len(traj.t)} frames")
-    if traj.status != "ok":
+    if traj.status == "extinct":         # the flow's own end, not an error
+        print(f"the flow ended: {traj.message}")
+    elif traj.status != "ok":
         print(f"error: {traj.message} (frames up to step {traj.steps[-1]} kept)",
               file=sys.stderr)
         return 1
@@ -409,17 +411,23 @@ def _report(args):
     return 0
 
 
+def _origin(entry):
+    """`` [distribution version]`` of an installed package's scheme or problem, else ``""``."""
+    source = entry.source
+    return f" [{source['distribution']} {source['version']}]" if source else ""
+
+
 def _schemes(args):
     width = max(map(len, SCHEMES))
     for scheme in SCHEMES.values():
-        print(f"{scheme.name:{width}}  {scheme.description}")
+        print(f"{scheme.name:{width}}  {scheme.description}{_origin(scheme)}")
     return 0
 
 
 def _problems(args):
     width = max(map(len, PROBLEMS))
     for problem in PROBLEMS.values():
-        print(f"{problem.name:{width}}  {problem.label}: {problem.exact}")
+        print(f"{problem.name:{width}}  {problem.label}: {problem.exact}{_origin(problem)}")
     return 0
 
 

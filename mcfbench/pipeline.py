@@ -41,10 +41,10 @@ from contextlib import contextmanager
 from functools import wraps
 from pathlib import Path
 
+from mcfbench.running.identity import registry_identity
 from mcfbench.running.problems import get_problem
 from mcfbench.running.schemes import SCHEMES
 from mcfbench.storage.atomic import write_json
-from mcfbench.storage.provenance import code_hash
 from mcfbench.studies.config import ConfigError, check_threads
 
 PROBLEM = "sphere"
@@ -174,7 +174,8 @@ class Plans:
     def __init__(self, config, schemas):
         self.config = config
         self.schemas = Path(schemas)
-        self.code = code_hash()
+        # the code of every run the registries make (not the studies' presentation)
+        self.code = registry_identity()
         # threads of every run job and of the kernels' job: checked at once
         self.threads = check_threads(config)
         self._plans = {}

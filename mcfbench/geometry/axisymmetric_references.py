@@ -5,15 +5,15 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from mcfbench.geometry.axisymmetric import (
-    cross_section,
-    evolve,
-    evolve_until,
-    initial_meridian,
-    measures,
-)
+from mcfbench.geometry.axisymmetric import evolve, evolve_until, initial_meridian
+from mcfbench.geometry.meridians import cross_section, measures
 from mcfbench.geometry.exact import J01_SQUARED, catenoid_area
-from mcfbench.geometry.extrapolation import pinch_time_neck, pinch_time_tube, richardson
+from mcfbench.geometry.extrapolation import (
+    extinction_time,
+    pinch_time_neck,
+    pinch_time_tube,
+    richardson,
+)
 from mcfbench.geometry.metrics import catenoid_parameter
 
 
@@ -69,6 +69,15 @@ def _pinch_run(shape, n, levels, times, params, rtol, quantity):
     return out
 
 
+def _bulb_run(n, delta, times, rho_levels, rtol):
+    from mcfbench.geometry.meridian_surgery import bulb_through_pinch
+
+    run = bulb_through_pinch(n, delta, times, rho_levels, rtol)
+    T, _ = extinction_time(run["t_levels"], rho_levels)
+    return {"bulb_volume": run["volume"], "bulb_area": run["area"], "extinction_time": T,
+            "t_cut": run["t_cut"]}
+
+
 def _series_run(run, ns, *args, rtol=1e-11):
     per_mesh = [run(n, *args, rtol) for n in ns]
     coarse_tight = run(ns[0], *args, rtol / 10)
@@ -83,8 +92,8 @@ def _tube(X):
     return math.sqrt(cross_section(X) / math.pi)
 
 
-def reference_numbers(problems=("torus", "dumbbell", "catenoid", "hemisphere", "long_cylinder"),
-                      quick=False):
+def reference_numbers(problems=("torus", "dumbbell", "dumbbell_after_pinch", "catenoid",
+                                "hemisphere", "long_cylinder"), quick=False):
     """Reference answers for the suite's axisymmetric problems (computed, nothing cached).
 
     Every number is ``(value, error_estimate)``: Richardson extrapolation over
@@ -100,6 +109,14 @@ def reference_numbers(problems=("torus", "dumbbell", "catenoid", "hemisphere", "
       (the tube shrinks to a circle of radius ``ring_radius``).
     * ``dumbbell``: ``volume``, ``area``, ``mid_radius`` (the neck on
       ``z = 0``), ``max_height`` at ``times``; ``pinch_time``.
+    * ``dumbbell_after_pinch``: the dumbbell continued through its pinch
+      (:mod:`mcfbench.geometry.meridian_surgery`: cut at the neck radius ``delta``,
+      each bulb closed at the axis and flowed to its extinction), for each cut
+      radius of ``deltas``: ``bulb_volume`` and ``bulb_area`` (one bulb; the two
+      are mirror images) at ``times`` and the bulbs' ``extinction_time``
+      (:func:`extinction_time`); the entries without a suffix are those of the
+      smallest ``delta`` with the change from the next larger one added to their
+      error (``delta_effect``: that change, per quantity).
     * ``catenoid``: cylinder ``R = 1, h = 0.5`` between fixed circles:
       ``mid_radius`` (neck) and ``area`` at ``times``, the last one (t = 8) at
       the steady state, with the exact catenoid ``a``, its area.
@@ -147,6 +164,20 @@ def reference_numbers(problems=("torus", "dumbbell", "catenoid", "hemisphere", "
                    max_height_at_last_level=ex["max_height_at_last_level"],
                    pinch_time=(T, eT + float(ex["t_levels"][1].max())))
         out["dumbbell"] = res
+    if "dumbbell_after_pinch" in problems:
+        ns = (1601, 3201, 6401, 12801) if not quick else (201, 401, 801)
+        deltas = (0.01, 0.005, 0.0025) if not quick else (0.04, 0.02, 0.01)
+        times = (0.12, 0.16, 0.2)
+        rho_levels = 0.2 * 2.0 ** (-0.5 * np.arange(9))
+        by_delta = {delta: _series_run(lambda n, rtol, d=delta: _bulb_run(
+            n, d, times, rho_levels, rtol), ns)[0] for delta in deltas}
+        finest, coarser = by_delta[deltas[-1]], by_delta[deltas[-2]]
+        keys = ("bulb_volume", "bulb_area", "extinction_time")
+        effect = {k: np.abs(np.asarray(finest[k][0]) - np.asarray(coarser[k][0])) for k in keys}
+        res = {k: (finest[k][0], finest[k][1] + effect[k]) for k in keys}
+        res.update(times=times, meshes=ns, deltas=deltas, rho_levels=rho_levels,
+                   by_delta=by_delta, delta_effect=effect)
+        out["dumbbell_after_pinch"] = res
     if "catenoid" in problems:
         ns = (33, 65, 129, 257, 513) if not quick else (17, 33, 65)
         times = (0.1, 0.25, 0.5, 1.0, 1.5, 8.0)
@@ -211,3 +242,31 @@ def format_reference_table(ref):
             if key in res:
                 lines.append(f"{prob:<14}{key:<26}{'':>8}  {res[key]:>22.15g}  {'exact':>10}")
     return "\n".join(lines)
+
+
+def format_cut_table(result):
+    """Plain-text table of the dumbbell continued through its pinch
+    (:func:`reference_numbers`' ``dumbbell_after_pinch``): every quantity at each cut
+    radius ``delta`` with its error estimate over meshes, and the change from the
+    next larger ``delta`` (the cut's effect, to be compared with the error).
+
+    Returns
+    -------
+    str
+    """
+    lines = [f"{'quantity':<18}{'t':>6}{'delta':>9}  {'value':>20}  {'error est.':>10}  "
+             f"{'change from 2 delta':>20}"]
+    deltas, times = result["deltas"], result["times"]
+    rows = [("extinction_time", None)] + [(k, i) for k in ("bulb_volume", "bulb_area")
+                                           for i in range(len(times))]
+    for key, i in rows:
+        previous = None
+        for delta in deltas:
+            value, err = result["by_delta"][delta][key]
+            value, err = (value, err) if i is None else (value[i], err[i])
+            change = "" if previous is None else f"{value - previous:>20.2e}"
+            t = "" if i is None else f"{times[i]:g}"
+            lines.append(f"{key:<18}{t:>6}{delta:>9g}  {value:>20.12g}  {err:>10.1e}  {change}")
+            previous = value
+    return "\n".join(lines)
+

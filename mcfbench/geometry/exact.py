@@ -81,7 +81,8 @@ class SphereL2Error:
     def __call__(self, flow):
         if flow.n == 0:
             return
-        r = float(sphere_radius(flow.n * flow.tau, self.radius))
+        with np.errstate(invalid="ignore"):     # past R^2 / 4 (a run to the extinction,
+            r = float(sphere_radius(flow.n * flow.tau, self.radius))   # NaN: no error)
         X = np.asarray(flow.X, dtype=np.float64)
         w = np.asarray(flow.l2_weights, dtype=np.float64)
         if X.ndim != 2 or X.shape[0] != 3 or w.shape != (X.shape[1],):

@@ -55,8 +55,8 @@ def pinch_time_tube(t_levels, levels):
     ``d(pi rho^2)/dt = -2 pi + O(rho^2)`` for the cross-section radius
     ``rho = sqrt(A / pi)`` (the first term is ``-int kappa ds = -2 pi``; the
     parallel curvature ``cos(theta) / r`` integrates to ``O(rho^2)``), so
-    ``t(rho) = T - rho^2/2 - a rho^4 - b rho^6 - ...``. Least squares for
-    ``T, a, b`` on the given levels.
+    ``t(rho) = T - rho^2/2 - a rho^4 - b rho^6 - ...``: :func:`shrinking_time`
+    with ``rate = 2``.
 
     Parameters
     ----------
@@ -66,15 +66,60 @@ def pinch_time_tube(t_levels, levels):
     Returns
     -------
     T, error : float
+    """
+    return shrinking_time(t_levels, levels, rate=2.0)
+
+
+def extinction_time(t_levels, levels):
+    """Extinction time of a closed surface of revolution shrinking to a round point.
+
+    Its area radius ``rho = sqrt(A / (4 pi))`` obeys ``d(rho^2)/dt = -4`` on a
+    round sphere (``dA/dt = -int H^2 = -16 pi``, ``H`` the sum of the principal
+    curvatures), and the surface becomes round as it vanishes (Huisken 1984), so
+    ``t(rho) = T - rho^2/4 - a rho^4 - b rho^6 - ...``: :func:`shrinking_time`
+    with ``rate = 4``. Exact for a sphere: ``a = b = 0``, ``T = R^2 / 4``.
+
+    Parameters
+    ----------
+    t_levels, levels : (k,) float arrays
+        Times at which ``rho`` reached ``levels`` (decreasing), ``k >= 4``.
+
+    Returns
+    -------
+    T, error : float
+    """
+    return shrinking_time(t_levels, levels, rate=4.0)
+
+
+def shrinking_time(t_levels, levels, rate):
+    """The time ``T`` at which a radius ``rho`` with ``d(rho^2)/dt -> -rate`` vanishes.
+
+    Least squares for ``T, a, b`` in ``t(rho) = T - rho^2 / rate - a rho^4 - b rho^6``
+    on the given levels.
+
+    Parameters
+    ----------
+    t_levels, levels : (k,) float arrays
+        Times at which ``rho`` reached ``levels`` (decreasing), ``k >= 4``.
+    rate : float
+        The limit of ``-d(rho^2)/dt`` (2: a tube's cross-section radius; 4: the
+        area radius of a shrinking sphere).
+
+    Returns
+    -------
+    T, error : float
         ``T`` from the fit with ``rho^4, rho^6``; the error estimate is the
         largest change of ``T`` when the ``rho^6`` term or the largest level is
         dropped.
     """
     t, r = np.asarray(t_levels, float), np.asarray(levels, float)
+    if len(t) < 4 or len(t) != len(r):
+        raise ValueError(f"need at least 4 levels with their times, got {len(r)} levels "
+                         f"and {len(t)} times")
 
     def fit(sel, powers):
         A = np.column_stack([np.ones(sel.sum())] + [-r[sel] ** p for p in powers])
-        return np.linalg.lstsq(A, t[sel] + 0.5 * r[sel] ** 2, rcond=None)[0][0]
+        return np.linalg.lstsq(A, t[sel] + r[sel] ** 2 / rate, rcond=None)[0][0]
 
     allk = np.ones(len(t), bool)
     drop = allk.copy()

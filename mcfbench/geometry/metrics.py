@@ -507,3 +507,47 @@ def triangle_normals(V, F):
     """(m, 3) normals ``(b - a) x (c - a)`` of the triangles ``(a, b, c)`` (length
     twice the area; no validation of the arrays)."""
     return np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+
+
+def covolume_ratio(covolumes, faces):
+    """The largest ratio of the covolumes of two vertices joined by an edge.
+
+    The covolume of a vertex is its finite volume (the paper, Section 2.1:
+    bounded by the barycentres of its triangles and the midpoints of its
+    edges; DDFV: ``chi(V_i^F)``, Section 2.2.4); a scheme's own are its
+    quadrature weights (``flow.l2_weights``: the lumped mass of a vertex
+    scheme, ``chi / 2`` of DDFV). The ratio is 1 on a mesh of equal
+    covolumes and grows where the mesh is graded or degenerates: the local
+    quasi-uniformity of the finite volumes, which a tangential motion keeps
+    or loses.
+
+    Parameters
+    ----------
+    covolumes : (n,) float array
+        One per vertex of ``faces`` (any common positive factor).
+    faces : (m, 3) int array
+
+    Returns
+    -------
+    float
+        ``max over edges (i, j) of max(c_i / c_j, c_j / c_i)``; ``inf`` when
+        a covolume is not positive (a collapsed or folded cell), NaN when one
+        is not finite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> covolume_ratio(np.array([1.0, 2.0, 4.0, 1.0]), np.array([[0, 1, 2], [0, 2, 3]]))
+    4.0
+    """
+    c = np.asarray(covolumes, dtype=float)
+    F = np.asarray(faces)
+    if c.ndim != 1 or F.ndim != 2 or F.shape[1] != 3 or F.size == 0 or F.max() >= len(c):
+        raise ValueError(f"covolumes must be one per vertex of the faces: got {c.shape} "
+                         f"covolumes for faces of shape {F.shape}")
+    if not np.isfinite(c).all():
+        return float("nan")
+    if not (c > 0).all():
+        return float("inf")
+    a, b = c[F], c[F[:, [1, 2, 0]]]
+    return float(np.maximum(a / b, b / a).max())

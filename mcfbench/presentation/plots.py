@@ -26,6 +26,7 @@ from matplotlib.ticker import FixedFormatter, FixedLocator, NullFormatter  # noq
 
 from mcfbench.presentation.formats import fix  # noqa: E402
 from mcfbench.running.schemes import find_scheme  # noqa: E402
+from mcfbench.storage.statuses import reached  # noqa: E402
 
 SMALLEST_TEXT = 8
 """The smallest text of a figure on a results page, in points: the matrix's page shows
@@ -75,8 +76,9 @@ def slope_guide(ax, ok, x, y, order, label):
 
 def failure_marks(ax, table, x):
     """A cross at the bottom of the axes for every row that did not finish (any
-    status but ``ok``), in the colour of its scheme."""
-    failed = table[table["status"] != "ok"]
+    status but ``ok`` and ``extinct``, :data:`mcfbench.storage.statuses.REACHED`), in
+    the colour of its scheme."""
+    failed = table[~table["status"].map(reached).astype(bool)]
     for i, r in enumerate(failed.itertuples()):
         ax.plot([getattr(r, x)], [0.03 + 0.05 * (i % 3)], linestyle="none", marker="x",
                 markersize=8, markeredgewidth=2, color=style(r.scheme)[1]["color"],

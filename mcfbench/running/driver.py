@@ -61,6 +61,17 @@ class Trajectory:
         occurrence): ``status``, ``step``, ``time``, ``detail``.
     wall_seconds, cpu_seconds : float
         Time of the stepping, observers included.
+    events : list of dict
+        What happened to the surface without ending the run, and what ended it
+        ``extinct``: one ``{"event": "extinct", "step", "time", "component",
+        "kind", "area", "volume", "extinction_time"}`` per component that vanished
+        round (:mod:`mcfbench.geometry.collapse`): ``time`` the state's, ``kind``
+        ``"point"`` or ``"circle"``, ``area`` and ``volume`` the component's then,
+        ``extinction_time`` the state's time plus the time the round component
+        had left.
+    flow : mcfbench.running.flow.SchemeFlow
+        The flow at the run's end: the one stepped, or the one rebuilt on the
+        components that remained (``rebuild``).
     continue_with : callable or None
         For a run that ended with a solver failure (a ``solver_*`` status; not one
         turned into ``degenerated`` by a collapsed mesh), ``continue_with(solver,
@@ -85,11 +96,20 @@ class Trajectory:
     defects: list = field(default_factory=list)
     wall_seconds: float = 0.0
     cpu_seconds: float = 0.0
+    events: list = field(default_factory=list)
+    flow: object = field(default=None, repr=False, compare=False)
     continue_with: object = field(default=None, repr=False, compare=False)
 
     @property
     def ok(self):
         return self.status == "ok"
+
+    @property
+    def extinction_time(self):
+        """The time the last component vanished (:attr:`events`'s
+        ``extinction_time``) of a run that ended ``extinct``, NaN otherwise."""
+        return float(self.events[-1]["extinction_time"]) if self.status == "extinct" \
+            and self.events else float("nan")
 
     @property
     def t_failed(self):
@@ -113,7 +133,7 @@ class _NoBar:
 
 def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrapolate",
              save_every=1, observers=(), on_defect="stop", until=None, progress=False,
-             collapse=True, invariants=True):
+             collapse=True, invariants=True, rebuild=None):
     """Step ``flow`` ``steps`` times.
 
     Parameters
@@ -154,7 +174,10 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
         before the next solve, for a component that shrank to a point or a
         line or has non-finite coordinates
         (:class:`mcfbench.geometry.collapse.CollapseCheck`): status
-        ``degenerated`` naming the component. It ends the run in both
+        ``degenerated`` naming the component; or that vanished round (a point,
+        or a circle: the flow's extinction, with less than two time steps left),
+        status ``extinct`` naming the component and its extinction time (an
+        event of :attr:`Trajectory.events`). Either ends the run in both
         ``on_defect`` modes (there is no surface left to step).
     invariants : bool
         Check every state of the mesh (``flow.vertices``, ``flow.faces``)
@@ -165,6 +188,15 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
         solver failure on a mesh whose smallest angle collapsed ends the run
         as ``degenerated`` (the mesh's verdict), naming the angle and since
         when. Off only for toy flows that are not mean curvature flows.
+    rebuild : callable, optional
+        ``rebuild(flow, keep) -> flow``: the flow on the mesh vertices ``keep``
+        ((n,) bool, whole components) at the same time level, or ``ValueError``
+        saying why it cannot be (:func:`mcfbench.running.continuation.sub_flow`).
+        When a component vanishes round and others remain, the run goes on with
+        them (an ``extinct`` event of :attr:`Trajectory.events`; the frames keep the
+        initial mesh's layout, the vanished points where they vanished, and the
+        integrator starts afresh); without ``rebuild``, or when it cannot, the run
+        ends ``degenerated`` saying why (the event's ``why_not``).
 
     Returns
     -------
@@ -179,7 +211,8 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
         raise ValueError(f"unknown on_defect {on_defect!r}; choose one of {', '.join(ON_DEFECT)}")
     stepping = _Stepping(flow, int(steps), get_integrator(integrator, warm_start=warm_start),
                          save_every=save_every, observers=observers, on_defect=on_defect,
-                         until=until, collapse=collapse, invariants=invariants)
+                         until=until, collapse=collapse, invariants=invariants,
+                         rebuild=rebuild)
     # a copy per run: what a solver keeps between solves (the kept ILU factor) is the
     # run's own, built inside its timed steps, never carried in from a warm-up or an
     # earlier run (a timed repeat pays for its factor as the first execution did)
@@ -194,17 +227,24 @@ class _Stepping:
     failure with another one."""
 
     def __init__(self, flow, steps, stepper, *, save_every, observers, on_defect, until,
-                 collapse, invariants):
+                 collapse, invariants, rebuild=None):
         self.flow, self.steps, self.stepper = flow, steps, stepper
         self.save_every, self.observers, self.on_defect = save_every, observers, on_defect
         self.until = until
         self.frames, self.steps_kept, self.iterations, self.defects = [], [], [], []
+        self.events = []
+        self.rebuild, self.faces = rebuild, np.asarray(flow.faces)
+        # the initial mesh's points and triangles still in the flow (all until a
+        # component vanishes and the run goes on without it), and the last full frame
+        self.kept_vertices = np.arange(len(flow.vertices))
+        self.kept_faces = np.arange(len(self.faces))
+        self.full = None
         self.seen = set()
         # one compiled measuring pass per state serves both checks
         self.measures = StateMeasures(flow.vertices, flow.faces) \
             if collapse or invariants else None
-        self.collapsed = CollapseCheck(flow.vertices, flow.faces, measures=self.measures) \
-            if collapse else None
+        self.collapsed = CollapseCheck(flow.vertices, flow.faces, measures=self.measures,
+                                       tau=flow.tau) if collapse else None
         self.invariant = FlowInvariants(flow.vertices, flow.faces, measures=self.measures) \
             if invariants else None
         self.wall = self.cpu = 0.0
@@ -222,21 +262,26 @@ class _Stepping:
 
     def save(self):
         self.steps_kept.append(self.flow.n)
-        self.frames.append(self.flow.frame())
+        self.frames.append(self.full_frame())
 
     def check(self):
         """Record the defects of the current state; raise in stop mode (always for a
-        collapse)."""
+        collapse or an extinction). A component that vanished round is an extinction
+        only of a state that passes the other checks (an invalid state is never counted
+        as the flow's end), and at the run's last state only once it collapsed (its time
+        left matters only before a next step)."""
         flow = self.flow
         # the mesh vertices once (DDFV's are a gather of its F-vertices), measured once
         # for both checks
         V = flow.vertices if self.measures is not None else None
         measured = self.measures(V) if V is not None else None
-        detail = self.collapsed(V, measured) if self.collapsed is not None else None
-        if detail is not None:
-            self.defects.append({"status": "degenerated", "step": flow.n,
-                                 "time": flow.n * flow.tau, "detail": detail})
-            raise FlowBreakdown("degenerated", flow.n, flow.n * flow.tau, detail)
+        vanished = self.collapsed(V, measured, flow.n * flow.tau,
+                                  final=flow.n >= self.steps) \
+            if self.collapsed is not None else None
+        if vanished is not None and vanished.status != "extinct":
+            self.defects.append({"status": vanished.status, "step": flow.n,
+                                 "time": flow.n * flow.tau, "detail": vanished.detail})
+            raise FlowBreakdown(vanished.status, flow.n, flow.n * flow.tau, vanished.detail)
         found = flow.defects()
         if self.invariant is not None:
             found = [*found, *self.invariant(V, flow.n, measured)]
@@ -248,6 +293,72 @@ class _Stepping:
                                  "time": flow.n * flow.tau, "detail": detail})
             if self.on_defect == "stop":
                 raise FlowBreakdown(status, flow.n, flow.n * flow.tau, detail)
+        if vanished is not None:
+            self.vanished(vanished)
+            if len(vanished.components) < self.collapsed.count and self.go_on(vanished):
+                return self.check()
+            self.defects.append({"status": "extinct", "step": flow.n,
+                                 "time": flow.n * flow.tau, "detail": vanished.detail})
+            raise FlowBreakdown("extinct", flow.n, flow.n * flow.tau, vanished.detail)
+
+    def vanished(self, found):
+        """Record the components of an ``extinct`` :class:`~mcfbench.geometry.collapse.Collapse`
+        as events of the run (the components numbered as in the initial mesh)."""
+        flow = self.flow
+        for c, kind, area, volume, time in zip(found.components, found.kinds, found.areas,
+                                               found.volumes, found.times):
+            self.events.append({"event": "extinct", "step": flow.n, "time": flow.n * flow.tau,
+                                "component": int(self.collapsed.ids[c]), "kind": kind,
+                                "area": area, "volume": volume, "extinction_time": time})
+
+    def go_on(self, found):
+        """Drop the vanished components of ``found`` and go on with the flow rebuilt on
+        the rest (``rebuild``, :mod:`mcfbench.running.continuation`); True when it
+        did. Else the last event says why not, and the run ends ``degenerated``."""
+        check, flow = self.collapsed, self.flow
+        keep = ~np.isin(check.labels, found.components)
+        try:
+            if self.rebuild is None:
+                raise ValueError("no continuation given (simulate's rebuild)")
+            new = self.rebuild(flow, keep)
+        except ValueError as err:
+            self.events[-1]["continued"] = False
+            self.events[-1]["why_not"] = str(err)
+            found = found._replace(status="degenerated", detail=(
+                f"{found.detail}; the run cannot go on without it: {err}"))
+            self.defects.append({"status": "degenerated", "step": flow.n,
+                                 "time": flow.n * flow.tau, "detail": found.detail})
+            raise FlowBreakdown("degenerated", flow.n, flow.n * flow.tau, found.detail) \
+                from None
+        self.full = self.full_frame()          # the vanished vertices stay where they were
+        kept_faces = keep[np.asarray(flow.faces)].all(axis=1)
+        self.kept_vertices = self.kept_vertices[keep]
+        self.kept_faces = self.kept_faces[kept_faces]
+        self.flow = new
+        self.stepper = get_integrator(self.stepper.name, warm_start=self.stepper.warm_start)
+        self.measures = StateMeasures(new.vertices, new.faces)
+        collapsed = CollapseCheck(new.vertices, new.faces, measures=self.measures, tau=new.tau,
+                                  area_tol=check.area_tol, diameter_tol=check.diameter_tol)
+        # the remaining components keep their initial size and names
+        old = check.labels[keep][collapsed.first]
+        collapsed.renamed(check.area0[old], check.diameter0[old], check.ids[old],
+                          self.kept_vertices, check.total)
+        self.collapsed = collapsed
+        if self.invariant is not None:
+            self.invariant = FlowInvariants(new.vertices, new.faces, measures=self.measures)
+        return True
+
+    def full_frame(self):
+        """The current frame in the initial mesh's layout: the vanished components'
+        points where they were when they vanished."""
+        frame = self.flow.frame()
+        if self.full is None:
+            return frame
+        full = {key: value.copy() for key, value in self.full.items()}
+        full["vertices"][self.kept_vertices] = frame["vertices"]
+        if "extra_points" in full:
+            full["extra_points"][self.kept_faces] = frame["extra_points"]
+        return full
 
     def observe(self):
         for observer in self.observers:
@@ -274,8 +385,8 @@ class _Stepping:
 
     def go(self, solver, progress=False):
         """Step with ``solver`` until the run's end, a breakdown or ``until``; the
-        :class:`Trajectory` of the whole run so far."""
-        flow = self.flow
+        :class:`Trajectory` of the whole run so far (its flow may be rebuilt on the
+        remaining components: read ``self.flow``)."""
         wall, cpu = time.perf_counter(), time.process_time()
         if progress and self.broken is None:
             from tqdm import tqdm  # on first use: not paid at start-up without a bar
@@ -294,11 +405,11 @@ class _Stepping:
                 finally:
                     bar.update()
                 self.observe()
-                if self.save_every and flow.n % self.save_every == 0:
+                if self.save_every and self.flow.n % self.save_every == 0:
                     self.save()
-                if self.until is not None and self.until(flow):
+                if self.until is not None and self.until(self.flow):
                     break
-        self.end_frame = self.steps_kept[-1] != flow.n
+        self.end_frame = self.steps_kept[-1] != self.flow.n
         if self.end_frame:
             self.save()
         self.wall += time.perf_counter() - wall
@@ -329,8 +440,8 @@ class _Stepping:
                    for key in self.frames[0]}
         return Trajectory(
             frames=stacked, steps=np.array(self.steps_kept),
-            t=np.array(self.steps_kept) * flow.tau, faces=np.asarray(flow.faces),
+            t=np.array(self.steps_kept) * flow.tau, faces=self.faces,
             iterations=np.array(self.iterations, dtype=int), status=status, message=message,
             failed_step=failed, steps_done=len(self.iterations), defects=defects,
-            wall_seconds=self.wall, cpu_seconds=self.cpu,
-            continue_with=self.continue_with if self.solver_failed else None)
+            wall_seconds=self.wall, cpu_seconds=self.cpu, events=list(self.events),
+            flow=flow, continue_with=self.continue_with if self.solver_failed else None)

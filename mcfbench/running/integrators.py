@@ -111,6 +111,10 @@ operators at the extrapolated state, Kovacs, Li, Lubich, Numer. Math. 143 (2019)
     threefold, which matters for schemes whose tangential motion is not smooth
     in time (BGN, ``baselines/README.md``).
 
+A flow that integrates in time itself (``integrates_itself``: BGN/BDF-k on predictor
+surfaces, :mod:`baselines.bgn_bdf`) is stepped by the Euler integrator's
+:meth:`Euler._own_step` alone: it solves its own systems with the run's solver.
+
 Every integrator solves one linear system per step (the BDF3 start-up: three
 at the first step) with the initial guess ``2 X^n - X^{n-1}`` (``X^0`` at the
 first step; BDF3, from the third step: its ``X*``; ``warm_start="previous"``:
@@ -230,6 +234,8 @@ class Euler:
             What ``solve`` returned (the BDF3 start-up: the last solve's, its
             ``iterations`` those of its three solves).
         """
+        if getattr(flow, "integrates_itself", False):
+            return self._own_step(flow, solve)
         X, past = flow.state, self._past
         if not past and self.order > 2:
             x, info = self._extrapolated_euler(flow, solve)
@@ -244,6 +250,33 @@ class Euler:
         state = flow.state
         self._moved = None if np.may_share_memory(state, x) else x - state
         return info
+
+    def _own_step(self, flow, solve):
+        """The step of a flow that integrates in time itself (``integrates_itself``: its
+        step needs solves at states only it knows, e.g. the predictor surfaces of
+        :mod:`baselines.bgn_bdf`): ``flow.step(solve_system)`` calls
+        ``solve_system((at, base, dt), x0) -> x`` for each of its systems
+        (:meth:`SchemeFlow.system`), timed and solved as every other step's, and
+        advances itself. Only the Euler integrator steps such a flow (no generic BDF
+        on top of its own).
+
+        Returns
+        -------
+        info
+            Its last solve's, ``iterations`` those of all its solves.
+        """
+        if self.name != "euler":
+            raise ValueError(f"the flow {type(flow).__name__} integrates in time itself; "
+                             f"it cannot be stepped by the integrator {self.name!r}")
+        infos = []
+
+        def solve_system(system, x0):
+            x, info = self._solve(flow, solve, system, x0)
+            infos.append(info)
+            return x
+
+        flow.step(solve_system)
+        return replace(infos[-1], iterations=sum(info.iterations for info in infos))
 
     def _solve(self, flow, solve, system, x0):
         """Solve ``flow.system(*system)`` from ``x0``; the seconds go to the flow's

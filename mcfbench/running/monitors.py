@@ -17,7 +17,7 @@ class Monitor:
         self.t, self.t_monitor = [], []
         self.quality = {"quality_t": [], "min_angle": [], "max_aspect": [], "flipped": [],
                         "covolume_ratio": []}
-        self._neighbours = None
+        self._neighbours, self._faces = None, 0
 
     def __call__(self, flow):
         t = flow.n * flow.tau
@@ -44,19 +44,17 @@ class Monitor:
     def sample(self, flow):
         if self.quality["quality_t"] and self.quality["quality_t"][-1] == flow.n * flow.tau:
             return
-        if self._neighbours is None:
-            self._neighbours = metrics.edge_neighbours(flow.faces)
+        if self._neighbours is None or self._faces != len(flow.faces):
+            # (again for the flow rebuilt on the components that remain of a run)
+            self._neighbours, self._faces = metrics.edge_neighbours(flow.faces), len(flow.faces)
         V = flow.vertices
         q = metrics.quality(V, flow.faces, self._neighbours)
         self.quality["quality_t"].append(flow.n * flow.tau)
         self.quality["min_angle"].append(q["min_angle"])
         self.quality["max_aspect"].append(q["max_aspect_ratio"])
         self.quality["flipped"].append(q["flipped_triangles"])
-        # the scheme's own covolumes (DDFV: the F-vertices' come first); the module
-        # imports pandas, on first use (the warm-up's)
-        from mcfbench.geometry.quality import covolume_ratio
-
-        self.quality["covolume_ratio"].append(covolume_ratio(
+        # the scheme's own covolumes (DDFV: the F-vertices' come first)
+        self.quality["covolume_ratio"].append(metrics.covolume_ratio(
             np.asarray(flow.l2_weights)[:len(V)], flow.faces))
 
 
@@ -74,7 +72,8 @@ class Steady:
 
     def __call__(self, flow):
         V = flow.vertices
-        if self.previous is None:
+        if self.previous is None or self.previous.shape != V.shape:
+            # (again for the flow rebuilt on the components that remain of a run)
             self.previous = np.array(V, dtype=float, order="F")
             self.reached = False
             return False

@@ -1,7 +1,8 @@
 """Real meshes as problems: one problem ``real_<name>`` per committed mesh.
 
 Every mesh of :mod:`mcfbench.geometry.committed_meshes` is one problem of
-:data:`mcfbench.running.problems.PROBLEMS`, generated here from two files and
+:data:`mcfbench.running.problems.PROBLEMS` (declared by the problem module
+:mod:`mcfbench.problems.real_meshes`), generated here from two files and
 nothing else: the mesh's manifest entry and its reference answers
 ``mcfbench/data/meshes/references/<name>.json`` (made by
 ``benchmarks/real_mesh_references.py``, which names the command that remakes
@@ -50,7 +51,7 @@ import numpy as np
 
 from mcfbench.geometry import metrics
 from mcfbench.geometry.committed_meshes import MESH_DIR, mesh_manifest, real_mesh
-from mcfbench.geometry.surface_distance import mean_surface_distance
+from mcfbench.running.problem import Problem
 
 REFERENCE_DIR = MESH_DIR / "references"
 """One ``<name>.json`` of reference answers per real mesh."""
@@ -125,10 +126,11 @@ def real_mesh_problem(name, reference):
 
     Returns
     -------
-    mcfbench.running.problems.Problem
+    mcfbench.running.problem.Problem
+        Of kind ``real_mesh``, main metric ``area_error``; its data files the mesh
+        and the reference files (not the manifest: its other meshes' entries change
+        no run of this one, and the mesh's own bytes are hashed).
     """
-    from mcfbench.running.problems import Problem  # the registry imports this module
-
     entry = mesh_manifest()[name]
     tau_0 = TAU_EDGE * reference["h0"] ** 2
     singular = reference.get("singularity", {}).get("time")
@@ -140,7 +142,9 @@ def real_mesh_problem(name, reference):
         levels=tuple(reference["levels"]), tau_1=tau_0 / 4.0,
         t_final=reference["steps"] * tau_0, metrics=("real_mesh",),
         exact=f"reference: finest levels of cotan and bgn ({when})",
-        reference=dict(reference),
+        reference=dict(reference), kind="real_mesh", main_metric="area_error",
+        data_files=(MESH_DIR / entry["file"], reference_path(name),
+                    *[p for p in (surface_path(name),) if p.is_file()]),
         description=f"The {entry['kind']} mesh {entry['file']} ({entry['vertices']} vertices, "
                     f"genus {entry['genus']}; {entry['author']}), refined by Loop subdivision "
                     f"to its limit surface; tau_k = {TAU_EDGE} h_0^2 / 4^k to "
@@ -221,6 +225,8 @@ class RealMeshShape:
             out[f"{key}_error"] = math.nan if any(map(math.isnan, errors)) else worst
         if self.surface is not None and (self.final is None
                                          or len(self.final[0]) < self.surface_vertices):
+            from mcfbench.geometry.surface_distance import mean_surface_distance  # libigl
+
             *key, length = self.surface
             out["distance_error"] = math.nan if self.final is None else \
                 mean_surface_distance(*self.final, *reference_surface(*key)) / length

@@ -15,12 +15,14 @@ solution: order 2 expected).
 
 import time
 from dataclasses import dataclass, replace
+from functools import partial
 
 import numpy as np
 
 from mcfbench.geometry import metrics
 from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.mesh import validate_mesh
+from mcfbench.running.continuation import sub_flow
 from mcfbench.running.cost import check_size
 from mcfbench.running.driver import simulate
 from mcfbench.running.monitors import Monitor, Steady
@@ -150,11 +152,11 @@ def _result(timed, scheme, problem, level, nF, h, tau, steps, method, integrator
     """The :class:`RunResult` of an execution of a run (:func:`_timed_run`,
     :func:`_continued`) with ``nF`` mesh vertices of mean edge length ``h``."""
     flow, traj, monitor = timed.flow, timed.trajectory, timed.monitor
-    X = flow.X
+    nV = sum(points.shape[1] for points in traj.frames.values())   # the initial mesh's
     q = monitor.quality
     return RunResult(
-        scheme=scheme.name, problem=problem.name, level=int(level), nV=X.shape[1],
-        nF=nF, nT=X.shape[1] - nF, h=h, tau=tau, N=steps, steps_done=traj.steps_done,
+        scheme=scheme.name, problem=problem.name, level=int(level), nV=nV,
+        nF=nF, nT=nV - nF, h=h, tau=tau, N=steps, steps_done=traj.steps_done,
         status=traj.status, message=traj.message, t_failed=traj.t_failed,
         t_end=flow.n * tau, steady=bool(timed.steady),
         iterations=int(traj.iterations.sum()), solver=method, integrator=integrator,
@@ -237,7 +239,10 @@ def _timed_run(scheme, problem, mesh, tau, steps, *, solver, integrator, warm_st
     traj = simulate(flow, steps, solver=solver, integrator=integrator, warm_start=warm_start,
                     save_every=save_every,
                     observers=[monitor, *metric_observers, *observers], on_defect=on_defect,
-                    until=until, progress=progress)
+                    until=until, progress=progress,
+                    rebuild=partial(sub_flow, scheme, integrator=integrator, threads=threads,
+                                    **options))
+    flow = traj.flow                      # rebuilt when a component vanished
     finished = monitor.finished(flow)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
     return _Timed(flow, traj, finished, monitor, metric_observers, until, cpu, wall)
@@ -249,9 +254,10 @@ def _continued(timed, solver, progress):
     its monitor and observers going on; timed alone."""
     cpu, wall = time.process_time(), time.perf_counter()
     traj = timed.trajectory.continue_with(solver, progress=progress)
-    finished = timed.running.finished(timed.flow)
+    finished = timed.running.finished(traj.flow)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
-    return replace(timed, trajectory=traj, monitor=finished, cpu=cpu, wall=wall)
+    return replace(timed, flow=traj.flow, trajectory=traj, monitor=finished, cpu=cpu,
+                   wall=wall)
 
 
 WARM_UP_STEPS = 3
@@ -330,6 +336,8 @@ def _metric_values(timed, problem):
         values.update({k: v if kept else float("nan") for k, v in observer.result().items()})
     if "pinch_time" in problem.reference:
         values["pinch_time_error"] = pinch_time_error(traj, problem.reference["pinch_time"])
+    if problem.to_extinction and problem.t_max is not None:
+        values["extinction_time_error"] = traj.extinction_time / problem.t_max - 1.0
     return values
 
 
@@ -337,9 +345,15 @@ def pinch_time_error(traj, pinch_time):
     """Relative error of the time a run stopped against the reference
     ``pinch_time`` of the singularity: ``t_failed / pinch_time - 1`` for a run
     that broke down (a state defect, or a solver that fails on the collapsing
-    cells: the status says which), NaN for a run that finished (it went
-    through the pinch without noticing it)."""
-    return float("nan") if traj.ok else traj.t_failed / pinch_time - 1.0
+    cells: the status says which), ``extinction_time / pinch_time - 1`` for one
+    that ended ``extinct`` (the torus's tube vanishing round onto its core circle:
+    :attr:`mcfbench.running.driver.Trajectory.extinction_time`, which does not move
+    with the step at which the check stops the run), NaN for a run that finished
+    (it went through the pinch without noticing it)."""
+    if traj.ok:
+        return float("nan")
+    return (traj.extinction_time if traj.status == "extinct" else traj.t_failed) \
+        / pinch_time - 1.0
 
 
 def _worst(reduce, values):

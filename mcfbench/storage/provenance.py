@@ -31,35 +31,17 @@ def package_dir(name):
     return Path(spec.origin).parent if spec is not None and spec.origin else None
 
 
-# harness modules that present results (tables, plots, report, command line,
-# file handling) but do not change what a run computes: left out of the code
-# hash that decides when the pipeline redoes a run
-COMPUTING_LAYERS = ("geometry", "running", "studies")
-"""The harness's layers whose code determines what a run computes (the code hash):
-not ``presentation`` and ``storage`` (how results are shown and stored), nor the
-command line and the Snakemake glue at the top."""
-
-
 @functools.cache
-def source_hash(name, only=None):
-    """Short SHA-256 of the Python sources of package ``name`` (paths and contents);
-    with ``only``, of the files in those subpackages only."""
+def source_hash(name):
+    """Short SHA-256 of the Python sources of package ``name`` (paths and contents):
+    what a result file's provenance names; what decides that a run is redone is
+    its code identity (:mod:`mcfbench.running.identity`)."""
     digest = hashlib.sha256()
     root = package_dir(name)
     for path in sorted(root.rglob("*.py")):
-        if only is not None and path.relative_to(root).parts[0] not in only:
-            continue
         digest.update(path.relative_to(root).as_posix().encode() + b"\0")
         digest.update(path.read_bytes() + b"\0")
     return digest.hexdigest()[:16]
-
-
-def code_hash():
-    """``{package: hash}`` of the code that determines what a run computes: the
-    scheme packages and the harness's :data:`COMPUTING_LAYERS`, so that a change of
-    a table, a plot or the report redoes no run."""
-    return {name: source_hash(name, COMPUTING_LAYERS if name == "mcfbench" else None)
-            for name in SOURCE_PACKAGES if package_dir(name) is not None}
 
 
 @functools.cache
@@ -88,7 +70,7 @@ def dependency_versions():
     (recursively, the extras included), sorted by name.
 
     Each distribution's metadata headers are parsed once (not the description
-    that follows them: :func:`_headers`), and a requirement that is not
+    that follows them: :func:`distribution_headers`), and a requirement that is not
     installed is looked up once: 0.02 s of CPU instead of 0.12 s, paid by
     every job when it writes its first record."""
     seen, missing, todo = {}, set(), [DISTRIBUTION]
@@ -98,16 +80,16 @@ def dependency_versions():
         if key in seen or key in missing:
             continue
         try:
-            meta = _headers(metadata.distribution(name))
+            meta = distribution_headers(metadata.distribution(name))
         except metadata.PackageNotFoundError:
             missing.add(key)
             continue
         seen[key] = meta["Version"]
-        todo += [_requirement_name(r) for r in meta.get_all("Requires-Dist") or []]
+        todo += [requirement_name(r) for r in meta.get_all("Requires-Dist") or []]
     return dict(sorted(seen.items()))
 
 
-def _headers(dist):
+def distribution_headers(dist):
     """The header fields of a distribution's core metadata (``METADATA``, or
     ``PKG-INFO``), an :class:`email.message.Message`: the part before the first
     empty line (after it comes the description, the longest part to parse)."""
@@ -117,7 +99,7 @@ def _headers(dist):
     return email.message_from_string(text.split("\n\n", 1)[0])
 
 
-def _requirement_name(requirement):
+def requirement_name(requirement):
     name = requirement.split(";")[0]
     for stop in "<>=!~[ (":
         name = name.split(stop)[0]
@@ -157,7 +139,6 @@ def provenance(config=None):
         "version": version,
         "source_hash": {name: source_hash(name) for name in SOURCE_PACKAGES
                         if package_dir(name) is not None},
-        "code_hash": code_hash(),
         "git_commit": commit,
         "git_dirty": dirty,
         "packages": dependency_versions(),

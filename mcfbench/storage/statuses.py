@@ -4,6 +4,13 @@ Statuses
 --------
 ``ok``
     Every step done and every state valid.
+``extinct``
+    The flow's own end: the last closed component vanished round, to a point
+    (isoperimetric ratio near a sphere's) or to a circle (a torus's tube round
+    about its core circle), before the final time
+    (:mod:`mcfbench.geometry.collapse`); the message names the component and its
+    extinction time. Every state before it valid: the run *reached the end*
+    (:data:`REACHED`), not a breakdown.
 ``solver_failed``
     The iteration limit was reached without meeting the tolerance.
 ``solver_breakdown``
@@ -12,7 +19,8 @@ Statuses
     The residual stopped decreasing above the tolerance.
 ``degenerated``
     Non-finite coordinates or collapsed cells (diamonds, triangles), a
-    connected component that shrank to a point or a line (the driver's check
+    connected component that shrank to a point or a line without vanishing round
+    (a flattening, a needle, a fold; the driver's check
     before every solve, :mod:`mcfbench.geometry.collapse`), or a linear solver
     that failed on a mesh whose smallest angle had collapsed
     (:meth:`mcfbench.geometry.invariants.FlowInvariants.quality_collapse`: the
@@ -34,7 +42,15 @@ Statuses
     that has none); nothing was computed.
 """
 
-STATUSES = ("ok", "solver_failed", "solver_breakdown", "solver_stagnated", "degenerated",
+STATUSES = ("ok", "extinct", "solver_failed", "solver_breakdown", "solver_stagnated", "degenerated",
             "t_escaped", "inverted", "area_grew", "unsupported")
 SOLVER_STATUSES = ("solver_failed", "solver_breakdown", "solver_stagnated")
 STATE_STATUSES = ("degenerated", "t_escaped", "inverted", "area_grew")
+REACHED = ("ok", "extinct")
+"""The statuses of a run that reached its end: the final time (or a steady state), or
+the flow's extinction. The tables and findings count the others as breakdowns."""
+
+
+def reached(status):
+    """Whether a run of ``status`` reached its end (:data:`REACHED`)."""
+    return status in REACHED

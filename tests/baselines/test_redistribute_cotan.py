@@ -15,7 +15,7 @@ from mcfbench.running.driver import simulate
 from mcfbench.running.integrators import Euler
 from mcfbench.geometry.exact import eoc
 from mcfbench.running.solver import Solver
-from mcfbench.geometry.shapes import cylinder, flat_lattice
+from mcfbench.geometry.shapes import cylinder, flat_lattice, hemisphere
 from mcfbench.geometry.spheres import icosphere
 
 EXACT = Solver(method="direct", rtol=1e-12)
@@ -42,6 +42,21 @@ def test_potential_solves_the_cotangent_poisson_problem():
     residual = L @ psi + m * f
     assert np.abs(residual).max() < 1e-11 * np.abs(m * f).max()
     assert abs((m * psi).sum()) < 1e-13                              # constant projected out
+
+
+def test_source_is_numpys():
+    """(R2)'s ``|h_i|^2 = |(L X)_i|^2 / m_i^2`` in one compiled pass: numpy's product and
+    sums to round-off, zero at the fixed vertices (a hemisphere's equator)."""
+    V, F = hemisphere(rings=4)
+    flow = redistributing(V, F, 0.01)
+    L, m, X = flow.laplacian(), flow.mass, flow.X
+    LX = L @ X.T
+    hV = np.where(flow.fixed, 0.0, (LX * LX).sum(axis=1) / m**2)
+    assert flow.fixed.any() and hV[~flow.fixed].min() > 0.0
+    area = m.sum()
+    expected = hV - (m * hV).sum() / area + 10.0 * (area / (len(m) * m) - 1.0)
+    f = redistribution_source(L, m, X, flow.fixed, 10.0)
+    np.testing.assert_allclose(f, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
 
 
 def _direct_potential(L, m, f):

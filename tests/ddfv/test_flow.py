@@ -214,6 +214,29 @@ def test_elimination_right_hand_side_is_numpys_bitwise(surface, dual_length, req
     assert not np.array_equal(rhs, base)
 
 
+@pytest.mark.parametrize("surface", ["bumpy", "hemisphere"])
+def test_squared_normal_speed_is_numpys(surface, request):
+    """The redistribution's ``h.V = (h.N)^2`` (R3) in one compiled pass
+    (``squared_normal_speed_kernel``): numpy's ``h = (X* - A X*) / dt`` and ``((h * N)
+    .sum(axis=0))^2`` bit for bit (the components summed in order), zero on the
+    Dirichlet rows (the hemisphere's equator)."""
+    from ddfv.geometry import vertex_normals
+    from ddfv.tangential_kernels import squared_normal_speed_kernel
+
+    V, F = request.getfixturevalue("bumpy") if surface == "bumpy" else hemisphere(rings=4)
+    flow = Flow(V, F, 0.002, tangential="eliminate", dual_length="chord")  # keeps u, v
+    at = flow.state + 0.01 * np.random.default_rng(5).standard_normal(flow.state.shape)
+    A, _ = flow.system(at, at, 0.0013)
+    N = vertex_normals(flow._mesh, flow._geometry_at(at)[0])
+    out = np.empty(A.shape[0])
+    squared_normal_speed_kernel(A.indptr, A.indices, A.data, at, N, 0.0013, out)
+    h = (at - (A @ at.T).T) / 0.0013
+    assert np.array_equal(out, ((h[0] * N[0] + h[1] * N[1]) + h[2] * N[2]) ** 2)
+    fixed = flow._mesh.boundary_vertices
+    assert (surface == "hemisphere") == fixed.any() and not out[:flow._mesh.n_f][fixed].any()
+    assert out[:flow._mesh.n_f][~fixed].min() > 0.0
+
+
 @pytest.mark.parametrize("options, message", [
     (dict(tau=0.0), "tau must be a positive number"),
     (dict(tau=float("nan")), "tau must be a positive number"),

@@ -12,7 +12,7 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from kept_factor import KeptFactorSolver, cholesky_solve, factorise, pinned
+from kept_factor import KeptFactorSolver, cholesky_solve, factorise, family_blocks, pinned
 from kept_factor.nearby_systems import _preconditioned_cg
 from mcfbench.geometry.spheres import icosphere
 
@@ -160,6 +160,32 @@ def test_size_change_factorises_again():
     A = sp.eye(5, format="csr") * 2.0
     np.testing.assert_allclose(_solve(solver, A, np.ones(5), sequence="x"), 0.5)
     assert solver.factorisations == 2
+
+
+def test_family_blocks_precondition_cg_to_the_direct_solution():
+    """Two families coupled: ``[[I + L, C], [C^T, I + L]]`` with ``C = 0.2 I`` (SPD, the
+    blocks' factors not the matrix's): CG with the blocks reaches the tolerance, the
+    solution is the direct one to it, one factorisation for the sequence; the blocks
+    alone (``C = 0``) are exact (no iteration); a nonsymmetric matrix gets the LU of
+    the whole."""
+    n = len(V)
+    solver = KeptFactorSolver(rtol=1e-10, max_iterations=30, factorise=family_blocks(n))
+    for k in range(4):
+        block = _matrix(k)
+        A = sp.bmat([[block, 0.2 * sp.eye(n)], [0.2 * sp.eye(n), block]]).tocsr()
+        b = np.r_[_rhs(k), _rhs(k + 5)]
+        x = _solve(solver, A, b, sequence="x")
+        assert np.linalg.norm(b - A @ x) <= 1e-10 * np.linalg.norm(b)
+        np.testing.assert_allclose(x, spla.spsolve(A.tocsc(), b), rtol=0, atol=1e-8)
+    assert (solver.factorisations, solver.method) == (1, "cg")
+    assert solver.iterations >= 4                   # the coupling costs iterations
+    A = sp.block_diag([_matrix(0), _matrix(1)]).tocsr()
+    method, solve = family_blocks(n)(A)
+    b = np.r_[_rhs(0), _rhs(1)]
+    assert method == "cg"
+    np.testing.assert_allclose(solve(b), spla.spsolve(A.tocsc(), b), rtol=0, atol=1e-12)
+    A = sp.bmat([[_matrix(0), 0.2 * sp.eye(n)], [None, _matrix(1)]]).tocsr()
+    assert family_blocks(n)(A)[0] == "refinement"
 
 
 def test_pinned_system():

@@ -25,14 +25,18 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 HARNESS = ROOT / "mcfbench"
-LAYERS = ("storage", "geometry", "running", "problems", "presentation", "studies")
+LAYERS = ("storage", "geometry", "running", "schemes", "problems", "presentation", "studies")
 # layer -> the mcfbench modules (prefixes) it may import
 ALLOWED = {
     "storage": ("mcfbench.storage",),
     "geometry": ("mcfbench.storage", "mcfbench.geometry"),
-    "running": ("mcfbench.storage", "mcfbench.geometry", "mcfbench.running", "mcfbench.problems"),
-    # a problem module: what the registry's own entries use
-    "problems": ("mcfbench.storage", "mcfbench.geometry", "mcfbench.running.problems",
+    "running": ("mcfbench.storage", "mcfbench.geometry", "mcfbench.running", "mcfbench.schemes",
+                "mcfbench.problems"),
+    # a scheme module: the class it declares, never the registry (which imports it)
+    "schemes": ("mcfbench.running.scheme", "mcfbench.schemes"),
+    # a problem module: the class, the observers, the real meshes' generator
+    "problems": ("mcfbench.storage", "mcfbench.geometry", "mcfbench.running.problem",
+                 "mcfbench.running.observers", "mcfbench.running.real_mesh_problems",
                  "mcfbench.problems"),
     "presentation": ("mcfbench.storage", "mcfbench.geometry", "mcfbench.presentation",
                      "mcfbench.running.schemes", "mcfbench.running.problems",

@@ -417,14 +417,22 @@ def test_run_jobs_wait_for_one_kernel_compilation(tmp_path, env):
 
 
 def test_a_code_change_compiles_and_reruns_in_one_invocation(tmp_path, env):
-    """The kernels' file is named by the code hash: after a change of a scheme's
-    source the dry run plans the compilation and the runs it redoes together."""
+    """The kernels' file is named by the runs' code identity: after a change of a
+    presentation module the dry run plans no run; after a change of a scheme's
+    source it plans the compilation and the runs it redoes together."""
     work = copy_workflow(tmp_path / "work")
-    shutil.copytree(REPO / "baselines", work / "baselines", ignore=IGNORE)  # ours to change
+    for package in ("baselines", "mcfbench"):                     # ours to change
+        shutil.copytree(REPO / package, work / package, ignore=IGNORE)
     env = {**env, "PYTHONPATH": os.pathsep.join([str(work), env["PYTHONPATH"]])}
     target = ["--cores", "1", "convergence", "--config", "levels=[1]", "schemes=[cotan]"]
     code, out = snakemake(work, env, *target)
     assert code == 0, out[-3000:]
+    with open(work / "mcfbench" / "studies" / "convergence" / "tables.py", "a") as source:
+        source.write("\n# a change of the table's presentation\n")
+    dry = subprocess.run([sys.executable, "-m", "snakemake", "-n", *target], cwd=work, env=env,
+                         capture_output=True, text=True, timeout=TIMEOUT)
+    assert dry.returncode == 0, dry.stdout[-2000:]
+    assert "rule compile_kernels:" not in dry.stdout and "rule run_scheme:" not in dry.stdout
     with open(work / "baselines" / "cotan.py", "a") as source:
         source.write("\n# a change of the scheme's source\n")
     dry = subprocess.run([sys.executable, "-m", "snakemake", "-n", *target], cwd=work, env=env,

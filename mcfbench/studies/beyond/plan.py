@@ -243,8 +243,10 @@ TABLE_STUDIES = ("levels", "long_time", "space", "time")
 
 def every_scheme():
     """Every scheme of the registry with every time integrator (``NAME``, then
-    ``NAME@bdf2``, ...): the default schemes of the time study."""
+    ``NAME@bdf2``, ...; a scheme that integrates in time itself only as ``NAME``): the
+    default schemes of the time study."""
     from mcfbench.running.integrators import INTEGRATORS
     from mcfbench.running.schemes import SCHEMES, joined_name
 
-    return [joined_name(s, i) for i in INTEGRATORS for s in SCHEMES]
+    return [joined_name(s, i) for i in INTEGRATORS for s in SCHEMES
+            if i == "euler" or not SCHEMES[s].integrates_itself]

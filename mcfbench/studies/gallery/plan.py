@@ -6,11 +6,13 @@ from pathlib import Path
 
 from mcfbench.studies.config import ConfigError
 from mcfbench.studies.gallery import MESH
-from mcfbench.studies.matrix import REAL_WORLD_SURFACES, is_real_world
+from mcfbench.studies.matrix import is_real_world
 from mcfbench.studies.matrix.plan import robust_method
 
-GALLERY_SURFACES = REAL_WORLD_SURFACES
-"""Surfaces of the built-in gallery when the registry has no real-world-like problem."""
+GALLERY_SURFACES = ("blobby", "implicit_torus", "perturbed_sphere", "remeshed_sphere",
+                    "anisotropic_sphere", "flat_patch")
+"""Surfaces of :mod:`mcfbench.geometry.surfaces` that imitate meshes from the real world:
+the built-in gallery when the registry has no real-world-like problem."""
 
 
 MESH_SUFFIXES = (".obj", ".off", ".ply", ".stl")

@@ -11,7 +11,8 @@ meshes (``tau_rule = "mesh"``). The study's modules
   spec of every run (its record and first and last frames in the run store,
   :mod:`mcfbench.storage.run_store`; computed by :mod:`mcfbench.running.batch`);
 * :mod:`.aggregate`: the records into the tables (:mod:`.tables`);
-* :mod:`.findings`: ``findings.md`` from the summary table only, in words;
+* :mod:`.findings`: ``findings.md`` from the summary table only, in words, the
+  verdicts' data from :mod:`.verdicts`;
 * :mod:`.plots`: the figures; :mod:`.page`: the results page (``index.html``).
 
 The presentation modules (:mod:`.tables`, :mod:`.findings`, :mod:`.plots`,
@@ -59,22 +60,17 @@ def is_mesh_problem(problem):
     return getattr(problem, "tau_rule", "level") == "mesh"
 
 
-REAL_WORLD_SURFACES = ("blobby", "implicit_torus", "perturbed_sphere", "remeshed_sphere",
-                       "anisotropic_sphere", "flat_patch", "real_mesh")
-"""Surfaces of :mod:`mcfbench.geometry.surfaces` that imitate meshes from the real world,
-and ``real_mesh``: the committed real meshes (:mod:`mcfbench.running.real_mesh_problems`)."""
-
-
 def is_real_mesh(problem):
-    """One of the committed real meshes with its reference answers."""
-    return getattr(problem, "surface", "") == "real_mesh"
+    """One of the committed real meshes with its reference answers (the problem's
+    ``kind``, :data:`mcfbench.running.problem.KINDS`)."""
+    return getattr(problem, "kind", "") == "real_mesh"
 
 
 def is_real_world(problem):
-    """A real-world-like mesh: a mesh problem or one on a surface of
-    :data:`REAL_WORLD_SURFACES` (a bad mesh of a simple surface). The
-    recommendation asks that a scheme does not break down on these."""
-    return is_mesh_problem(problem) or getattr(problem, "surface", "") in REAL_WORLD_SURFACES
+    """A real-world-like mesh: a problem of kind ``real_world`` (a bad mesh of a
+    simple surface, a scanned-like mesh) or ``real_mesh``. The recommendation asks
+    that a scheme does not break down on these."""
+    return getattr(problem, "kind", "") in ("real_world", "real_mesh")
 
 
 def reference_accuracies(plan):

@@ -21,6 +21,7 @@ from mcfbench.presentation.picture_grid import draw_grid, last_frames, run_note 
 from mcfbench.presentation.plots import SMALLEST_TEXT  # noqa: E402
 from mcfbench.presentation.plots import style as scheme_style  # noqa: E402
 from mcfbench.storage.atomic import save_figure  # noqa: E402
+from mcfbench.storage.statuses import reached  # noqa: E402
 from mcfbench.studies.matrix.tables import is_error, main_runs  # noqa: E402
 
 T_FLOOR = -0.5
@@ -81,7 +82,7 @@ def error_figure(table, paths, problems=None, schemes=None):
             if not len(rows):
                 continue
             label, style = scheme_style(scheme)
-            if (rows["status"] != "ok").any():
+            if not rows["status"].map(reached).all():       # ok or extinct: reached
                 broke.append(scheme)
             if error:     # a value measured before a later breakdown (the pinch) counts
                 ok = rows[np.isfinite(rows["value"])]

@@ -14,7 +14,7 @@ schemes and the problems they ran (:func:`strategy_frame`):
   error of the finest-level error relative to the smallest of any scheme there
   (:func:`mcfbench.studies.matrix.tables.error_ratios`, the recommendation's score);
 - mesh quality over time: the smallest angle of the triangles and the largest
-  ratio of neighbouring covolumes (:func:`mcfbench.geometry.quality.covolume_ratio`)
+  ratio of neighbouring covolumes (:func:`mcfbench.geometry.metrics.covolume_ratio`)
   at the start, the middle and the end of the finest level's run
   (:func:`mcfbench.studies.matrix.tables.quality_over_time`), the median over
   its schemes and problems;

@@ -3,12 +3,15 @@
 import numpy as np
 import pytest
 
+from baselines.cotan import CotanFlow
+from ddfv import Flow
 from mcfbench.geometry.metrics import (
     area,
     area_ratio,
     aspect_ratios,
     catenoid_parameter,
     catenoid_profile_error,
+    covolume_ratio,
     flipped_triangles,
     l2_height,
     lumped_mass,
@@ -23,7 +26,7 @@ from mcfbench.geometry.metrics import (
     volume,
 )
 from mcfbench.geometry.shapes import cylinder, flat_lattice, hemisphere
-from mcfbench.geometry.spheres import icosahedron
+from mcfbench.geometry.spheres import icosahedron, icosphere
 
 # a* of R = 1, h = 0.5 to 21 digits (mpmath.findroot at 30 digits)
 A_CATENOID = 0.848337938094979002054
@@ -299,3 +302,27 @@ def test_quality_kernel_matches_a_numpy_evaluation():
                 assert got[key] == pytest.approx(expected[key], rel=1e-12), key
     with pytest.raises(ValueError):
         quality(V, F, (np.array([0]), np.array([len(F)])))
+
+
+def test_covolume_ratio_of_known_covolumes_and_of_a_flowing_mesh():
+    """The largest ratio over the edges, either way round; 1 on the icosahedron (equal
+    covolumes by symmetry), for the lumped mass of cotan and DDFV's chi alike; a
+    non-positive covolume is a collapsed cell (inf), a non-finite one NaN."""
+    faces = np.array([[0, 1, 2], [0, 2, 3]])
+    assert covolume_ratio([1.0, 2.0, 8.0, 0.5], faces) == 16.0        # edge 2-3
+    assert covolume_ratio([3.0, 3.0, 3.0, 3.0], faces) == 1.0
+    assert covolume_ratio([1.0, 0.0, 1.0, 1.0], faces) == np.inf
+    assert np.isnan(covolume_ratio([1.0, np.nan, 1.0, 1.0], faces))
+    with pytest.raises(ValueError, match="one per vertex"):
+        covolume_ratio([1.0, 2.0], faces)
+    V, F = icosphere(0)
+    for flow in (CotanFlow(V, F, 0.01), Flow(V, F, 0.01)):
+        assert covolume_ratio(flow.l2_weights[:len(V)], F) == pytest.approx(1.0, abs=1e-12)
+    # level 2 of the icosphere is graded: its covolumes differ by up to ~1.3
+    V, F = icosphere(2)
+    ratio = covolume_ratio(CotanFlow(V, F, 0.01).l2_weights, F)
+    masses = CotanFlow(V, F, 0.01).l2_weights
+    i, j = F.ravel(), F[:, [1, 2, 0]].ravel()
+    assert ratio == pytest.approx(max((masses[i] / masses[j]).max(),
+                                      (masses[j] / masses[i]).max()))
+    assert 1.1 < ratio < 1.5

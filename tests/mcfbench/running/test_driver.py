@@ -8,8 +8,10 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate
 from mcfbench.running.flow import SchemeFlow
+from mcfbench.running.schemes import SCHEMES
 from mcfbench.running.solver import Solver
 
 
@@ -185,3 +187,28 @@ def test_every_run_builds_its_own_kept_factor(monkeypatch):
     again = simulate(Decay(V0, FACES, 0.1), 3, solver=solver)
     assert factored == [(4, 4), (4, 4)] and solver._kept == {}
     assert np.array_equal(first.frames["vertices"], again.frames["vertices"])
+
+
+def test_a_run_that_ends_ok_has_no_extinction():
+    V, F = icosphere(1)
+    traj = simulate(SCHEMES["cotan"].make(V, F, 0.01), 5, save_every=0)
+    assert traj.ok and traj.events == [] and np.isnan(traj.extinction_time)
+    assert traj.flow.n == 5 and np.array_equal(traj.faces, F)
+    ended = simulate(SCHEMES["cotan"].make(V, F, 0.01), 40, save_every=0)
+    assert ended.status == "extinct" and ended.extinction_time == \
+        ended.events[-1]["extinction_time"] > ended.t_failed
+
+
+def test_an_invalid_state_is_never_the_flows_end():
+    """The icosphere under x' = -x, tau = 0.5: round, its area 0.198 of the initial one at
+    step 2 with A / (16 pi) = 0.046 < 2 tau left: ``extinct`` there, unless the state has
+    a defect of its own, which is the run's status (stop and record modes alike)."""
+    V, F = icosphere(1)
+    assert simulate(Decay(V, F, 0.5), 6).status == "extinct"
+    stopped = simulate(Decay(V, F, 0.5, defect_at=2), 6)
+    assert stopped.status == "t_escaped" and stopped.events == [] and stopped.steps_done == 2
+    recorded = simulate(Decay(V, F, 0.5, defect_at=2), 6, on_defect="record")
+    assert recorded.status == "t_escaped" and recorded.steps_done == 2
+    assert [d["status"] for d in recorded.defects] == ["t_escaped", "extinct"]
+    # its last state: extinct only once collapsed, whatever its time left
+    assert simulate(Decay(V, F, 0.5), 2).status == "ok"

@@ -95,7 +95,7 @@ TINY = '''"""A unit sphere at level 1-2 with its radius as the metric (a drop-in
 
 import numpy as np
 
-from mcfbench.running.problems import Problem
+from mcfbench.running.problem import Problem
 
 
 def surface(subdivisions=1):
@@ -130,7 +130,7 @@ def test_a_problem_is_one_file_found_by_the_registry(tmp_path, monkeypatch):
     """One new module, no other file edited: the registry finds the problem, its
     surface, its observer and its main metric; the matrix plans it and a run measures it."""
     from mcfbench.geometry import surfaces
-    from mcfbench.running import problems
+    from mcfbench.running import observers, problems
     from mcfbench.running.run import run
     from mcfbench.studies.matrix import plan as matrix_plan
     from mcfbench.studies.matrix.tables import main_metric
@@ -141,7 +141,7 @@ def test_a_problem_is_one_file_found_by_the_registry(tmp_path, monkeypatch):
     (package / "tiny_sphere.py").write_text(TINY)
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.setattr(problems, "PROBLEMS", dict(problems.PROBLEMS))
-    monkeypatch.setattr(problems, "METRICS", dict(problems.METRICS))
+    monkeypatch.setattr(observers, "METRICS", dict(observers.METRICS))
     monkeypatch.setattr(surfaces, "SURFACES", dict(surfaces.SURFACES))
 
     assert problems.discover_problems([str(package)], "dropin_problems") == ["tiny_sphere"]
@@ -156,5 +156,45 @@ def test_a_problem_is_one_file_found_by_the_registry(tmp_path, monkeypatch):
     # one step of tau = 0.04 from the unit sphere: R = sqrt(1 - 4 tau) = 0.916..., up to h^2
     assert result.status == "ok" and result.steps_done == 1
     assert abs(result.metrics["mean_radius"] - np.sqrt(1 - 4 * 0.04)) < 0.03
-    with pytest.raises(ValueError, match="already in the registry"):
+    with pytest.raises(ValueError, match="'tiny_sphere' is declared twice: by dropin_problems.tiny_sphere and by dropin_problems.tiny_sphere"):
         problems.discover_problems([str(package)], "dropin_problems")
+
+
+def test_a_problems_kind_says_what_it_tests():
+    """``kind`` decides what the matrix's REAL_WORLD_SURFACES and tau_rule decided before:
+    the same 12 real-world-like generated or committed meshes' problems."""
+    from mcfbench.studies.matrix import is_real_mesh, is_real_world
+
+    kinds = {name: p.kind for name, p in PROBLEMS.items()}
+    assert [n for n, k in kinds.items() if k == "reference"] == ["torus", "dumbbell"]
+    assert [n for n, k in kinds.items() if k == "real_world"] == [
+        "perturbed_sphere", "remeshed_sphere", "anisotropic_sphere", "flat_patch", "blobby",
+        "marching_torus"]
+    assert {n for n, k in kinds.items() if k == "real_mesh"} == \
+        {n for n in PROBLEMS if n.startswith("real_")}
+    assert all(is_real_world(p) == (p.kind in ("real_world", "real_mesh"))
+               and is_real_mesh(p) == (p.kind == "real_mesh") for p in PROBLEMS.values())
+    assert all(p.kind != "exact" for p in PROBLEMS.values() if p.tau_rule == "mesh")
+    assert Problem.user_mesh("my mesh", steps=3).kind == "real_world"
+
+
+def test_a_problem_records_the_data_files_it_reads():
+    for name, problem in PROBLEMS.items():
+        if problem.kind != "real_mesh":
+            assert problem.data_files == (), name
+            continue
+        mesh = name.removeprefix("real_")
+        assert all(f.is_file() for f in problem.data_files)
+        assert [f.name for f in problem.data_files] == [
+            mesh_manifest()[mesh]["file"], f"{mesh}.json", f"{mesh}.npz"]
+
+
+def test_to_extinction_lets_a_run_pass_t_max():
+    sphere = get_problem("sphere")
+    with pytest.raises(ValueError, match="set the problem's to_extinction"):
+        sphere.time_steps(0.01, 0.3)
+    with pytest.raises(ValueError, match="past the extinction time"):
+        sphere.time_steps(0.01, 0.25)
+    assert sphere.time_steps(0.01, 0.24) == 24
+    assert sphere.with_settings(to_extinction=True).time_steps(0.01, 0.3) == 30
+    assert not any(p.to_extinction for p in PROBLEMS.values())

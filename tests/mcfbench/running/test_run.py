@@ -58,7 +58,7 @@ def test_run_records_quality_and_the_t_monitor():
     # the covolume ratio at every sample: at t = 0 that of the icosphere's lumped mass
     # (cotan) and of the F-covolumes chi of the paper's T-vertices (DDFV, not the same)
     from mcfbench.geometry.metrics import lumped_mass
-    from mcfbench.geometry.quality import covolume_ratio
+    from mcfbench.geometry.metrics import covolume_ratio
 
     V, F = icosphere(1)
     for r in (result, cotan):
@@ -88,6 +88,43 @@ def test_breakdown_keeps_partial_results_and_names_the_time():
 def test_running_past_the_extinction_of_the_sphere_is_refused():
     with pytest.raises(ValueError, match="past the extinction time 0.25 of the sphere"):
         run("ddfv", "sphere", 1, tau=0.04, t_final=0.32)
+
+
+@pytest.mark.parametrize("scheme, level, tau, error", [
+    ("cotan", 1, 2.5e-4, 4.6e-3), ("bgn", 3, 5e-4, 8.2e-4), ("ddfv-chord", 2, 2.5e-4, 5.8e-3)])
+def test_the_unit_sphere_run_to_its_extinction_ends_within_one_percent(scheme, level, tau,
+                                                                      error):
+    """Issue #44's target: past t = 0.25 (``to_extinction``) the run ends ``extinct``
+    within 1 % of R^2 / 4, its extinction time the last state's time plus the time a
+    round sphere of its area has left (:mod:`mcfbench.geometry.collapse`). The levels
+    and steps are those where each scheme gets within it: BGN's coarse spheres shrink
+    faster (level 2, tau = 5e-4: 0.2445, -2.2 %), the semi-implicit steps lag at the
+    end (cotan, level 1, tau = 1e-3: 0.2535, +1.4 %)."""
+    problem = get_problem("sphere").with_settings(to_extinction=True)
+    result, traj = run(scheme, problem, level, tau=tau, t_final=0.3)
+    assert result.status == "extinct", result.message
+    assert result.metrics["extinction_time_error"] == pytest.approx(error, abs=1e-4)
+    assert abs(result.metrics["extinction_time_error"]) < 0.01
+    assert traj.extinction_time == pytest.approx(0.25 * (1 + error), abs=2.5e-5)
+    assert traj.t_failed == result.t_failed == result.t_end
+    assert 0 < traj.extinction_time - result.t_failed < 2 * tau
+    assert np.isnan(result.metrics["l2_error"])       # no error at t_final = 0.3
+
+
+def test_the_torus_past_its_pinch_ends_extinct_on_its_core_circle():
+    """Issue #45, item 2: the torus (2, 0.5) collapses onto its core circle; cotan at
+    levels 1-2 ends ``extinct`` (a circle), its extinction time 5.3 % and 2.2 % after the
+    axisymmetric reference's pinch at 0.127111 (before: ``degenerated`` at t = 0.148 and
+    0.133, the tube shrunk to a line)."""
+    errors = []
+    for level in (1, 2):
+        result, traj = run("cotan", "torus", level)
+        assert result.status == "extinct", result.message
+        [event] = traj.events
+        assert event["kind"] == "circle" and "to a circle" in result.message
+        errors.append(result.metrics["pinch_time_error"])
+        assert errors[-1] == pytest.approx(traj.extinction_time / 0.127110542534 - 1)
+    assert errors == pytest.approx([0.0530, 0.0218], abs=5e-4)
 
 
 FIRST_AND_SECOND = """

@@ -54,25 +54,6 @@ def test_config_hash_ignores_key_order():
     assert config_hash({"a": 1}) != config_hash({"a": 2})
 
 
-def test_code_hash_follows_the_computing_layers_only(tmp_path, monkeypatch):
-    """A change in presentation or storage redoes no run; one in running does."""
-    import shutil
-
-    from mcfbench.storage import provenance
-
-    copy = tmp_path / "mcfbench"
-    shutil.copytree(ROOT / "mcfbench", copy, ignore=shutil.ignore_patterns("__pycache__"))
-    monkeypatch.setattr(provenance, "package_dir", lambda name: copy)
-    before = provenance.source_hash.__wrapped__("mcfbench", provenance.COMPUTING_LAYERS)
-    for changed in (copy / "presentation" / "formats.py", copy / "storage" / "atomic.py"):
-        with open(changed, "a") as f:
-            f.write("# changed\n")
-    assert provenance.source_hash.__wrapped__("mcfbench", provenance.COMPUTING_LAYERS) == before
-    with open(copy / "running" / "run.py", "a") as f:
-        f.write("# changed\n")
-    assert provenance.source_hash.__wrapped__("mcfbench", provenance.COMPUTING_LAYERS) != before
-
-
 def test_git_is_asked_once_per_process_and_path(monkeypatch, tmp_path):
     from mcfbench.storage import provenance as module
 

@@ -424,9 +424,12 @@ def test_default_config_passes_the_schema_and_the_checks():
     assert settings["levels"] == [1, 2, 3, 4, 5, 6]
     assert settings["schemes"] == ["ddfv", "ddfv-chord", "ddfv-eliminate", "cotan",
                                    "ddfv@bdf2", "ddfv-chord@bdf2", "cotan@bdf2"]
-    # the time study: every scheme of the registry with each integrator
+    # the time study: every scheme of the registry with each integrator (a scheme that
+    # integrates in time itself with its own only)
     assert settings["time_study"]["schemes"] == [
-        *SCHEMES, *(f"{s}@{i}" for i in INTEGRATORS if i != "euler" for s in SCHEMES)]
+        *SCHEMES, *(f"{s}@{i}" for i in INTEGRATORS if i != "euler" for s in SCHEMES
+                    if not SCHEMES[s].integrates_itself)]
+    assert "bgn-bdf2" in settings["time_study"]["schemes"]
     assert settings["long_time"]["t_final"] == 0.15 and settings["long_time"]["level"] == 5
     assert settings["time_study"]["taus"] == sorted(settings["time_study"]["taus"],
                                                     reverse=True)

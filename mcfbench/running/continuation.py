@@ -1,0 +1,112 @@
+"""A run that loses one closed component of several goes on with the rest.
+
+When a component vanishes round (``extinct``, :mod:`mcfbench.geometry.collapse`)
+and others remain, the driver (:func:`mcfbench.running.driver.simulate`, its
+``rebuild``) drops the component's vertices and triangles and builds the
+scheme's flow anew on what remains (:func:`sub_flow`): the positions of the
+remaining vertices, and DDFV's T-vertices of the remaining triangles as its
+``T0`` (:attr:`mcfbench.running.schemes.Scheme.extra_points`), at the same time
+level. That is the same flow only for a scheme whose step depends on its
+current state alone; :func:`why_not` names the others, whose runs end
+``degenerated`` saying so:
+
+- a tangential strategy that keeps something of the initial state:
+  ``conformal`` (conformalized MCF keeps its initial stiffness), ``deturck``
+  (its harmonic map heat flow is onto the initial mesh), ``redistribute`` (its
+  rate is ``omega 4 pi / A_0``, ``A_0`` the initial area; DDFV's needs a
+  connected surface anyway), ``kll`` (its evolved normal and mean curvature
+  would be measured again from the mesh);
+- an integrator with past states (BDF2, BDF3: ``X^{n-1}, ...`` of the vanished
+  vertices, in each flow's own numbering).
+"""
+
+import numpy as np
+
+from mcfbench.running.integrators import INTEGRATORS
+
+STATE_ONLY = ("none", "eliminate", "bgn", "mdr", "intrinsic-delaunay")
+"""The tangential strategies (:data:`mcfbench.running.schemes.TANGENTIAL`) whose step
+depends on the current state alone: a flow of them rebuilt on a sub-mesh is the same
+flow there. DDFV's carried T-vertices keep their barycentric coordinates, which the
+rebuilt flow reads from ``T0``."""
+
+
+def why_not(scheme, integrator=None):
+    """Why a run of ``scheme`` cannot go on without a vanished component, or None.
+
+    Parameters
+    ----------
+    scheme : mcfbench.running.schemes.Scheme
+    integrator : str, optional
+        Default the scheme's.
+
+    Returns
+    -------
+    str or None
+    """
+    integrator = scheme.integrator if integrator is None else integrator
+    if scheme.tangential not in STATE_ONLY:
+        return (f"{scheme.name}'s tangential strategy {scheme.tangential!r} keeps something "
+                "of the initial state, which a flow rebuilt on the remaining components "
+                "would not (mcfbench.running.continuation)")
+    if INTEGRATORS[integrator].order > 1:
+        return (f"the {integrator} integrator's past states are not carried to the "
+                "remaining components (mcfbench.running.continuation)")
+    return None
+
+
+def sub_mesh(faces, keep):
+    """The triangles of the vertices ``keep``, renumbered.
+
+    Parameters
+    ----------
+    faces : (m, 3) int array
+    keep : (n,) bool array
+        The vertices kept; a triangle is kept when its vertices are.
+
+    Returns
+    -------
+    faces : (m', 3) int array
+        In the kept vertices' numbering (their order kept).
+    kept_faces : (m,) bool array
+    """
+    F = np.asarray(faces)
+    kept_faces = keep[F].all(axis=1)
+    number = np.cumsum(keep) - 1
+    return number[F[kept_faces]], kept_faces
+
+
+def sub_flow(scheme, flow, keep, *, integrator=None, threads=1, **options):
+    """The flow of ``scheme`` on the vertices ``keep`` of ``flow``, at its time level.
+
+    Parameters
+    ----------
+    scheme : mcfbench.running.schemes.Scheme
+    flow : mcfbench.running.flow.SchemeFlow
+    keep : (n,) bool array
+        The mesh vertices kept (whole components).
+    integrator : str, optional
+        The run's integrator (default the scheme's).
+    threads : int
+    **options
+        The run's options of the flow class.
+
+    Returns
+    -------
+    mcfbench.running.flow.SchemeFlow
+
+    Raises
+    ------
+    ValueError
+        The scheme cannot go on this way (:func:`why_not`).
+    """
+    reason = why_not(scheme, integrator)
+    if reason is not None:
+        raise ValueError(reason)
+    faces, kept_faces = sub_mesh(flow.faces, keep)
+    if scheme.extra_points:
+        options = {**options, "T0": flow.frame()["extra_points"][kept_faces]}
+    new = scheme.make(np.asarray(flow.vertices)[keep], faces, flow.tau, threads=threads,
+                      **options)
+    new.n = flow.n
+    return new

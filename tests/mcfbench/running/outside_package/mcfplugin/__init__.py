@@ -1,0 +1,1 @@
+"""A researcher's own scheme, outside the suite: joins it by an entry point."""
