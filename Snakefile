@@ -17,7 +17,7 @@ import os
 
 from snakemake.utils import min_version
 
-from mcfbench.pipeline import check_config, message_only
+from mcfbench.pipeline import check_config, message_only, study_rule_files
 from mcfbench.storage.provenance import BLAS_THREAD_VARIABLES
 
 # One BLAS thread per job, set once here: every job inherits it (local or
@@ -42,14 +42,13 @@ report: "workflow/report/workflow.rst"
 include: "workflow/rules/common.smk"
 include: "workflow/rules/kernels.smk"
 include: "workflow/rules/runs.smk"
-include: "workflow/rules/convergence.smk"
-# Hook for the figure rules maintained separately: figures.smk defines
-# FIGURE_TARGETS (the files `rule all` builds) and its rules.
-include: "workflow/rules/figures.smk"
-include: "workflow/rules/beyond.smk"
-include: "workflow/rules/report.smk"
-include: "workflow/rules/matrix.smk"
-include: "workflow/rules/gallery.smk"
+
+
+# every study's rule file, in name order (report.smk after beyond.smk and
+# figures.smk, whose targets it reads): a new study is a rule file there, no line here
+for _rules in study_rule_files(f"{workflow.basedir}/workflow/rules"):
+
+    include: _rules
 
 
 rule all:
@@ -58,30 +57,4 @@ rule all:
         CONVERGENCE_TARGETS,
         FIGURE_TARGETS,
         REPORT_TARGETS,
-    localrule: True
-
-
-rule beyond:
-    """Target: level 6, the scheme variants and the stability study (slow)."""
-    input:
-        # the plan first: a bad value under `beyond` is named here
-        lambda wildcards: PLANS.checked("beyond", BEYOND_TARGETS),
-    localrule: True
-
-
-rule matrix:
-    """Target: every scheme x every problem x its levels (config key `matrix`; its
-    cost: config/config.yaml), tables, figures and findings in results/matrix/."""
-    input:
-        # the plan first: a bad value under `matrix` is named here
-        lambda wildcards: PLANS.checked("matrix", MATRIX_TARGETS),
-    localrule: True
-
-
-rule gallery:
-    """Target: every scheme on every mesh file (`--config meshes=DIR`; default the
-    suite's own meshes), table and pictures in results/gallery/."""
-    input:
-        # the plan first: a bad value under `gallery` is named here
-        lambda wildcards: PLANS.checked("gallery", GALLERY_TARGETS),
     localrule: True

@@ -50,8 +50,34 @@ from mcfbench.studies.config import ConfigError, check_threads
 PROBLEM = "sphere"
 """The problem of the kernels' warm-up (:func:`warm_kernels`)."""
 
-RUN_STUDIES = ("convergence", "beyond", "matrix", "gallery")
-"""The studies whose runs are in the run store (``plan.run_specs(plans)`` of each)."""
+FRAMEWORK_RULES = ("common.smk", "kernels.smk", "runs.smk")
+"""The rule files every study's builds on (the Snakefile includes them first)."""
+
+
+def studies():
+    """The studies: the folders of :mod:`mcfbench.studies` with a ``plan`` module, in
+    name order. A new study is a folder there (and its rule file and config key):
+    nothing here lists them."""
+    import mcfbench.studies
+
+    folder = Path(mcfbench.studies.__path__[0])
+    return [p.name for p in sorted(folder.iterdir()) if (p / "plan.py").is_file()]
+
+
+def run_studies():
+    """The studies whose runs are in the run store (their ``plan`` module has
+    ``run_specs(plans)``), in name order. Every one is planned while Snakemake reads
+    the workflow, whatever the targets (Snakemake sets them after reading it): the
+    gallery's specs hash the meshes it generates, in memory until its rule writes
+    them (2 CPU s under load, once)."""
+    return [study for study in studies()
+            if hasattr(importlib.import_module(f"mcfbench.studies.{study}.plan"), "run_specs")]
+
+
+def study_rule_files(folder):
+    """The rule files of ``folder`` (``workflow/rules``) but :data:`FRAMEWORK_RULES`,
+    in name order: what the Snakefile includes after those."""
+    return [str(p) for p in sorted(Path(folder).glob("*.smk")) if p.name not in FRAMEWORK_RULES]
 
 
 def check_config(config, schema_path):
@@ -67,11 +93,12 @@ def check_config(config, schema_path):
     import yaml
 
     known = yaml.safe_load(Path(schema_path).read_text())["properties"]
-    unknown = sorted(set(config) - set(known))
+    unknown = sorted(set(config) - set(known) - set(studies()))
     if unknown:
         raise ConfigError(f"unknown config key(s) {unknown}; known keys: "
-                          f"{', '.join(sorted(known))} (config/README.md)")
-    _validate(config, schema_path, [])
+                          f"{', '.join(sorted({*known, *studies()}))} (config/README.md)")
+    # a study's section that the schema does not name is its plan's to check
+    _validate({k: v for k, v in config.items() if k in known}, schema_path, [])
 
 
 def check_section(config, key, schema_path):
@@ -237,24 +264,21 @@ class Plans:
 
 class RunStore:
     """The run store's plan for the workflow: the specs of every study of
-    :data:`RUN_STUDIES` whose section is good (a bad one contributes no spec; its
+    :func:`run_studies` whose section is good (a bad one contributes no spec; its
     target names the key, :meth:`Plans.checked`), gathered into batches.
 
     Parameters
     ----------
     plans : Plans or WorkflowPlans
     studies : sequence of str
-        The studies planned (default :data:`RUN_STUDIES`). The gallery's specs hash
-        its mesh files (the suite's own ones generated in memory before their rule
-        writes them: seconds), so the workflow plans them only when the gallery is
-        asked for; no other study shares its runs, so the other batches stay the same.
+        The studies planned (default :func:`run_studies`).
     """
 
-    def __init__(self, plans, studies=RUN_STUDIES):
+    def __init__(self, plans, studies=None):
         from mcfbench.running.batching import batches
 
         self.requests = {}
-        for study in studies:
+        for study in run_studies() if studies is None else studies:
             module = importlib.import_module(f"mcfbench.studies.{study}.plan")
             try:
                 self.requests[study] = list(module.run_specs(plans))

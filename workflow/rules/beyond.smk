@@ -246,3 +246,11 @@ rule beyond_scaling:
         settings={"t_final": config["t_final"]},
     script:
         "../scripts/beyond_scaling.py"
+
+
+rule beyond:
+    """Target: level 6, the scheme variants and the stability study (slow)."""
+    input:
+        # the plan first: a bad value under `beyond` is named here
+        lambda wildcards: PLANS.checked("beyond", BEYOND_TARGETS),
+    localrule: True

@@ -9,8 +9,7 @@
 # (config key `gallery`). Without `meshes` the suite first writes its own
 # real-world-like meshes and the real meshes shipped inside pinned packages
 # (mcfbench.geometry.packaged_meshes: pyvista, nilearn; read from the installed
-# package, SHA-256 checked) as OBJ to results/gallery/meshes/. Uses _alternatives
-# (mcfbench.pipeline.alternatives) of workflow/rules/matrix.smk (included before).
+# package, SHA-256 checked) as OBJ to results/gallery/meshes/.
 #
 # Its runs are specs in the run store (a mesh file's path and SHA-256 in each;
 # about 20 frames each; workflow/rules/runs.smk). Outputs under results/gallery/
@@ -18,6 +17,7 @@
 # table.md, table.csv, pictures.png, pictures.pdf.
 
 import mcfbench.studies.gallery as _gallery
+from mcfbench.pipeline import alternatives as _alternatives
 from mcfbench.studies.gallery import plan as _gallery_plan
 
 # the plan; without meshes (no runs) when the section `gallery` or `meshes` is
@@ -134,3 +134,12 @@ rule gallery_movie:
         plan=GALLERY,
     script:
         "../scripts/gallery_movie.py"
+
+
+rule gallery:
+    """Target: every scheme on every mesh file (`--config meshes=DIR`; default the
+    suite's own meshes), table and pictures in results/gallery/."""
+    input:
+        # the plan first: a bad value under `gallery` is named here
+        lambda wildcards: PLANS.checked("gallery", GALLERY_TARGETS),
+    localrule: True

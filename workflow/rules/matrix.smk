@@ -170,3 +170,12 @@ rule matrix_page:
         plan=MATRIX,
     script:
         "../scripts/matrix_page.py"
+
+
+rule matrix:
+    """Target: every scheme x every problem x its levels (config key `matrix`),
+    tables, figures and findings in results/matrix/."""
+    input:
+        # the plan first: a bad value under `matrix` is named here
+        lambda wildcards: PLANS.checked("matrix", MATRIX_TARGETS),
+    localrule: True

@@ -15,15 +15,11 @@
 # digests changes, and only the runs whose spec or code changed are computed.
 # The studies' views take the manifests of their specs as inputs.
 
-from mcfbench.pipeline import RUN_STUDIES, batch_resources
+from mcfbench.pipeline import batch_resources, run_studies
 from mcfbench.storage.run_store import manifest_path
 
-# the gallery's runs only when it is asked for (mcfbench.pipeline.RunStore)
-_TARGETS = " ".join(getattr(workflow.dag_settings, "targets", None) or ())
-RUNS = RunStore(
-    PLANS,
-    [s for s in RUN_STUDIES if s != "gallery" or "gallery" in _TARGETS],
-)
+# every study's specs, whatever the targets (mcfbench.pipeline.run_studies)
+RUNS = RunStore(PLANS, run_studies())
 
 
 for _batch in RUNS.batches:
