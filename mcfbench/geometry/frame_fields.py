@@ -101,25 +101,3 @@ def ddfv_frame_fields(F, T, faces):
                           "t_monitor": monitor},
                     "triangles": {"t_monitor": monitor}})
     return out
-
-
-def final_state_distance(frames, reference, weights):
-    """How far the last state of ``frames`` is from the last state of ``reference`` (two
-    runs of one scheme on one mesh; :mod:`mcfbench.storage.frames`' layout, ``faces``
-    included): ``(error, volume_error)``.
-
-    ``error`` is ``sqrt(sum_i w_i |X_i - X_i^ref|^2)`` over every point of the state
-    (DDFV: F- then T-vertices), ``w`` (n_points,) the scheme's quadrature weights of
-    the reference (``flow.l2_weights``); ``volume_error`` is ``|vol(X) - vol(X^ref)|``
-    of the mesh (:func:`mcfbench.geometry.metrics.volume`), blind to tangential motion.
-    """
-    from mcfbench.geometry.metrics import volume
-
-    def last(arrays):
-        vertices, extra = arrays.get("vertices"), arrays.get("extra_points")
-        X = vertices[-1] if extra is None else np.concatenate([vertices[-1], extra[-1]])
-        return X.T, volume(vertices[-1], arrays["faces"])
-
-    (X, vol), (ref, ref_volume) = last(frames), last(reference)
-    return (float(np.sqrt(np.asarray(weights) @ np.sum((X - ref) ** 2, axis=0))),
-            abs(vol - ref_volume))

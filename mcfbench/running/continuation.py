@@ -52,6 +52,9 @@ def why_not(scheme, integrator=None):
     if INTEGRATORS[integrator].order > 1:
         return (f"the {integrator} integrator's past states are not carried to the "
                 "remaining components (mcfbench.running.continuation)")
+    if scheme.integrates_itself:
+        return (f"{scheme.name} integrates in time itself, from past states that are not "
+                "carried to the remaining components (mcfbench.running.continuation)")
     return None
 
 

@@ -452,7 +452,7 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
     """
     import pandas as pd
 
-    from mcfbench.geometry.frame_fields import final_state_distance
+    from mcfbench.geometry.metrics import final_state_distance
 
     def final(tau):
         result, traj = run(scheme, problem, level, tau=tau, t_final=t_final, solver=solver,

@@ -24,7 +24,7 @@ def time_records(specs, records, plan, root=None):
     of :func:`mcfbench.studies.beyond.tables.time_table`'s input (``scheme``, ``level``,
     ``t_final``, ``reference_tau``, ``outcome``, ``message``, ``rows``). Each row's
     ``error`` and ``volume_error`` compare the run's final state with the reference's
-    (:func:`mcfbench.geometry.frame_fields.final_state_distance`, the reference's
+    (:func:`mcfbench.geometry.metrics.final_state_distance`, the reference's
     quadrature weights saved in its frames); a reference that broke down gives
     ``outcome = "reference_failed"`` and no rows.
 
@@ -39,7 +39,7 @@ def time_records(specs, records, plan, root=None):
     """
     import numpy as np
 
-    from mcfbench.geometry.frame_fields import final_state_distance
+    from mcfbench.geometry.metrics import final_state_distance
     from mcfbench.storage.frames import load_frames
     from mcfbench.storage.run_store import STORE, frames_path
     from mcfbench.studies.beyond.plan import time_taus

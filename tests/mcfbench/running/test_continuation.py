@@ -75,6 +75,7 @@ def test_which_schemes_go_on():
                      "ddfv-chord-eliminate", "ddfv-chord-mdr-carried", "ddfv-eliminate",
                      "mdr"]
     assert "bdf2" in why_not(get_scheme("cotan@bdf2"))
+    assert "integrates in time itself" in why_not(get_scheme("bgn-bdf2"))
 
 
 def test_run_goes_on_and_records_the_whole_mesh():
