@@ -67,3 +67,52 @@ def check_threads(config):
     if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
         raise ConfigError(f"config key 'threads': a whole number >= 1, got {threads!r}")
     return threads
+
+
+def check_mesh_runs(section, study, defaults=None):
+    """The settings of a study that runs every scheme on mesh files for a number of
+    steps (the gallery, the survival study), each bad value named ``<study>.<key>``.
+
+    Parameters
+    ----------
+    section : dict or None
+        ``schemes`` ("all" or names, :func:`check_schemes`), ``C`` (``tau = C (mean
+        edge length)^2``), ``steps``, ``solver`` (a method of
+        :data:`mcfbench.running.solver.METHODS` or ``"robust"``,
+        :data:`mcfbench.running.solver.ROBUST`), ``rtol``, ``maxiter``.
+    study : str
+    defaults : dict, optional
+        Defaults of those keys (otherwise every scheme, ``C`` 0.1, 40 steps, the
+        robust solver, ``rtol`` 1e-9, ``maxiter`` 1000).
+
+    Returns
+    -------
+    dict
+        ``schemes`` (list), ``C``, ``steps``, ``solver`` (the method), ``rtol``, ``maxiter``.
+
+    Raises
+    ------
+    ConfigError
+    """
+    from mcfbench.running import solver as _solver
+    from mcfbench.running.schemes import SCHEMES
+
+    section = {"schemes": "all", "C": 0.1, "steps": 40, "solver": "robust", "rtol": 1e-9,
+               "maxiter": 1000, **(defaults or {}), **(section or {})}
+    chosen = section["schemes"]
+    chosen = list(SCHEMES) if chosen in ("all", None) else \
+        [chosen] if isinstance(chosen, str) else list(chosen)
+    check_schemes(f"{study}.schemes", chosen)
+    method = _solver.ROBUST if section["solver"] == "robust" else section["solver"]
+    if method not in _solver.METHODS:
+        raise ConfigError(f"config key '{study}.solver': unknown solver {method!r}; choose "
+                          f"one of {', '.join(_solver.METHODS)} or robust")
+    C, steps = float(section["C"]), int(section["steps"])
+    if not C > 0:
+        raise ConfigError(f"config key '{study}.C': must be > 0, got {C!r}")
+    if steps < 1:
+        raise ConfigError(f"config key '{study}.steps': must be >= 1, got {steps!r}")
+    return {"C": C, "steps": steps, "solver": method,
+            "rtol": check_rtol(f"{study}.rtol", section["rtol"]),
+            "maxiter": int(section["maxiter"]), "schemes": chosen}
+

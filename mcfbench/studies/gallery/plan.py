@@ -4,10 +4,9 @@
 
 from pathlib import Path
 
-from mcfbench.studies.config import ConfigError
+from mcfbench.studies.config import ConfigError, check_mesh_runs
 from mcfbench.studies.gallery import MESH
 from mcfbench.studies.matrix import is_real_world
-from mcfbench.studies.matrix.plan import robust_method
 
 GALLERY_SURFACES = ("blobby", "implicit_torus", "perturbed_sphere", "remeshed_sphere",
                     "anisotropic_sphere", "flat_patch")
@@ -41,8 +40,6 @@ def plan(section=None, meshes=None, schemes=None):
         path), ``generated`` (file name -> ``(kind, name, level)``, kind
         ``problem``, ``surface`` or ``packaged``).
     """
-    from mcfbench.running import solver as _solver
-
     if schemes is None:
         from mcfbench.running.schemes import SCHEMES as schemes
     section = dict(section or {})
@@ -53,19 +50,7 @@ def plan(section=None, meshes=None, schemes=None):
     if unknown:
         raise ConfigError(f"config key 'gallery.schemes': unknown scheme(s) {unknown}; the "
                           f"registry mcfbench.running.schemes.SCHEMES has {list(schemes)}")
-    method = section.get("solver", "robust")
-    method = robust_method() if method == "robust" else method
-    if method not in _solver.METHODS:
-        raise ConfigError(f"config key 'gallery.solver': unknown solver {method!r}; choose one "
-                          f"of {', '.join(_solver.METHODS)} or robust")
-    C, steps = float(section.get("C", 0.1)), int(section.get("steps", 40))
-    if not C > 0:
-        raise ConfigError(f"config key 'gallery.C': must be > 0, got {C!r}")
-    if steps < 1:
-        raise ConfigError(f"config key 'gallery.steps': must be >= 1, got {steps!r}")
-    plan = {"C": C, "steps": steps, "solver": method,
-            "rtol": float(section.get("rtol", 1e-9)),
-            "maxiter": int(section.get("maxiter", 1000)), "schemes": chosen}
+    plan = check_mesh_runs({**section, "schemes": chosen}, "gallery")
     if meshes:
         folder = Path(meshes)
         if not folder.is_dir():

@@ -1,0 +1,55 @@
+"""The survival study's findings, worded from its scheme table only (:func:`findings`)."""
+
+import numpy as np
+
+TARGET = 0.9
+"""The share of the meshes without thin features that some scheme should take to the
+end (issue #44's target)."""
+
+
+def findings(summary, plan):
+    """A few sentences read from :func:`mcfbench.studies.survival.tables.survival_table`.
+
+    Returns
+    -------
+    str
+        Markdown: the best scheme on the meshes without thin features against
+        :data:`TARGET`, the best DDFV variant, the best on the meshes with thin
+        features, and when the runs that did not reach the end broke down.
+    """
+    from mcfbench.running.schemes import find_scheme
+
+    def best(rows, column):
+        rows = rows[np.isfinite(rows[column])]
+        if not len(rows):
+            return None
+        top = rows[column].max()
+        return rows[rows[column] == top]
+
+    def named(rows, prefix):
+        k, n = int(rows.iloc[0][f"{prefix}reached"]), int(rows.iloc[0][f"{prefix}meshes"])
+        return f"{', '.join(rows['scheme'])} ({k} of {n}, {100 * k / n:.0f} %)"
+
+    lines = ["# Survival on raw meshes: findings", "",
+             f"Every number below is read from `survival.csv`: {len(summary)} schemes on the "
+             f"{len(plan['meshes'])} raw meshes the intake reads, {plan['steps']} steps of "
+             f"{plan['C']:g} h^2."]
+    plain = best(summary, "plain_share")
+    if plain is not None:
+        met = "meets" if plain.iloc[0]["plain_share"] >= TARGET else "misses"
+        lines += ["", f"- **Without thin features**: the most are taken to the end by "
+                      f"{named(plain, 'plain_')}: it {met} the target of {TARGET:.0%}."]
+    ddfv = summary[[getattr(find_scheme(s), "family", "") == "ddfv" for s in summary["scheme"]]]
+    top = best(ddfv, "plain_share")
+    if top is not None:
+        lines.append(f"- **The best DDFV variant** there: {named(top, 'plain_')}.")
+    thin = best(summary, "thin_share")
+    if thin is not None:
+        lines.append(f"- **With thin features** (the flow pinches them; no scheme here goes "
+                     f"through a pinch): {named(thin, 'thin_')}.")
+    median = np.nanmedian(summary["defect_fraction_median"]) \
+        if np.isfinite(summary["defect_fraction_median"]).any() else np.nan
+    if np.isfinite(median):
+        lines.append(f"- The runs that did not reach the end broke down early: the median "
+                     f"scheme's median first defect came at {median:.0%} of the final time.")
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,69 @@
+"""The plan of the survival study: the config key ``survival`` checked (:func:`plan`) and
+one run-store spec per readable raw mesh and scheme (:func:`survival_specs`)."""
+
+from mcfbench.studies.config import ConfigError, check_mesh_runs
+
+
+def plan(section=None):
+    """The config key ``survival`` checked and normalised.
+
+    Parameters
+    ----------
+    section : dict, optional
+        ``schemes``, ``C``, ``steps``, ``solver``, ``rtol``, ``maxiter``
+        (:func:`mcfbench.studies.config.check_mesh_runs`) and ``meshes`` ("all" or
+        names of the raw corpus).
+
+    Returns
+    -------
+    dict
+        Those settings and ``meshes``: name -> ``{"file", "sha256", "thin_features",
+        "kind"}`` of the chosen meshes that the intake reads (the refused ones name
+        their defect in the manifest: the intake's verdict, not a run's), and
+        ``refused``: their names.
+
+    Raises
+    ------
+    ConfigError
+        A bad value, or a mesh name not in the corpus, naming the key.
+    """
+    from mcfbench.geometry.committed_meshes import RAW_DIR, raw_manifest
+
+    section = dict(section or {})
+    chosen = section.pop("meshes", "all")
+    settings = check_mesh_runs(section, "survival")
+    manifest = raw_manifest()
+    names = list(manifest) if chosen in ("all", None) else \
+        [chosen] if isinstance(chosen, str) else list(chosen)
+    unknown = [n for n in names if n not in manifest]
+    if unknown:
+        raise ConfigError(f"config key 'survival.meshes': unknown mesh(es) {unknown}; the "
+                          f"raw corpus (mcfbench/data/raw_meshes) has {', '.join(manifest)}")
+    read = [n for n in names if manifest[n]["intake"] == "read"]
+    return {**settings,
+            "meshes": {n: {"file": str(RAW_DIR / manifest[n]["file"]),
+                           "sha256": manifest[n]["sha256"],
+                           "thin_features": bool(manifest[n]["thin_features"]),
+                           "kind": manifest[n]["kind"]} for n in read},
+            "refused": [n for n in names if n not in read]}
+
+
+def survival_specs(plan):
+    """``{(mesh, scheme): spec}``: every scheme on every mesh of the plan, its first
+    and last frames kept (:func:`mcfbench.running.batch.mesh_spec`)."""
+    from mcfbench.running.batch import mesh_spec
+
+    solver = {"method": plan["solver"], "rtol": plan["rtol"], "maxiter": plan["maxiter"]}
+    return {(name, scheme): mesh_spec(scheme, mesh["file"], mesh["sha256"], tau_edge=plan["C"],
+                                      steps=plan["steps"], solver=solver, frames=2)
+            for name, mesh in plan["meshes"].items() for scheme in plan["schemes"]}
+
+
+def run_specs(plans):
+    """The specs of the study (the run store's: :class:`mcfbench.pipeline.RunStore`)."""
+    return survival_specs(plans.plan("survival")).values()
+
+
+def from_config(config, plans):
+    """:func:`plan` of the config (:meth:`mcfbench.pipeline.Plans.plan`)."""
+    return plan(config.get("survival"))
