@@ -245,8 +245,9 @@ class RunStore:
     studies : sequence of str
         The studies planned (default :data:`RUN_STUDIES`). The gallery's specs hash
         its mesh files (the suite's own ones generated in memory before their rule
-        writes them: seconds), so the workflow plans them only when the gallery is
-        asked for; no other study shares its runs, so the other batches stay the same.
+        writes them: seconds), so the workflow makes its batches itself, one per mesh
+        file, their specs made when a batch joins the job graph
+        (``workflow/rules/gallery.smk``); no other study shares its runs.
     """
 
     def __init__(self, plans, studies=RUN_STUDIES):
@@ -269,9 +270,9 @@ class RunStore:
             self._digests.update(code_digests([spec]))
         return self._digests[spec]
 
-    def entries(self, batch):
-        """The params of a batch's job: per spec its dict and code digest."""
-        return [{"spec": spec.to_dict(), "code": self.digest(spec)} for spec in batch.specs]
+    def entries(self, specs):
+        """The params of a batch's job (its ``specs``): per spec its dict and code digest."""
+        return [{"spec": spec.to_dict(), "code": self.digest(spec)} for spec in specs]
 
     def manifests(self, specs):
         """The manifests of the batches holding ``specs`` (a view's inputs), sorted."""

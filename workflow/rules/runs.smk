@@ -18,12 +18,8 @@
 from mcfbench.pipeline import RUN_STUDIES, batch_resources
 from mcfbench.storage.run_store import manifest_path
 
-# the gallery's runs only when it is asked for (mcfbench.pipeline.RunStore)
-_TARGETS = " ".join(getattr(workflow.dag_settings, "targets", None) or ())
-RUNS = RunStore(
-    PLANS,
-    [s for s in RUN_STUDIES if s != "gallery" or "gallery" in _TARGETS],
-)
+# the gallery's batches: workflow/rules/gallery.smk (mcfbench.pipeline.RunStore)
+RUNS = RunStore(PLANS, [s for s in RUN_STUDIES if s != "gallery"])
 
 
 for _batch in RUNS.batches:
@@ -34,7 +30,6 @@ for _batch in RUNS.batches:
             f"runs_{_batch.name}"
         input:
             kernels=ancient(KERNELS),
-            meshes=sorted({s.mesh_file for s in _batch.specs if s.mesh_file}),
         output:
             manifest_path(_batch.name),
         log:
@@ -51,6 +46,6 @@ for _batch in RUNS.batches:
             mem_mb=_mem_mb,
             runtime=_runtime,
         params:
-            runs=RUNS.entries(_batch),
+            runs=RUNS.entries(_batch.specs),
         script:
             "../scripts/run_batch.py"

@@ -411,7 +411,7 @@ def test_snakemake_dry_run(tmp_path):
     assert all(int(n) == 1 for rule, n in counts.items() if rule.startswith("runs_"))
     assert int(counts["matrix_page"]) == 1  # results/matrix/index.html
     # one mesh file: one batch of every scheme on it
-    assert int(counts["runs_gallery_gallery_batch1"]) == 1
+    assert int(counts["runs_gallery_batch1"]) == 1
     assert "gallery_mesh" not in counts  # a folder given: no generated meshes
 
 
