@@ -65,13 +65,18 @@ def studies():
 
 
 def run_studies():
-    """The studies whose runs are in the run store (their ``plan`` module has
-    ``run_specs(plans)``), in name order. Every one is planned while Snakemake reads
-    the workflow, whatever the targets (Snakemake sets them after reading it): the
-    gallery's specs hash the meshes it generates, in memory until its rule writes
-    them (2 CPU s under load, once)."""
-    return [study for study in studies()
-            if hasattr(importlib.import_module(f"mcfbench.studies.{study}.plan"), "run_specs")]
+    """The studies whose runs the run store's shared batches make (their ``plan``
+    module has ``run_specs(plans)``), in name order, but those whose ``plan`` says
+    ``OWN_BATCHES``: their rule file makes their batches (the gallery's, one per mesh
+    file, its specs made when a batch joins the job graph: they hash the meshes it
+    generates, seconds, and Snakemake does not know the targets while it reads the
+    workflow)."""
+    chosen = []
+    for study in studies():
+        module = importlib.import_module(f"mcfbench.studies.{study}.plan")
+        if hasattr(module, "run_specs") and not getattr(module, "OWN_BATCHES", False):
+            chosen.append(study)
+    return chosen
 
 
 def study_rule_files(folder):
@@ -294,9 +299,9 @@ class RunStore:
             self._digests.update(code_digests([spec]))
         return self._digests[spec]
 
-    def entries(self, batch):
-        """The params of a batch's job: per spec its dict and code digest."""
-        return [{"spec": spec.to_dict(), "code": self.digest(spec)} for spec in batch.specs]
+    def entries(self, specs):
+        """The params of a batch's job (its ``specs``): per spec its dict and code digest."""
+        return [{"spec": spec.to_dict(), "code": self.digest(spec)} for spec in specs]
 
     def manifests(self, specs):
         """The manifests of the batches holding ``specs`` (a view's inputs), sorted."""

@@ -9,6 +9,8 @@ from mcfbench.pipeline import RunStore, WorkflowPlans
 import mcfbench.studies.convergence as _convergence_paths
 from mcfbench.studies.beyond import plan as _beyond
 from mcfbench.studies.convergence import plan as _convergence
+from mcfbench.studies.gallery import plan as _gallery_plan
+from mcfbench.storage.run_store import manifest_path as _manifest_path
 
 PLANS = WorkflowPlans(config, f"{workflow.basedir}/workflow/schemas")
 # the config key `threads` (every run job), checked here
@@ -42,6 +44,16 @@ def beyond_specs(studies):
 
 
 def gallery_runs(wildcards):
-    """The manifests of the gallery's batches (planned when the gallery is asked
-    for: workflow/rules/runs.smk)."""
-    return RUNS.manifests(RUNS.requests["gallery"])
+    """The manifests of the gallery's batches, one per mesh file (gallery.smk)."""
+    return [
+        _manifest_path(f"gallery_batch{k}")
+        for k in range(1, len(GALLERY["meshes"]) + 1)
+    ]
+
+
+def gallery_batch_runs(mesh):
+    """The params of the gallery's batch of ``mesh``: its specs (every scheme on the
+    file, its SHA-256 taken when the batch joins the job graph) and code digests."""
+    return lambda wildcards: RUNS.entries(
+        _gallery_plan.mesh_specs(GALLERY, mesh).values()
+    )

@@ -18,7 +18,6 @@
 
 import mcfbench.studies.gallery as _gallery
 from mcfbench.pipeline import alternatives as _alternatives
-from mcfbench.studies.gallery import plan as _gallery_plan
 
 # the plan; without meshes (no runs) when the section `gallery` or `meshes` is
 # bad: then `snakemake gallery` names the bad key (rule gallery)
@@ -61,6 +60,35 @@ if GALLERY["generated"]:
             code=PLANS.code,
         script:
             "../scripts/gallery_mesh.py"
+
+
+# One batch per mesh file: every scheme on it (the run store's job,
+# workflow/scripts/run_batch.py); its specs, with the file's SHA-256, are made when
+# the batch joins the job graph (the suite's own meshes are written by gallery_mesh).
+for _k, _mesh in enumerate(GALLERY["meshes"], start=1):
+
+    rule:
+        name:
+            f"runs_gallery_batch{_k}"
+        input:
+            kernels=ancient(KERNELS),
+            mesh=GALLERY["meshes"][_mesh],
+        output:
+            _manifest_path(f"gallery_batch{_k}"),
+        log:
+            f"results/logs/runs/gallery_batch{_k}.log",
+        benchmark:
+            f"results/benchmarks/runs/gallery_batch{_k}.tsv"
+        conda:
+            "../envs/ddfv.yaml"
+        threads: 1
+        resources:
+            mem_mb=2000,
+            runtime=60 * len(GALLERY["schemes"]),
+        params:
+            runs=gallery_batch_runs(_mesh),
+        script:
+            "../scripts/run_batch.py"
 
 
 rule gallery_table:

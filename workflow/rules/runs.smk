@@ -18,7 +18,8 @@
 from mcfbench.pipeline import batch_resources, run_studies
 from mcfbench.storage.run_store import manifest_path
 
-# every study's specs, whatever the targets (mcfbench.pipeline.run_studies)
+# every study's specs but those whose rule file makes its own batches (the gallery's,
+# one per mesh file: mcfbench.pipeline.run_studies)
 RUNS = RunStore(PLANS, run_studies())
 
 
@@ -30,7 +31,6 @@ for _batch in RUNS.batches:
             f"runs_{_batch.name}"
         input:
             kernels=ancient(KERNELS),
-            meshes=sorted({s.mesh_file for s in _batch.specs if s.mesh_file}),
         output:
             manifest_path(_batch.name),
         log:
@@ -47,6 +47,6 @@ for _batch in RUNS.batches:
             mem_mb=_mem_mb,
             runtime=_runtime,
         params:
-            runs=RUNS.entries(_batch),
+            runs=RUNS.entries(_batch.specs),
         script:
             "../scripts/run_batch.py"

@@ -32,6 +32,12 @@ rule survival_tables:
     log:
         "results/logs/survival/tables.log",
     localrule: True
+    conda:
+        "../envs/ddfv.yaml"
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
     params:
         view="survival.aggregate",
         plan=SURVIVAL,

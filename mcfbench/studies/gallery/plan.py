@@ -117,22 +117,34 @@ def mesh_digest(plan, name):
     return hashlib.sha256(generated_mesh_text(plan["generated"][name]).encode()).hexdigest()
 
 
-def gallery_specs(plan):
-    """``{(mesh, scheme): spec}`` of the gallery: every scheme on every mesh file,
-    ``tau = C (mean edge length)^2``, ``steps`` steps, about :data:`MOVIE_FRAMES`
-    frames (:func:`mcfbench.running.batch.mesh_spec`)."""
+def mesh_specs(plan, name):
+    """``{scheme: spec}`` of the mesh file ``name``: every scheme, ``tau = C (mean edge
+    length)^2``, ``steps`` steps, about :data:`MOVIE_FRAMES` frames
+    (:func:`mcfbench.running.batch.mesh_spec`)."""
     from mcfbench.running.batch import mesh_spec
 
     solver = {k: plan[k] for k in ("rtol", "maxiter")} | {"method": plan["solver"]}
-    digests = {name: mesh_digest(plan, name) for name in plan["meshes"]}
-    return {(name, scheme): mesh_spec(scheme, path, digests[name], tau_edge=plan["C"],
-                                      steps=plan["steps"], solver=solver,
-                                      frames=MOVIE_FRAMES)
-            for name, path in plan["meshes"].items() for scheme in plan["schemes"]}
+    digest = mesh_digest(plan, name)
+    return {scheme: mesh_spec(scheme, plan["meshes"][name], digest, tau_edge=plan["C"],
+                              steps=plan["steps"], solver=solver, frames=MOVIE_FRAMES)
+            for scheme in plan["schemes"]}
+
+
+def gallery_specs(plan):
+    """``{(mesh, scheme): spec}`` of the gallery: every scheme on every mesh file
+    (:func:`mesh_specs`)."""
+    return {(name, scheme): spec for name in plan["meshes"]
+            for scheme, spec in mesh_specs(plan, name).items()}
+
+
+OWN_BATCHES = True
+"""Its rule file makes its batches, one per mesh file (``workflow/rules/gallery.smk``;
+:func:`mcfbench.pipeline.run_studies`)."""
 
 
 def run_specs(plans):
-    """The specs of the gallery (the run store's: :class:`mcfbench.pipeline.RunStore`)."""
+    """The specs of the gallery (:class:`mcfbench.pipeline.RunStore`; the workflow
+    makes the gallery's batches itself, one per mesh file: ``gallery.smk``)."""
     return gallery_specs(plans.plan("gallery")).values()
 
 

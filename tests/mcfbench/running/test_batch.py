@@ -63,3 +63,27 @@ def test_a_stored_run_is_the_studies_run_with_its_final_weights(tmp_path):
     assert weights.shape == (482,) and np.all(weights > 0)
     radius = np.sqrt(1 - 4 * 0.08)
     assert weights.sum() == pytest.approx(4 * np.pi * radius ** 2, rel=0.02)
+
+
+def test_each_scheme_of_a_batch_is_warmed_up_before_its_first_run_is_timed(tmp_path,
+                                                                         monkeypatch):
+    """One process, several schemes (a batch job): each scheme's first run is warmed up
+    before the clock starts, also after another scheme ran first."""
+    from mcfbench.running import run as run_module
+
+    timed, timed_run = [], run_module._timed_run
+
+    def spy(scheme, problem, mesh, tau, steps, **kwargs):
+        timed.append((scheme.name, steps))
+        return timed_run(scheme, problem, mesh, tau, steps, **kwargs)
+
+    monkeypatch.setattr(run_module, "_warmed", set())       # as a fresh process
+    monkeypatch.setattr(run_module, "_timed_run", spy)
+    specs = [spec_of(s, "sphere", 1, solver=SOLVER) for s in ("cotan", "bgn")]
+    run_batch([{"spec": s.to_dict(), "code": "c"} for s in specs], tmp_path / "m.json",
+              tmp_path / "batch.log", root=str(tmp_path))
+    assert [call for k, call in enumerate(timed) if k == 0 or timed[k - 1] != call] == \
+        [("cotan", run_module.WARM_UP_STEPS), ("cotan", 2),
+         ("bgn", run_module.WARM_UP_STEPS), ("bgn", 2)]
+    text = (tmp_path / "batch.log").read_text()
+    assert "cotan on sphere level 1" in text and "bgn on sphere level 1" in text
