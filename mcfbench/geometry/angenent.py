@@ -6,8 +6,9 @@ import math
 import numpy as np
 
 from mcfbench.geometry.construction import quad_grid
+from mcfbench.geometry.meridians import meridian_max_height
 
-# scipy.integrate, scipy.optimize and the axisymmetric solver are imported on first
+# scipy.integrate and scipy.optimize are imported on first
 # use: mcfbench.geometry.surfaces imports this module for every surface, and
 # importing them took 0.3-1.1 s of each pipeline job that builds another surface
 
@@ -83,8 +84,6 @@ def angenent_profile(rho0=None):
         the inner point); ``upper`` (the dense ODE solution of the upper
         half, state ``(rho, z, a, ...)``), ``half_length``.
     """
-    from mcfbench.geometry.axisymmetric import meridian_max_height
-
     rho0 = angenent_rho0() if rho0 is None else float(rho0)
     sol, S, y_end = _angenent_shoot(rho0)
     ss = np.linspace(0.0, S, 4001)

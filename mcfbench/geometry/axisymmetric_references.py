@@ -5,13 +5,8 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from mcfbench.geometry.axisymmetric import (
-    cross_section,
-    evolve,
-    evolve_until,
-    initial_meridian,
-    measures,
-)
+from mcfbench.geometry.axisymmetric import evolve, evolve_until, initial_meridian
+from mcfbench.geometry.meridians import cross_section, measures
 from mcfbench.geometry.exact import J01_SQUARED, catenoid_area
 from mcfbench.geometry.extrapolation import (
     extinction_time,

@@ -34,7 +34,8 @@ import math
 
 import numpy as np
 
-from mcfbench.geometry.axisymmetric import evolve_until, initial_meridian, meridian_area
+from mcfbench.geometry.axisymmetric import evolve_until, initial_meridian
+from mcfbench.geometry.meridians import meridian_area, meridian_volume
 
 
 def capped_bulb(X, spacing=None):
@@ -133,8 +134,6 @@ def bulb_through_pinch(n, delta, times, rho_levels, rtol=1e-11):
     ValueError
         A time of ``times`` before the cut.
     """
-    from mcfbench.geometry.axisymmetric import meridian_volume
-
     X, ends, periodic = initial_meridian("dumbbell", n)
     (t_cut,), _, X_cut = evolve_until(X, _mid, [delta], ends, periodic, rtol=rtol, atol=rtol)
     early = [t for t in times if t <= t_cut]

@@ -1,6 +1,8 @@
 """A grid of mesh pictures (rows x columns of saved frames, one length scale per
 column or per row), shared by the matrix's final surfaces and the gallery."""
 
+import math
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -74,17 +76,28 @@ def last_frames(entries, subjects, schemes, note, first_note):
 
 
 def draw_grid(cells, row_labels, col_labels, paths, title, views=None, share="column",
-               size=1.9):
+              size=1.9, max_cols=None):
     """Draw ``cells[i][j] = (vertices, extra, faces, note)`` (:func:`frame_surface`)
-    or None; one length scale per
-    column (``share="column"``) or per row (``"row"``); each mesh an image
-    (:func:`panel_image`)."""
+    or None; one length scale per column (``share="column"``) or per row
+    (``"row"``); each mesh an image (:func:`panel_image`).
+
+    With ``max_cols``, a subject's row of more cells than that wraps onto as
+    many lines as it needs, of equal length (20 cells at most 6 a line: 4 lines
+    of 5), each panel titled with its column's label; titles and notes are
+    broken at spaces to fit the panel (:func:`fitted`)."""
     from mcfbench.presentation.render import project
 
     rows, cols = len(row_labels), len(col_labels)
-    fig, axes = plt.subplots(rows, cols, figsize=(size * cols + 1.2, size * rows + 0.5),
-                             squeeze=False)
+    lines = math.ceil(cols / max_cols) if max_cols and cols > max_cols else 1
+    per_line = math.ceil(cols / lines)
+    fig, axes = plt.subplots(rows * lines, per_line, squeeze=False,
+                             figsize=(size * per_line + 0.8,
+                                      (size + 0.3 * (lines > 1)) * rows * lines + 0.5))
     views = views or [(20.0, -60.0)] * cols
+    width = 0.9 * 72.0 * size     # points of a panel a title or a note may take
+
+    def axis(i, j):
+        return axes[i * lines + j // per_line, j % per_line]
 
     def group(i, j):
         return j if share == "column" else i
@@ -104,21 +117,24 @@ def draw_grid(cells, row_labels, col_labels, paths, title, views=None, share="co
         lo, hi = np.min([b[0] for b in bs], axis=0), np.max([b[1] for b in bs], axis=0)
         scale[key] = (0.5 * (lo + hi), 0.55 * max(max(hi - lo), 1e-12))
     for i in range(rows):
-        for j in range(cols):
-            ax, cell = axes[i, j], cells[i][j]
+        for j in range(lines * per_line):
+            if j >= cols:                 # the last line's empty places
+                axis(i, j).set_axis_off()
+                continue
+            ax, cell = axis(i, j), cells[i][j]
             ax.set_xticks([])
             ax.set_yticks([])
             for spine in ax.spines.values():
                 spine.set_visible(False)
-            if i == 0:
-                ax.set_title(col_labels[j], fontsize=SMALLEST_TEXT)
-            if j == 0:
+            if i == 0 or lines > 1:
+                ax.set_title(fitted(col_labels[j], width, SMALLEST_TEXT), fontsize=SMALLEST_TEXT)
+            if j % per_line == 0:
                 ax.set_ylabel(row_labels[i], fontsize=SMALLEST_TEXT)
             if not finite(cell):
                 text = "no frame" if cell is None else cell[3] if cell[0] is None \
                     else "non-finite state"
-                ax.text(0.5, 0.5, text, ha="center", va="center", fontsize=SMALLEST_TEXT,
-                        transform=ax.transAxes)
+                ax.text(0.5, 0.5, fitted(text, width, SMALLEST_TEXT), ha="center",
+                        va="center", fontsize=SMALLEST_TEXT, transform=ax.transAxes)
                 continue
             vertices, extra, faces, note = cell
             if extra is not None and len(faces) > DIAMONDS_UP_TO:
@@ -132,11 +148,30 @@ def draw_grid(cells, row_labels, col_labels, paths, title, views=None, share="co
             ax.set_ylim(*extent[2:])
             ax.set_aspect("equal")
             if note:
-                ax.text(0.5, 0.01, note, ha="center", va="bottom", fontsize=SMALLEST_TEXT,
-                        transform=ax.transAxes)
+                ax.text(0.5, 0.01, fitted(note, width, SMALLEST_TEXT), ha="center",
+                        va="bottom", fontsize=SMALLEST_TEXT, transform=ax.transAxes)
     fig.suptitle(title, fontsize=9)
-    fig.tight_layout()
+    # the suptitle's line kept clear of the first titles; a line's notes of the next titles
+    fig.tight_layout(rect=(0, 0, 1, 1 - 0.3 / fig.get_size_inches()[1]), h_pad=1.0)
     save_figure(fig, *paths, dpi=120)
+
+
+def fitted(text, width, fontsize):
+    """``text`` broken at spaces into lines at most ``width`` points wide at
+    ``fontsize`` (matplotlib's default font, measured as it draws it); a word
+    wider than that stands on its own line."""
+    from matplotlib.textpath import TextPath
+
+    def wide(line):
+        return TextPath((0, 0), line, size=fontsize).get_extents().width
+
+    out = []
+    for word in str(text).split(" "):
+        if out and wide(f"{out[-1]} {word}") <= width:
+            out[-1] = f"{out[-1]} {word}"
+        else:
+            out.append(word)
+    return "\n".join(out)
 
 
 def panel_image(vertices, extra, faces, view, extent, size, dpi=PANEL_DPI):

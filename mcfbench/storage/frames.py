@@ -10,6 +10,8 @@ Keys (every study's frames file, the ``run`` command's ``--out``):
   surface: the initial surface);
 * ``faces`` (m, 3), ``steps`` (frames,) the time levels kept, ``t`` (frames,)
   their times;
+* ``format_version`` (a 0-d int array): :data:`FORMAT_VERSION`, written by
+  :func:`save_frames`; :func:`load_frames` refuses a newer one and drops the key;
 * anything else the writer adds (the ``run`` command: status, provenance).
 
 The state of a frame is ``vertices`` then ``extra_points`` (the order of the
@@ -30,7 +32,9 @@ empty ``faces``, ``steps`` and ``t`` and no vertices. :func:`surface_points`
 reads the points of any run's frames alike. :func:`save_frames` writes
 (atomically, :func:`mcfbench.storage.atomic.save_npz`), :func:`load_frames`
 reads; both check the layout. Files written before this layout (keys ``V``, or
-``F`` and ``T``) are read as if written with it (:data:`LEGACY_KEYS`).
+``F`` and ``T``) are read as if written with it (:data:`LEGACY_KEYS`), and so are
+files of this layout written before ``format_version`` existed. Every change of the
+keys is listed in ``docs/formats.md``.
 """
 
 import zipfile
@@ -40,6 +44,10 @@ from pathlib import Path
 import numpy as np
 
 from mcfbench.storage.atomic import save_npz
+
+FORMAT_VERSION = 1
+"""The version of the layout :func:`save_frames` writes (``docs/formats.md``); a file
+without the key is read as the layout before it (version 0, :data:`LEGACY_KEYS`)."""
 
 REQUIRED = ("faces", "steps", "t")
 """Keys of every frames file."""
@@ -172,5 +180,24 @@ def load_frames(path):
         raise ValueError(f"{path}: not a run's .npz ({err})") from None
     except (OSError, EOFError, zipfile.BadZipFile, zlib.error) as err:
         raise ValueError(f"{path}: not a readable .npz ({err})") from None
+    check_version(arrays.pop("format_version", np.array(0)).tolist(), FORMAT_VERSION, path,
+                  "frames file")
     check_frames(arrays, path)
     return arrays
+
+
+def check_version(version, newest, path, what):
+    """Raise ValueError naming ``path`` when ``version`` (a file's ``format_version``)
+    is not an integer from 0 (before the key existed) to ``newest``, the version
+    this code writes: a newer file's keys may mean what this reader does not know."""
+    try:
+        number = int(version)
+    except (TypeError, ValueError):
+        number = None
+    if number is None or number != version or number < 0:
+        raise ValueError(f"{path}: format_version {version!r} is not a version number "
+                         f"(0 to {newest}) of a {what}")
+    if number > newest:
+        raise ValueError(f"{path}: a {what} of format_version {number}, written by a newer "
+                         f"mcfbench; this one reads versions up to {newest} (update mcfbench, "
+                         f"or see docs/formats.md for what changed)")

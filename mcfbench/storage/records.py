@@ -7,7 +7,10 @@ each job writes one record, at its end), the settings that produced it and
 their provenance (:func:`mcfbench.storage.provenance.provenance`), and a SHA-256
 ``checksum`` of everything else, so that a record edited by hand is refused
 instead of shown in a table. NaN is stored as ``null`` (standard JSON);
-records are written atomically (:mod:`mcfbench.storage.atomic`).
+records are written atomically (:mod:`mcfbench.storage.atomic`). A record
+carries ``format_version`` (:data:`FORMAT_VERSION`); a record without it is read
+as before (version 0), a newer one is refused. Every change of the keys is listed
+in ``docs/formats.md``.
 """
 
 import hashlib
@@ -16,6 +19,7 @@ from dataclasses import MISSING, asdict, dataclass, field, fields
 from pathlib import Path
 
 from mcfbench.storage.atomic import json_value, write_json
+from mcfbench.storage.frames import check_version
 from mcfbench.storage.memory import peak_rss_mb
 from mcfbench.storage.provenance import config_hash, provenance
 from mcfbench.storage.statuses import STATUSES
@@ -122,10 +126,16 @@ class RunResult:
 
 # field -> type of the fixed part of a record; float fields may be null (NaN)
 FIELDS = {f.name: f.type for f in fields(RunResult) if f.name != "metrics"}
-FIELDS.update({"peak_rss_mb": float, "settings": dict, "provenance": dict, "checksum": str})
+FIELDS.update({"peak_rss_mb": float, "settings": dict, "provenance": dict, "checksum": str,
+               "format_version": int})
 DEFAULTS = {f.name: f.default for f in fields(RunResult) if f.default is not MISSING}
+DEFAULTS["format_version"] = 0
 """Fields a record may lack (written before they existed) -> the value they read as."""
 RECOMPUTE = "delete it and run snakemake again to recompute it"
+
+FORMAT_VERSION = 1
+"""The version of the record :func:`write_record` writes (``docs/formats.md``); a
+record without the key reads as version 0."""
 
 
 class RecordError(ValueError):
@@ -158,7 +168,8 @@ def write_record(path, result, settings, **extra):
         The record as written.
     """
     row = result.to_dict() if isinstance(result, RunResult) else dict(result)
-    record = json_value({**row, **extra, "peak_rss_mb": peak_rss_mb(),
+    record = json_value({**row, **extra, "format_version": FORMAT_VERSION,
+                         "peak_rss_mb": peak_rss_mb(),
                          "settings": settings, "provenance": provenance(settings)})
     record["checksum"] = checksum(record)
     write_json(path, record)
@@ -202,10 +213,15 @@ def read_record(path, settings=None, required=FIELDS):
     ------
     RecordError
         Unreadable or invalid JSON, a missing key, a value of the wrong
-        type, an unknown status, a checksum that does not match the content
+        type, an unknown status, a ``format_version`` newer than
+        :data:`FORMAT_VERSION`, a checksum that does not match the content
         (edited by hand), or other settings; the message names the file.
     """
     record = load_json(path)
+    try:
+        check_version(record.get("format_version", 0), FORMAT_VERSION, path, "run record")
+    except ValueError as err:
+        raise RecordError(str(err)) from None
     missing = [k for k in required if k not in record and k not in DEFAULTS]
     if missing:
         raise RecordError(f"{path}: missing key(s) {missing}; {RECOMPUTE}")

@@ -35,8 +35,15 @@ def run_movie(record, frames, out, log_path=None):
     log.info("%s: %d frames, %s -> %s", title, len(arrays["t"]), data["status"], out)
 
 
+GRID_COLUMNS = 6
+"""At most this many pictures a line of the gallery's grid: a mesh's initial surface and
+every scheme's last frame wrap onto lines of equal length (12.2 in wide at most, a
+laptop page's column at print size)."""
+
+
 def gallery_grid(entries, paths, meshes, schemes):
-    """Per mesh (row) the initial surface and each scheme's last frame (columns).
+    """Per mesh the initial surface and each scheme's last frame, in lines of at most
+    :data:`GRID_COLUMNS` pictures.
 
     ``entries``: ``(mesh, scheme) -> (record, frames)``.
     """
@@ -44,4 +51,4 @@ def gallery_grid(entries, paths, meshes, schemes):
                         lambda record, faces: f"{len(faces)} triangles")
     labels = ["initial"] + [scheme_style(s)[0] for s in schemes]
     draw_grid(cells, list(meshes), labels, paths, "Gallery: first and last frame per scheme",
-               share="row")
+              share="row", max_cols=GRID_COLUMNS)

@@ -11,7 +11,8 @@ meshes (``tau_rule = "mesh"``). The study's modules
   settings of one run and the paths of its record and frames;
 * :mod:`.job`: one run with its record and first and last frames;
 * :mod:`.aggregate`: the records into the tables (:mod:`.tables`);
-* :mod:`.findings`: ``findings.md`` from the summary table only, in words;
+* :mod:`.findings`: ``findings.md`` from the summary table only, in words, the
+  verdicts' data from :mod:`.verdicts`;
 * :mod:`.plots`: the figures; :mod:`.page`: the results page (``index.html``).
 
 The presentation modules (:mod:`.tables`, :mod:`.findings`, :mod:`.plots`,

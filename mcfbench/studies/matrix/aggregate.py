@@ -6,8 +6,10 @@ from pathlib import Path
 from mcfbench.presentation.formats import tex_escape
 from mcfbench.presentation.tables import Table, csv, latex, markdown
 from mcfbench.storage.records import read_records
+from mcfbench.studies.matrix import reference_accuracies
 from mcfbench.studies.matrix.plan import solver_method
 from mcfbench.studies.matrix.tables import (
+    BELOW_ACCURACY,
     FLOAT_FORMAT,
     TIMING_NOTE,
     long_table,
@@ -51,7 +53,9 @@ def write_tables(table, out_dir, plan):
     for problem in problems:
         frame, metric = problem_table(table, problem, plan["schemes"], labels)
         notes = [f"Main metric: `{metric}` per level (value, or the status of a run that "
-                 f"did not finish); EOC (3.1) between consecutive levels."] + \
+                 f"did not finish); EOC (3.1) between consecutive levels, {BELOW_ACCURACY} "
+                 "where an error of the pair is within the stated accuracy of the problem's "
+                 "reference."] + \
             problem_notes(problem, plan) + [TIMING_NOTE]
         md, tex = documents(frame, f"Matrix: {problem}", f"Benchmark matrix, problem {problem}",
                             notes)
@@ -63,7 +67,8 @@ def write_tables(table, out_dir, plan):
     notes = ["Each cell: the EOC (3.1) between the two finest finished levels and the "
              "finest finished level's value of the problem's main metric (in brackets "
              "after the problem), or the status and breakdown time of the coarsest run "
-             "that did not finish.", TIMING_NOTE]
+             f"that did not finish; EOC {BELOW_ACCURACY} where the finest error or the one "
+             "before is within the stated accuracy of the problem's reference.", TIMING_NOTE]
     md, tex = documents(wide, "Matrix summary", "Benchmark matrix: summary", notes)
     write_text(out / "summary.md", md)
     write_text(out / "summary.tex", tex)
@@ -73,5 +78,6 @@ def write_tables(table, out_dir, plan):
 def aggregate(expected, plan, out_dir):
     """The records of every planned run into the long table and its views
     (:func:`write_tables`); returns ``(table, summary)``."""
-    table = long_table(list(read_records(expected).values()), plan["schemes"], list(plan["problems"]))
+    table = long_table(list(read_records(expected).values()), plan["schemes"],
+                       list(plan["problems"]), reference_accuracies(plan))
     return table, write_tables(table, out_dir, plan)

@@ -6,8 +6,12 @@ A metric is an *error* when its exact value is zero (:func:`is_error`:
 ``l2_error``, the catenoid's neck and profile errors, the height of the
 hemisphere above the flat disk, the displacement of the flat patch). Its
 EOC between levels ``k - 1`` and ``k`` is ``log2(|e_{k-1}| / |e_k|)``
-(levels one apart, both runs finished). Other metrics (volume, area) have
-no exact value: no EOC. The *main metric* of a problem
+(levels one apart, both runs finished), not computed (``eoc_below_accuracy``)
+when either error is within the stated accuracy of the problem's reference
+(``reference_accuracy``, a reference computed by schemes: the real meshes',
+:func:`mcfbench.studies.matrix.reference_accuracies`): there the error says
+nothing of the scheme's order. Other metrics (volume, area) have no exact
+value: no EOC. The *main metric* of a problem
 (:func:`main_metric`) is the one of the summary, the plots and the
 findings.
 """
@@ -42,7 +46,7 @@ ZERO_METRICS = ("max_height", "l2_height", "max_displacement")
 
 # modules that do not change what a run computes (left out of the code digest)
 LONG_COLUMNS = ["scheme", "problem", "level", "h", "tau", "steps", "steps_done", "metric",
-                "main", "value", "eoc", "status", "t_failed", "min_angle", "max_flipped",
+                "main", "value", "eoc", "eoc_below_accuracy", "reference_accuracy", "status", "t_failed", "min_angle", "max_flipped",
                 "t_min_barycentric", "iterations", "cpu_seconds", "robust_status",
                 "robust_value", "robust_t_failed", *(
                     f"{monitor}_{when}" for monitor in ("min_angle", "covolume_ratio")
@@ -50,7 +54,10 @@ LONG_COLUMNS = ["scheme", "problem", "level", "h", "tau", "steps", "steps_done",
 """Columns of the long table. ``main``: the metric is its problem's main metric
 (:func:`main_metric`, decided here once: the summary, the problem tables, the
 plots, the page and the findings take these rows, :func:`main_runs`).
-``min_angle_*``, ``covolume_ratio_*``: the mesh quality of the run over time
+``reference_accuracy``: the relative accuracy the reference answer of the
+problem states for its main metric (NaN where none); ``eoc_below_accuracy``:
+the row's EOC is not computed, an error of its pair being within it
+(:func:`add_eoc`). ``min_angle_*``, ``covolume_ratio_*``: the mesh quality of the run over time
 (:func:`quality_over_time`; ``min_angle`` is its worst over the run).
 ``robust_*``: the re-run of a run that ended with a ``solver_*`` status with
 the robust solver, continued from its last accepted state
@@ -90,7 +97,7 @@ def _metric_names(record):
     return list(names)
 
 
-def long_table(records, schemes=None, problems=None):
+def long_table(records, schemes=None, problems=None, accuracy=None):
     """One row per run and metric (:data:`LONG_COLUMNS`), with the EOC of the errors.
 
     Parameters
@@ -99,6 +106,9 @@ def long_table(records, schemes=None, problems=None):
         Run records (:func:`mcfbench.storage.records.read_record`).
     schemes, problems : list of str, optional
         Row order (default: order of first appearance).
+    accuracy : dict, optional
+        Problem -> the relative accuracy of its reference answer's main metric
+        (:func:`mcfbench.studies.matrix.reference_accuracies`): no EOC into it.
 
     A run without a value of a metric another run of its problem has (a
     scheme that refused the surface) gets a row with NaN.
@@ -111,6 +121,7 @@ def long_table(records, schemes=None, problems=None):
         names.extend(m for m in _metric_names(r) if m not in names)
     main = {problem: main_metric(problem, names) for problem, names in by_problem.items()}
     quality = {id(r): quality_over_time(r) for r in records}
+    accuracy = accuracy or {}
     rows = []
     for r in records:
         for metric in by_problem[r["problem"]] or [""]:
@@ -120,12 +131,14 @@ def long_table(records, schemes=None, problems=None):
                 "h": r["h"], "tau": r["tau"], "steps": int(r["N"]),
                 "steps_done": int(r["steps_done"]), "metric": metric,
                 "main": metric == main[r["problem"]], "value": float("nan") if value is None else float(value), "eoc": float("nan"),
+                "eoc_below_accuracy": False, "reference_accuracy": accuracy.get(
+                    r["problem"], float("nan")) if metric == main[r["problem"]] else float("nan"),
                 "status": r["status"], "t_failed": r["t_failed"], "min_angle": r["min_angle"],
                 "max_flipped": r["max_flipped"], "t_min_barycentric": r["t_min_barycentric"],
                 "iterations": int(r["iterations"]), "cpu_seconds": r["cpu_seconds"],
                 **_robust(r, metric), **quality[id(r)]})
     table = pd.DataFrame(rows, columns=LONG_COLUMNS)
-    for column in ("h", "tau", "value", "eoc", "t_failed", "min_angle", "max_flipped",
+    for column in ("h", "tau", "value", "eoc", "reference_accuracy", "t_failed", "min_angle", "max_flipped",
                    "t_min_barycentric", "cpu_seconds", "robust_value", "robust_t_failed",
                    *LONG_COLUMNS[LONG_COLUMNS.index("robust_t_failed") + 1:]):
         table[column] = table[column].astype(float)
@@ -203,15 +216,45 @@ def _ordered(table, schemes, problems):
 
 def add_eoc(table):
     """Fill ``eoc``: ``log2(|e_{k-1}| / |e_k|)`` for error metrics, levels one apart,
-    both values finite and non-zero; NaN elsewhere."""
+    both values finite and non-zero, neither within the row's ``reference_accuracy``
+    (:func:`eocs_above_accuracy`; ``eoc_below_accuracy`` marks those); NaN elsewhere."""
     table = table.copy()
     table["eoc"] = np.nan
+    table["eoc_below_accuracy"] = False
+    if "reference_accuracy" not in table:
+        table["reference_accuracy"] = np.nan
     for (_, _, metric), group in table.groupby(["scheme", "problem", "metric"], sort=False):
         if not is_error(metric):
             continue
         group = group.sort_values("level")
-        table.loc[group.index, "eoc"] = eoc(group["value"], levels=group["level"])
+        orders, cut = eocs_above_accuracy(group["value"], group["level"],
+                                          group["reference_accuracy"])
+        table.loc[group.index, "eoc"] = orders
+        table.loc[group.index, "eoc_below_accuracy"] = cut
     return table
+
+
+def eocs_above_accuracy(values, levels, accuracy):
+    """The EOCs of one series of errors (:func:`mcfbench.geometry.exact.eoc`), none
+    into or out of an error at most the reference's ``accuracy`` (NaN: none stated).
+
+    Returns
+    -------
+    eocs : (k,) float array
+        NaN where :func:`~mcfbench.geometry.exact.eoc` gives none or it is cut.
+    cut : (k,) bool array
+        The EOCs computable but not computed: an error of the pair within the
+        accuracy.
+    """
+    values = np.asarray(values, dtype=float)
+    orders = eoc(values, levels=np.asarray(levels))
+    within = np.abs(values) <= np.asarray(accuracy, dtype=float)   # False for NaN
+    cut = np.isfinite(orders) & (within | np.r_[False, within[:-1]])
+    return np.where(cut, np.nan, orders), cut
+
+
+BELOW_ACCURACY = "n/a (below the reference's accuracy)"
+"""An EOC not computed: an error of its pair within the reference's accuracy."""
 
 
 def levels_text(levels):
@@ -240,16 +283,19 @@ def summary_table(table, problems=None, schemes=None):
     -------
     pandas.DataFrame
         Columns ``problem, scheme, metric, error, levels, runs, runs_ok,
-        eoc, eoc_levels, finest_level, finest_value, eocs, values, status,
+        eoc, eoc_below_accuracy, eoc_levels, finest_level, finest_value, status,
         failed_level, t_failed, min_angle, t_min_barycentric,
         cpu_seconds`` (CPU of the finest finished level). ``runs_ok`` counts
         the runs that reached their end, the flow's extinction included
         (:data:`mcfbench.storage.statuses.REACHED`); ``status`` is that of the
         coarsest run that did not, else ``extinct`` when a run ended so, else
-        ``ok``. The scheme's
+        ``ok``. ``eoc`` is NaN and ``eoc_below_accuracy`` true when the finest
+        finished level's EOC is not computed, its error or the one before within
+        the reference's accuracy (:func:`add_eoc`). The scheme's
         own verdict, with the robust solver's re-run in place of a run whose
         failure it removes (:func:`solver_only`): ``runs_robust_ok``,
-        ``robust_eoc``, ``robust_eoc_levels``, ``robust_finest_level``,
+        ``robust_eoc``, ``robust_eoc_below_accuracy``, ``robust_eoc_levels``,
+        ``robust_finest_level``,
         ``robust_finest_value``. One value a cell: the values by level stay in
         the long table (:func:`with_levels`).
     """
@@ -271,13 +317,15 @@ def summary_table(table, problems=None, schemes=None):
             finished = runs[np.isfinite(runs["value"])]
             finest = finished.iloc[-1] if len(finished) else None
             eoc_rows = finished[np.isfinite(finished["eoc"])]
-            last_eoc = eoc_rows.iloc[-1] if len(eoc_rows) else None
+            cut = finest is not None and bool(finest["eoc_below_accuracy"])
+            last_eoc = eoc_rows.iloc[-1] if len(eoc_rows) and not cut else None
             first_fail = failed.iloc[0] if len(failed) else None
             rows.append({
                 "problem": problem, "scheme": scheme, "metric": metric,
                 "error": is_error(metric), "levels": levels_text(runs["level"]),
                 "runs": len(runs), "runs_ok": len(ok),
                 "eoc": np.nan if last_eoc is None else last_eoc["eoc"],
+                "eoc_below_accuracy": cut,
                 "eoc_levels": "" if last_eoc is None else
                 f"{int(last_eoc['level']) - 1}-{int(last_eoc['level'])}",
                 "finest_level": np.nan if finest is None else int(finest["level"]),
@@ -312,13 +360,15 @@ def _robust_summary(runs, metric):
     values = _robust_values(runs)
     fixed = sum(solver_only(r) for _, r in runs.iterrows())
     levels = runs["level"].to_numpy()
-    eocs = eoc(values, levels=levels) if is_error(metric) and len(values) \
-        else np.full(len(values), np.nan)
+    eocs, cut = eocs_above_accuracy(values, levels, runs["reference_accuracy"]) \
+        if is_error(metric) and len(values) else (np.full(len(values), np.nan), [])
     finite = np.flatnonzero(np.isfinite(values))
-    with_eoc = np.flatnonzero(np.isfinite(eocs))
+    cut = bool(len(finite) and len(cut) and cut[finite[-1]])
+    with_eoc = np.flatnonzero(np.isfinite(eocs)) if not cut else []
     return {
         "runs_robust_ok": int(runs["status"].map(reached).sum()) + fixed,
         "robust_eoc": eocs[with_eoc[-1]] if len(with_eoc) else np.nan,
+        "robust_eoc_below_accuracy": cut,
         "robust_eoc_levels": f"{int(levels[with_eoc[-1]]) - 1}-{int(levels[with_eoc[-1]])}"
         if len(with_eoc) else "",
         "robust_finest_level": int(levels[finite[-1]]) if len(finite) else np.nan,
@@ -400,6 +450,8 @@ def summary_cell(row):
     parts = []
     if row["error"] and np.isfinite(row["eoc"]):
         parts.append(f"EOC {row['eoc']:.2f}")
+    elif row["error"] and row["eoc_below_accuracy"]:
+        parts.append(f"EOC {BELOW_ACCURACY}")
     if np.isfinite(row["finest_value"]):
         parts.append(f"{row['finest_value']:.3e} (L{int(row['finest_level'])})")
     if row["status"] != "ok":
@@ -455,7 +507,8 @@ def problem_table(table, problem, schemes=None, labels=None):
             r = runs.loc[level]
             row[f"L{level}"] = formatted(r["value"], ".3e") if reached(r["status"]) and \
                 np.isfinite(r["value"]) else r["status"]
-        row["EOC"] = ", ".join(formatted(v, ".2f") for v in runs["eoc"].iloc[1:]) \
+        row["EOC"] = ", ".join(BELOW_ACCURACY if cut else formatted(v, ".2f") for v, cut in
+                               zip(runs["eoc"].iloc[1:], runs["eoc_below_accuracy"].iloc[1:])) \
             if is_error(metric) and len(runs) > 1 else "–"
         failed = runs[runs["status"] != "ok"]         # an extinction is named too
         row["status"] = "ok" if not len(failed) else "; ".join(
@@ -482,7 +535,8 @@ def read_summary(path):
     for column in SUMMARY_TEXT:
         if column in summary:
             summary[column] = summary[column].fillna("")
-    summary["error"] = summary["error"].astype(bool)
+    for column in ("error", "eoc_below_accuracy", "robust_eoc_below_accuracy"):
+        summary[column] = summary[column].astype(bool) if column in summary else False
     return summary
 
 
@@ -494,6 +548,8 @@ def read_long_table(path):
                                      "problem": str, "robust_status": str})
     for column in ("metric", "robust_status"):
         table[column] = table[column].fillna("")
+    if "eoc_below_accuracy" not in table:      # written before the column
+        table["eoc_below_accuracy"], table["reference_accuracy"] = False, np.nan
     return table
 
 

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from mcfbench.geometry import angenent, extrapolation, metrics
+from mcfbench.geometry import angenent, extrapolation, meridians, metrics
 from mcfbench.geometry import axisymmetric as ax
 from mcfbench.geometry import axisymmetric_references as refs
 
@@ -17,7 +17,7 @@ def _series(shape, ns, times, **params):
     out = []
     for n in ns:
         X, ends, per = ax.initial_meridian(shape, n, **params)
-        out.append([ax.measures(Y, per) for Y in
+        out.append([meridians.measures(Y, per) for Y in
                     ax.evolve(X, times, ends, per, rtol=RTOL, atol=RTOL)])
     return out
 
@@ -49,8 +49,8 @@ def test_crank_nicolson_is_second_order_in_time():
     """Fixed-step Crank-Nicolson against Radau on the same mesh: orders 2 +- 0.02,
     and one Richardson step in tau gains at least two digits."""
     X, ends, per = ax.initial_meridian("sphere", 41)
-    ref = ax.measures(ax.evolve(X, [0.1], ends, per, rtol=RTOL, atol=RTOL)[0])["max_height"]
-    vals = [ax.measures(ax.evolve(X, [0.1], ends, per, method="cn", tau=tau)[0])["max_height"]
+    ref = meridians.measures(ax.evolve(X, [0.1], ends, per, rtol=RTOL, atol=RTOL)[0])["max_height"]
+    vals = [meridians.measures(ax.evolve(X, [0.1], ends, per, method="cn", tau=tau)[0])["max_height"]
             for tau in (0.01, 0.005, 0.0025)]
     eoc = extrapolation.observed_orders(vals)
     assert np.all(np.abs(eoc - 2.0) < 0.02), eoc
@@ -95,7 +95,7 @@ def test_angenent_torus_shrinks_self_similarly():
         X, ends, per = ax.initial_meridian("angenent", n)
         Y = ax.evolve(X, [t], ends, per, rtol=RTOL, atol=RTOL)[0]
         dist.append(angenent.angenent_distance(Y, t, prof).max())
-        areas.append(ax.measures(Y, per)["area"])
+        areas.append(meridians.measures(Y, per)["area"])
     assert dist[-1] < 2e-4
     assert np.all(np.abs(extrapolation.observed_orders(dist) - 2.0) < 0.1)
     assert abs(extrapolation.richardson(areas)[0] / angenent.angenent_area(t, prof) - 1.0) < 1e-7

@@ -7,11 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from mcfbench.geometry.axisymmetric import (
-    evolve_until,
-    initial_meridian,
-    meridian_volume,
-)
+from mcfbench.geometry.axisymmetric import evolve_until, initial_meridian
+from mcfbench.geometry.meridians import meridian_volume
 from mcfbench.geometry.extrapolation import extinction_time, observed_orders
 from mcfbench.geometry.shapes import dumbbell_profile
 from mcfbench.running.problems import get_problem

@@ -87,3 +87,25 @@ def test_a_record_written_before_timing_repeats_existed_reads_as_timed_once(tmp_
     path.write_text(json.dumps(record))
     with pytest.raises(RecordError, match="'timing_repeats' should be int"):
         read_record(path, SETTINGS)
+
+
+def test_a_record_carries_its_format_version_and_a_newer_one_is_refused(tmp_path, result):
+    """format_version 1 written; a record without it (written before) reads as version 0
+    with everything else as it was; a newer version is refused, naming the file."""
+    from mcfbench.storage.records import FORMAT_VERSION, checksum
+
+    path = tmp_path / "level1.json"
+    record = write_record(path, result, SETTINGS)
+    assert record["format_version"] == FORMAT_VERSION == 1
+    assert read_record(path, SETTINGS)["format_version"] == 1
+    del record["format_version"]
+    record["checksum"] = checksum(record)
+    path.write_text(json.dumps(record))
+    old = read_record(path, SETTINGS)
+    assert old["format_version"] == 0 and old["l2_error"] == result.metrics["l2_error"]
+    record["format_version"] = 2
+    record["checksum"] = checksum(record)
+    path.write_text(json.dumps(record))
+    with pytest.raises(RecordError, match=r"level1\.json: a run record of format_version 2, "
+                                          r"written by a newer mcfbench"):
+        read_record(path, SETTINGS)

@@ -21,8 +21,6 @@ from mcfbench.storage.records import FIELDS, read_record, read_records, write_re
 from mcfbench.storage.statuses import STATUSES
 from mcfbench.studies.config import ConfigError
 from mcfbench.studies.gallery import job as gallery_job
-from mcfbench.studies.gallery import plan as gallery_plan
-from mcfbench.studies.gallery import tables as gallery_tables
 from mcfbench.studies.matrix import aggregate as matrix_aggregate
 from mcfbench.studies.matrix import findings as matrix_findings
 from mcfbench.studies.matrix import job as matrix_job
@@ -492,39 +490,6 @@ def test_snakemake_dry_run(tmp_path):
     assert "gallery_mesh" not in counts  # a folder given: no generated meshes
 
 
-# ------------------------------------------------------------ the gallery
-
-
-def test_gallery_runs_every_scheme_on_every_file(tmp_path):
-    from mcfbench.geometry.surfaces import make_surface
-
-    meshes = tmp_path / "meshes"
-    gallery_job.write_obj(meshes / "ball.obj", *make_surface("sphere", level=2))
-    (meshes / "broken.off").write_text("OFF\n3 1 0\n0 0 0\n1 0 0\n")
-    (meshes / "notes.txt").write_text("not a mesh")
-    plan = gallery_plan.plan({"schemes": ["ddfv", "cotan"], "steps": 3}, str(meshes))
-    assert list(plan["meshes"]) == ["ball.obj", "broken.off"]
-    assert plan["C"] == 0.1 and plan["solver"] == matrix_plan.robust_method()
-    records = []
-    for mesh, path in plan["meshes"].items():
-        for scheme in plan["schemes"]:
-            settings = {"study": "gallery", "mesh": mesh, "scheme": scheme,
-                        **{k: plan[k] for k in ("C", "steps", "solver", "rtol", "maxiter")}}
-            out = tmp_path / "runs" / mesh / f"{scheme}.json"
-            gallery_job.job(path, scheme, settings, out, out.with_suffix(".npz"))
-            records.append(read_record(out, settings=settings))
-    table = gallery_tables.gallery_table(records)
-    ball = table[table["mesh"] == "ball.obj"]
-    assert ball["status"].tolist() == ["ok", "ok"] and ball["steps_done"].tolist() == [3, 3]
-    h = ball["h"].iloc[0]
-    assert ball["tau"].iloc[0] == pytest.approx(0.1 * h * h)
-    assert (table[table["mesh"] == "broken.off"]["status"] == "unsupported").all()
-    text = gallery_tables.gallery_markdown(table, plan)
-    assert "same footing" in text and "| ball.obj | ddfv | ok | 3/3 |" in text
-    with pytest.raises(ConfigError, match="'meshes'"):
-        gallery_plan.plan({}, str(tmp_path / "missing"))
-
-
 def test_cheapest_to_reach_reads_the_long_table():
     """The work-precision verdict on known numbers: target = the largest of the
     schemes' smallest errors; per scheme the cheapest run at or below it."""
@@ -587,8 +552,7 @@ def test_a_recommendation_never_hides_an_order_the_verdicts_call_off():
     text = matrix_findings.matrix_findings(table)
     assert "**b** converges at order 1.58 (levels 2-3), not ~2" in text
     assert "**Recommendation: b**" in text
-    assert ("It does not show order ~2 everywhere: EOC 1.58 on torus, not ~2 (no scheme "
-            "reaches order ~2 there).") in text
+    assert "| torus | 1.58 | 1 | b | not ~2 (no scheme reaches order ~2 there) |" in text
 
 
 def test_an_eoc_from_two_levels_does_not_disqualify():
@@ -597,13 +561,14 @@ def test_an_eoc_from_two_levels_does_not_disqualify():
     text = matrix_findings.matrix_findings(table)
     assert "**b** converges, EOC 2.58 (levels 1-2): from two levels only, the order is " \
            "not settled" in text
-    assert "Left out" not in text
+    assert "left out" not in text
     assert "**a** converges at order ~2 from two levels only: EOC 2.00" in text
-    assert "**Recommendation: b**" in text
-    assert "EOC 2.58 on sphere from two levels only (the order is not settled)" in text
+    assert "**Recommendation: b**" in text and "| a | 2.5 | – | candidate |" in text
+    assert "| sphere | 2.58 | 1 | b | from two levels only: the order is not settled |" in text
     three = _table({"a": [4e-2, 1e-2, 2.5e-3], "b": [3.6e-2, 6e-3, 1e-3]})
     text = matrix_findings.matrix_findings(three)           # three levels: it counts
-    assert "Left out: b (EOC 2.58 on sphere)." in text and "**Recommendation: a**" in text
+    assert "| b | 1 | – | left out: EOC 2.58 on sphere |" in text
+    assert "**Recommendation: a**" in text
 
 
 def test_an_error_at_a_floor_below_every_order2_scheme_does_not_disqualify():
@@ -614,25 +579,46 @@ def test_an_error_at_a_floor_below_every_order2_scheme_does_not_disqualify():
     table = _table({"a": [4e-2, 1e-2, 2.5e-3], "b": [4e-3, 1e-3, 1e-3],
                     "c": [2e-2, 5e-3, 5e-3], "d": [3.6e-2, 6e-3, 1e-3]})
     text = matrix_findings.matrix_findings(table)
-    assert "Left out: c (EOC 0.00 on sphere); d (EOC 2.58 on sphere)." in text
+    assert "| c | 5 | – | left out: EOC 0.00 on sphere |" in text
+    assert "| d | 1 | – | left out: EOC 2.58 on sphere |" in text
     assert "**Recommendation: b**" in text
-    assert ("It does not show order ~2 everywhere: EOC 0.00 on sphere, at an error no larger "
-            "than that of any scheme of order ~2 there (a floor).") in text
+    assert ("| sphere | 0.00 | 1 | b | at an error no larger than any scheme of order ~2 "
+            "there (a floor) |") in text
 
 
-def test_an_eoc_into_an_error_within_the_reference_accuracy_is_not_judged():
-    """A reference computed by schemes states its accuracy (1e-3 here): d's EOC 2.58
-    into 5e-4 and b's EOC 0 at 8e-4 are not measurements, so neither is held against
-    them (and the recommendation says why); without the accuracy d's EOC above the
-    band leaves it out (b's error is at the floor below a's order-2 one either way)."""
-    table = _table({"a": [4e-2, 1e-2, 2.5e-3], "b": [3.2e-3, 8e-4, 8e-4],
-                    "d": [1.8e-2, 3e-3, 5e-4]})
-    text = matrix_findings.matrix_findings(table)
-    assert "Left out: d (EOC 2.58 on sphere)." in text and "**Recommendation: b**" in text
-    judged = matrix_findings.matrix_findings(table, accuracy={"sphere": 1e-3})
-    assert "Left out" not in judged and "**Recommendation: d**" in judged
-    assert ("It does not show order ~2 everywhere: EOC 2.58 on sphere, into an error "
-            "within the reference's accuracy.") in judged
+def test_no_eoc_is_computed_into_an_error_within_the_reference_accuracy():
+    """A reference computed by schemes states its accuracy (1e-3 here): d's EOC into 5e-4
+    and b's into and at 8e-4 say nothing of their orders, so they are not computed
+    (marked in the long table, the summary, the problem table and the findings) and not
+    held against them; without the accuracy d's EOC 2.58 above the band leaves it out
+    (b's error is at the floor below a's order-2 one either way)."""
+    errors = {"a": [4e-2, 1e-2, 2.5e-3], "b": [3.2e-3, 8e-4, 8e-4], "d": [1.8e-2, 3e-3, 5e-4]}
+    records = [_record(s, "sphere", k + 1, e) for s, es in errors.items()
+               for k, e in enumerate(es)]
+    text = matrix_findings.matrix_findings(matrix_tables.long_table(records))
+    assert "| d | 1 | – | left out: EOC 2.58 on sphere |" in text
+    assert "**Recommendation: b**" in text
+    table = matrix_tables.long_table(records, accuracy={"sphere": 1e-3})
+    assert (table["reference_accuracy"] == 1e-3).all()
+    cut = {s: table[table["scheme"] == s]["eoc_below_accuracy"].tolist() for s in errors}
+    assert cut == {"a": [False] * 3, "b": [False, True, True], "d": [False, False, True]}
+    d = table[table["scheme"] == "d"]["eoc"].tolist()
+    assert math.isnan(d[0]) and d[1] == pytest.approx(math.log2(6)) and math.isnan(d[2])
+    summary = matrix_tables.with_levels(matrix_tables.summary_table(table), table)
+    row = summary.set_index("scheme").loc["d"]
+    assert row["eoc_below_accuracy"] and math.isnan(row["eoc"]) and row["eoc_levels"] == ""
+    assert matrix_tables.summary_cell(row) == \
+        "EOC n/a (below the reference's accuracy); 5.000e-04 (L3)"
+    frame, _ = matrix_tables.problem_table(table, "sphere")
+    assert frame.set_index("scheme").loc["d", "EOC"] == \
+        "2.58, n/a (below the reference's accuracy)"
+    judged = matrix_findings.matrix_findings(table)
+    assert "left out" not in judged and "**Recommendation: d**" in judged
+    assert ("**d** reaches an error within the reference's accuracy, finest 5.000e-04 "
+            "(level 3): EOC n/a (below the reference's accuracy)") in judged
+    assert ("| sphere | n/a (below the reference's accuracy) | 1 | d | EOC not computed (an "
+            "error within the reference's accuracy) |") in judged
+    assert "EOC 2.58 on sphere" not in judged and "-0." not in judged
 
 
 def test_findings_show_values_as_the_tables_do():
@@ -641,7 +627,7 @@ def test_findings_show_values_as_the_tables_do():
     text = matrix_findings.matrix_findings(table)
     summary = matrix_tables.with_levels(matrix_tables.summary_table(table), table)
     assert "-8.424e-04" in text and matrix_tables.summary_cell(summary.iloc[0]).count("-8.424e-04")
-    assert "%" not in text.split("## Across problems")[0].split("## Per problem")[1]
+    assert "%" not in text.split("## Per problem")[1].split("\n## ")[0]
 
 
 def test_noise_level_timings_are_marked_and_not_ranked():
@@ -751,7 +737,7 @@ def test_summary_keeps_a_value_measured_before_a_later_breakdown():
 
 
 def test_a_pinch_after_the_measurement_is_judged_by_the_measured_error():
-    from mcfbench.studies.matrix.findings import _classify as classify_row  # noqa: PLC2701
+    from mcfbench.studies.matrix.verdicts import classify as classify_row
 
     row = {"runs": 3, "runs_ok": 0, "error": True, "values": [0.164, 0.0463, 0.0129],
            "eoc": 1.84}
@@ -817,7 +803,12 @@ def test_the_real_meshes_get_a_survival_count_and_a_breakdown_there_disqualifies
     section = text.split("## On the real meshes")[1].split("## ")[0]
     assert "- **a**: 2 of 2, median error 2.000e-02." in section
     assert "- **b**: 1 of 2, median error 1.500e-02; broke down on real_spot." in section
-    assert "**Recommendation: a**" in text and "b (broke down on real_spot)" in text
+    assert "**Recommendation: a**" in text
+    assert "| a | 1.15 | 0 of 2 | recommended |" in text
+    assert "| b | 1 | 1 of 2 | left out: broke down on real_spot |" in text
+    assert "On the 2 real-world-like meshes 1 of the 2 schemes break down at least once " \
+        "(most often b, on 1)." in text
+    assert "| real_nut | 2.00 | 1.33 | b | – |" in text          # b more accurate there
 
 
 def test_an_extinct_run_reached_its_end():

@@ -12,6 +12,7 @@ from mcfbench.studies.matrix import findings as matrix_findings
 from mcfbench.studies.matrix import page as matrix_page
 from mcfbench.studies.matrix import tables as matrix_tables
 from mcfbench.studies.matrix.tangential import strategy_frame, tangential_section
+from mcfbench.studies.matrix.verdicts import scheme_view
 
 # scheme -> (CPU seconds per step, smallest angle and covolume ratio at t = 0, T/2, T)
 RUNS = {"cotan": (1.0, [30.0, 20.0, 10.0], [1.2, 1.5, 2.0]),
@@ -47,7 +48,7 @@ def matrix():
     records = [_record(s, p, level + (p == "sphere"), e) for (s, p), errors in ERRORS.items()
                for level, e in enumerate(errors)]
     table = matrix_tables.long_table(records)
-    summary = matrix_findings.scheme_view(matrix_tables.with_levels(
+    summary = scheme_view(matrix_tables.with_levels(
         matrix_tables.summary_table(table), table))
     return table, summary
 
