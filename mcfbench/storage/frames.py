@@ -18,7 +18,7 @@ The state of a frame is ``vertices`` then ``extra_points`` (the order of the
 scheme's ``X``).
 
 **Versions.** ``format_version`` (a 0-d int array; :data:`FORMAT_VERSION`) says
-which layout a file has; a file without it is version 1, the layout above. Version 2
+which layout a file has (0: before the key, 1: the layout above). Version 2
 adds the frames of a run whose mesh changed (a remeshed run,
 :mod:`mcfbench.running.remeshing`): each frame keeps its own faces, so the frames
 cannot be stacked. Such a file has no ``vertices`` and ``extra_points`` but
@@ -45,15 +45,13 @@ import numpy as np
 
 from mcfbench.storage.atomic import save_npz
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 """The version of the layout :func:`save_frames` writes (``docs/formats.md``); a file
-without the key is read as the layout before it (version 0, :data:`LEGACY_KEYS`)."""
+without the key is read as the layout before it (version 0, :data:`LEGACY_KEYS`);
+2 adds the frames with their own faces (module docstring)."""
 
 REQUIRED = ("faces", "steps", "t")
 """Keys of every frames file."""
-
-FORMAT_VERSION = 2
-"""The frames layout written (module docstring): 2 adds the frames with their own faces."""
 
 CHANGING = ("frame_vertices", "frame_faces", "frame_sizes")
 """Keys of the frames of a run whose mesh changed (version 2)."""
@@ -78,10 +76,6 @@ def check_frames(arrays, path):
         raise ValueError(f"{path}: not a run's frames file: it has {sorted(arrays)}, expected "
                          f"faces, steps, t and vertices (and extra_points), or frame_vertices, "
                          f"frame_faces and frame_sizes")
-    version = int(arrays.get("format_version", 1))
-    if version > FORMAT_VERSION:
-        raise ValueError(f"{path}: frames layout version {version}, newer than this code's "
-                         f"{FORMAT_VERSION}")
     if changing:
         sizes = np.asarray(arrays["frame_sizes"])
         if sizes.shape != (len(arrays["t"]), 3) or \
