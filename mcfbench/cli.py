@@ -71,13 +71,24 @@ def _count(text, least=0):
     return value
 
 
+def _scheme_name(text):
+    """A scheme name :func:`get_scheme` knows (derived names included), else the error
+    naming the known ones."""
+    try:
+        get_scheme(text)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+    return text
+
+
 def _level(text):
     return _count(text, least=1)
 
 
 def _common(parser, default_solver):
-    parser.add_argument("--scheme", default="ddfv", choices=list(SCHEMES),
-                        help="scheme (default: ddfv; see `schemes`)")
+    parser.add_argument("--scheme", default="ddfv", type=_scheme_name, metavar="SCHEME",
+                        help="scheme (default: ddfv; see `schemes`): a name of the registry, "
+                             "NAME@INTEGRATOR, NAME+remesh or NAME@INTEGRATOR+remesh")
     parser.add_argument("--variant", choices=list(VARIANTS),
                         help="DDFV variant: same as --scheme ddfv-VARIANT")
     parser.add_argument("--solver", choices=METHODS, default=default_solver,

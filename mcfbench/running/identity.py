@@ -88,8 +88,9 @@ def scheme_values(scheme):
     from mcfbench.running.schemes import get_scheme
 
     entry = get_scheme(scheme)
-    values = {"flow": entry.flow, "options": entry.options, "integrator": entry.integrator,
-              "mesh_strategy": entry.mesh_strategy}
+    values = {"flow": entry.flow, "options": entry.options, "integrator": entry.integrator}
+    if entry.mesh_strategy != "none":   # (the others' identities as before the strategies)
+        values["mesh_strategy"] = entry.mesh_strategy
     source = getattr(entry, "source", None)
     return {**values, "source": source} if source else values
 

@@ -124,6 +124,25 @@ def frame_mesh(frames, k):
     return frames["vertices"][k], frames["faces"]
 
 
+def mesh_segments(frames):
+    """The frames in runs of one mesh: ``[(faces, vertices, extra)]``, ``vertices``
+    (frames_s, n_s, 3) stacked, ``extra`` (frames_s, k_s, 3) or None, in frame order;
+    one segment for a run whose mesh stayed, one per remesh more for a remeshed run
+    (a reader that compares frames, e.g. their displacements, compares within one)."""
+    vertices, extra = surface_points(frames)
+    if "frame_sizes" not in frames:
+        return [(np.asarray(frames["faces"]), vertices, extra)] if vertices is not None \
+            else []
+    faces = _split(frames, "frame_faces", 2)
+    segments, start = [], 0
+    for k in range(1, len(faces) + 1):
+        if k == len(faces) or not np.array_equal(faces[k], faces[start]):
+            segments.append((faces[start], np.stack(vertices[start:k]),
+                             None if extra is None else np.stack(extra[start:k])))
+            start = k
+    return segments
+
+
 def surface_points(frames):
     """``(vertices, extra)`` of a run's frames (a frames file's arrays, or the
     trajectory's): the surface mesh's vertices (frames, n, 3), a DDFV run's
