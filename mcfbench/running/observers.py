@@ -18,13 +18,13 @@ class _Final:
 
     def __init__(self, problem):
         self.problem = problem
-        self.V = self.faces = self.fixed = None
+        self.V = self.faces = self.fixed = self.flow = None
         self.t = 0.0
 
     def __call__(self, flow):
         self.V, self.t = flow.vertices, flow.n * flow.tau
-        if self.faces is None:     # the flow's for the whole run (DDFV's fixed: a gather)
-            self.faces, self.fixed = flow.faces, getattr(flow, "fixed", None)
+        if flow is not self.flow:  # once a flow (DDFV's fixed: a gather); a rebuilt one's
+            self.flow, self.faces, self.fixed = flow, flow.faces, getattr(flow, "fixed", None)
 
     def result(self):
         raise NotImplementedError

@@ -257,7 +257,9 @@ def test_bad_paths_are_named(tmp_path, capsys, name, text, message):
     (["--tau", "nan"], r"--tau: must be a positive number"),
     (["--steps", "0"], r"--steps: must be a whole number >= 1"),
     (["--rtol", "0"], r"--rtol: must be a positive number"),
-    (["--scheme", "fast"], r"--scheme: invalid choice: 'fast'"),
+    (["--scheme", "fast"], r"--scheme: unknown scheme 'fast'"),
+    (["--scheme", "cotan+remesh@bdf2"], r"--scheme: scheme 'cotan\+remesh@bdf2': unknown mesh "
+                                        r"strategy 'remesh@bdf2'"),
     (["--solver", "magic"], r"--solver: invalid choice: 'magic'"),
 ])
 def test_bad_settings_are_named(tmp_path, capsys, options, message):
