@@ -135,3 +135,18 @@ def test_kll_is_reinitialised_from_the_new_mesh():
     np.testing.assert_allclose(np.einsum("ij,ij->i", nu, X / np.linalg.norm(X, axis=1)[:, None]),
                                1.0, atol=0.01)
     assert event["distance"] < metrics.mean_edge_length(V, F) ** 2
+
+
+def test_a_final_metric_is_measured_on_the_remeshed_runs_own_mesh():
+    """The problems' final observers follow the rebuilt flow (its faces, its fixed)."""
+    from mcfbench.running.observers import METRICS
+
+    V, F = _sliver_sphere()
+    scheme = get_scheme("cotan+remesh")
+    shape = METRICS["shape"](None)
+    traj = simulate(scheme.make(V, F, 1e-3), 3, remesh=Remesher(scheme, (V, F)),
+                    observers=[shape])
+    assert traj.frame_faces is not None
+    last_V, last_F = traj.flow.vertices, traj.flow.faces
+    assert shape.result() == {"volume": metrics.volume(last_V, last_F),
+                              "area": metrics.area(last_V, last_F)}
