@@ -30,7 +30,7 @@ import numpy as np
 from ddfv.variants import VARIANTS
 from mcfbench.running.integrators import INTEGRATORS
 from mcfbench.running.problems import PROBLEMS, Problem, get_problem
-from mcfbench.running.schemes import SCHEMES, get_scheme
+from mcfbench.running.schemes import MESH_STRATEGIES, SCHEMES, get_scheme
 from mcfbench.running.solver import METHODS, ROBUST, Solver
 from mcfbench.storage.atomic import check_writable, write_json
 from mcfbench.storage.frames import save_frames
@@ -432,6 +432,10 @@ def _schemes(args):
     width = max(map(len, SCHEMES))
     for scheme in SCHEMES.values():
         print(f"{scheme.name:{width}}  {scheme.description}{_origin(scheme)}")
+    print("\nEach also as NAME@INTEGRATOR (" + ", ".join(i for i in INTEGRATORS if i != "euler")
+          + "), NAME+STRATEGY and NAME@INTEGRATOR+STRATEGY:")
+    for strategy, description in MESH_STRATEGIES.items():
+        print(f"  +{strategy}  {description}")
     return 0
 
 
