@@ -65,7 +65,7 @@ def test_registries_are_listed_in_aligned_columns(capsys):
 
     for command, registry in (("schemes", SCHEMES), ("problems", PROBLEMS)):
         assert main([command]) == 0
-        lines = capsys.readouterr().out.splitlines()
+        lines = capsys.readouterr().out.split("\n\n")[0].splitlines()   # (then the suffixes)
         assert [line.split()[0] for line in lines] == list(registry)
         # every description starts in one column, two spaces after the longest name
         start = max(map(len, registry)) + 2
