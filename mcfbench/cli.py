@@ -30,7 +30,7 @@ import numpy as np
 from ddfv.variants import VARIANTS
 from mcfbench.running.integrators import INTEGRATORS
 from mcfbench.running.problems import PROBLEMS, Problem, get_problem
-from mcfbench.running.schemes import SCHEMES, get_scheme
+from mcfbench.running.schemes import MESH_STRATEGIES, SCHEMES, get_scheme
 from mcfbench.running.solver import METHODS, ROBUST, Solver
 from mcfbench.storage.atomic import check_writable, write_json
 from mcfbench.storage.frames import save_frames
@@ -71,13 +71,24 @@ def _count(text, least=0):
     return value
 
 
+def _scheme_name(text):
+    """A scheme name :func:`get_scheme` knows (derived names included), else the error
+    naming the known ones."""
+    try:
+        get_scheme(text)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+    return text
+
+
 def _level(text):
     return _count(text, least=1)
 
 
 def _common(parser, default_solver):
-    parser.add_argument("--scheme", default="ddfv", choices=list(SCHEMES),
-                        help="scheme (default: ddfv; see `schemes`)")
+    parser.add_argument("--scheme", default="ddfv", type=_scheme_name, metavar="SCHEME",
+                        help="scheme (default: ddfv; see `schemes`): a name of the registry, "
+                             "NAME@INTEGRATOR, NAME+remesh or NAME@INTEGRATOR+remesh")
     parser.add_argument("--variant", choices=list(VARIANTS),
                         help="DDFV variant: same as --scheme ddfv-VARIANT")
     parser.add_argument("--solver", choices=METHODS, default=default_solver,
@@ -421,6 +432,10 @@ def _schemes(args):
     width = max(map(len, SCHEMES))
     for scheme in SCHEMES.values():
         print(f"{scheme.name:{width}}  {scheme.description}{_origin(scheme)}")
+    print("\nEach also as NAME@INTEGRATOR (" + ", ".join(i for i in INTEGRATORS if i != "euler")
+          + "), NAME+STRATEGY and NAME@INTEGRATOR+STRATEGY:")
+    for strategy, description in MESH_STRATEGIES.items():
+        print(f"  +{strategy}  {description}")
     return 0
 
 

@@ -22,7 +22,7 @@ from matplotlib.animation import FuncAnimation, PillowWriter
 
 from mcfbench.presentation.render import draw_mesh, project
 from mcfbench.storage.atomic import write_files
-from mcfbench.storage.frames import surface_points
+from mcfbench.storage.frames import frame_mesh, surface_points
 
 OK_COLOR, DEFECT_COLOR = "#1a7f37", "#c0261c"
 
@@ -108,8 +108,9 @@ def write_movie(arrays, out, *, title="", view=(20.0, -60.0), fps=4, size=4.0, d
         raise ValueError(f"{out}: the animation is a GIF; name it *.gif")
     # a DDFV run the scheme refused (status unsupported) kept its surface, no T-vertices
     V, T = surface_points(arrays)
-    V = np.asarray(V if V is not None else [], dtype=float)
-    T = None if T is None else np.asarray(T, dtype=float)
+    if "frame_sizes" not in arrays:          # one mesh (a remeshed run's: lists, per frame)
+        V = np.asarray(V if V is not None else [], dtype=float)
+        T = None if T is None else np.asarray(T, dtype=float)
     faces, t = np.asarray(arrays["faces"]), np.asarray(arrays["t"], dtype=float)
     if len(t) == 0 or len(V) != len(t):
         raise ValueError(f"{out}: no frames to animate ({len(V)} frames, {len(t)} times)")
@@ -130,7 +131,7 @@ def write_movie(arrays, out, *, title="", view=(20.0, -60.0), fps=4, size=4.0, d
         ax.set_axis_off()
         finite = np.isfinite(V[k]).all() and (T is None or np.isfinite(T[k]).all())
         if finite:
-            draw_mesh(ax, V[k], None if T is None else T[k], faces, view=view,
+            draw_mesh(ax, V[k], None if T is None else T[k], frame_mesh(arrays, k)[1], view=view,
                       points_per_unit=72.0 * size / (2 * half))
         else:
             ax.text(0.5, 0.5, "non-finite coordinates", transform=ax.transAxes,

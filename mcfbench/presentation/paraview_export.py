@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from mcfbench.geometry.frame_fields import ddfv_frame_fields, vertex_frame_fields
-from mcfbench.storage.frames import load_frames, surface_points
+from mcfbench.storage.frames import load_frames, mesh_segments
 from mcfbench.storage.paraview import Piece, write_pvd
 from mcfbench.storage.provenance import provenance
 from mcfbench.storage.records import load_json
@@ -57,26 +57,28 @@ def run_pieces(arrays):
     Parameters
     ----------
     arrays : dict
-        ``faces`` (m, 3) and the points of
-        :func:`~mcfbench.storage.frames.surface_points` (a DDFV run's
-        T-vertices, (frames, m, 3), as their own piece).
+        A run's frames (:func:`~mcfbench.storage.frames.mesh_segments`: a DDFV run's
+        T-vertices as their own piece; a remeshed run's frames each with its faces,
+        the displacements since the last remesh).
 
     Returns
     -------
     list of dict of str -> mcfbench.storage.paraview.Piece
         Per frame: ``surface`` (and ``t_vertices`` for DDFV).
     """
-    faces = np.asarray(arrays["faces"], dtype=np.int64)
-    V, T = surface_points(arrays)
-    V = np.asarray(V, dtype=np.float64)
-    if T is None:
-        return [{"surface": Piece(V[k], faces, point_data)}
-                for k, point_data in enumerate(vertex_frame_fields(V, faces))]
-    T = np.asarray(T, dtype=np.float64)
-    single = np.arange(len(faces))[:, None]
-    return [{"surface": Piece(V[k], faces, fields["vertices"], fields["triangles"]),
-             "t_vertices": Piece(T[k], single, fields["extra_points"])}
-            for k, fields in enumerate(ddfv_frame_fields(V, T, faces))]
+    pieces = []
+    for faces, V, T in mesh_segments(arrays):    # a remeshed run: displacements per mesh
+        faces, V = np.asarray(faces, dtype=np.int64), np.asarray(V, dtype=np.float64)
+        if T is None:
+            pieces += [{"surface": Piece(V[k], faces, point_data)}
+                       for k, point_data in enumerate(vertex_frame_fields(V, faces))]
+            continue
+        T = np.asarray(T, dtype=np.float64)
+        single = np.arange(len(faces))[:, None]
+        pieces += [{"surface": Piece(V[k], faces, fields["vertices"], fields["triangles"]),
+                    "t_vertices": Piece(T[k], single, fields["extra_points"])}
+                   for k, fields in enumerate(ddfv_frame_fields(V, T, faces))]
+    return pieces
 
 
 def run_provenance(arrays, source=None):

@@ -11,7 +11,7 @@ import numpy as np  # noqa: E402
 
 from mcfbench.presentation.plots import SMALLEST_TEXT  # noqa: E402
 from mcfbench.storage.atomic import save_figure  # noqa: E402
-from mcfbench.storage.frames import surface_points  # noqa: E402
+from mcfbench.storage.frames import frame_mesh, surface_points  # noqa: E402
 
 DIAMONDS_UP_TO = 1500
 """Draw the DDFV diamond mesh (T-vertices) of meshes with at most this many triangles."""
@@ -23,13 +23,14 @@ where the meshes were rasterized before too)."""
 
 def frame_surface(frames, which=-1):
     """``(vertices, extra, faces)`` of a saved frame (:func:`surface_points`: ``extra``
-    the DDFV T-vertices, None for vertex schemes; ``vertices`` None without frames)."""
-    faces = np.asarray(frames["faces"])
+    the DDFV T-vertices, None for vertex schemes; ``vertices`` None without frames;
+    ``faces`` the frame's own, :func:`frame_mesh`)."""
     vertices, extra = surface_points(frames)
     if vertices is None or not len(vertices):
-        return None, None, faces
+        return None, None, np.asarray(frames["faces"])
     return (np.asarray(vertices[which]),
-            extra[which] if extra is not None and len(extra) else None, faces)
+            extra[which] if extra is not None and len(extra) else None,
+            np.asarray(frame_mesh(frames, which)[1]))
 
 
 def last_frames(entries, subjects, schemes, note, first_note):

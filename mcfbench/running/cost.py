@@ -45,7 +45,7 @@ unknown and every run goes on.
 
 from dataclasses import dataclass
 
-from mcfbench.running.schemes import find_scheme, get_scheme, split_name
+from mcfbench.running.schemes import find_scheme, get_scheme, parse_name
 from mcfbench.storage.memory import available_mb
 
 COSTS = {
@@ -72,8 +72,8 @@ def cost_class(scheme):
     redistribution (a potential solved at every step)."""
     entry = get_scheme(scheme) if isinstance(scheme, str) else scheme
     entry = find_scheme(entry.name) or entry      # a study's wrapper -> the registry's entry
-    if split_name(entry.name)[0] in ("bgn", "kll"):
-        return split_name(entry.name)[0]
+    if parse_name(entry.name).base in ("bgn", "kll"):
+        return parse_name(entry.name).base
     options = getattr(entry, "options", {})
     redistributing = options.get("redistribution") is not None or \
         options.get("tangential") == "redistribute"

@@ -23,6 +23,7 @@ from mcfbench.geometry.measures import StateMeasures
 from mcfbench.running.flow import FlowBreakdown
 from mcfbench.running.integrators import get_integrator
 from mcfbench.running.solver import Solver, SolverFailure
+from mcfbench.storage.frames import changing_frames
 
 ON_DEFECT = ("stop", "record")
 
@@ -44,6 +45,12 @@ class Trajectory:
         Time level of each frame.
     t : (frames,) float array
     faces : (m, 3) int array
+        The initial mesh's (frame 0's).
+    frame_faces : list of (m_k, 3) int arrays, or None
+        Each frame's faces, for a run whose mesh changed (``remesh``): then
+        ``frames`` holds the frames of :func:`mcfbench.storage.frames.changing_frames`
+        (read them with :func:`~mcfbench.storage.frames.frame_mesh`); None when every
+        frame has ``faces``.
     iterations : (n_steps,) int array
         Solver iterations of each completed step.
     status : str
@@ -68,7 +75,10 @@ class Trajectory:
         round (:mod:`mcfbench.geometry.collapse`): ``time`` the state's, ``kind``
         ``"point"`` or ``"circle"``, ``area`` and ``volume`` the component's then,
         ``extinction_time`` the state's time plus the time the round component
-        had left.
+        had left; one ``{"event": "remeshed", "step", "time", "why", ...}`` per remesh
+        (``remesh``; the fields of :func:`mcfbench.geometry.remeshing.remesh_change`:
+        the distance between the surfaces before and after, the changes of area and
+        volume, the vertex counts, whether the components or genus changed).
     flow : mcfbench.running.flow.SchemeFlow
         The flow at the run's end: the one stepped, or the one rebuilt on the
         components that remained (``rebuild``).
@@ -89,6 +99,7 @@ class Trajectory:
     t: np.ndarray
     faces: np.ndarray
     iterations: np.ndarray
+    frame_faces: list | None = None
     status: str = "ok"
     message: str = ""
     failed_step: int = -1
@@ -133,7 +144,7 @@ class _NoBar:
 
 def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrapolate",
              save_every=1, observers=(), on_defect="stop", until=None, progress=False,
-             collapse=True, invariants=True, rebuild=None):
+             collapse=True, invariants=True, rebuild=None, remesh=None):
     """Step ``flow`` ``steps`` times.
 
     Parameters
@@ -197,6 +208,15 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
         initial mesh's layout, the vanished points where they vanished, and the
         integrator starts afresh); without ``rebuild``, or when it cannot, the run
         ends ``degenerated`` saying why (the event's ``why_not``).
+    remesh : callable, optional
+        ``remesh(flow) -> (flow, event)`` or None, after every state that passed the
+        checks (the initial one included): the flow rebuilt on a new mesh of its
+        surface at the same time level, and what changed
+        (:class:`mcfbench.running.remeshing.Remesher`). The run goes on with it: the
+        integrator starts afresh, the checks start again from the new mesh (the
+        invariants hold between remeshes; the event records the change across one,
+        a ``"remeshed"`` event of :attr:`Trajectory.events`), and the frames keep
+        each its own faces (:attr:`Trajectory.frame_faces`).
 
     Returns
     -------
@@ -212,7 +232,7 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
     stepping = _Stepping(flow, int(steps), get_integrator(integrator, warm_start=warm_start),
                          save_every=save_every, observers=observers, on_defect=on_defect,
                          until=until, collapse=collapse, invariants=invariants,
-                         rebuild=rebuild)
+                         rebuild=rebuild, remesh=remesh)
     # a copy per run: what a solver keeps between solves (the kept ILU factor) is the
     # run's own, built inside its timed steps, never carried in from a warm-up or an
     # earlier run (a timed repeat pays for its factor as the first execution did)
@@ -227,13 +247,14 @@ class _Stepping:
     failure with another one."""
 
     def __init__(self, flow, steps, stepper, *, save_every, observers, on_defect, until,
-                 collapse, invariants, rebuild=None):
+                 collapse, invariants, rebuild=None, remesh=None):
         self.flow, self.steps, self.stepper = flow, steps, stepper
         self.save_every, self.observers, self.on_defect = save_every, observers, on_defect
         self.until = until
         self.frames, self.steps_kept, self.iterations, self.defects = [], [], [], []
         self.events = []
-        self.rebuild, self.faces = rebuild, np.asarray(flow.faces)
+        self.rebuild, self.remesh, self.faces = rebuild, remesh, np.asarray(flow.faces)
+        self.frame_faces = []
         # the initial mesh's points and triangles still in the flow (all until a
         # component vanishes and the run goes on without it), and the last full frame
         self.kept_vertices = np.arange(len(flow.vertices))
@@ -258,11 +279,46 @@ class _Stepping:
         except FlowBreakdown as err:
             self.broken = err
         self.save()
+        if self.broken is None:
+            try:
+                self.remeshed()
+            except FlowBreakdown as err:
+                self.broken = err
         self.wall, self.cpu = time.perf_counter() - wall, time.process_time() - cpu
 
     def save(self):
         self.steps_kept.append(self.flow.n)
         self.frames.append(self.full_frame())
+        self.frame_faces.append(self.faces)
+
+    def remeshed(self):
+        """Go on with the flow on a new mesh when ``remesh`` gives one (``simulate``'s
+        ``remesh``): the checks start again from it, the integrator afresh; the new
+        state is checked (an invalid remesh ends the run as any state does)."""
+        if self.remesh is None:
+            return
+        found = self.remesh(self.flow)
+        if found is None:
+            return
+        new, event = found
+        self.events.append(event)
+        check = self.collapsed
+        self.flow, self.faces, self.full = new, np.asarray(new.faces), None
+        self.kept_vertices = np.arange(len(new.vertices))
+        self.kept_faces = np.arange(len(self.faces))
+        self.stepper = get_integrator(self.stepper.name, warm_start=self.stepper.warm_start)
+        if self.measures is not None:
+            self.measures = StateMeasures(new.vertices, new.faces)
+        if check is not None:
+            self.collapsed = CollapseCheck(new.vertices, new.faces, measures=self.measures,
+                                           tau=new.tau, area_tol=check.area_tol,
+                                           diameter_tol=check.diameter_tol)
+            if check.count == self.collapsed.count == 1:   # its initial size and name
+                self.collapsed.renamed(check.area0, check.diameter0, check.ids,
+                                       self.kept_vertices, check.total)
+        if self.invariant is not None:
+            self.invariant = FlowInvariants(new.vertices, new.faces, measures=self.measures)
+        self.check()
 
     def check(self):
         """Record the defects of the current state; raise in stop mode (always for a
@@ -409,6 +465,11 @@ class _Stepping:
                     self.save()
                 if self.until is not None and self.until(self.flow):
                     break
+                try:
+                    self.remeshed()
+                except FlowBreakdown as err:
+                    self.broken = err
+                    break
         self.end_frame = self.steps_kept[-1] != self.flow.n
         if self.end_frame:
             self.save()
@@ -426,6 +487,7 @@ class _Stepping:
         if self.end_frame:                  # the failed step's state, kept as its end
             self.steps_kept.pop()
             self.frames.pop()
+            self.frame_faces.pop()
         return self.go(solver, progress)
 
     def trajectory(self):
@@ -436,11 +498,21 @@ class _Stepping:
             status, failed = first["status"], first["step"]
             message = str(self.broken) if self.broken is not None else str(
                 FlowBreakdown(first["status"], first["step"], first["time"], first["detail"]))
-        stacked = {key: np.stack([frame[key] for frame in self.frames])
-                   for key in self.frames[0]}
+        frame_faces = None
+        if all(faces is self.frame_faces[0] for faces in self.frame_faces):
+            stacked = {key: np.stack([frame[key] for frame in self.frames])
+                       for key in self.frames[0]}
+        else:                                 # remeshed: each frame its own mesh
+            frame_faces = list(self.frame_faces)
+            extra = [frame["extra_points"] for frame in self.frames] \
+                if "extra_points" in self.frames[0] else None
+            stacked = changing_frames([frame["vertices"] for frame in self.frames], extra,
+                                      frame_faces)
+            del stacked["faces"]
         return Trajectory(
             frames=stacked, steps=np.array(self.steps_kept),
-            t=np.array(self.steps_kept) * flow.tau, faces=self.faces,
+            t=np.array(self.steps_kept) * flow.tau, faces=self.frame_faces[0],
+            frame_faces=frame_faces,
             iterations=np.array(self.iterations, dtype=int), status=status, message=message,
             failed_step=failed, steps_done=len(self.iterations), defects=defects,
             wall_seconds=self.wall, cpu_seconds=self.cpu, events=list(self.events),

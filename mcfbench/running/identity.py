@@ -46,8 +46,12 @@ HARNESS = ("mcfbench.running.run",)
 """The roots of the harness code every run shares."""
 
 STOP = frozenset({"mcfbench.running.schemes", "mcfbench.running.problems", "mcfbench.problems",
+                  "mcfbench.running.remeshing",
                   "mcfbench.schemes"})
-"""The listings: not followed where they are imported (module docstring)."""
+"""The listings: not followed where they are imported (module docstring); and the mesh
+strategies' hooks (:mod:`mcfbench.running.remeshing`), which the harness's ``run``
+imports for every run but only a ``NAME+STRATEGY`` scheme's runs use: a root of
+those (:func:`scheme_roots`)."""
 
 PROBLEM_DEFINITIONS = ("mcfbench.running.problem", "mcfbench.running.observers")
 """The modules defining ``Problem`` and the metric observers: roots of every problem."""
@@ -59,15 +63,20 @@ def _module_of(qualified):
 
 
 def scheme_roots(scheme):
-    """The modules of ``scheme`` (a registry name, ``NAME@INTEGRATOR`` included):
-    its flow's and, for another integrator than Euler, the integrator's."""
+    """The modules of ``scheme`` (a registry name, ``NAME@INTEGRATOR`` and
+    ``NAME+STRATEGY`` included): its flow's, for another integrator than Euler the
+    integrator's, and for a mesh strategy its hook's class's
+    (:data:`mcfbench.running.remeshing.STRATEGIES`)."""
     from mcfbench.running.integrators import INTEGRATORS
+    from mcfbench.running.remeshing import STRATEGIES
     from mcfbench.running.schemes import get_scheme
 
     entry = get_scheme(scheme)
     roots = [_module_of(entry.flow)]
     if entry.integrator != "euler":
         roots.append(INTEGRATORS[entry.integrator].__module__)
+    if entry.mesh_strategy != "none":
+        roots.append(STRATEGIES[entry.mesh_strategy].__module__)
     return tuple(roots)
 
 
@@ -80,6 +89,8 @@ def scheme_values(scheme):
 
     entry = get_scheme(scheme)
     values = {"flow": entry.flow, "options": entry.options, "integrator": entry.integrator}
+    if entry.mesh_strategy != "none":   # (the others' identities as before the strategies)
+        values["mesh_strategy"] = entry.mesh_strategy
     source = getattr(entry, "source", None)
     return {**values, "source": source} if source else values
 

@@ -44,9 +44,11 @@ class Monitor:
     def sample(self, flow):
         if self.quality["quality_t"] and self.quality["quality_t"][-1] == flow.n * flow.tau:
             return
-        if self._neighbours is None or self._faces != len(flow.faces):
-            # (again for the flow rebuilt on the components that remain of a run)
-            self._neighbours, self._faces = metrics.edge_neighbours(flow.faces), len(flow.faces)
+        if self._neighbours is None or not np.array_equal(self._faces, flow.faces):
+            # (again for the flow rebuilt on the components that remain of a run, or
+            # on a new mesh)
+            self._faces = np.array(flow.faces)
+            self._neighbours = metrics.edge_neighbours(self._faces)
         V = flow.vertices
         q = metrics.quality(V, flow.faces, self._neighbours)
         self.quality["quality_t"].append(flow.n * flow.tau)

@@ -18,13 +18,13 @@ class _Final:
 
     def __init__(self, problem):
         self.problem = problem
-        self.V = self.faces = self.fixed = None
+        self.V = self.faces = self.fixed = self.flow = None
         self.t = 0.0
 
     def __call__(self, flow):
         self.V, self.t = flow.vertices, flow.n * flow.tau
-        if self.faces is None:     # the flow's for the whole run (DDFV's fixed: a gather)
-            self.faces, self.fixed = flow.faces, getattr(flow, "fixed", None)
+        if flow is not self.flow:  # once a flow (DDFV's fixed: a gather); a rebuilt one's
+            self.flow, self.faces, self.fixed = flow, flow.faces, getattr(flow, "fixed", None)
 
     def result(self):
         raise NotImplementedError
@@ -148,17 +148,25 @@ class _Enneper(_Final):
 
 
 class _Still(_Final):
-    """Largest displacement of a vertex from its initial position (flat patch)."""
+    """Largest displacement of a vertex from its initial position (flat patch); of a
+    remeshed run, the largest distance of a vertex from the initial surface."""
 
     def __call__(self, flow):
         if self.V is None:
-            self.V0 = flow.vertices.copy()
+            self.V0, self.F0, self.first = flow.vertices.copy(), flow.faces, flow
         super().__call__(flow)
 
     def result(self):
         import numpy as np
 
-        return {"max_displacement": float(np.linalg.norm(self.V - self.V0, axis=1).max()),
+        if self.flow is self.first:
+            moved = np.linalg.norm(self.V - self.V0, axis=1)
+        else:       # a remeshed run's vertices are new ones: their distance to the initial
+            import igl                                                  # surface
+
+            moved = np.sqrt(igl.point_mesh_squared_distance(
+                np.asarray(self.V, float), self.V0, np.asarray(self.F0, np.int64))[0])
+        return {"max_displacement": float(moved.max()),
                 "max_height": _metrics.max_height(self.V)}
 
 

@@ -27,6 +27,7 @@ from mcfbench.running.cost import check_size
 from mcfbench.running.driver import simulate
 from mcfbench.running.monitors import Monitor, Steady
 from mcfbench.running.problems import get_problem
+from mcfbench.running.remeshing import mesh_hook
 from mcfbench.running.schemes import get_scheme
 from mcfbench.running.solver import Solver
 from mcfbench.storage.frames import surface_points
@@ -152,7 +153,7 @@ def _result(timed, scheme, problem, level, nF, h, tau, steps, method, integrator
     """The :class:`RunResult` of an execution of a run (:func:`_timed_run`,
     :func:`_continued`) with ``nF`` mesh vertices of mean edge length ``h``."""
     flow, traj, monitor = timed.flow, timed.trajectory, timed.monitor
-    nV = sum(points.shape[1] for points in traj.frames.values())   # the initial mesh's
+    nV = sum(len(points[0]) for points in surface_points(traj.frames) if points is not None)
     q = monitor.quality
     return RunResult(
         scheme=scheme.name, problem=problem.name, level=int(level), nV=nV,
@@ -241,7 +242,8 @@ def _timed_run(scheme, problem, mesh, tau, steps, *, solver, integrator, warm_st
                     observers=[monitor, *metric_observers, *observers], on_defect=on_defect,
                     until=until, progress=progress,
                     rebuild=partial(sub_flow, scheme, integrator=integrator, threads=threads,
-                                    **options))
+                                    **options),
+                    remesh=mesh_hook(scheme, (V, F), threads=threads, options=options))
     flow = traj.flow                      # rebuilt when a component vanished
     finished = monitor.finished(flow)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
@@ -457,6 +459,10 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
     def final(tau):
         result, traj = run(scheme, problem, level, tau=tau, t_final=t_final, solver=solver,
                            integrator=integrator, **options)
+        if traj.frame_faces is not None:          # remeshed: other vertices than the input's
+            raise ValueError(f"{result.scheme} remeshed the run at tau = {tau:g} "
+                             f"(mcfbench.running.remeshing): its final state is not on the "
+                             f"input's mesh, which the time study compares point by point")
         return result, {**traj.frames, "faces": traj.faces}
 
     ref_result, ref = final(min(taus) / reference_factor)
@@ -587,5 +593,5 @@ def framed_run(scheme, problem, level, *, solver, mesh=None, tau=None, save_ever
                   "t": np.zeros(2)}
         return (result, frames) if robust is None else (result, frames, None)
     frames = dict(traj.frames)
-    frames.update(faces=traj.faces, steps=traj.steps, t=traj.t)
+    frames.update(faces=traj.faces, steps=traj.steps, t=traj.t)     # frame 0's faces
     return (result, frames, *continued)

@@ -9,6 +9,7 @@ not the registry.
 import importlib
 import inspect
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 MATRICES = {
     "nonsymmetric": "BiCGStab (the paper's) or a sparse LU (`direct`): the matrix is not "
@@ -39,6 +40,47 @@ TANGENTIAL = {
 moves its vertices along the surface, the grouping of the findings' comparison
 (:mod:`mcfbench.studies.matrix.tangential`). DDFV's are the values of its
 ``tangential`` option (:data:`ddfv.variants.VARIANTS`)."""
+
+
+MESH_STRATEGIES = {
+    "remesh": "isotropic remeshing when the mesh's quality fails (Botsch, Kobbelt 2004; "
+              "mcfbench.running.remeshing)",
+}
+"""Suffixes of a scheme name ``NAME[@INTEGRATOR][+STRATEGY]`` -> description: what a run
+does to its mesh besides stepping it (:attr:`Scheme.mesh_strategy`, :func:`parse_name`;
+the driver's hook is built by :func:`mcfbench.running.remeshing.mesh_hook`). A new
+strategy is one key here and one entry of that function's table."""
+
+
+class SchemeName(NamedTuple):
+    """The parts of a scheme name (:func:`parse_name`)."""
+
+    base: str
+    """The registry entry's name."""
+    integrator: str
+    """``"euler"`` unless ``@INTEGRATOR`` says otherwise."""
+    strategy: str
+    """A key of :data:`MESH_STRATEGIES`, or ``"none"``."""
+
+
+def parse_name(name):
+    """The parts of a scheme name ``NAME[@INTEGRATOR][+STRATEGY]``: the integrator first,
+    then the mesh strategy (``"cotan@bdf2+remesh"`` -> ``("cotan", "bdf2", "remesh")``;
+    ``"cotan"`` -> ``("cotan", "euler", "none")``). Checks the strategy (a key of
+    :data:`MESH_STRATEGIES`), not the base or integrator (the registry's).
+
+    Raises
+    ------
+    ValueError
+        An unknown strategy, or the suffixes in the other order.
+    """
+    rest, plus, strategy = name.partition("+")
+    base, _, integrator = rest.partition("@")
+    if plus and strategy not in MESH_STRATEGIES:
+        raise ValueError(f"scheme {name!r}: unknown mesh strategy {strategy!r} (after '+'); "
+                         f"choose one of {', '.join(MESH_STRATEGIES)}; the order is "
+                         "NAME@INTEGRATOR+STRATEGY")
+    return SchemeName(base, integrator or "euler", strategy if plus else "none")
 
 
 @dataclass(frozen=True)
@@ -93,6 +135,10 @@ class Scheme:
         :mod:`baselines.bgn_bdf`): no ``<name>@<integrator>`` of it
         (:func:`mcfbench.running.schemes.get_scheme`), said here so that a name
         resolves without importing the flow.
+    mesh_strategy : str
+        What its runs do to the mesh besides stepping it: ``"none"`` for every
+        registry entry, a key of :data:`MESH_STRATEGIES` for a name
+        ``<name>+<strategy>``.
     module : str
         The module that declared it (set by the registry's discovery,
         :mod:`mcfbench.running.discovery`).
@@ -116,16 +162,19 @@ class Scheme:
     integrator: str = "euler"
     tangential: str = "none"
     integrates_itself: bool = False
+    mesh_strategy: str = "none"
     module: str = field(default="", compare=False)
     source: dict | None = field(default=None, compare=False)
 
     def __post_init__(self):
-        base, at, integrator = self.name.partition("@")   # NAME@INTEGRATOR: get_scheme's
+        base, integrator, strategy = parse_name(self.name)     # get_scheme's derived names
+        at = "@" in self.name
         if not base or any(c in base for c in "/ ") or \
-                (at and integrator in ("euler", "") or at and integrator != self.integrator):
+                (at and integrator in ("euler", "") or integrator != self.integrator) or \
+                strategy != self.mesh_strategy:
             raise ValueError(f"scheme {self.name!r}: a name is a non-empty word without "
-                             "'/', '@' or spaces (a folder of the results; '@' joins an "
-                             "integrator)")
+                             "'/', '@', '+' or spaces (a folder of the results; '@' joins an "
+                             "integrator, '+' a mesh strategy)")
         if self.matrix not in MATRICES:
             raise ValueError(f"scheme {self.name!r}: unknown matrix kind {self.matrix!r}; "
                              f"choose one of {', '.join(MATRICES)}")

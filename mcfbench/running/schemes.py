@@ -15,7 +15,10 @@ Every scheme is stepped by the paper's semi-implicit Euler step unless
 asked otherwise; ``<name>@<integrator>`` (e.g. ``cotan@bdf2``) names the
 scheme ``<name>`` stepped by another integrator of
 :data:`mcfbench.running.integrators.INTEGRATORS` (:func:`get_scheme`), so
-that a study lists it like any scheme (the matrix, the beyond study).
+that a study lists it like any scheme (the matrix, the beyond study);
+``<name>+<strategy>`` (``cotan+remesh``, ``cotan@bdf2+remesh``: the integrator
+first) the scheme whose runs also treat the mesh by a strategy of
+:data:`~mcfbench.running.scheme.MESH_STRATEGIES` (:func:`~mcfbench.running.scheme.parse_name`).
 """
 
 from dataclasses import replace
@@ -23,7 +26,8 @@ from dataclasses import replace
 import mcfbench.schemes
 from mcfbench.running.discovery import discover
 from mcfbench.running.integrators import INTEGRATORS
-from mcfbench.running.scheme import MATRICES, TANGENTIAL, Scheme  # noqa: F401 (the API)
+from mcfbench.running.scheme import (  # noqa: F401 (the API)
+    MATRICES, MESH_STRATEGIES, TANGENTIAL, Scheme, parse_name)
 
 GROUP = "mcfbench.schemes"
 """The entry-point group of installed packages' schemes."""
@@ -34,21 +38,29 @@ SCHEMES, _ = discover(mcfbench.schemes.__path__, mcfbench.schemes.__name__, "SCH
 
 
 def split_name(name):
-    """``(registry name, integrator)`` of a scheme name: ``"cotan@bdf2"`` ->
-    ``("cotan", "bdf2")``, ``"cotan"`` -> ``("cotan", "euler")``."""
-    base, _, integrator = name.partition("@")
-    return base, integrator or "euler"
+    """``(name without the integrator, integrator)`` of a scheme name: ``"cotan@bdf2"`` ->
+    ``("cotan", "bdf2")``, ``"cotan"`` -> ``("cotan", "euler")``, ``"cotan@bdf2+remesh"``
+    -> ``("cotan+remesh", "bdf2")`` (a mesh strategy stays with its scheme:
+    :func:`~mcfbench.running.scheme.parse_name` gives the registry entry's name)."""
+    base, integrator, strategy = parse_name(name)
+    return joined_name(base, "euler", strategy), integrator
 
 
-def joined_name(base, integrator):
+def joined_name(base, integrator, strategy=None):
     """The scheme name of ``base`` stepped by ``integrator`` (:func:`split_name`'s
-    inverse): ``base`` itself for Euler, else ``base@integrator``."""
-    return base if integrator == "euler" else f"{base}@{integrator}"
+    inverse): ``base`` itself for Euler, else ``base@integrator``; a mesh
+    ``strategy`` (default ``base``'s own ``+STRATEGY``, if any) after it."""
+    name, _, own = base.partition("+")
+    strategy = (own or "none") if strategy is None else strategy
+    stepped = name if integrator == "euler" else f"{name}@{integrator}"
+    return stepped if strategy == "none" else f"{stepped}+{strategy}"
 
 
 def get_scheme(name, registry=None):
     """The registry entry ``name``, or ``<name>@<integrator>``: that entry stepped by
-    another integrator (its label says which; hollow markers).
+    another integrator (its label says which; hollow markers), or with ``+<strategy>``:
+    its runs treat the mesh by that strategy too (its label says which; dashed
+    lines).
 
     Parameters
     ----------
@@ -59,24 +71,31 @@ def get_scheme(name, registry=None):
     Raises
     ------
     ValueError
-        Unknown name or integrator, listing the known ones.
+        Unknown name, integrator or strategy, listing the known ones.
     """
     registry = SCHEMES if registry is None else registry
-    base, integrator = split_name(name)
+    base, integrator, strategy = parse_name(name)
     if base not in registry:
         raise ValueError(f"unknown scheme {name!r}; choose one of "
-                         f"{', '.join(registry)} (or NAME@INTEGRATOR)")
+                         f"{', '.join(registry)} (or NAME@INTEGRATOR, NAME+STRATEGY, "
+                         "NAME@INTEGRATOR+STRATEGY)")
     entry = registry[base]
     if name == base:
         return entry
-    if integrator not in INTEGRATORS:
+    if integrator not in INTEGRATORS or "@" in name and integrator == "euler":
         raise ValueError(f"unknown integrator {integrator!r} in scheme {name!r}; choose one "
-                         f"of {', '.join(INTEGRATORS)}")
-    if entry.integrates_itself:
+                         f"of {', '.join(i for i in INTEGRATORS if i != 'euler')}")
+    if integrator != "euler" and entry.integrates_itself:
         raise ValueError(f"scheme {base!r} integrates in time itself: no {name!r}")
-    return replace(entry, name=name, integrator=integrator,
-                   label=f"{entry.label}, {INTEGRATORS[integrator].label}",
-                   style={**entry.style, "markerfacecolor": "none"})
+    if integrator != "euler":
+        entry = replace(entry, name=joined_name(base, integrator, "none"), integrator=integrator,
+                        label=f"{entry.label}, {INTEGRATORS[integrator].label}",
+                        style={**entry.style, "markerfacecolor": "none"})
+    if strategy != "none":
+        entry = replace(entry, name=name, mesh_strategy=strategy,
+                        label=f"{entry.label}, {strategy}",
+                        style={**entry.style, "linestyle": "--"})
+    return entry
 
 
 def find_scheme(name, registry=None):

@@ -65,7 +65,7 @@ def test_registries_are_listed_in_aligned_columns(capsys):
 
     for command, registry in (("schemes", SCHEMES), ("problems", PROBLEMS)):
         assert main([command]) == 0
-        lines = capsys.readouterr().out.splitlines()
+        lines = capsys.readouterr().out.split("\n\n")[0].splitlines()   # (then the suffixes)
         assert [line.split()[0] for line in lines] == list(registry)
         # every description starts in one column, two spaces after the longest name
         start = max(map(len, registry)) + 2
@@ -257,7 +257,9 @@ def test_bad_paths_are_named(tmp_path, capsys, name, text, message):
     (["--tau", "nan"], r"--tau: must be a positive number"),
     (["--steps", "0"], r"--steps: must be a whole number >= 1"),
     (["--rtol", "0"], r"--rtol: must be a positive number"),
-    (["--scheme", "fast"], r"--scheme: invalid choice: 'fast'"),
+    (["--scheme", "fast"], r"--scheme: unknown scheme 'fast'"),
+    (["--scheme", "cotan+remesh@bdf2"], r"--scheme: scheme 'cotan\+remesh@bdf2': unknown mesh "
+                                        r"strategy 'remesh@bdf2'"),
     (["--solver", "magic"], r"--solver: invalid choice: 'magic'"),
 ])
 def test_bad_settings_are_named(tmp_path, capsys, options, message):
@@ -409,3 +411,25 @@ def test_export_names_a_file_it_cannot_read(tmp_path, capsys, name, out):
     assert re.search(message, err), err
     assert "Traceback" not in err and "Errno" not in err and "allow_pickle" not in err
     assert not (tmp_path / out).exists()
+
+
+def test_a_remeshed_run_writes_frames_with_their_faces_and_schemes_lists_the_suffix(
+        tmp_path, capsys):
+    """``run --scheme cotan+remesh`` on a mesh of 5.5-degree angles remeshes at step 0: the
+    frames file has each frame's faces (version 2); ``schemes`` names the suffix."""
+    from mcfbench.geometry.spheres import anisotropic_sphere
+    from mcfbench.storage.frames import frame_mesh, load_frames
+
+    V, F = anisotropic_sphere(1)
+    mesh = tmp_path / "aniso.obj"
+    igl.write_triangle_mesh(str(mesh), V, F)
+    out = tmp_path / "run.npz"
+    assert main(["run", str(mesh), "--scheme", "cotan+remesh", "--tau-edge", "0.1",
+                 "--steps", "4", "--save-every", "2", "--out", str(out)]) == 0
+    frames = load_frames(out)
+    assert frames["frame_sizes"].shape == (3, 3)
+    np.testing.assert_array_equal(frame_mesh(frames, 0)[1], F)
+    assert len(frame_mesh(frames, 2)[1]) != len(F)
+    capsys.readouterr()
+    assert main(["schemes"]) == 0
+    assert "+remesh  isotropic remeshing" in capsys.readouterr().out

@@ -89,6 +89,7 @@ def plan(section=None, schemes=None, problems=None):
                               f"{integrator!r}; choose one of "
                               f"{', '.join(i for i in INTEGRATORS if i != 'euler')}")
         stepped.update({joined_name(name, integrator): name for name in names})
+    stepped.update({f"{n}+remesh": n for n in section.get("with_remeshing") or ()})  # NAME+remesh
     select = section.get("select") or {}
     if not isinstance(select, dict) or set(select) - {"schemes", "problems"}:
         raise ConfigError(f"config key 'matrix.select': a mapping with the keys schemes "

@@ -24,7 +24,7 @@ def _run_sizes(folder, keys):
         path = Path(folder) / f"{key}.npz"
         if path.is_file():
             vertices, extra = surface_points(load_frames(path))
-            sizes[key] = int(vertices.shape[1]) + (0 if extra is None else int(extra.shape[1]))
+            sizes[key] = len(vertices[0]) + (0 if extra is None else len(extra[0]))
     return sizes
 
 

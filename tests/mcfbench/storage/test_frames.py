@@ -75,7 +75,7 @@ def test_a_file_of_the_layout_before_reads_as_one_of_this_one(name, tmp_path):
 
 
 def test_the_file_carries_its_format_version_and_a_newer_one_is_refused(tmp_path):
-    """save_frames writes format_version (1); load_frames checks it and drops it, reads
+    """save_frames writes format_version (2); load_frames checks it and drops it, reads
     a file of the layout written before the key (version 0) as it is, and refuses a
     newer version or a key that is no version, naming the file."""
     from mcfbench.storage.frames import FORMAT_VERSION
@@ -83,14 +83,14 @@ def test_the_file_carries_its_format_version_and_a_newer_one_is_refused(tmp_path
     empty = {"faces": np.zeros((0, 3), int), "steps": np.zeros(0, int), "t": np.zeros(0)}
     save_frames(tmp_path / "now.npz", empty)
     with np.load(tmp_path / "now.npz") as data:
-        assert int(data["format_version"]) == FORMAT_VERSION == 1
+        assert int(data["format_version"]) == FORMAT_VERSION == 2
     assert set(load_frames(tmp_path / "now.npz")) == {"faces", "steps", "t"}
     np.savez(tmp_path / "before.npz", **empty)
     assert set(load_frames(tmp_path / "before.npz")) == {"faces", "steps", "t"}
-    np.savez(tmp_path / "future.npz", **empty, format_version=np.array(2))
-    with pytest.raises(ValueError, match=r"future\.npz: a frames file of format_version 2, "
+    np.savez(tmp_path / "future.npz", **empty, format_version=np.array(3))
+    with pytest.raises(ValueError, match=r"future\.npz: a frames file of format_version 3, "
                                          r"written by a newer mcfbench; this one reads "
-                                         r"versions up to 1"):
+                                         r"versions up to 2"):
         load_frames(tmp_path / "future.npz")
     np.savez(tmp_path / "odd.npz", **empty, format_version=np.array(1.5))
     with pytest.raises(ValueError, match=r"odd\.npz: format_version 1\.5 is not a version"):

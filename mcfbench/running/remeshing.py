@@ -1,0 +1,125 @@
+"""A run's mesh strategies (``NAME+remesh``): the driver's hook that remeshes a flow.
+
+:func:`mesh_hook` builds, for a scheme whose name carries a strategy of
+:data:`mcfbench.running.scheme.MESH_STRATEGIES`, the callable the driver
+(:func:`mcfbench.running.driver.simulate`, its ``remesh``) calls after every state
+that passed its checks. :class:`Remesher`, the ``remesh`` strategy, remeshes the
+current surface when :class:`mcfbench.geometry.remeshing.RemeshTrigger` says so
+(:func:`mcfbench.geometry.remeshing.remesh`: Botsch and Kobbelt's isotropic
+remeshing, the target edge that keeps the input's vertex count) and rebuilds the
+flow there, as the continuation after a vanished component does
+(:mod:`mcfbench.running.continuation`): the scheme's own construction on the new
+vertices and faces, at the same time level, the integrator restarted by the driver.
+What the new flow carries over:
+
+- the positions: the remesher's (projected onto the current surface);
+- DDFV's T-vertices: re-initialised by the scheme's own placement rule
+  (``t_init``), as the paper's start does (a new triangle has no old T-vertex);
+- KLL's normal and mean curvature: re-initialised from the new mesh, as KLL's own
+  start measures them from the initial mesh (a closest-point interpolation of the
+  old values would add an interpolation error of the same ``O(h^2)`` as the
+  measurement's and a second code path for one scheme);
+- BDF2 and BDF3: their past states lived on the old vertices: the run restarts
+  with the integrator's first step (the driver's fresh integrator), as after a
+  vanished component;
+- the tangential strategies that keep something of the initial state
+  (``deturck``'s map onto the initial mesh, ``conformal``'s initial stiffness,
+  ``redistribute``'s initial area): the remeshed surface becomes their initial one
+  (:data:`mcfbench.running.continuation.STATE_ONLY` names those that lose nothing).
+"""
+
+from mcfbench.geometry.remeshing import (
+    ANGLE, PASSES, RemeshTrigger, remesh, remesh_change, target_edge)
+from mcfbench.running.scheme import parse_name
+
+
+def rebuilt_flow(scheme, flow, vertices, faces, *, threads=1, **options):
+    """The flow of ``scheme`` on a new mesh of the surface, at ``flow``'s time level
+    (module docstring: what is carried over).
+
+    Parameters
+    ----------
+    scheme : mcfbench.running.schemes.Scheme
+    flow : mcfbench.running.flow.SchemeFlow
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+    threads : int
+    **options
+        The run's options of the flow class.
+    """
+    new = scheme.make(vertices, faces, flow.tau, threads=threads, **options)
+    new.n = flow.n
+    return new
+
+
+class Remesher:
+    """The ``remesh`` strategy: ``remesher(flow) -> (new flow, event)`` or None.
+
+    Parameters
+    ----------
+    scheme : mcfbench.running.schemes.Scheme
+    mesh : tuple of ((n, 3) float array, (m, 3) int array)
+        The run's input mesh: the target edge length's (:func:`target_edge`).
+    threads : int
+    options : dict
+        The run's options of the flow class.
+    angle, every : float
+        The trigger's (:class:`~mcfbench.geometry.remeshing.RemeshTrigger`).
+    passes : int
+
+    Attributes
+    ----------
+    h : float
+        The target edge length.
+    calls : int
+    seconds : float
+        Wall seconds spent remeshing and measuring the change.
+    """
+
+    def __init__(self, scheme, mesh, *, threads=1, options=None, angle=ANGLE, every=None,
+                 passes=PASSES):
+        self.scheme, self.threads, self.options = scheme, threads, dict(options or {})
+        self.h, self.passes = target_edge(*mesh), passes
+        self.trigger = RemeshTrigger(angle, every)
+        self.calls, self.seconds = 0, 0.0
+
+    def __call__(self, flow):
+        import time
+
+        V, F, t = flow.vertices, flow.faces, flow.n * flow.tau
+        why = self.trigger(V, F, t)
+        if why is None:
+            return None
+        start = time.perf_counter()
+        U, G = remesh(V, F, self.h, self.passes)
+        event = {"event": "remeshed", "step": flow.n, "time": t, "why": why,
+                 **remesh_change((V, F), (U, G))}
+        self.seconds += time.perf_counter() - start
+        self.calls += 1
+        self.trigger.done(t)
+        return rebuilt_flow(self.scheme, flow, U, G, threads=self.threads,
+                            **self.options), event
+
+
+STRATEGIES = {"remesh": Remesher}
+"""A mesh strategy (a key of :data:`mcfbench.running.scheme.MESH_STRATEGIES`) -> the
+class of its hook, built as ``cls(scheme, mesh, threads=, options=)``."""
+
+
+def mesh_hook(scheme, mesh, *, threads=1, options=None):
+    """The driver's ``remesh`` hook of ``scheme`` (its name's ``+STRATEGY``), or None for
+    a scheme without one.
+
+    Parameters
+    ----------
+    scheme : mcfbench.running.schemes.Scheme
+    mesh : tuple of ((n, 3) float array, (m, 3) int array)
+        The run's input mesh.
+    threads : int
+    options : dict
+        The run's options of the flow class.
+    """
+    strategy = getattr(scheme, "mesh_strategy", None) or parse_name(scheme.name).strategy
+    if strategy == "none":
+        return None
+    return STRATEGIES[strategy](scheme, mesh, threads=threads, options=options)
