@@ -416,10 +416,10 @@ def test_time_study_from_the_stored_final_states_is_time_convergence(tmp_path):
 # -- the config key `beyond` ----------------------------------------------------
 
 def test_default_config_passes_the_schema_and_the_checks():
-    from snakemake.utils import validate
+    from mcfbench.pipeline import check_config
 
     config = json.loads(json.dumps(CONFIG))
-    validate(config, str(REPO / "workflow" / "schemas" / "config.schema.yaml"))
+    check_config(config, REPO / "workflow" / "schemas" / "config.schema.yaml")
     settings = Plans(config, SCHEMAS).plan("beyond")
     assert settings["levels"] == [1, 2, 3, 4, 5, 6]
     assert settings["schemes"] == ["ddfv", "ddfv-chord", "ddfv-eliminate", "cotan",
@@ -493,14 +493,14 @@ def test_finest_level_adds_its_runs_only():
 def test_beyond_schema_names_the_bad_key(path, value, message):
     """The section ``beyond`` has its own schema, checked with its plan (Plans.plan("beyond")),
     not while Snakemake reads the workflow: the whole config passes the main schema."""
-    from snakemake.utils import validate
+    from mcfbench.pipeline import check_config
 
     config = json.loads(json.dumps(CONFIG))
     node = config["beyond"]
     for key in path[:-1]:
         node = node[key]
     node[path[-1]] = value
-    validate(json.loads(json.dumps(config)), str(SCHEMAS / "config.schema.yaml"))
+    check_config(json.loads(json.dumps(config)), SCHEMAS / "config.schema.yaml")
     with pytest.raises(ConfigError) as err:
         Plans(config, SCHEMAS).plan("beyond")
     assert message in str(err.value)
