@@ -1,0 +1,324 @@
+"""Topological surgery at a neck pinch: cut the neck of a closed triangle mesh and cap both
+sides, once the neck has shrunk below the mesh's resolution.
+
+Mean curvature flow pinches a thin neck in finite time (the dumbbell; Grayson 1989,
+Angenent 1992); the flow past the pinch is that of the two parts, each closed
+(Altschuler, Angenent and Giga 1995 for a rotationally symmetric neck; the numerical
+surgery of Huisken and Sinestrari 2009 and of Kovacs 2022, arXiv 2210.14046, cut
+the neck and glue in caps). A mesh cannot follow the neck below its own resolution:
+the neck's triangles fold or degenerate (the dumbbell's runs end ``inverted`` or
+``degenerated`` a few steps after the pinch). :func:`find_neck` sees the neck before
+that, :func:`cut_neck` cuts it.
+
+The neck
+--------
+The mean curvature vector ``H n = -Delta X`` (the cotangent Laplacian over the
+lumped mass, libigl's ``cotmatrix`` and ``massmatrix``; ``H`` the sum of the principal
+curvatures) points towards the axis at a neck, and the Gaussian curvature (the angle
+defect) is negative there (a saddle): the neck's vertex is the one of largest
+``|H|`` among the vertices of negative angle defect. Its *ring* is the vertices
+joined to it by edges through vertices of ``|H|`` at least half its own. The neck's
+*axis* is the line that the ring's normal lines meet (on a surface of revolution
+every normal line meets the axis): its direction the right singular vector of the
+ring's unit vectors ``H n / |H n|`` of smallest singular value (they are all
+perpendicular to it), its point ``c`` the least-squares point nearest to all the
+normal lines, ``sum (I - u u^T)(c - p) = 0``. The neck's *radius* ``r`` is the
+median distance of the ring's vertices from the axis.
+
+The criterion
+-------------
+A neck is *pinched* when ``r < NECK_RESOLUTION * h``, ``h`` the mesh's resolution
+(the run's initial mean edge length): half an edge. On the dumbbell the neck's
+radius falls as ``r^2 = 2 (T - t)`` (a shrinking cylinder, ``r r' = -1``); at
+``r = h / 2`` the runs of cotan, BGN and DDFV are 2-4 time steps (level 1, tau =
+0.004) before their first fold or degenerate triangle.
+
+The cut
+-------
+The plane through the neck's vertex perpendicular to the axis cuts the neck: the
+*band* is the strip of triangles that the plane crosses (some vertex on each side)
+joined by edges to a triangle of the neck's vertex (a tube's one ring of
+triangles). The band is removed, which leaves two boundary loops (one on each side),
+and each loop is closed by a fan of triangles to a new vertex at its centroid (the
+polygon's, its edges' midpoints weighted by their lengths),
+oriented as the triangles it meets. :func:`cut_neck` refuses (``None`` and the
+reason) a cut that does not leave exactly two loops or does not add one closed,
+consistently oriented component.
+
+Area and volume removed
+-----------------------
+The band lies within ``r_band`` of the axis and within ``l_band`` of the plane
+(``r_band`` the largest distance of its vertices from the axis, ``l_band`` its
+longest edge), so its area is at most that of a tube of radius ``r_band`` and height
+``2 l_band`` (``4 pi r_band l_band``, tested); the caps add at most ``2 pi
+r_band^2``. The reported ``area_removed`` is the area before minus after, the
+``volume_removed`` likewise.
+"""
+
+from typing import NamedTuple
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from mcfbench.geometry.collapse import component_topology, component_volumes
+from mcfbench.geometry.measures import vertex_components
+
+NECK_RESOLUTION = 0.5
+"""A neck whose radius is below this many times the mesh's resolution ``h`` is
+pinched (module docstring)."""
+
+RING_FRACTION = 0.5
+"""The neck's ring: vertices of ``|H|`` at least this fraction of the neck vertex's."""
+
+
+class Neck(NamedTuple):
+    """A neck found by :func:`find_neck`.
+
+    Attributes
+    ----------
+    vertex : int
+        The neck's vertex (largest ``|H|`` of negative angle defect).
+    ring : (k,) int array
+        The ring's vertices.
+    centre : (3,) float array
+        The axis's point nearest to the ring's normal lines.
+    axis : (3,) float array
+        Unit direction of the axis.
+    radius : float
+        Median distance of the ring's vertices from the axis.
+    curvature : float
+        ``|H|`` at the neck's vertex.
+    """
+
+    vertex: int
+    ring: np.ndarray
+    centre: np.ndarray
+    axis: np.ndarray
+    radius: float
+    curvature: float
+
+
+class Surgery(NamedTuple):
+    """What :func:`cut_neck` did.
+
+    Attributes
+    ----------
+    vertices : (n', 3) float array
+        The kept vertices (in their order) and then one new vertex per cap.
+    faces : (m', 3) int array
+        The kept triangles (in their order, renumbered) and then the caps' triangles.
+    keep_vertices : (n,) bool array
+        The input's vertices kept (those of the band's triangles alone are dropped).
+    keep_faces : (m,) bool array
+        The input's triangles kept (all but the band's).
+    where : (3,) float array
+        The neck's point on the axis (in the cutting plane).
+    radius : float
+        The neck's radius (:class:`Neck`).
+    band_radius, band_edge : float
+        ``r_band`` and ``l_band`` (module docstring).
+    components_before, components_after : int
+    area_removed, volume_removed : float
+        Before minus after.
+    band_area : float
+        The removed triangles' area.
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    keep_vertices: np.ndarray
+    keep_faces: np.ndarray
+    where: np.ndarray
+    radius: float
+    band_radius: float
+    band_edge: float
+    components_before: int
+    components_after: int
+    area_removed: float
+    volume_removed: float
+    band_area: float
+
+
+def mean_curvature_vectors(vertices, faces):
+    """``H n = -M^{-1} L X`` at every vertex (libigl's cotangent Laplacian ``L`` and
+    Voronoi mass ``M``): ``2 / R`` times the inward normal on a sphere of radius ``R``.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+
+    Returns
+    -------
+    (n, 3) float array
+    """
+    import igl  # on first use
+
+    V, F = np.asarray(vertices, dtype=float), np.asarray(faces, dtype=np.int64)
+    L = igl.cotmatrix(V, F)
+    mass = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
+    return (L @ V) / mass[:, None]
+
+
+def angle_defects(vertices, faces):
+    """``2 pi`` minus the angle sum at every vertex (the Gaussian curvature times its
+    area; negative at a saddle), (n,) float array."""
+    V, F = np.asarray(vertices, dtype=float), np.asarray(faces, dtype=np.int64)
+    a, b, c = (V[F[:, k]] for k in range(3))
+    angles = np.stack([_angle(b - a, c - a), _angle(c - b, a - b), _angle(a - c, b - c)], 1)
+    return 2 * np.pi - np.bincount(F.ravel(), angles.ravel(), minlength=len(V))
+
+
+def _angle(u, w):
+    return np.arctan2(np.linalg.norm(np.cross(u, w), axis=1), np.einsum("ij,ij->i", u, w))
+
+
+def _adjacency(n, pairs):
+    """The symmetric (n, n) adjacency of the index ``pairs`` (k, 2)."""
+    i, j = pairs[:, 0], pairs[:, 1]
+    return sp.coo_matrix((np.ones(2 * len(i)), (np.r_[i, j], np.r_[j, i])), shape=(n, n)).tocsr()
+
+
+def _edges(F):
+    return F[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
+
+
+def find_neck(vertices, faces):
+    """The neck of a closed mesh (module docstring), or None when no vertex has a
+    negative angle defect.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+
+    Returns
+    -------
+    Neck or None
+    """
+    V, F = np.asarray(vertices, dtype=float), np.asarray(faces, dtype=np.int64)
+    Hn = mean_curvature_vectors(V, F)
+    H = np.linalg.norm(Hn, axis=1)
+    saddle = angle_defects(V, F) < 0
+    if not saddle.any():
+        return None
+    v0 = int(np.flatnonzero(saddle)[np.argmax(H[saddle])])
+    strong = H >= RING_FRACTION * H[v0]
+    E = _edges(F)
+    E = E[strong[E].all(axis=1)]
+    labels = connected_components(_adjacency(len(V), E), directed=False)[1]
+    ring = np.flatnonzero(strong & (labels == labels[v0]))
+    u = Hn[ring] / H[ring, None]
+    axis = np.linalg.svd(u, full_matrices=False)[2][-1]
+    P = np.eye(3)[None] - u[:, :, None] * u[:, None, :]          # (k, 3, 3)
+    centre = np.linalg.lstsq(P.sum(0), np.einsum("kij,kj->i", P, V[ring]), rcond=None)[0]
+    rho = _axis_distance(V[ring], centre, axis)
+    return Neck(v0, ring, centre, axis, float(np.median(rho)), float(H[v0]))
+
+
+def _axis_distance(points, centre, axis):
+    d = points - centre
+    return np.linalg.norm(d - np.outer(d @ axis, axis), axis=1)
+
+
+def pinched(neck, h, resolution=NECK_RESOLUTION):
+    """Whether ``neck`` (a :class:`Neck` or None) is below ``resolution * h``."""
+    return neck is not None and neck.radius < resolution * h
+
+
+def cut_neck(vertices, faces, neck):
+    """Cut ``neck`` and cap both sides (module docstring).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+        A closed, consistently oriented mesh.
+    neck : Neck
+
+    Returns
+    -------
+    surgery : Surgery or None
+    reason : str
+        Why there is no surgery (empty when there is one).
+    """
+    V, F = np.asarray(vertices, dtype=float), np.asarray(faces, dtype=np.int64)
+    n, m = len(V), len(F)
+    p0 = V[neck.vertex]
+    z = (V - p0) @ neck.axis
+    where = neck.centre + ((p0 - neck.centre) @ neck.axis) * neck.axis
+    zf = z[F]
+    crossing = (zf.min(axis=1) < 0) & (zf.max(axis=1) >= 0)
+    # the crossing triangles' strip joined by edges to a triangle of the neck's vertex
+    E = _edges(F)
+    owner = np.repeat(np.arange(m), 3)
+    key = np.sort(E, axis=1) @ np.array([n, 1])
+    order = np.argsort(key, kind="stable")
+    pair = owner[order].reshape(-1, 2) if len(order) % 2 == 0 else None
+    if pair is None or not np.array_equal(key[order][0::2], key[order][1::2]):
+        return None, "the mesh is not closed (an edge not shared by two triangles)"
+    strip = pair[crossing[pair].all(axis=1)]
+    labels = connected_components(_adjacency(m, strip), directed=False)[1]
+    start = np.flatnonzero(crossing & (F == neck.vertex).any(axis=1))
+    if not len(start):
+        return None, "the cutting plane crosses no triangle of the neck's vertex"
+    band = crossing & np.isin(labels, labels[start])
+    keep_faces = ~band
+    kept = F[keep_faces]
+    keep_vertices = np.zeros(n, bool)
+    keep_vertices[kept.ravel()] = True
+    number = np.cumsum(keep_vertices) - 1
+    kept = number[kept]
+    # the boundary edges left (directed as in their triangle), their loops
+    directed = _edges(kept)
+    undirected = np.sort(directed, axis=1) @ np.array([n, 1])
+    _, index, counts = np.unique(undirected, return_index=True, return_counts=True)
+    boundary = directed[index[counts == 1]]
+    k = int(keep_vertices.sum())
+    nloops, loop_of = connected_components(_adjacency(k, boundary), directed=False)
+    on_loop = np.unique(boundary)
+    loops = np.unique(loop_of[on_loop])
+    degree = np.bincount(boundary.ravel(), minlength=k)[on_loop]
+    if len(loops) != 2 or (degree != 2).any():
+        return None, (f"removing the band of {int(band.sum())} triangles left "
+                      f"{len(loops)} boundary loop(s), not two simple ones")
+    # each cap's vertex at its loop's centroid (of the polygon's edges, by length)
+    which = np.searchsorted(loops, loop_of[boundary[:, 0]])
+    ends = V[keep_vertices][boundary]                                # (b, 2, 3)
+    length = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
+    centres = np.zeros((2, 3))
+    np.add.at(centres, which, length[:, None] * ends.mean(axis=1))
+    centres /= np.bincount(which, length, minlength=2)[:, None]
+    caps = np.column_stack([boundary[:, 1], boundary[:, 0], k + which])
+    V2 = np.vstack([V[keep_vertices], centres])
+    F2 = np.vstack([kept, caps])
+    before, labels1 = vertex_components(F, n)
+    after, lab2 = vertex_components(F2, len(V2))
+    chi, closed = component_topology(F2, lab2, after)
+    if after != before + 1 or not closed.all() or not _oriented(F2):
+        return None, (f"the cut left {after} component(s) from {before} (closed: "
+                      f"{closed.all()}, oriented: {_oriented(F2)})")
+    area0, area1 = _area(V, F), _area(V2, F2)
+    vol0 = component_volumes(V, F, labels1[F[:, 0]], before).sum()
+    vol1 = component_volumes(V2, F2, lab2[F2[:, 0]], after).sum()
+    bv = np.unique(F[band])
+    band_edges = np.linalg.norm(np.diff(V[F[band]][:, [0, 1, 2, 0]], axis=1), axis=2)
+    return Surgery(V2, F2, keep_vertices, keep_faces, where, neck.radius,
+                   float(_axis_distance(V[bv], neck.centre, neck.axis).max()),
+                   float(band_edges.max()), int(before), int(after), float(area0 - area1),
+                   float(vol0 - vol1), float(_area(V, F[band]))), ""
+
+
+def _area(V, F):
+    a, b, c = (V[F[:, k]] for k in range(3))
+    return float(np.linalg.norm(np.cross(b - a, c - a), axis=1).sum() / 2)
+
+
+def _oriented(F):
+    """Every directed edge once (a closed, consistently oriented, edge-manifold mesh)."""
+    directed = _edges(np.asarray(F, dtype=np.int64))
+    n = int(directed.max()) + 1
+    key = directed @ np.array([n, 1])
+    reverse = directed[:, ::-1] @ np.array([n, 1])
+    return len(np.unique(key)) == len(key) and np.isin(reverse, key).all()
