@@ -38,20 +38,26 @@ The cut
 The plane through the neck's vertex perpendicular to the axis cuts the neck: the
 *band* is the strip of triangles that the plane crosses (some vertex on each side)
 joined by edges to a triangle of the neck's vertex (a tube's one ring of
-triangles). The band is removed, which leaves two boundary loops (one on each side),
-and each loop is closed by a fan of triangles to a new vertex at its centroid (the
-polygon's, its edges' midpoints weighted by their lengths),
-oriented as the triangles it meets. :func:`cut_neck` refuses (``None`` and the
+triangles), and every triangle of a vertex within :data:`TUBE` neck radii of the
+axis joined to the neck's vertex within that tube: the whole thin part. A flowed
+neck's triangles are long along its axis and its vertices zigzag in radius (the
+dumbbell's at level 1: rings at 0.02 and 0.037 from the axis within 0.05 of the
+plane, the next at 0.07 and 0.17), so that the strip's own loops would mix both
+rings; and at level 2 the neck is a tube of radius 0.025-0.03 over 0.1 of its
+length, whose stumps, cut at one plane only, pinch again at once. The band is removed, which leaves two boundary loops (one on each side),
+and each loop is closed by a dome of rings, a hemisphere over the loop towards the
+plane (:func:`_dome`), oriented as the triangles it meets. :func:`cut_neck` refuses (``None`` and the
 reason) a cut that does not leave exactly two loops or does not add one closed,
 consistently oriented component.
 
 Area and volume removed
 -----------------------
-The band lies within ``r_band`` of the axis and within ``l_band`` of the plane
-(``r_band`` the largest distance of its vertices from the axis, ``l_band`` its
-longest edge), so its area is at most that of a tube of radius ``r_band`` and height
-``2 l_band`` (``4 pi r_band l_band``, tested); the caps add at most ``2 pi
-r_band^2``. The reported ``area_removed`` is the area before minus after, the
+The band lies within ``r_band`` of the axis and within ``z_band`` of the plane
+(the largest distance of its vertices from the axis and from the plane; ``z_band``
+the thin part's length plus an edge), and its area stays below
+that of a tube of radius ``r_band`` and height ``2 z_band``, ``4 pi r_band z_band``
+(tested on the dumbbell; a bound for a band that winds about the axis once without
+folding, not for every surface); the caps add at most ``2 pi r_band^2``. The reported ``area_removed`` is the area before minus after, the
 ``volume_removed`` likewise.
 """
 
@@ -67,6 +73,14 @@ from mcfbench.geometry.measures import vertex_components
 NECK_RESOLUTION = 0.5
 """A neck whose radius is below this many times the mesh's resolution ``h`` is
 pinched (module docstring)."""
+
+TUBE = 2.0
+"""The band also takes every triangle of a vertex within this many neck radii of the
+axis (joined to the neck's vertex within that tube)."""
+
+MIN_RING = 6
+"""The fewest vertices of a neck's ring; and they surround the axis (no angle about
+it without one of them wider than pi)."""
 
 RING_FRACTION = 0.5
 """The neck's ring: vertices of ``|H|`` at least this fraction of the neck vertex's."""
@@ -116,8 +130,8 @@ class Surgery(NamedTuple):
         The neck's point on the axis (in the cutting plane).
     radius : float
         The neck's radius (:class:`Neck`).
-    band_radius, band_edge : float
-        ``r_band`` and ``l_band`` (module docstring).
+    band_radius, band_height : float
+        ``r_band`` and ``z_band`` (module docstring).
     components_before, components_after : int
     area_removed, volume_removed : float
         Before minus after.
@@ -132,7 +146,7 @@ class Surgery(NamedTuple):
     where: np.ndarray
     radius: float
     band_radius: float
-    band_edge: float
+    band_height: float
     components_before: int
     components_after: int
     area_removed: float
@@ -186,7 +200,8 @@ def _edges(F):
 
 def find_neck(vertices, faces):
     """The neck of a closed mesh (module docstring), or None when no vertex has a
-    negative angle defect.
+    negative angle defect or the neck vertex's ring is no ring (fewer than
+    :data:`MIN_RING` vertices, or not around the axis: a dimple, a fold).
 
     Parameters
     ----------
@@ -214,6 +229,11 @@ def find_neck(vertices, faces):
     P = np.eye(3)[None] - u[:, :, None] * u[:, None, :]          # (k, 3, 3)
     centre = np.linalg.lstsq(P.sum(0), np.einsum("kij,kj->i", P, V[ring]), rcond=None)[0]
     rho = _axis_distance(V[ring], centre, axis)
+    d = V[ring] - centre
+    e1 = np.cross(axis, np.eye(3)[np.argmin(np.abs(axis))])
+    angle = np.sort(np.arctan2(d @ np.cross(axis, e1), d @ e1))
+    if len(ring) < MIN_RING or np.diff(np.r_[angle, angle[0] + 2 * np.pi]).max() > np.pi:
+        return None
     return Neck(v0, ring, centre, axis, float(np.median(rho)), float(H[v0]))
 
 
@@ -263,7 +283,10 @@ def cut_neck(vertices, faces, neck):
     start = np.flatnonzero(crossing & (F == neck.vertex).any(axis=1))
     if not len(start):
         return None, "the cutting plane crosses no triangle of the neck's vertex"
-    band = crossing & np.isin(labels, labels[start])
+    thin = _axis_distance(V, neck.centre, neck.axis) < TUBE * neck.radius
+    near = connected_components(_adjacency(n, E[thin[E].all(axis=1)]), directed=False)[1]
+    inside = thin & (near == near[neck.vertex])
+    band = (crossing & np.isin(labels, labels[start])) | inside[F].any(axis=1)
     keep_faces = ~band
     kept = F[keep_faces]
     keep_vertices = np.zeros(n, bool)
@@ -283,16 +306,14 @@ def cut_neck(vertices, faces, neck):
     if len(loops) != 2 or (degree != 2).any():
         return None, (f"removing the band of {int(band.sum())} triangles left "
                       f"{len(loops)} boundary loop(s), not two simple ones")
-    # each cap's vertex at its loop's centroid (of the polygon's edges, by length)
-    which = np.searchsorted(loops, loop_of[boundary[:, 0]])
-    ends = V[keep_vertices][boundary]                                # (b, 2, 3)
-    length = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
-    centres = np.zeros((2, 3))
-    np.add.at(centres, which, length[:, None] * ends.mean(axis=1))
-    centres /= np.bincount(which, length, minlength=2)[:, None]
-    caps = np.column_stack([boundary[:, 1], boundary[:, 0], k + which])
-    V2 = np.vstack([V[keep_vertices], centres])
-    F2 = np.vstack([kept, caps])
+    Vk, points, caps = V[keep_vertices], [], []
+    for loop in range(2):
+        cap_points, cap_faces = _dome(Vk, boundary[loop_of[boundary[:, 0]] == loops[loop]],
+                                      neck, where, k + sum(len(p) for p in points))
+        points.append(cap_points)
+        caps.append(cap_faces)
+    V2 = np.vstack([Vk, *points])
+    F2 = np.vstack([kept, *caps])
     before, labels1 = vertex_components(F, n)
     after, lab2 = vertex_components(F2, len(V2))
     chi, closed = component_topology(F2, lab2, after)
@@ -303,11 +324,95 @@ def cut_neck(vertices, faces, neck):
     vol0 = component_volumes(V, F, labels1[F[:, 0]], before).sum()
     vol1 = component_volumes(V2, F2, lab2[F2[:, 0]], after).sum()
     bv = np.unique(F[band])
-    band_edges = np.linalg.norm(np.diff(V[F[band]][:, [0, 1, 2, 0]], axis=1), axis=2)
     return Surgery(V2, F2, keep_vertices, keep_faces, where, neck.radius,
                    float(_axis_distance(V[bv], neck.centre, neck.axis).max()),
-                   float(band_edges.max()), int(before), int(after), float(area0 - area1),
+                   float(np.abs(z[bv]).max()), int(before), int(after), float(area0 - area1),
                    float(vol0 - vol1), float(_area(V, F[band]))), ""
+
+
+def _dome(V, edges, neck, where, first):
+    """The cap of one loop: a dome of rings over it, towards the cutting plane.
+
+    The loop's points ordered by their angle about the axis (seen from the plane),
+    its centre ``c`` the polygon's centroid (its edges' midpoints weighted by their
+    lengths), ``rho`` their mean distance from ``c`` across the axis, ``l`` the mean
+    edge: rings at ``psi_j = (pi / 2) j / J``, ``J = round((pi / 2) rho / l)``, of
+    radius ``rho cos psi_j`` and ``round(k cos psi_j)`` points (``k`` the loop's),
+    ``rho' sin psi_j`` towards the plane (``rho' = min(rho, 0.9`` the centre's
+    distance from the plane``)``), the last one a pole: a hemisphere meets the tube
+    tangentially and its triangles keep about the loop's edge, where a flat fan of
+    long thin triangles makes a rim the flow pulls into the axis within a few steps
+    (the dumbbell's level 2). Neighbouring rings are joined by :func:`_zip`.
+
+    Parameters
+    ----------
+    V : (n, 3) float array
+    edges : (b, 2) int array
+        The loop's boundary edges, as directed in their triangles.
+    neck : Neck
+    where : (3,) float array
+        A point of the cutting plane.
+    first : int
+        The number of the cap's first new point.
+
+    Returns
+    -------
+    points : (p, 3) float array
+    faces : (q, 3) int array
+        Oriented as the triangles the loop's edges belong to, when the loop is ordered
+        by angle as along its edges (else the caller's orientation check refuses it).
+    """
+    ends = V[edges]
+    length = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
+    c = (length[:, None] * ends.mean(axis=1)).sum(axis=0) / length.sum()
+    height = (c - where) @ neck.axis
+    out = -np.sign(height) * neck.axis if height != 0 else neck.axis
+    e1 = np.cross(out, np.eye(3)[np.argmin(np.abs(out))])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(out, e1)
+    ids = np.unique(edges)
+    d = V[ids] - c
+    theta = np.arctan2(d @ e2, d @ e1)
+    order = np.argsort(theta)
+    ring, angles = ids[order], theta[order]
+    rho = float(np.linalg.norm(d - np.outer(d @ out, out), axis=1).mean())
+    J = max(1, int(round(np.pi / 2 * rho / length.mean())))
+    rise = min(rho, 0.9 * abs(height))
+    points, faces, number = [], [], first
+    for j in range(1, J + 1):
+        psi = np.pi / 2 * j / J
+        count = 1 if j == J else max(3, int(round(len(ids) * np.cos(psi))))
+        a = angles[0] + 2 * np.pi * (np.arange(count) + 0.5) / count
+        new = (c + rho * np.cos(psi) * (np.outer(np.cos(a), e1) + np.outer(np.sin(a), e2))
+               + rise * np.sin(psi) * out)
+        inner = number + np.arange(count)
+        faces.append(_zip(ring, angles, inner, a))
+        points.append(new)
+        ring, angles, number = inner, a, number + count
+    return np.vstack(points), np.vstack(faces)
+
+
+def _zip(A, ta, B, tb):
+    """The triangles joining ring ``A`` to the ring ``B`` inside it, both ordered by
+    their angles ``ta``, ``tb`` (ascending, ``tb`` within ``[ta[0], ta[0] + 2 pi)``),
+    walking both by angle: at each next angle of ``A`` the triangle ``(A_i, A_{i+1},
+    B_current)``, of ``B`` the triangle ``(A_current, B_j, B_{j-1})``; a ring ``B`` of
+    one point is a fan. Normals along ``e1 x e2`` of the angles' frame.
+
+    Returns
+    -------
+    (len(A) + len(B) or len(A), 3) int array
+    """
+    ka, kb = len(A), len(B)
+    step_b = tb if kb > 1 else np.empty(0)
+    events = np.r_[ta[1:], ta[0] + 2 * np.pi, step_b]
+    is_a = np.r_[np.ones(ka, bool), np.zeros(len(step_b), bool)][np.argsort(events,
+                                                                        kind="stable")]
+    a = np.cumsum(is_a) - is_a                       # A's steps before each event
+    b = np.cumsum(~is_a) - ~is_a                     # B's steps before each event
+    return np.where(is_a[:, None],
+                    np.column_stack([A[a % ka], A[(a + 1) % ka], B[(b - 1) % kb]]),
+                    np.column_stack([A[a % ka], B[b % kb], B[(b - 1) % kb]]))
 
 
 def _area(V, F):

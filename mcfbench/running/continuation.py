@@ -18,11 +18,29 @@ current state alone; :func:`why_not` names the others, whose runs end
   would be measured again from the mesh);
 - an integrator with past states (BDF2, BDF3: ``X^{n-1}, ...`` of the vanished
   vertices, in each flow's own numbering).
+
+A run of ``NAME+surgery`` (:attr:`mcfbench.running.scheme.Scheme.continuation`) goes
+on through a neck pinch the same way (:func:`neck_surgery`, the driver's
+``surgery``): once a neck's radius falls below half the run's resolution
+(:func:`mcfbench.geometry.mesh_surgery.pinched`), the neck is cut and both sides
+capped (:func:`mcfbench.geometry.mesh_surgery.cut_neck`) and the scheme's flow is
+built anew on the operated mesh, DDFV's T-vertices placed anew by its own rule
+(the caps' triangles have none to carry; the kept ones are re-initialised too, so
+that every T-vertex of the new flow is placed alike). A run whose surgeries removed
+more than :data:`MAX_REMOVED_SHARE` of the initial area does not count as reaching
+its end (:func:`exceeded`; the record's ``removed_area_share`` and
+``surgery_exceeded``).
 """
 
 import numpy as np
 
+from mcfbench.geometry.mesh_surgery import NECK_RESOLUTION, cut_neck, find_neck, pinched
 from mcfbench.running.integrators import INTEGRATORS
+
+MAX_REMOVED_SHARE = 0.01
+"""The largest share of the initial area a run's surgeries may remove (``|area
+removed|`` summed over its cuts) for the run to count as reaching its end: the
+dumbbell's cuts remove 1e-4 to 5e-4 of it (level 1-2)."""
 
 STATE_ONLY = ("none", "eliminate", "bgn", "mdr", "intrinsic-delaunay")
 """The tangential strategies (:data:`mcfbench.running.schemes.TANGENTIAL`) whose step
@@ -110,3 +128,49 @@ def sub_flow(scheme, flow, keep, *, integrator=None, threads=1, **options):
                       **options)
     new.n = flow.n
     return new
+
+
+def neck_surgery(scheme, flow, *, h, integrator=None, threads=1, **options):
+    """The driver's ``surgery`` of a ``NAME+surgery`` run: None while no neck of
+    ``flow``'s mesh has pinched (below ``h / 2``), else the cut and the flow of
+    ``scheme`` rebuilt on the operated mesh at the same time level (module docstring).
+
+    Parameters
+    ----------
+    scheme : mcfbench.running.schemes.Scheme
+    flow : mcfbench.running.flow.SchemeFlow
+    h : float
+        The run's resolution (its initial mesh's mean edge length).
+    integrator, threads, **options
+        As :func:`sub_flow`'s.
+
+    Returns
+    -------
+    None or (mcfbench.geometry.mesh_surgery.Surgery, mcfbench.running.flow.SchemeFlow)
+
+    Raises
+    ------
+    ValueError
+        A neck pinched but the cut was refused (the reason), or the scheme cannot be
+        rebuilt (:func:`why_not`).
+    """
+    V, F = np.asarray(flow.vertices), np.asarray(flow.faces)
+    neck = find_neck(V, F)
+    if not pinched(neck, h):
+        return None
+    reason = why_not(scheme, integrator)
+    if reason is None:
+        cut, reason = cut_neck(V, F, neck)
+    if reason:
+        raise ValueError(f"the neck at {np.round(V[neck.vertex], 4).tolist()} (radius "
+                         f"{neck.radius:.3g} < {NECK_RESOLUTION:g} h = {NECK_RESOLUTION * h:.3g}): {reason}")
+    options = {k: v for k, v in options.items() if k != "T0"}
+    new = scheme.make(cut.vertices, cut.faces, flow.tau, threads=threads, **options)
+    new.n = flow.n
+    return cut, new
+
+
+def exceeded(removed_area_share):
+    """Whether a run's surgeries removed more than :data:`MAX_REMOVED_SHARE` of its
+    initial area: it does not count as reaching its end."""
+    return bool(removed_area_share > MAX_REMOVED_SHARE)

@@ -68,7 +68,12 @@ class Trajectory:
         round (:mod:`mcfbench.geometry.collapse`): ``time`` the state's, ``kind``
         ``"point"`` or ``"circle"``, ``area`` and ``volume`` the component's then,
         ``extinction_time`` the state's time plus the time the round component
-        had left.
+        had left; one ``{"event": "surgery", "step", "time", "where", "neck_radius",
+        "pinch_time", "components_before", "components_after", "area_removed",
+        "volume_removed", "band_area", "area_share"}`` per neck cut (``simulate``'s
+        ``surgery``): ``where`` the neck's point on its axis, ``pinch_time`` the
+        state's time plus ``r^2 / 2`` (a neck of radius ``r`` shrinks as a cylinder,
+        ``r r' = -1``), ``area_share`` the area removed over the initial area.
     flow : mcfbench.running.flow.SchemeFlow
         The flow at the run's end: the one stepped, or the one rebuilt on the
         components that remained (``rebuild``).
@@ -112,6 +117,17 @@ class Trajectory:
             and self.events else float("nan")
 
     @property
+    def surgeries(self):
+        """The ``surgery`` events (:attr:`events`)."""
+        return [e for e in self.events if e["event"] == "surgery"]
+
+    @property
+    def removed_area_share(self):
+        """The area the surgeries removed (``|area_removed|`` summed) over the initial
+        area, 0 without one."""
+        return float(sum(abs(e["area_share"]) for e in self.surgeries))
+
+    @property
     def t_failed(self):
         """Time of the breakdown or first defect, NaN when ``ok``."""
         return float("nan") if self.ok else float(self.defects[0]["time"]) \
@@ -133,7 +149,7 @@ class _NoBar:
 
 def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrapolate",
              save_every=1, observers=(), on_defect="stop", until=None, progress=False,
-             collapse=True, invariants=True, rebuild=None):
+             collapse=True, invariants=True, rebuild=None, surgery=None):
     """Step ``flow`` ``steps`` times.
 
     Parameters
@@ -197,6 +213,17 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
         initial mesh's layout, the vanished points where they vanished, and the
         integrator starts afresh); without ``rebuild``, or when it cannot, the run
         ends ``degenerated`` saying why (the event's ``why_not``).
+    surgery : callable, optional
+        ``surgery(flow) -> None or (Surgery, flow)``, asked about every state before
+        its checks (:func:`mcfbench.running.continuation.neck_surgery`): None while no
+        neck has pinched, else the cut (:class:`mcfbench.geometry.mesh_surgery.Surgery`)
+        and the flow rebuilt on the operated mesh at the same time level; the run goes
+        on with it (a ``surgery`` event of :attr:`Trajectory.events`; the frames keep
+        the initial mesh's layout, the points the cut removed where they were then,
+        the caps' new points left out; the integrator starts afresh, the area's and
+        the folds' checks start from the operated mesh). A ``ValueError`` (a neck
+        pinched that cannot be cut, or a scheme that cannot be rebuilt) ends the run
+        ``degenerated`` saying why.
 
     Returns
     -------
@@ -212,7 +239,7 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
     stepping = _Stepping(flow, int(steps), get_integrator(integrator, warm_start=warm_start),
                          save_every=save_every, observers=observers, on_defect=on_defect,
                          until=until, collapse=collapse, invariants=invariants,
-                         rebuild=rebuild)
+                         rebuild=rebuild, surgery=surgery)
     # a copy per run: what a solver keeps between solves (the kept ILU factor) is the
     # run's own, built inside its timed steps, never carried in from a warm-up or an
     # earlier run (a timed repeat pays for its factor as the first execution did)
@@ -227,15 +254,17 @@ class _Stepping:
     failure with another one."""
 
     def __init__(self, flow, steps, stepper, *, save_every, observers, on_defect, until,
-                 collapse, invariants, rebuild=None):
+                 collapse, invariants, rebuild=None, surgery=None):
         self.flow, self.steps, self.stepper = flow, steps, stepper
         self.save_every, self.observers, self.on_defect = save_every, observers, on_defect
         self.until = until
         self.frames, self.steps_kept, self.iterations, self.defects = [], [], [], []
         self.events = []
         self.rebuild, self.faces = rebuild, np.asarray(flow.faces)
-        # the initial mesh's points and triangles still in the flow (all until a
-        # component vanishes and the run goes on without it), and the last full frame
+        self.surgery = surgery
+        self.initial_area = None
+        # the initial mesh's number of every point and triangle of the flow (all until
+        # a component vanishes or a neck is cut; -1 for a cap's), and the last full frame
         self.kept_vertices = np.arange(len(flow.vertices))
         self.kept_faces = np.arange(len(self.faces))
         self.full = None
@@ -270,6 +299,8 @@ class _Stepping:
         only of a state that passes the other checks (an invalid state is never counted
         as the flow's end), and at the run's last state only once it collapsed (its time
         left matters only before a next step)."""
+        if self.surgery is not None and self.operate():
+            return self.check()
         flow = self.flow
         # the mesh vertices once (DDFV's are a gather of its F-vertices), measured once
         # for both checks
@@ -332,32 +363,84 @@ class _Stepping:
                 from None
         self.full = self.full_frame()          # the vanished vertices stay where they were
         kept_faces = keep[np.asarray(flow.faces)].all(axis=1)
-        self.kept_vertices = self.kept_vertices[keep]
-        self.kept_faces = self.kept_faces[kept_faces]
+        self.renew(new, np.flatnonzero(keep), kept_faces)
+        return True
+
+    def operate(self):
+        """Cut a pinched neck of the current state (``surgery``) and go on with the flow
+        rebuilt on the operated mesh; True when it did. A ``ValueError`` of ``surgery``
+        ends the run ``degenerated`` saying why."""
+        flow = self.flow
+        if self.initial_area is None:
+            self.initial_area = float(np.sum(self.measures(flow.vertices).component_area)) \
+                if self.measures is not None else float("nan")
+        t = flow.n * flow.tau
+        try:
+            done = self.surgery(flow)
+        except ValueError as err:
+            detail = f"a neck pinched and the run cannot go on: {err}"
+            self.defects.append({"status": "degenerated", "step": flow.n, "time": t,
+                                 "detail": detail})
+            raise FlowBreakdown("degenerated", flow.n, t, detail) from None
+        if done is None:
+            return False
+        cut, new = done
+        self.events.append({
+            "event": "surgery", "step": flow.n, "time": t,
+            "where": [float(x) for x in cut.where], "neck_radius": cut.radius,
+            "pinch_time": t + cut.radius ** 2 / 2.0,
+            "components_before": cut.components_before,
+            "components_after": cut.components_after, "area_removed": cut.area_removed,
+            "volume_removed": cut.volume_removed, "band_area": cut.band_area,
+            "area_share": cut.area_removed / self.initial_area})
+        self.full = self.full_frame()          # the band's points stay where they were
+        self.renew(new, np.flatnonzero(cut.keep_vertices), cut.keep_faces)
+        return True
+
+    def renew(self, new, old_vertices, kept_faces):
+        """Go on with ``new``, a flow on the previous one's points ``old_vertices`` (in
+        its numbering, in order) and its triangles ``kept_faces`` ((m,) bool), then new
+        points and triangles: the layout of the frames, a fresh integrator, the checks
+        of the new mesh (the components keep their initial size and names, the second
+        piece of a component cut in two is named as a new one)."""
+        check = self.collapsed
+        added_v = len(new.vertices) - len(old_vertices)
+        added_f = len(new.faces) - int(np.sum(kept_faces))
+        self.kept_vertices = np.r_[self.kept_vertices[old_vertices], np.full(added_v, -1)]
+        self.kept_faces = np.r_[self.kept_faces[kept_faces], np.full(added_f, -1)]
         self.flow = new
         self.stepper = get_integrator(self.stepper.name, warm_start=self.stepper.warm_start)
-        self.measures = StateMeasures(new.vertices, new.faces)
-        collapsed = CollapseCheck(new.vertices, new.faces, measures=self.measures, tau=new.tau,
-                                  area_tol=check.area_tol, diameter_tol=check.diameter_tol)
-        # the remaining components keep their initial size and names
-        old = check.labels[keep][collapsed.first]
-        collapsed.renamed(check.area0[old], check.diameter0[old], check.ids[old],
-                          self.kept_vertices, check.total)
-        self.collapsed = collapsed
+        self.measures = StateMeasures(new.vertices, new.faces) \
+            if self.measures is not None else None
+        if check is not None:
+            collapsed = CollapseCheck(new.vertices, new.faces, measures=self.measures,
+                                      tau=new.tau, area_tol=check.area_tol,
+                                      diameter_tol=check.diameter_tol)
+            # a component's first point is one of the previous flow's (they come first)
+            old = check.labels[old_vertices[collapsed.first]]
+            ids = check.ids[old].copy()
+            again = np.ones(len(old), bool)
+            again[np.unique(old, return_index=True)[1]] = False
+            ids[again] = check.total + np.arange(int(again.sum()))
+            collapsed.renamed(check.area0[old], check.diameter0[old], ids,
+                              self.kept_vertices, check.total + int(again.sum()))
+            self.collapsed = collapsed
         if self.invariant is not None:
             self.invariant = FlowInvariants(new.vertices, new.faces, measures=self.measures)
-        return True
 
     def full_frame(self):
         """The current frame in the initial mesh's layout: the vanished components'
-        points where they were when they vanished."""
+        points where they were when they vanished, the points a surgery removed where
+        they were then, its caps' points left out."""
         frame = self.flow.frame()
         if self.full is None:
             return frame
         full = {key: value.copy() for key, value in self.full.items()}
-        full["vertices"][self.kept_vertices] = frame["vertices"]
+        kept = self.kept_vertices >= 0
+        full["vertices"][self.kept_vertices[kept]] = frame["vertices"][kept]
         if "extra_points" in full:
-            full["extra_points"][self.kept_faces] = frame["extra_points"]
+            kept = self.kept_faces >= 0
+            full["extra_points"][self.kept_faces[kept]] = frame["extra_points"][kept]
         return full
 
     def observe(self):

@@ -22,7 +22,7 @@ import numpy as np
 from mcfbench.geometry import metrics
 from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.mesh import validate_mesh
-from mcfbench.running.continuation import sub_flow
+from mcfbench.running.continuation import exceeded, neck_surgery, sub_flow
 from mcfbench.running.cost import check_size
 from mcfbench.running.driver import simulate
 from mcfbench.running.monitors import Monitor, Steady
@@ -165,7 +165,8 @@ def _result(timed, scheme, problem, level, nF, h, tau, steps, method, integrator
         min_angle=_worst(np.min, q["min_angle"]), max_aspect=_worst(np.max, q["max_aspect"]),
         max_flipped=_worst(np.max, q["flipped"]), metrics=_metric_values(timed, problem),
         series={"t": monitor.t, "t_min_barycentric": monitor.t_monitor, **q},
-        timing_repeats=repeats)
+        timing_repeats=repeats, removed_area_share=traj.removed_area_share,
+        surgery_exceeded=exceeded(traj.removed_area_share))
 
 
 def problem_mesh(problem, level):
@@ -234,6 +235,9 @@ def _timed_run(scheme, problem, mesh, tau, steps, *, solver, integrator, warm_st
     monitor = Monitor(max(1, steps // max(1, samples)))
     metric_observers = problem.observers()
     until = Steady(problem.steady_speed) if problem.steady_speed else None
+    surgery = partial(neck_surgery, scheme, h=metrics.mean_edge_length(V, F),
+                      integrator=integrator, threads=threads, **options) \
+        if scheme.continuation == "surgery" else None
     cpu, wall = time.process_time(), time.perf_counter()
     flow = scheme.make(V, F, tau, threads=threads, **options)
     traj = simulate(flow, steps, solver=solver, integrator=integrator, warm_start=warm_start,
@@ -241,7 +245,7 @@ def _timed_run(scheme, problem, mesh, tau, steps, *, solver, integrator, warm_st
                     observers=[monitor, *metric_observers, *observers], on_defect=on_defect,
                     until=until, progress=progress,
                     rebuild=partial(sub_flow, scheme, integrator=integrator, threads=threads,
-                                    **options))
+                                    **options), surgery=surgery)
     flow = traj.flow                      # rebuilt when a component vanished
     finished = monitor.finished(flow)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
@@ -336,8 +340,9 @@ def _metric_values(timed, problem):
         values.update({k: v if kept else float("nan") for k, v in observer.result().items()})
     if "pinch_time" in problem.reference:
         values["pinch_time_error"] = pinch_time_error(traj, problem.reference["pinch_time"])
-    if problem.to_extinction and problem.t_max is not None:
-        values["extinction_time_error"] = traj.extinction_time / problem.t_max - 1.0
+    extinction = problem.reference.get("extinction_time", problem.t_max)
+    if problem.to_extinction and extinction is not None:
+        values["extinction_time_error"] = traj.extinction_time / extinction - 1.0
     return values
 
 
@@ -349,7 +354,12 @@ def pinch_time_error(traj, pinch_time):
     that ended ``extinct`` (the torus's tube vanishing round onto its core circle:
     :attr:`mcfbench.running.driver.Trajectory.extinction_time`, which does not move
     with the step at which the check stops the run), NaN for a run that finished
-    (it went through the pinch without noticing it)."""
+    (it went through the pinch without noticing it). A run that cut a neck
+    (``NAME+surgery``) has its first cut's ``pinch_time`` (the state's time plus
+    ``r^2 / 2``: :class:`mcfbench.running.driver.Trajectory`'s events), whatever
+    its end."""
+    if traj.surgeries:
+        return traj.surgeries[0]["pinch_time"] / pinch_time - 1.0
     if traj.ok:
         return float("nan")
     return (traj.extinction_time if traj.status == "extinct" else traj.t_failed) \
@@ -513,6 +523,7 @@ class _Guarded:
         self.scheme = scheme
         self.name, self.family, self.label = scheme.name, scheme.family, scheme.label
         self.extra_points, self.integrator = scheme.extra_points, scheme.integrator
+        self.tangential, self.continuation = scheme.tangential, scheme.continuation
 
     def make(self, vertices, faces, tau, **options):
         try:

@@ -40,6 +40,14 @@ moves its vertices along the surface, the grouping of the findings' comparison
 (:mod:`mcfbench.studies.matrix.tangential`). DDFV's are the values of its
 ``tangential`` option (:data:`ddfv.variants.VARIANTS`)."""
 
+CONTINUATIONS = {
+    "none": "the run ends where a neck folds its mesh",
+    "surgery": "a neck pinched below half an edge is cut and both sides capped, the run "
+               "going on (mcfbench.running.continuation)",
+}
+"""What a scheme's runs do at a neck pinch -> description (:attr:`Scheme.continuation`;
+``NAME+surgery``, :func:`mcfbench.running.schemes.get_scheme`)."""
+
 
 @dataclass(frozen=True)
 class Scheme:
@@ -88,6 +96,11 @@ class Scheme:
     tangential : str
         Its tangential strategy, a key of :data:`TANGENTIAL` (DDFV: its
         ``tangential`` option, ``"none"`` without one).
+    continuation : str
+        What its runs do at a neck pinch, a key of :data:`CONTINUATIONS`: ``"none"``
+        (every registry entry: the run ends where the mesh folds) or ``"surgery"``
+        (a name ``<name>+surgery``: the neck cut and capped, the run going on;
+        :mod:`mcfbench.running.continuation`).
     module : str
         The module that declared it (set by the registry's discovery,
         :mod:`mcfbench.running.discovery`).
@@ -110,11 +123,14 @@ class Scheme:
     robust_solver: str = "jacobi-direct"
     integrator: str = "euler"
     tangential: str = "none"
+    continuation: str = "none"
     module: str = field(default="", compare=False)
     source: dict | None = field(default=None, compare=False)
 
     def __post_init__(self):
-        base, at, integrator = self.name.partition("@")   # NAME@INTEGRATOR: get_scheme's
+        suffix = f"+{self.continuation}"                   # NAME+surgery: get_scheme's
+        core = self.name.removesuffix(suffix) if self.continuation != "none" else self.name
+        base, at, integrator = core.partition("@")        # NAME@INTEGRATOR: get_scheme's
         if not base or any(c in base for c in "/ ") or \
                 (at and integrator in ("euler", "") or at and integrator != self.integrator):
             raise ValueError(f"scheme {self.name!r}: a name is a non-empty word without "
@@ -123,6 +139,9 @@ class Scheme:
         if self.matrix not in MATRICES:
             raise ValueError(f"scheme {self.name!r}: unknown matrix kind {self.matrix!r}; "
                              f"choose one of {', '.join(MATRICES)}")
+        if self.continuation not in CONTINUATIONS:
+            raise ValueError(f"scheme {self.name!r}: unknown continuation "
+                             f"{self.continuation!r}; choose one of {', '.join(CONTINUATIONS)}")
         if self.tangential not in TANGENTIAL:
             raise ValueError(f"scheme {self.name!r}: unknown tangential strategy "
                              f"{self.tangential!r}; choose one of {', '.join(TANGENTIAL)}")

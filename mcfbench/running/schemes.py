@@ -15,7 +15,9 @@ Every scheme is stepped by the paper's semi-implicit Euler step unless
 asked otherwise; ``<name>@<integrator>`` (e.g. ``cotan@bdf2``) names the
 scheme ``<name>`` stepped by another integrator of
 :data:`mcfbench.running.integrators.INTEGRATORS` (:func:`get_scheme`), so
-that a study lists it like any scheme (the matrix, the beyond study).
+that a study lists it like any scheme (the matrix, the beyond study);
+``<name>+surgery`` names it with the surgery at a neck pinch
+(:data:`mcfbench.running.scheme.CONTINUATIONS`, :mod:`mcfbench.running.continuation`).
 """
 
 from dataclasses import replace
@@ -23,7 +25,8 @@ from dataclasses import replace
 import mcfbench.schemes
 from mcfbench.running.discovery import discover
 from mcfbench.running.integrators import INTEGRATORS
-from mcfbench.running.scheme import MATRICES, TANGENTIAL, Scheme  # noqa: F401 (the API)
+from mcfbench.running.scheme import (CONTINUATIONS, MATRICES, TANGENTIAL,  # noqa: F401
+                                     Scheme)
 
 GROUP = "mcfbench.schemes"
 """The entry-point group of installed packages' schemes."""
@@ -31,6 +34,15 @@ GROUP = "mcfbench.schemes"
 SCHEMES, _ = discover(mcfbench.schemes.__path__, mcfbench.schemes.__name__, "SCHEME", "SCHEMES",
                       Scheme, GROUP)
 """Scheme name -> :class:`Scheme`, in the registry's order (module docstring)."""
+
+
+def split_continuation(name):
+    """``(name without its continuation, continuation)``: ``"cotan+surgery"`` ->
+    ``("cotan", "surgery")``, ``"cotan@bdf2+surgery"`` -> ``("cotan@bdf2", "surgery")``,
+    ``"cotan"`` -> ``("cotan", "none")`` (:data:`CONTINUATIONS`)."""
+    rest, plus, continuation = name.rpartition("+")
+    return (rest, continuation) if plus and continuation in CONTINUATIONS \
+        and continuation != "none" else (name, "none")
 
 
 def split_name(name):
@@ -48,7 +60,8 @@ def joined_name(base, integrator):
 
 def get_scheme(name, registry=None):
     """The registry entry ``name``, or ``<name>@<integrator>``: that entry stepped by
-    another integrator (its label says which; hollow markers).
+    another integrator (its label says which; hollow markers), or either with
+    ``+surgery``: its runs go on through a neck pinch (:attr:`Scheme.continuation`).
 
     Parameters
     ----------
@@ -62,10 +75,15 @@ def get_scheme(name, registry=None):
         Unknown name or integrator, listing the known ones.
     """
     registry = SCHEMES if registry is None else registry
+    rest, continuation = split_continuation(name)
+    if continuation != "none":
+        entry = get_scheme(rest, registry)
+        return replace(entry, name=name, continuation=continuation,
+                       label=f"{entry.label}, {continuation}")
     base, integrator = split_name(name)
     if base not in registry:
         raise ValueError(f"unknown scheme {name!r}; choose one of "
-                         f"{', '.join(registry)} (or NAME@INTEGRATOR)")
+                         f"{', '.join(registry)} (or NAME@INTEGRATOR, NAME+surgery)")
     entry = registry[base]
     if name == base:
         return entry

@@ -53,24 +53,28 @@ def test_the_cut_leaves_two_closed_oriented_bulbs(dumbbell):
     count, labels = vertex_components(F2, len(V2))
     chi, closed = component_topology(F2, labels, count)
     assert count == 2 and chi.tolist() == [2, 2] and closed.all() and _oriented(F2)
-    assert np.bincount(labels).tolist() == [1274, 1274]     # symmetric halves, each a cap vertex
-    assert len(V2) == len(V) + 2 and (~surgery.keep_faces).sum() == 34
-    assert len(F2) == len(F)                  # the caps: one triangle a loop edge, 34
+    # symmetric halves; the neck's thin part (16 vertices, their 64 triangles) removed,
+    # each loop (16 edges at about 0.07 from the axis) capped by a dome of 33 points
+    # and 80 triangles
+    assert np.bincount(labels).tolist() == [1298, 1298]
+    assert (~surgery.keep_vertices).sum() == 16 and (~surgery.keep_faces).sum() == 64
+    assert len(V2) == len(V) - 16 + 66 and len(F2) == len(F) - 64 + 160
+    assert metrics.min_angle(V2, F2) > metrics.min_angle(V, F)           # 13.8 > 5.0 degrees
     assert np.array_equal(F2[: surgery.keep_faces.sum()],
                           (np.cumsum(surgery.keep_vertices) - 1)[F[surgery.keep_faces]])
-    # the band within r_band of the axis and l_band of the plane: a tube's area at most
-    r, l = surgery.band_radius, surgery.band_edge
-    assert r < 1.5 * h and l < 2 * h
-    assert surgery.band_area <= 4 * np.pi * r * l
-    assert abs(surgery.area_removed) <= surgery.band_area + 2 * np.pi * r ** 2
+    # the band within r_band of the axis and z_band of the plane: a tube's area at most
+    r, z = surgery.band_radius, surgery.band_height
+    assert r < h and z < 2 * neck.radius + 2 * h
+    assert 0.1 < surgery.band_area <= 4 * np.pi * r * z                 # 0.131 <= 0.179
+    assert 0 < surgery.area_removed <= surgery.band_area
     assert surgery.area_removed == pytest.approx(
         metrics.area(V, F) - metrics.area(V2, F2), abs=1e-12)
-    assert 0 < surgery.volume_removed < 2 * np.pi * r ** 2 * l
-    assert abs(surgery.area_removed) < 1e-3 * metrics.area(V, F)
-    # the two caps' vertices at the loops' centroids, within the neck's radius of the
-    # axis (0.015: the strip's loops zigzag out to r_band = 0.088), one on each side
-    assert np.linalg.norm(V2[-2:, :2], axis=1).max() < neck.radius
-    assert V2[-2, 2] * V2[-1, 2] < 0
+    assert 0 < surgery.volume_removed < 2 * np.pi * r ** 2 * z
+    assert surgery.area_removed < 6e-3 * metrics.area(V, F)             # 0.082 of 15.3
+    # the domes inside the band's tube, one on each side of the plane
+    new = V2[surgery.keep_vertices.sum():]
+    assert np.linalg.norm(new[:, :2], axis=1).max() < r and np.abs(new[:, 2]).max() < z
+    assert (new[:, 2] > 0).sum() == (new[:, 2] < 0).sum() == 33
 
 
 def test_a_cut_that_does_not_separate_is_refused(dumbbell):
