@@ -7,7 +7,9 @@ import closure (:mod:`mcfbench.storage.code_identity`: static, lazy imports,
 * the scheme: its flow class's module (the registry entry's ``"module:Class"``;
   an outside package's flow is followed and hashed as the repository's are, and
   its ``source``: distribution, version, files' SHA-256), for ``NAME@INTEGRATOR``
-  the integrator's module, and the entry's values that change the numbers (its
+  the integrator's module, for ``NAME+surgery`` the surgery's modules
+  (:data:`CONTINUATION_ROOTS`; today in every run's through the harness's
+  driver as well), and the entry's values that change the numbers (its
   flow, options and integrator: :func:`scheme_values`; not its label or style);
 * the problem: the module that defines it (``Problem.module`` where the problem
   has one, else the module of its ``params`` function) and the registry module
@@ -49,6 +51,11 @@ STOP = frozenset({"mcfbench.running.schemes", "mcfbench.running.problems", "mcfb
                   "mcfbench.schemes"})
 """The listings: not followed where they are imported (module docstring)."""
 
+CONTINUATION_ROOTS = {"surgery": ("mcfbench.running.continuation",
+                                  "mcfbench.geometry.mesh_surgery")}
+"""A continuation (:attr:`mcfbench.running.scheme.Scheme.continuation`) -> the modules
+its runs step with besides the scheme's."""
+
 PROBLEM_DEFINITIONS = ("mcfbench.running.problem", "mcfbench.running.observers")
 """The modules defining ``Problem`` and the metric observers: roots of every problem."""
 
@@ -59,8 +66,9 @@ def _module_of(qualified):
 
 
 def scheme_roots(scheme):
-    """The modules of ``scheme`` (a registry name, ``NAME@INTEGRATOR`` included):
-    its flow's and, for another integrator than Euler, the integrator's."""
+    """The modules of ``scheme`` (a registry name, ``NAME@INTEGRATOR`` and
+    ``NAME+surgery`` included): its flow's, for another integrator than Euler the
+    integrator's, for a continuation its modules (:data:`CONTINUATION_ROOTS`)."""
     from mcfbench.running.integrators import INTEGRATORS
     from mcfbench.running.schemes import get_scheme
 
@@ -68,18 +76,22 @@ def scheme_roots(scheme):
     roots = [_module_of(entry.flow)]
     if entry.integrator != "euler":
         roots.append(INTEGRATORS[entry.integrator].__module__)
+    roots.extend(CONTINUATION_ROOTS.get(entry.continuation, ()))
     return tuple(roots)
 
 
 def scheme_values(scheme):
     """What the registry entry of ``scheme`` sets that changes a run's numbers: its
-    flow, options and integrator, and an installed package's ``source``
+    flow, options, integrator and continuation (when not ``"none"``), and an installed
+    package's ``source``
     (distribution, version, SHA-256 of its files); not its label, style or
     description."""
     from mcfbench.running.schemes import get_scheme
 
     entry = get_scheme(scheme)
     values = {"flow": entry.flow, "options": entry.options, "integrator": entry.integrator}
+    if entry.continuation != "none":
+        values["continuation"] = entry.continuation
     source = getattr(entry, "source", None)
     return {**values, "source": source} if source else values
 

@@ -7,7 +7,7 @@ from mcfbench.geometry.spheres import icosphere, random_bumpy_sphere
 from mcfbench.running.driver import simulate
 from mcfbench.running.flow import SchemeFlow
 from mcfbench.running.integrators import Euler
-from mcfbench.running.schemes import SCHEMES, get_scheme
+from mcfbench.running.schemes import SCHEMES, Scheme, get_scheme
 from mcfbench.running.solver import ROBUST
 
 
@@ -142,3 +142,27 @@ def test_scheme_names_split_and_join_back(name, parts):
     assert split_name(name) == parts
     assert joined_name(*parts) == name
     assert get_scheme(name).integrator == parts[1]
+
+
+@pytest.mark.parametrize("name, parts", [("cotan", ("cotan", "none")),
+                                         ("cotan+surgery", ("cotan", "surgery")),
+                                         ("bgn@bdf2+surgery", ("bgn@bdf2", "surgery")),
+                                         ("cotan+sideways", ("cotan+sideways", "none"))])
+def test_a_continuation_is_split_off_the_name(name, parts):
+    from mcfbench.running.schemes import split_continuation
+
+    assert split_continuation(name) == parts
+
+
+def test_name_plus_surgery_is_the_entry_with_the_surgery():
+    entry, cut = get_scheme("ddfv-chord-carried"), get_scheme("ddfv-chord-carried+surgery")
+    assert cut.continuation == "surgery" and entry.continuation == "none"
+    assert (cut.flow, cut.options, cut.integrator, cut.tangential) == \
+        (entry.flow, entry.options, entry.integrator, entry.tangential)
+    assert cut.name == "ddfv-chord-carried+surgery" and cut.label.endswith(", surgery")
+    both = get_scheme("bgn@bdf2+surgery")
+    assert (both.integrator, both.continuation) == ("bdf2", "surgery")
+    with pytest.raises(ValueError, match="unknown scheme 'cotan\\+sideways'"):
+        get_scheme("cotan+sideways")
+    with pytest.raises(ValueError, match="unknown continuation 'glue'"):
+        Scheme("x", "x", "baselines.cotan:CotanFlow", continuation="glue")
