@@ -354,16 +354,12 @@ def pinch_time_error(traj, pinch_time):
     that ended ``extinct`` (the torus's tube vanishing round onto its core circle:
     :attr:`mcfbench.running.driver.Trajectory.extinction_time`, which does not move
     with the step at which the check stops the run), NaN for a run that finished
-    (it went through the pinch without noticing it). A run that cut a neck
-    (``NAME+surgery``) has its first cut's ``pinch_time`` (the state's time plus
-    ``r^2 / 2``: :class:`mcfbench.running.driver.Trajectory`'s events), whatever
-    its end."""
+    (it went through the pinch without noticing it); a run that cut a neck, its first
+    cut's ``pinch_time`` (:class:`mcfbench.running.driver.Trajectory`), whatever its end."""
     if traj.surgeries:
         return traj.surgeries[0]["pinch_time"] / pinch_time - 1.0
-    if traj.ok:
-        return float("nan")
-    return (traj.extinction_time if traj.status == "extinct" else traj.t_failed) \
-        / pinch_time - 1.0
+    stop = traj.extinction_time if traj.status == "extinct" else traj.t_failed
+    return float("nan") if traj.ok else stop / pinch_time - 1.0
 
 
 def _worst(reduce, values):
