@@ -69,6 +69,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+from mcfbench.geometry import metrics
 from mcfbench.geometry.collapse import component_topology, component_volumes
 from mcfbench.geometry.measures import vertex_components
 
@@ -180,14 +181,9 @@ def mean_curvature_vectors(vertices, faces):
 def angle_defects(vertices, faces):
     """``2 pi`` minus the angle sum at every vertex (the Gaussian curvature times its
     area; negative at a saddle), (n,) float array."""
-    V, F = np.asarray(vertices, dtype=float), np.asarray(faces, dtype=np.int64)
-    a, b, c = (V[F[:, k]] for k in range(3))
-    angles = np.stack([_angle(b - a, c - a), _angle(c - b, a - b), _angle(a - c, b - c)], 1)
-    return 2 * np.pi - np.bincount(F.ravel(), angles.ravel(), minlength=len(V))
-
-
-def _angle(u, w):
-    return np.arctan2(np.linalg.norm(np.cross(u, w), axis=1), np.einsum("ij,ij->i", u, w))
+    F = np.asarray(faces, dtype=np.int64)
+    angles = np.radians(metrics.triangle_angles(vertices, F))
+    return 2 * np.pi - np.bincount(F.ravel(), angles.ravel(), minlength=len(vertices))
 
 
 def _adjacency(n, pairs):
@@ -322,14 +318,14 @@ def cut_neck(vertices, faces, neck):
     if after != before + 1 or not closed.all() or not _oriented(F2):
         return None, (f"the cut left {after} component(s) from {before} (closed: "
                       f"{closed.all()}, oriented: {_oriented(F2)})")
-    area0, area1 = _area(V, F), _area(V2, F2)
+    area0, area1 = metrics.area(V, F), metrics.area(V2, F2)
     vol0 = component_volumes(V, F, labels1[F[:, 0]], before).sum()
     vol1 = component_volumes(V2, F2, lab2[F2[:, 0]], after).sum()
     bv = np.unique(F[band])
     return Surgery(V2, F2, keep_vertices, keep_faces, where, neck.radius,
                    float(_axis_distance(V[bv], neck.centre, neck.axis).max()),
                    float(np.abs(z[bv]).max()), int(before), int(after), float(area0 - area1),
-                   float(vol0 - vol1), float(_area(V, F[band]))), ""
+                   float(vol0 - vol1), float(metrics.area(V, F[band]))), ""
 
 
 def _dome(V, edges, neck, where, first):
@@ -415,11 +411,6 @@ def _zip(A, ta, B, tb):
     return np.where(is_a[:, None],
                     np.column_stack([A[a % ka], A[(a + 1) % ka], B[(b - 1) % kb]]),
                     np.column_stack([A[a % ka], B[b % kb], B[(b - 1) % kb]]))
-
-
-def _area(V, F):
-    a, b, c = (V[F[:, k]] for k in range(3))
-    return float(np.linalg.norm(np.cross(b - a, c - a), axis=1).sum() / 2)
 
 
 def _oriented(F):
