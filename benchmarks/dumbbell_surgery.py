@@ -61,9 +61,11 @@ def row(scheme, level):
                      for t, v in zip(ref["bulb_volume_times"], ref["bulb_volume"])]
     cut = (f"{cuts[0]['time']:.4f} {cuts[0]['neck_radius']:.4f} {len(cuts)}" if cuts
            else "-")
-    return (f"{scheme:28s} {level:2d} {result.nF:6d} {result.status + (' (robust)' if robust else ''):20s} "
+    status = result.status + (" (robust)" if robust else "")
+    return (f"{scheme:28s} {level:2d} {result.nF:6d} {status:20s} "
             f"{cut:>22s} {result.removed_area_share:9.2e} "
-            f"{m.get('pinch_time_error', np.nan):+9.4f} {m.get('extinction_time_error', np.nan):+9.4f} "
+            f"{m.get('pinch_time_error', np.nan):+9.4f} "
+            f"{m.get('extinction_time_error', np.nan):+9.4f} "
             + " ".join(f"{e:+9.4f}" for e in volume_errors)
             + f" {result.cpu_seconds:7.1f}")
 

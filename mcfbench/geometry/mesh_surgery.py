@@ -46,21 +46,23 @@ neck's triangles are long along its axis and its vertices zigzag in radius (the
 dumbbell's at level 1: rings at 0.02 and 0.037 from the axis within 0.05 of the
 plane, the next at 0.07 and 0.17), so that the strip's own loops would mix both
 rings; and at level 2 the neck is a tube of radius 0.025-0.03 over 0.1 of its
-length, whose stumps, cut at one plane only, pinch again at once. The band is removed, which leaves two boundary loops (one on each side),
-and each loop is closed by a dome of rings, a hemisphere over the loop towards the
-plane (:func:`_dome`), oriented as the triangles it meets. :func:`cut_neck` refuses (``None`` and the
-reason) a cut that does not leave exactly two loops or does not add one closed,
-consistently oriented component.
+length, whose stumps, cut at one plane only, pinch again at once. The band is
+removed, which leaves two boundary loops (one on each side), and each loop is
+closed by a dome of rings, a hemisphere over the loop towards the plane
+(:func:`_dome`), oriented as the triangles it meets. :func:`cut_neck` refuses
+(``None`` and the reason) a cut that does not leave exactly two loops or does not
+add one closed, consistently oriented component.
 
 Area and volume removed
 -----------------------
 The band lies within ``r_band`` of the axis and within ``z_band`` of the plane
 (the largest distance of its vertices from the axis and from the plane; ``z_band``
-the thin part's length plus an edge), and its area stays below
-that of a tube of radius ``r_band`` and height ``2 z_band``, ``4 pi r_band z_band``
-(tested on the dumbbell; a bound for a band that winds about the axis once without
-folding, not for every surface); the caps add at most ``2 pi r_band^2``. The reported ``area_removed`` is the area before minus after, the
-``volume_removed`` likewise.
+the thin part's length plus an edge), and its area stays below that of a tube of
+radius ``r_band`` and height ``2 z_band``, ``4 pi r_band z_band`` (tested on the
+dumbbell; a bound for a band that winds about the axis once without folding, not
+for every surface); each cap, a hemisphere of radius at most ``r_band``, adds at
+most ``2 pi r_band^2``. The reported ``area_removed`` is the area before minus
+after, the ``volume_removed`` likewise.
 """
 
 from typing import NamedTuple

@@ -164,7 +164,8 @@ def neck_surgery(scheme, flow, *, h, integrator=None, threads=1, **options):
         cut, reason = cut_neck(V, F, neck)
     if reason:
         raise ValueError(f"the neck at {np.round(V[neck.vertex], 4).tolist()} (radius "
-                         f"{neck.radius:.3g} < {NECK_RESOLUTION:g} h = {NECK_RESOLUTION * h:.3g}): {reason}")
+                         f"{neck.radius:.3g} < {NECK_RESOLUTION:g} h = "
+                         f"{NECK_RESOLUTION * h:.3g}): {reason}")
     options = {k: v for k, v in options.items() if k != "T0"}
     new = scheme.make(cut.vertices, cut.faces, flow.tau, threads=threads, **options)
     new.n = flow.n

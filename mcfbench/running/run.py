@@ -235,9 +235,9 @@ def _timed_run(scheme, problem, mesh, tau, steps, *, solver, integrator, warm_st
     monitor = Monitor(max(1, steps // max(1, samples)))
     metric_observers = problem.observers()
     until = Steady(problem.steady_speed) if problem.steady_speed else None
-    surgery = partial(neck_surgery, scheme, h=metrics.mean_edge_length(V, F),
-                      integrator=integrator, threads=threads, **options) \
-        if scheme.continuation == "surgery" else None
+    surgery = None if scheme.continuation != "surgery" else partial(
+        neck_surgery, scheme, h=metrics.mean_edge_length(V, F), integrator=integrator,
+        threads=threads, **options)
     cpu, wall = time.process_time(), time.perf_counter()
     flow = scheme.make(V, F, tau, threads=threads, **options)
     traj = simulate(flow, steps, solver=solver, integrator=integrator, warm_start=warm_start,
@@ -353,13 +353,13 @@ def pinch_time_error(traj, pinch_time):
     cells: the status says which), ``extinction_time / pinch_time - 1`` for one
     that ended ``extinct`` (the torus's tube vanishing round onto its core circle:
     :attr:`mcfbench.running.driver.Trajectory.extinction_time`, which does not move
-    with the step at which the check stops the run), NaN for a run that finished
-    (it went through the pinch without noticing it); a run that cut a neck, its first
-    cut's ``pinch_time`` (:class:`mcfbench.running.driver.Trajectory`), whatever its end."""
+    with the step at which the check stops the run), NaN for a run that finished (it
+    went through the pinch unawares); a run that cut a neck, its first cut's ``pinch_time``."""
     if traj.surgeries:
         return traj.surgeries[0]["pinch_time"] / pinch_time - 1.0
-    stop = traj.extinction_time if traj.status == "extinct" else traj.t_failed
-    return float("nan") if traj.ok else stop / pinch_time - 1.0
+    if traj.ok:
+        return float("nan")
+    return (traj.extinction_time if traj.status == "extinct" else traj.t_failed) / pinch_time - 1
 
 
 def _worst(reduce, values):
