@@ -13,7 +13,8 @@ ORDER = 5
 
 PROBLEM = Problem("dumbbell", "dumbbell pinch-off", "dumbbell",
                   lambda level: {"level": int(level)},
-                  levels=(1, 2, 3), tau_1=0.004, t_final=0.2, metrics=("reference_volume", "shape"),
+                  levels=(1, 2, 3), tau_1=0.004, t_final=0.2, metrics=("reference_volume", "shape",
+                                                                       "bulb_volume"),
                   exact="axisymmetric reference: the neck pinches at t = 0.0905263, the bulbs "
                         "vanish at t = 0.2553923",
                   reference={"pinch_time": 0.0905263, "volume_time": 0.08, "volume": 4.93560212849,

@@ -18,11 +18,30 @@ current state alone; :func:`why_not` names the others, whose runs end
   would be measured again from the mesh);
 - an integrator with past states (BDF2, BDF3: ``X^{n-1}, ...`` of the vanished
   vertices, in each flow's own numbering).
+
+A run of ``NAME+surgery`` (:attr:`mcfbench.running.scheme.Scheme.mesh_strategy`)
+goes on through a neck pinch the same way (:func:`mcfbench.running.surgery.neck_surgery`,
+the driver's mesh hook :class:`mcfbench.running.surgery.Surgeon`): once a neck's
+radius falls below half the run's resolution
+(:func:`mcfbench.geometry.mesh_surgery.pinched`), the neck is cut and both sides
+capped (:func:`mcfbench.geometry.mesh_surgery.cut_neck`) and the scheme's flow is
+built anew on the operated mesh, DDFV's T-vertices placed anew by its own rule
+(the caps' triangles have none to carry; the kept ones are re-initialised too, so
+that every T-vertex of the new flow is placed alike). A run whose surgeries removed
+more than :data:`MAX_REMOVED_SHARE` of the initial area does not count as reaching
+its end (:func:`exceeded`; the record's ``removed_area_share`` and
+``surgery_exceeded``).
 """
 
 import numpy as np
 
 from mcfbench.running.integrators import INTEGRATORS
+
+MAX_REMOVED_SHARE = 0.01
+"""The largest share of the initial area a run's surgeries may remove (``|area
+removed|`` summed over its cuts) for the run to count as reaching its end: the
+dumbbell's cuts remove 1.2e-3 to 1.5e-3 of it at level 1, 3.9e-4 to 4.3e-4 at level 2
+(cotan, BGN, DDFV chord carried; ``benchmarks/dumbbell_surgery.py``)."""
 
 STATE_ONLY = ("none", "eliminate", "bgn", "mdr", "intrinsic-delaunay")
 """The tangential strategies (:data:`mcfbench.running.schemes.TANGENTIAL`) whose step
@@ -113,3 +132,9 @@ def sub_flow(scheme, flow, keep, *, integrator=None, threads=1, **options):
                       **options)
     new.n = flow.n
     return new
+
+
+def exceeded(removed_area_share):
+    """Whether a run's surgeries removed more than :data:`MAX_REMOVED_SHARE` of its
+    initial area: it does not count as reaching its end."""
+    return bool(removed_area_share > MAX_REMOVED_SHARE)

@@ -76,9 +76,17 @@ class Trajectory:
         ``"point"`` or ``"circle"``, ``area`` and ``volume`` the component's then,
         ``extinction_time`` the state's time plus the time the round component
         had left; one ``{"event": "remeshed", "step", "time", "why", ...}`` per remesh
-        (``remesh``; the fields of :func:`mcfbench.geometry.remeshing.remesh_change`:
-        the distance between the surfaces before and after, the changes of area and
-        volume, the vertex counts, whether the components or genus changed).
+        (``remesh``'s :class:`~mcfbench.running.remeshing.Remesher`; the fields of
+        :func:`mcfbench.geometry.remeshing.remesh_change`: the distance between the
+        surfaces before and after, the changes of area and volume, the vertex counts,
+        whether the components or genus changed); one ``{"event": "surgery", "step",
+        "time", "where", "neck_radius", "pinch_time", "components_before",
+        "components_after", "area_removed", "volume_removed", "band_area",
+        "area_share"}`` per neck cut (``remesh``'s
+        :class:`~mcfbench.running.surgery.Surgeon`): ``where`` the neck's point on its
+        axis, ``pinch_time`` the state's time plus ``r^2 / 2`` (a neck of radius ``r``
+        shrinks as a cylinder, ``r r' = -1``), ``area_share`` the area removed over the
+        initial area.
     flow : mcfbench.running.flow.SchemeFlow
         The flow at the run's end: the one stepped, or the one rebuilt on the
         components that remained (``rebuild``).
@@ -121,6 +129,17 @@ class Trajectory:
         ``extinction_time``) of a run that ended ``extinct``, NaN otherwise."""
         return float(self.events[-1]["extinction_time"]) if self.status == "extinct" \
             and self.events else float("nan")
+
+    @property
+    def surgeries(self):
+        """The ``surgery`` events (:attr:`events`)."""
+        return [e for e in self.events if e["event"] == "surgery"]
+
+    @property
+    def removed_area_share(self):
+        """The area the surgeries removed (``|area_removed|`` summed) over the initial
+        area, 0 without one."""
+        return float(sum(abs(e["area_share"]) for e in self.surgeries))
 
     @property
     def t_failed(self):
@@ -209,14 +228,21 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
         integrator starts afresh); without ``rebuild``, or when it cannot, the run
         ends ``degenerated`` saying why (the event's ``why_not``).
     remesh : callable, optional
-        ``remesh(flow) -> (flow, event)`` or None, after every state that passed the
-        checks (the initial one included): the flow rebuilt on a new mesh of its
-        surface at the same time level, and what changed
-        (:class:`mcfbench.running.remeshing.Remesher`). The run goes on with it: the
-        integrator starts afresh, the checks start again from the new mesh (the
-        invariants hold between remeshes; the event records the change across one,
-        a ``"remeshed"`` event of :attr:`Trajectory.events`), and the frames keep
-        each its own faces (:attr:`Trajectory.frame_faces`).
+        A mesh strategy's hook (:func:`mcfbench.running.remeshing.mesh_hook`):
+        ``remesh(flow) -> (flow, event)`` or None, asked about every state (the
+        initial one included) before its checks when ``remesh.before_checks``, else
+        after it passed them: the flow rebuilt on a new mesh of its surface at the
+        same time level, and what changed (an event of :attr:`Trajectory.events`).
+        The run goes on with it: the integrator starts afresh, the checks start again
+        from the new mesh (the invariants hold between changes; the event records the
+        change across one). The frames: where ``remesh.kept`` names the previous
+        flow's points and triangles the new one keeps (in order, then new ones), the
+        initial mesh's layout, the removed points where they were then, the new ones
+        left out (:class:`~mcfbench.running.surgery.Surgeon`: the neck's cut); where
+        it is None, each frame its own faces (:attr:`Trajectory.frame_faces`;
+        :class:`~mcfbench.running.remeshing.Remesher`). A ``ValueError`` of the hook
+        (a neck pinched that cannot be cut, or a scheme that cannot be rebuilt) ends
+        the run ``degenerated`` saying why.
 
     Returns
     -------
@@ -255,8 +281,8 @@ class _Stepping:
         self.events = []
         self.rebuild, self.remesh, self.faces = rebuild, remesh, np.asarray(flow.faces)
         self.frame_faces = []
-        # the initial mesh's points and triangles still in the flow (all until a
-        # component vanishes and the run goes on without it), and the last full frame
+        # the frame layout's number of every point and triangle of the flow (all until
+        # a component vanishes or a neck is cut; -1 for a cap's), and the last full frame
         self.kept_vertices = np.arange(len(flow.vertices))
         self.kept_faces = np.arange(len(self.faces))
         self.full = None
@@ -291,17 +317,38 @@ class _Stepping:
         self.frames.append(self.full_frame())
         self.frame_faces.append(self.faces)
 
-    def remeshed(self):
-        """Go on with the flow on a new mesh when ``remesh`` gives one (``simulate``'s
-        ``remesh``): the checks start again from it, the integrator afresh; the new
-        state is checked (an invalid remesh ends the run as any state does)."""
-        if self.remesh is None:
-            return
-        found = self.remesh(self.flow)
+    def remeshed(self, before_checks=False):
+        """Go on with the flow on a new mesh when the mesh strategy's hook (``simulate``'s
+        ``remesh``) gives one, asked where its ``before_checks`` says: the checks start
+        again from it, the integrator afresh; the new state is checked (an invalid mesh
+        ends the run as any state does). True when it did."""
+        hook = self.remesh
+        if hook is None or bool(hook.before_checks) != before_checks:
+            return False
+        flow = self.flow
+        try:
+            found = hook(flow)
+        except ValueError as err:
+            self.defects.append({"status": "degenerated", "step": flow.n,
+                                 "time": flow.n * flow.tau, "detail": str(err)})
+            raise FlowBreakdown("degenerated", flow.n, flow.n * flow.tau, str(err)) from None
         if found is None:
-            return
+            return False
         new, event = found
         self.events.append(event)
+        if hook.kept is not None:          # the frames keep their layout
+            self.full = self.full_frame()   # the removed points stay where they were
+            keep_vertices, keep_faces = hook.kept
+            self.renew(new, np.flatnonzero(keep_vertices), keep_faces)
+        else:                               # a new mesh: its frames carry their faces
+            self.new_mesh(new)
+        if not before_checks:
+            self.check()
+        return True
+
+    def new_mesh(self, new):
+        """Go on with ``new``, a flow on a new mesh of the surface (a remesh): its own
+        layout, a fresh integrator, the checks of the new mesh."""
         check = self.collapsed
         self.flow, self.faces, self.full = new, np.asarray(new.faces), None
         self.kept_vertices = np.arange(len(new.vertices))
@@ -318,7 +365,6 @@ class _Stepping:
                                        self.kept_vertices, check.total)
         if self.invariant is not None:
             self.invariant = FlowInvariants(new.vertices, new.faces, measures=self.measures)
-        self.check()
 
     def check(self):
         """Record the defects of the current state; raise in stop mode (always for a
@@ -326,6 +372,8 @@ class _Stepping:
         only of a state that passes the other checks (an invalid state is never counted
         as the flow's end), and at the run's last state only once it collapsed (its time
         left matters only before a next step)."""
+        if self.remeshed(before_checks=True):
+            return self.check()
         flow = self.flow
         # the mesh vertices once (DDFV's are a gather of its F-vertices), measured once
         # for both checks
@@ -388,32 +436,53 @@ class _Stepping:
                 from None
         self.full = self.full_frame()          # the vanished vertices stay where they were
         kept_faces = keep[np.asarray(flow.faces)].all(axis=1)
-        self.kept_vertices = self.kept_vertices[keep]
-        self.kept_faces = self.kept_faces[kept_faces]
+        self.renew(new, np.flatnonzero(keep), kept_faces)
+        return True
+
+    def renew(self, new, old_vertices, kept_faces):
+        """Go on with ``new``, a flow on the previous one's points ``old_vertices`` (in
+        its numbering, in order) and its triangles ``kept_faces`` ((m,) bool), then new
+        points and triangles: the layout of the frames, a fresh integrator, the checks
+        of the new mesh (the components keep their initial size and names, the second
+        piece of a component cut in two is named as a new one)."""
+        check = self.collapsed
+        added_v = len(new.vertices) - len(old_vertices)
+        added_f = len(new.faces) - int(np.sum(kept_faces))
+        self.kept_vertices = np.r_[self.kept_vertices[old_vertices], np.full(added_v, -1)]
+        self.kept_faces = np.r_[self.kept_faces[kept_faces], np.full(added_f, -1)]
         self.flow = new
         self.stepper = get_integrator(self.stepper.name, warm_start=self.stepper.warm_start)
-        self.measures = StateMeasures(new.vertices, new.faces)
-        collapsed = CollapseCheck(new.vertices, new.faces, measures=self.measures, tau=new.tau,
-                                  area_tol=check.area_tol, diameter_tol=check.diameter_tol)
-        # the remaining components keep their initial size and names
-        old = check.labels[keep][collapsed.first]
-        collapsed.renamed(check.area0[old], check.diameter0[old], check.ids[old],
-                          self.kept_vertices, check.total)
-        self.collapsed = collapsed
+        self.measures = StateMeasures(new.vertices, new.faces) \
+            if self.measures is not None else None
+        if check is not None:
+            collapsed = CollapseCheck(new.vertices, new.faces, measures=self.measures,
+                                      tau=new.tau, area_tol=check.area_tol,
+                                      diameter_tol=check.diameter_tol)
+            # a component's first point is one of the previous flow's (they come first)
+            old = check.labels[old_vertices[collapsed.first]]
+            ids = check.ids[old].copy()
+            again = np.ones(len(old), bool)
+            again[np.unique(old, return_index=True)[1]] = False
+            ids[again] = check.total + np.arange(int(again.sum()))
+            collapsed.renamed(check.area0[old], check.diameter0[old], ids,
+                              self.kept_vertices, check.total + int(again.sum()))
+            self.collapsed = collapsed
         if self.invariant is not None:
             self.invariant = FlowInvariants(new.vertices, new.faces, measures=self.measures)
-        return True
 
     def full_frame(self):
         """The current frame in the initial mesh's layout: the vanished components'
-        points where they were when they vanished."""
+        points where they were when they vanished, the points a surgery removed where
+        they were then, its caps' points left out."""
         frame = self.flow.frame()
         if self.full is None:
             return frame
         full = {key: value.copy() for key, value in self.full.items()}
-        full["vertices"][self.kept_vertices] = frame["vertices"]
+        kept = self.kept_vertices >= 0
+        full["vertices"][self.kept_vertices[kept]] = frame["vertices"][kept]
         if "extra_points" in full:
-            full["extra_points"][self.kept_faces] = frame["extra_points"]
+            kept = self.kept_faces >= 0
+            full["extra_points"][self.kept_faces[kept]] = frame["extra_points"][kept]
         return full
 
     def observe(self):

@@ -7,7 +7,9 @@ import closure (:mod:`mcfbench.storage.code_identity`: static, lazy imports,
 * the scheme: its flow class's module (the registry entry's ``"module:Class"``;
   an outside package's flow is followed and hashed as the repository's are, and
   its ``source``: distribution, version, files' SHA-256), for ``NAME@INTEGRATOR``
-  the integrator's module, and the entry's values that change the numbers (its
+  the integrator's module, for ``NAME+STRATEGY`` (``+remesh``, ``+surgery``) its
+  hook's module (:func:`scheme_roots`: the remeshing's, the neck's cut's, in no
+  other run's), and the entry's values that change the numbers (its
   flow, options and integrator: :func:`scheme_values`; not its label or style);
 * the problem: the module that defines it (``Problem.module`` where the problem
   has one, else the module of its ``params`` function) and the registry module
@@ -46,12 +48,12 @@ HARNESS = ("mcfbench.running.run",)
 """The roots of the harness code every run shares."""
 
 STOP = frozenset({"mcfbench.running.schemes", "mcfbench.running.problems", "mcfbench.problems",
-                  "mcfbench.running.remeshing",
+                  "mcfbench.running.remeshing", "mcfbench.running.surgery",
                   "mcfbench.schemes"})
 """The listings: not followed where they are imported (module docstring); and the mesh
-strategies' hooks (:mod:`mcfbench.running.remeshing`), which the harness's ``run``
-imports for every run but only a ``NAME+STRATEGY`` scheme's runs use: a root of
-those (:func:`scheme_roots`)."""
+strategies' hooks (:mod:`mcfbench.running.remeshing`, :mod:`mcfbench.running.surgery`),
+which the harness's ``run`` imports for every run but only a ``NAME+STRATEGY``
+scheme's runs use: a root of those (:func:`scheme_roots`)."""
 
 PROBLEM_DEFINITIONS = ("mcfbench.running.problem", "mcfbench.running.observers")
 """The modules defining ``Problem`` and the metric observers: roots of every problem."""
@@ -82,7 +84,8 @@ def scheme_roots(scheme):
 
 def scheme_values(scheme):
     """What the registry entry of ``scheme`` sets that changes a run's numbers: its
-    flow, options and integrator, and an installed package's ``source``
+    flow, options, integrator and mesh strategy (when not ``"none"``), and an installed
+    package's ``source``
     (distribution, version, SHA-256 of its files); not its label, style or
     description."""
     from mcfbench.running.schemes import get_scheme

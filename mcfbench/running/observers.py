@@ -23,7 +23,8 @@ class _Final:
 
     def __call__(self, flow):
         self.V, self.t = flow.vertices, flow.n * flow.tau
-        if flow is not self.flow:  # once a flow (DDFV's fixed: a gather); a rebuilt one's
+        if flow is not self.flow:  # read once per flow (DDFV's fixed: a gather); a new
+            # one when the run goes on without a component or through a neck's cut
             self.flow, self.faces, self.fixed = flow, flow.faces, getattr(flow, "fixed", None)
 
     def result(self):
@@ -108,6 +109,34 @@ class _ReferenceVolume(_Sampled):
                 - 1.0}
 
 
+class _BulbVolume(_Sampled):
+    """Past a pinch (``NAME+surgery``), the volume of every closed component at
+    ``reference["bulb_volume_times"]`` against the axisymmetric reference's one bulb
+    (:mod:`mcfbench.geometry.meridian_surgery`): ``bulb_volume_error``, the relative
+    error of largest size over the components and the times (a run that has not cut
+    its neck by then has one component, twice a bulb's volume: an error near 1),
+    NaN when a time was not reached."""
+
+    def __init__(self, problem):
+        super().__init__(problem)
+        self.times = tuple(problem.reference["bulb_volume_times"])
+
+    def measure(self, flow):
+        from mcfbench.geometry.collapse import component_volumes
+        from mcfbench.geometry.measures import vertex_components
+
+        count, labels = vertex_components(flow.faces, len(flow.vertices))
+        return component_volumes(flow.vertices, flow.faces, labels[flow.faces[:, 0]], count)
+
+    def result(self):
+        import numpy as np
+
+        errors = [np.abs(np.asarray(self.samples[t]) / volume - 1.0).max()
+                  if t in self.samples else math.nan
+                  for t, volume in zip(self.times, self.problem.reference["bulb_volume"])]
+        return {"bulb_volume_error": float(max(errors))}
+
+
 class _Height(_Final):
     """Distance of the final surface from the flat disk ``z = 0``."""
 
@@ -173,5 +202,5 @@ class _Still(_Final):
 METRICS = {"sphere_l2": _SphereError, "catenoid": _Catenoid, "height": _Height,
            "shape": _Shape, "still": _Still, "decay": _Decay,
            "reference_volume": _ReferenceVolume, "angenent": _Angenent,
-           "enneper": _Enneper}
+           "enneper": _Enneper, "bulb_volume": _BulbVolume}
 """Metric name -> observer class (called with the problem)."""

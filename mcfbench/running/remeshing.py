@@ -1,9 +1,13 @@
-"""A run's mesh strategies (``NAME+remesh``): the driver's hook that remeshes a flow.
+"""A run's mesh strategies (``NAME+remesh``, ``NAME+surgery``): the driver's hooks.
 
 :func:`mesh_hook` builds, for a scheme whose name carries a strategy of
-:data:`mcfbench.running.scheme.MESH_STRATEGIES`, the callable the driver
-(:func:`mcfbench.running.driver.simulate`, its ``remesh``) calls after every state
-that passed its checks. :class:`Remesher`, the ``remesh`` strategy, remeshes the
+:data:`mcfbench.running.scheme.MESH_STRATEGIES`, its hook (:data:`STRATEGIES`), which
+the driver (:func:`mcfbench.running.driver.simulate`, its ``remesh``) applies to every
+state: ``hook(flow) -> None or (new flow, event)``, asked before the state's checks
+when ``hook.before_checks``, else after them; the new flow's frames keep the previous
+layout where ``hook.kept`` names the points and triangles kept, else carry their own
+faces. :class:`mcfbench.running.surgery.Surgeon`, the ``surgery`` strategy, cuts a
+pinched neck. :class:`Remesher`, the ``remesh`` strategy, remeshes the
 current surface when :class:`mcfbench.geometry.remeshing.RemeshTrigger` says so
 (:func:`mcfbench.geometry.remeshing.remesh`: Botsch and Kobbelt's isotropic
 remeshing, the target edge that keeps the input's vertex count) and rebuilds the
@@ -31,6 +35,7 @@ What the new flow carries over:
 from mcfbench.geometry.remeshing import (
     ANGLE, PASSES, RemeshTrigger, remesh, remesh_change, target_edge)
 from mcfbench.running.scheme import parse_name
+from mcfbench.running.surgery import Surgeon
 
 
 def rebuilt_flow(scheme, flow, vertices, faces, *, threads=1, **options):
@@ -60,6 +65,9 @@ class Remesher:
     scheme : mcfbench.running.schemes.Scheme
     mesh : tuple of ((n, 3) float array, (m, 3) int array)
         The run's input mesh: the target edge length's (:func:`target_edge`).
+    integrator : str, optional
+        The run's integrator: the strategies' common signature (:func:`mesh_hook`);
+        a remesh restarts any (the driver's fresh integrator).
     threads : int
     options : dict
         The run's options of the flow class.
@@ -69,6 +77,10 @@ class Remesher:
 
     Attributes
     ----------
+    before_checks : bool
+        False: the driver asks after a state passed its checks.
+    kept : None
+        A remeshed flow keeps no layout: its frames carry their own faces.
     h : float
         The target edge length.
     calls : int
@@ -76,8 +88,11 @@ class Remesher:
         Wall seconds spent remeshing and measuring the change.
     """
 
-    def __init__(self, scheme, mesh, *, threads=1, options=None, angle=ANGLE, every=None,
-                 passes=PASSES):
+    before_checks = False
+    kept = None
+
+    def __init__(self, scheme, mesh, *, integrator=None, threads=1, options=None,
+                 angle=ANGLE, every=None, passes=PASSES):
         self.scheme, self.threads, self.options = scheme, threads, dict(options or {})
         self.h, self.passes = target_edge(*mesh), passes
         self.trigger = RemeshTrigger(angle, every)
@@ -101,12 +116,12 @@ class Remesher:
                             **self.options), event
 
 
-STRATEGIES = {"remesh": Remesher}
+STRATEGIES = {"remesh": Remesher, "surgery": Surgeon}
 """A mesh strategy (a key of :data:`mcfbench.running.scheme.MESH_STRATEGIES`) -> the
-class of its hook, built as ``cls(scheme, mesh, threads=, options=)``."""
+class of its hook, built as ``cls(scheme, mesh, integrator=, threads=, options=)``."""
 
 
-def mesh_hook(scheme, mesh, *, threads=1, options=None):
+def mesh_hook(scheme, mesh, *, integrator=None, threads=1, options=None):
     """The driver's ``remesh`` hook of ``scheme`` (its name's ``+STRATEGY``), or None for
     a scheme without one.
 
@@ -115,6 +130,8 @@ def mesh_hook(scheme, mesh, *, threads=1, options=None):
     scheme : mcfbench.running.schemes.Scheme
     mesh : tuple of ((n, 3) float array, (m, 3) int array)
         The run's input mesh.
+    integrator : str, optional
+        The run's integrator (default the scheme's).
     threads : int
     options : dict
         The run's options of the flow class.
@@ -122,4 +139,5 @@ def mesh_hook(scheme, mesh, *, threads=1, options=None):
     strategy = getattr(scheme, "mesh_strategy", None) or parse_name(scheme.name).strategy
     if strategy == "none":
         return None
-    return STRATEGIES[strategy](scheme, mesh, threads=threads, options=options)
+    return STRATEGIES[strategy](scheme, mesh, integrator=integrator, threads=threads,
+                                options=options)

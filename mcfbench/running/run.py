@@ -22,7 +22,7 @@ import numpy as np
 from mcfbench.geometry import metrics
 from mcfbench.geometry.exact import eoc
 from mcfbench.geometry.mesh import validate_mesh
-from mcfbench.running.continuation import sub_flow
+from mcfbench.running.continuation import exceeded, sub_flow
 from mcfbench.running.cost import check_size
 from mcfbench.running.driver import simulate
 from mcfbench.running.monitors import Monitor, Steady
@@ -166,7 +166,8 @@ def _result(timed, scheme, problem, level, nF, h, tau, steps, method, integrator
         min_angle=_worst(np.min, q["min_angle"]), max_aspect=_worst(np.max, q["max_aspect"]),
         max_flipped=_worst(np.max, q["flipped"]), metrics=_metric_values(timed, problem),
         series={"t": monitor.t, "t_min_barycentric": monitor.t_monitor, **q},
-        timing_repeats=repeats)
+        timing_repeats=repeats, removed_area_share=traj.removed_area_share,
+        surgery_exceeded=exceeded(traj.removed_area_share))
 
 
 def problem_mesh(problem, level):
@@ -243,7 +244,8 @@ def _timed_run(scheme, problem, mesh, tau, steps, *, solver, integrator, warm_st
                     until=until, progress=progress,
                     rebuild=partial(sub_flow, scheme, integrator=integrator, threads=threads,
                                     **options),
-                    remesh=mesh_hook(scheme, (V, F), threads=threads, options=options))
+                    remesh=mesh_hook(scheme, (V, F), integrator=integrator, threads=threads,
+                                     options=options))
     flow = traj.flow                      # rebuilt when a component vanished
     finished = monitor.finished(flow)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
@@ -338,24 +340,24 @@ def _metric_values(timed, problem):
         values.update({k: v if kept else float("nan") for k, v in observer.result().items()})
     if "pinch_time" in problem.reference:
         values["pinch_time_error"] = pinch_time_error(traj, problem.reference["pinch_time"])
-    if problem.to_extinction and problem.t_max is not None:
-        values["extinction_time_error"] = traj.extinction_time / problem.t_max - 1.0
+    extinction = problem.reference.get("extinction_time", problem.t_max)
+    if problem.to_extinction and extinction is not None:
+        values["extinction_time_error"] = traj.extinction_time / extinction - 1.0
     return values
 
 
 def pinch_time_error(traj, pinch_time):
-    """Relative error of the time a run stopped against the reference
-    ``pinch_time`` of the singularity: ``t_failed / pinch_time - 1`` for a run
-    that broke down (a state defect, or a solver that fails on the collapsing
-    cells: the status says which), ``extinction_time / pinch_time - 1`` for one
-    that ended ``extinct`` (the torus's tube vanishing round onto its core circle:
-    :attr:`mcfbench.running.driver.Trajectory.extinction_time`, which does not move
-    with the step at which the check stops the run), NaN for a run that finished
-    (it went through the pinch without noticing it)."""
+    """Relative error ``t / pinch_time - 1`` of the time ``t`` a run stopped against the
+    reference ``pinch_time``: the first cut's ``pinch_time`` for a run that cut a neck,
+    else the ``extinction_time`` of one that ended ``extinct`` (the torus's tube round
+    onto its core circle; :attr:`mcfbench.running.driver.Trajectory.extinction_time`,
+    not moved by the step at which the check stops the run), else ``t_failed`` (a state
+    defect or a solver failing: the status says which); NaN for a run that finished."""
+    if traj.surgeries:
+        return traj.surgeries[0]["pinch_time"] / pinch_time - 1.0
     if traj.ok:
         return float("nan")
-    return (traj.extinction_time if traj.status == "extinct" else traj.t_failed) \
-        / pinch_time - 1.0
+    return (traj.extinction_time if traj.status == "extinct" else traj.t_failed) / pinch_time - 1
 
 
 def _worst(reduce, values):
@@ -511,12 +513,13 @@ class _Unsupported(Exception):
 
 
 class _Guarded:
-    """A scheme whose constructor's ValueError becomes :class:`_Unsupported`."""
+    """A scheme (its fields) whose constructor's ValueError becomes :class:`_Unsupported`."""
 
     def __init__(self, scheme):
         self.scheme = scheme
-        self.name, self.family, self.label = scheme.name, scheme.family, scheme.label
-        self.extra_points, self.integrator = scheme.extra_points, scheme.integrator
+
+    def __getattr__(self, name):                # called for the fields alone
+        return getattr(self.__dict__["scheme"], name)
 
     def make(self, vertices, faces, tau, **options):
         try:

@@ -41,10 +41,11 @@ moves its vertices along the surface, the grouping of the findings' comparison
 (:mod:`mcfbench.studies.matrix.tangential`). DDFV's are the values of its
 ``tangential`` option (:data:`ddfv.variants.VARIANTS`)."""
 
-
 MESH_STRATEGIES = {
     "remesh": "isotropic remeshing when the mesh's quality fails (Botsch, Kobbelt 2004; "
               "mcfbench.running.remeshing)",
+    "surgery": "a neck pinched below half an edge is cut and both sides capped, the run "
+               "going on (mcfbench.running.surgery)",
 }
 """Suffixes of a scheme name ``NAME[@INTEGRATOR][+STRATEGY]`` -> description: what a run
 does to its mesh besides stepping it (:attr:`Scheme.mesh_strategy`, :func:`parse_name`;
@@ -138,7 +139,8 @@ class Scheme:
     mesh_strategy : str
         What its runs do to the mesh besides stepping it: ``"none"`` for every
         registry entry, a key of :data:`MESH_STRATEGIES` for a name
-        ``<name>+<strategy>``.
+        ``<name>+<strategy>``: ``"remesh"`` or ``"surgery"`` (a neck pinch cut and
+        capped, the run going on: :mod:`mcfbench.running.surgery`).
     module : str
         The module that declared it (set by the registry's discovery,
         :mod:`mcfbench.running.discovery`).

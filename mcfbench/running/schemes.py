@@ -16,9 +16,10 @@ asked otherwise; ``<name>@<integrator>`` (e.g. ``cotan@bdf2``) names the
 scheme ``<name>`` stepped by another integrator of
 :data:`mcfbench.running.integrators.INTEGRATORS` (:func:`get_scheme`), so
 that a study lists it like any scheme (the matrix, the beyond study);
-``<name>+<strategy>`` (``cotan+remesh``, ``cotan@bdf2+remesh``: the integrator
-first) the scheme whose runs also treat the mesh by a strategy of
-:data:`~mcfbench.running.scheme.MESH_STRATEGIES` (:func:`~mcfbench.running.scheme.parse_name`).
+``<name>+<strategy>`` (``cotan+remesh``, ``cotan@bdf2+remesh``, ``cotan+surgery``:
+the integrator first) the scheme whose runs also treat the mesh by a strategy of
+:data:`~mcfbench.running.scheme.MESH_STRATEGIES` (:func:`~mcfbench.running.scheme.parse_name`;
+``+surgery`` goes on through a neck pinch, :mod:`mcfbench.running.surgery`).
 """
 
 from dataclasses import replace
@@ -60,7 +61,7 @@ def get_scheme(name, registry=None):
     """The registry entry ``name``, or ``<name>@<integrator>``: that entry stepped by
     another integrator (its label says which; hollow markers), or with ``+<strategy>``:
     its runs treat the mesh by that strategy too (its label says which; dashed
-    lines).
+    lines): ``+remesh`` remeshes, ``+surgery`` goes on through a neck pinch.
 
     Parameters
     ----------

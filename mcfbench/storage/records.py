@@ -84,6 +84,14 @@ class RunResult:
         :data:`mcfbench.running.run.SHORT_RUN` CPU seconds), as :mod:`timeit`
         does. Optional in a record (:data:`DEFAULTS`): records written before
         it existed read as 1.
+    removed_area_share : float
+        The area a ``NAME+surgery`` run's neck cuts removed over its initial area
+        (0 without one; :mod:`mcfbench.running.continuation`).
+    surgery_exceeded : bool
+        Its cuts removed more than
+        :data:`mcfbench.running.continuation.MAX_REMOVED_SHARE` of the area: the run
+        does not count as reaching its end, whatever its status. Both optional in a
+        record (:data:`DEFAULTS`): 0 and False before they existed.
     """
 
     scheme: str
@@ -113,6 +121,8 @@ class RunResult:
     metrics: dict = field(default_factory=dict)
     series: dict = field(default_factory=dict, repr=False)
     timing_repeats: int = 1
+    removed_area_share: float = 0.0
+    surgery_exceeded: bool = False
 
     def to_dict(self, series=True):
         """Fields as a flat dict: the metrics as top-level keys; ``series=False``

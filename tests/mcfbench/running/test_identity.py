@@ -87,6 +87,25 @@ def test_a_scheme_s_identity_is_its_own_modules_and_the_shared_ones():
     assert _modules("bgn@bdf2") == _modules("bgn")
 
 
+def test_a_surgery_scheme_s_identity_has_the_surgery_modules_and_its_name(fresh,
+                                                                           monkeypatch):
+    """NAME+surgery: the neck's cut and the continuation are in its identity (as roots
+    of their own, whether or not the harness reaches them), and its scheme values say
+    so; cut out of the harness's closure, they stay in the surgery run's alone."""
+    for scheme in ("cotan+surgery", "ddfv-chord-carried+surgery", "bgn+surgery"):
+        modules = _modules(scheme, "dumbbell")
+        assert {"mcfbench/geometry/mesh_surgery.py", "mcfbench/running/continuation.py"} \
+            <= modules
+        assert run_identity(scheme, "dumbbell")["scheme"]["mesh_strategy"] == "surgery"
+    assert "mesh_strategy" not in run_identity("cotan", "dumbbell")["scheme"]
+    assert identity_digest(run_identity("cotan+surgery", "dumbbell")) != \
+        identity_digest(run_identity("cotan", "dumbbell"))
+    identity.forget_identities()
+    monkeypatch.setattr(identity, "HARNESS", ())
+    assert "mcfbench/geometry/mesh_surgery.py" in _modules("cotan+surgery", "dumbbell")
+    assert "mcfbench/geometry/mesh_surgery.py" not in _modules("cotan", "dumbbell")
+
+
 def test_the_registries_are_not_followed_from_the_harness():
     """From the harness's roots no scheme is reached through the scheme registry,
     which the harness imports (without the stop rule it would be in every run's

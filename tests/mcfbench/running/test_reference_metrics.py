@@ -57,13 +57,19 @@ def test_volume_before_the_pinch_survives_a_later_breakdown():
 
 
 def test_pinch_time_error_only_for_runs_that_stopped():
-    stopped = SimpleNamespace(ok=False, status="inverted", t_failed=0.11)
+    stopped = SimpleNamespace(ok=False, status="inverted", t_failed=0.11, surgeries=[])
     assert pinch_time_error(stopped, 0.1) == pytest.approx(0.1)
-    assert math.isnan(pinch_time_error(SimpleNamespace(ok=True, t_failed=math.nan), 0.1))
+    assert math.isnan(pinch_time_error(SimpleNamespace(ok=True, t_failed=math.nan,
+                                                       surgeries=[]), 0.1))
     # a tube that vanished round: its extinction time, not the step the run stopped at
     extinct = SimpleNamespace(ok=False, status="extinct", t_failed=0.11,
-                              extinction_time=0.115)
+                              extinction_time=0.115, surgeries=[])
     assert pinch_time_error(extinct, 0.1) == pytest.approx(0.15)
+    # a run that cut its neck (NAME+surgery): the first cut's pinch time, whatever its end
+    cut = [{"pinch_time": 0.105}, {"pinch_time": 0.2}]
+    for end in (extinct, SimpleNamespace(ok=True, t_failed=math.nan)):
+        end.surgeries = cut
+        assert pinch_time_error(end, 0.1) == pytest.approx(0.05)
 
 
 def test_registry_references_agree_with_the_meridian_solver():

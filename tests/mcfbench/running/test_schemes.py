@@ -7,7 +7,7 @@ from mcfbench.geometry.spheres import icosphere, random_bumpy_sphere
 from mcfbench.running.driver import simulate
 from mcfbench.running.flow import SchemeFlow
 from mcfbench.running.integrators import Euler
-from mcfbench.running.schemes import SCHEMES, get_scheme
+from mcfbench.running.schemes import SCHEMES, Scheme, get_scheme, parse_name
 from mcfbench.running.solver import ROBUST
 
 
@@ -142,3 +142,27 @@ def test_scheme_names_split_and_join_back(name, parts):
     assert split_name(name) == parts
     assert joined_name(*parts) == name
     assert get_scheme(name).integrator == parts[1]
+
+
+@pytest.mark.parametrize("name, parts", [("cotan", ("cotan", "euler", "none")),
+                                         ("cotan+surgery", ("cotan", "euler", "surgery")),
+                                         ("bgn@bdf2+surgery", ("bgn", "bdf2", "surgery"))])
+def test_the_surgery_is_a_mesh_strategy_parsed_off_the_name(name, parts):
+    """NAME+surgery is parsed as NAME+remesh is (one parser, parse_name)."""
+    assert parse_name(name) == parts
+    with pytest.raises(ValueError, match="unknown mesh strategy 'sideways'"):
+        parse_name("cotan+sideways")
+
+
+def test_name_plus_surgery_is_the_entry_with_the_surgery():
+    entry, cut = get_scheme("ddfv-chord-carried"), get_scheme("ddfv-chord-carried+surgery")
+    assert cut.mesh_strategy == "surgery" and entry.mesh_strategy == "none"
+    assert (cut.flow, cut.options, cut.integrator, cut.tangential) == \
+        (entry.flow, entry.options, entry.integrator, entry.tangential)
+    assert cut.name == "ddfv-chord-carried+surgery" and cut.label.endswith(", surgery")
+    both = get_scheme("bgn@bdf2+surgery")
+    assert (both.integrator, both.mesh_strategy) == ("bdf2", "surgery")
+    with pytest.raises(ValueError, match="scheme 'cotan\\+sideways': unknown mesh strategy"):
+        get_scheme("cotan+sideways")
+    with pytest.raises(ValueError, match="'\\+' a mesh strategy"):
+        Scheme("x", "x", "baselines.cotan:CotanFlow", mesh_strategy="glue")
