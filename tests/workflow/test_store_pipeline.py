@@ -3,11 +3,11 @@ is computed once, which batch a run falls in does not decide whether it is recom
 and an edit reruns exactly the runs whose code it changed.
 
 Each test runs Snakemake for real in a temporary copy of the workflow, on the sphere
-at levels 1-2. The two edit tests copy the packages too (``PYTHONPATH`` puts the copy
-first) and give the copy a per-scheme run identity (:data:`PER_SCHEME_IDENTITY`: the
-scheme's flow module and the harness's ``running`` layer), the interface of
-``mcfbench.running.identity`` that the import-closure identity implements; the interim
-identity of this tree hashes whole packages, ``studies`` included.
+at levels 1-2. The edit tests copy the packages too (``PYTHONPATH`` puts the copy
+first): a run's code identity is the import closure of its scheme, its problem and the
+harness's stepping code (``mcfbench.running.identity``), so an edit of the findings
+reruns no run, one of ``baselines/bgn.py`` bgn's alone among cotan, bgn and DDFV, one
+of ``ddfv/`` DDFV's alone.
 """
 
 import json
@@ -25,30 +25,6 @@ REPO = Path(__file__).resolve().parents[2]
 IGNORE = shutil.ignore_patterns(".snakemake", "__pycache__", "*.pyc")
 SPHERE = "problems: {sphere: [1, 2]}"
 THREE = f"matrix={{select: {{schemes: [cotan, bgn, ddfv-chord-carried], {SPHERE}}}}}"
-
-PER_SCHEME_IDENTITY = '''"""A run's code identity, per scheme (the tests' stand-in of the import closure)."""
-
-import hashlib
-from pathlib import Path
-
-from mcfbench.storage.provenance import config_hash
-
-
-def run_identity(scheme, problem):
-    from mcfbench.running.schemes import get_scheme
-
-    module = get_scheme(scheme).flow.partition(":")[0]
-    root = Path(__file__).resolve().parents[2]
-    files = [root / (module.replace(".", "/") + ".py"),
-             *sorted((root / "mcfbench" / "running").glob("*.py"))]
-    return {"files": {f.relative_to(root).as_posix():
-                      hashlib.sha256(f.read_bytes()).hexdigest()[:16] for f in files}}
-
-
-def identity_digest(identity):
-    return config_hash(identity)
-'''
-
 
 def records(work):
     """``{record path: (mtime, text)}`` of every record of the work's run store."""
@@ -103,12 +79,11 @@ def test_a_cut_down_matrix_then_the_full_one_leaves_its_records_alone(tmp_path, 
 
 @pytest.fixture(scope="module")
 def edited(tmp_path_factory, env):
-    """A copy of the repository (workflow and packages) with the per-scheme identity,
-    after the three-scheme matrix; its environment."""
+    """A copy of the repository (workflow and packages) after the three-scheme matrix;
+    its environment."""
     work = copy_workflow(tmp_path_factory.mktemp("edits") / "work")
     for name in ("ddfv", "baselines", "kept_factor", "mcfbench"):
         shutil.copytree(REPO / name, work / name, ignore=IGNORE)
-    (work / "mcfbench" / "running" / "identity.py").write_text(PER_SCHEME_IDENTITY)
     env = {**env, "PYTHONPATH": os.pathsep.join([str(work), env["PYTHONPATH"]])}
     code, out = snakemake(work, env, "--cores", "2", "matrix", "--config", THREE)
     assert code == 0, out[-3000:]
@@ -137,3 +112,15 @@ def test_editing_bgn_rewrites_only_bgns_records(edited):
     changed = sorted(p for p in before if after[p] != before[p])
     assert schemes_of(work, changed) == ["bgn"] and len(changed) == 2
     assert after.keys() == before.keys()
+
+
+def test_editing_ddfv_rewrites_only_ddfv_records(edited):
+    work, env = edited
+    before = records(work)
+    with open(work / "ddfv" / "flow.py", "a") as source:
+        source.write("\n# a change of the paper's scheme\n")
+    code, out = snakemake(work, env, "--cores", "2", "matrix", "--config", THREE)
+    assert code == 0, out[-3000:]
+    after = records(work)
+    changed = sorted(p for p in before if after[p] != before[p])
+    assert schemes_of(work, changed) == ["ddfv-chord-carried"] and len(changed) == 2

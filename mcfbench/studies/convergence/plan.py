@@ -12,6 +12,10 @@ from mcfbench.studies.config import (
     checked_steps,
 )
 
+SECTION = None
+"""Table 3.1's keys are the config's top level: no section named ``convergence``
+(:func:`mcfbench.pipeline.section_studies`)."""
+
 PROBLEM = "sphere"
 """The problem of Table 3.1 and of the beyond study."""
 

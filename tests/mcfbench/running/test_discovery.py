@@ -209,13 +209,14 @@ def test_a_scheme_of_an_installed_package_runs_without_an_edit_here(tmp_path):
     """pip installs ``outside_package`` (its own pyproject.toml, a flow class of its own,
     an entry point in ``mcfbench.schemes``) into a folder on PYTHONPATH: its scheme is
     listed, runs on a committed mesh as the exact sphere's flow does, and the matrix
-    plans it; a second package declaring ``cotan`` stops the registry, naming both."""
+    plans and runs it (Snakemake, no file of this repository edited); a second package declaring ``cotan`` stops the registry, naming both."""
     source, site = tmp_path / "pkg", tmp_path / "site"
     shutil.copytree(OUTSIDE, source)
     _pip_install(source, site)
     assert (site / "mcf_plugin-0.3.1.dist-info" / "entry_points.txt").is_file()
 
-    listed = _python(["-m", "mcfbench", "schemes"], site, tmp_path).stdout.splitlines()
+    listed = _python(["-m", "mcfbench", "schemes"], site, tmp_path).stdout.split("\n\n")[0]
+    listed = listed.splitlines()            # the registry's lines, before the suffixes' note
     assert listed[-1].split()[0] == "cotan-consistent" and listed[-1].endswith(
         "[mcf-plugin 0.3.1]")
     assert [line.split()[0] for line in listed[:-1]] == list(SCHEMES)
@@ -234,6 +235,22 @@ def test_a_scheme_of_an_installed_package_runs_without_an_edit_here(tmp_path):
                        "'problems': {'sphere': [1]}}}); "
                        "print(json.dumps([p['schemes'], p['problems']]))"], site, tmp_path)
     assert json.loads(planned.stdout) == [["cotan-consistent", "cotan"], {"sphere": [1]}]
+
+    # and the matrix runs it: Snakemake in a copy of the workflow, the package on PYTHONPATH
+    work = tmp_path / "work"
+    work.mkdir()
+    shutil.copy2(ROOT / "Snakefile", work / "Snakefile")
+    for name in ("workflow", "config"):
+        shutil.copytree(ROOT / name, work / name,
+                        ignore=shutil.ignore_patterns(".snakemake", "__pycache__"))
+    _python(["-m", "snakemake", "--cores", "2", "matrix", "--config",
+             "matrix={select: {schemes: [cotan-consistent, cotan], problems: {sphere: [1]}}}"],
+            site, work)
+    import pandas as pd
+
+    summary = pd.read_csv(work / "results" / "matrix" / "tables" / "summary.csv")
+    row = summary[summary["scheme"] == "cotan-consistent"].iloc[0]
+    assert row["status"] == "ok" and row["runs_ok"] == 1
 
     rival = tmp_path / "rival"
     shutil.copytree(OUTSIDE, rival)
