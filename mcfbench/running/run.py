@@ -25,6 +25,7 @@ from mcfbench.geometry.mesh import validate_mesh
 from mcfbench.running.continuation import sub_flow
 from mcfbench.running.cost import check_size
 from mcfbench.running.driver import simulate
+from mcfbench.running.locality import locality_order, stepped
 from mcfbench.running.monitors import Monitor, Steady
 from mcfbench.running.problems import get_problem
 from mcfbench.running.schemes import get_scheme
@@ -87,6 +88,10 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
     **options
         Options of the scheme's flow class (override the registry's).
 
+    A mesh of :data:`mcfbench.running.locality.MIN_VERTICES` vertices or more is
+    stepped renumbered for locality and given back in its own numbering
+    (:func:`mcfbench.running.locality.locality_order`).
+
     Returns
     -------
     result : RunResult
@@ -125,13 +130,14 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
              "on_defect": on_defect, "threads": threads, "samples": samples,
              "options": options}
     warm_up(scheme, problem, F, progress=progress, **setup)
+    order = locality_order(V, F)
     timed = _timed_run(scheme, problem, (V, F), tau, steps, save_every=save_every,
-                       progress=progress, observers=observers, **setup)
+                       progress=progress, observers=observers, order=order, **setup)
     traj = timed.trajectory
     cpu, wall, repeats, spent = timed.cpu, timed.wall, 1, timed.cpu
     while cpu < SHORT_RUN and repeats < MAX_REPEATS and spent < REPEAT_BUDGET:
         again = _timed_run(scheme, problem, (V, F), tau, steps, save_every=save_every,
-                           progress=False, observers=(), **setup)
+                           progress=False, observers=(), order=order, **setup)
         cpu, wall = min(cpu, again.cpu), min(wall, again.wall)
         repeats, spent = repeats + 1, spent + again.cpu
     h = metrics.mean_edge_length(V, F)
@@ -224,13 +230,19 @@ class _Timed:
 
 
 def _timed_run(scheme, problem, mesh, tau, steps, *, solver, integrator, warm_start,
-               on_defect, threads, samples, options, save_every, progress, observers):
+               on_defect, threads, samples, options, save_every, progress, observers,
+               order=None):
     """The part of a run whose CPU and wall times are recorded: the flow's
     construction (T-vertex initialisation included), the stepping with the driver's
     checks, the monitor and the problem's metric observers at every time level, and
     the last quality sample. Not timed: the mesh's construction and validation, the
-    warm-up (:func:`warm_up`), the metrics' final values."""
-    V, F = mesh
+    warm-up (:func:`warm_up`), the metrics' final values, and the renumbering for
+    locality (``order``, :mod:`mcfbench.running.locality`: the flow is built and
+    stepped on the renumbered mesh, the trajectory given back in the input's)."""
+    V, F = mesh if order is None else order.mesh(*mesh)
+    if order is not None:
+        options = order.options(options)
+        observers = [order.observer(observer) for observer in observers]
     monitor = Monitor(max(1, steps // max(1, samples)))
     metric_observers = problem.observers()
     until = Steady(problem.steady_speed) if problem.steady_speed else None
@@ -245,6 +257,7 @@ def _timed_run(scheme, problem, mesh, tau, steps, *, solver, integrator, warm_st
     flow = traj.flow                      # rebuilt when a component vanished
     finished = monitor.finished(flow)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
+    traj = traj if order is None else order.trajectory(traj)
     return _Timed(flow, traj, finished, monitor, metric_observers, until, cpu, wall)
 
 
@@ -254,9 +267,9 @@ def _continued(timed, solver, progress):
     its monitor and observers going on; timed alone."""
     cpu, wall = time.process_time(), time.perf_counter()
     traj = timed.trajectory.continue_with(solver, progress=progress)
-    finished = timed.running.finished(traj.flow)
+    finished = timed.running.finished(stepped(traj.flow))
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
-    return replace(timed, flow=traj.flow, trajectory=traj, monitor=finished, cpu=cpu,
+    return replace(timed, flow=stepped(traj.flow), trajectory=traj, monitor=finished, cpu=cpu,
                    wall=wall)
 
 
