@@ -18,11 +18,12 @@ numbering:
   vertices and weights are computed by each flow from its mesh);
 - observers given by the run's caller get a view of the flow in the input's order
   (:class:`InputOrder`); the problems' metric observers
-  (:mod:`mcfbench.running.observers`, :class:`mcfbench.running.real_mesh_problems.RealMeshShape`)
-  see the renumbered flow: each is a sum, an extremum or a surface measure over
-  all the points (area, volume, the sphere's error (3.2), heights, the catenoid's
-  profile with its own ``fixed``, a displacement from the same flow's initial
-  state), the same in any numbering up to the order of the floating-point sums;
+  (:mod:`mcfbench.running.observers`,
+  :class:`mcfbench.running.real_mesh_problems.RealMeshShape`) see the renumbered
+  flow: each is a sum, an extremum or a surface measure over all the points
+  (area, volume, the sphere's error (3.2), heights, the catenoid's profile with
+  its own ``fixed``, a displacement from the same flow's initial state), the same
+  in any numbering up to the order of the floating-point sums;
 - the sentences of defects and events naming ``vertex <i>`` or ``triangle <j>``
   (the driver's checks, the schemes' own) renamed into the input's numbering
   (:meth:`LocalityOrder.sentence`); the components keep their numbers, the
@@ -120,6 +121,12 @@ class LocalityOrder:
         F = self.vertex_rank[np.asarray(faces)[self.faces]]
         return np.ascontiguousarray(np.asarray(vertices)[self.vertices]), F
 
+    def intake(self, mesh, options, observers):
+        """What a run builds its flow with, renumbered: the mesh (:meth:`mesh`), the
+        flow's options (:meth:`options`), the caller's observers (:meth:`observer`)."""
+        return (self.mesh(*mesh), self.options(options),
+                [self.observer(observer) for observer in observers])
+
     def options(self, options):
         """A flow's options renumbered: ``T0`` (one point per input triangle)."""
         if options.get("T0") is None:
@@ -127,8 +134,8 @@ class LocalityOrder:
         return {**options, "T0": np.asarray(options["T0"])[self.faces]}
 
     def frame(self, frame):
-        """A frame of the renumbered flow (:meth:`SchemeFlow.frame`) in the input's order: ``"vertices"`` by vertex, ``"extra_points"`` by
-        triangle."""
+        """A frame of the renumbered flow (:meth:`SchemeFlow.frame`) in the input's
+        order: ``"vertices"`` by vertex, ``"extra_points"`` by triangle."""
         return self._undone(frame, 0)
 
     def _undone(self, frame, axis):

@@ -88,9 +88,8 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
     **options
         Options of the scheme's flow class (override the registry's).
 
-    A mesh of :data:`mcfbench.running.locality.MIN_VERTICES` vertices or more is
-    stepped renumbered for locality and given back in its own numbering
-    (:func:`mcfbench.running.locality.locality_order`).
+    A large mesh is stepped renumbered for locality, everything given back in its
+    numbering (:func:`mcfbench.running.locality.locality_order`).
 
     Returns
     -------
@@ -230,19 +229,14 @@ class _Timed:
 
 
 def _timed_run(scheme, problem, mesh, tau, steps, *, solver, integrator, warm_start,
-               on_defect, threads, samples, options, save_every, progress, observers,
-               order=None):
+               on_defect, threads, samples, options, save_every, progress, observers, order=None):
     """The part of a run whose CPU and wall times are recorded: the flow's
     construction (T-vertex initialisation included), the stepping with the driver's
     checks, the monitor and the problem's metric observers at every time level, and
     the last quality sample. Not timed: the mesh's construction and validation, the
-    warm-up (:func:`warm_up`), the metrics' final values, and the renumbering for
-    locality (``order``, :mod:`mcfbench.running.locality`: the flow is built and
-    stepped on the renumbered mesh, the trajectory given back in the input's)."""
-    V, F = mesh if order is None else order.mesh(*mesh)
-    if order is not None:
-        options = order.options(options)
-        observers = [order.observer(observer) for observer in observers]
+    warm-up (:func:`warm_up`), the metrics' final values, ``order``'s renumbering and undoing."""
+    (V, F), options, observers = (mesh, options, observers) if order is None else \
+        order.intake(mesh, options, observers)
     monitor = Monitor(max(1, steps // max(1, samples)))
     metric_observers = problem.observers()
     until = Steady(problem.steady_speed) if problem.steady_speed else None
@@ -267,10 +261,10 @@ def _continued(timed, solver, progress):
     its monitor and observers going on; timed alone."""
     cpu, wall = time.process_time(), time.perf_counter()
     traj = timed.trajectory.continue_with(solver, progress=progress)
-    finished = timed.running.finished(stepped(traj.flow))
+    flow = stepped(traj.flow)               # not the view in the input's order
+    finished = timed.running.finished(flow)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
-    return replace(timed, flow=stepped(traj.flow), trajectory=traj, monitor=finished, cpu=cpu,
-                   wall=wall)
+    return replace(timed, flow=flow, trajectory=traj, monitor=finished, cpu=cpu, wall=wall)
 
 
 WARM_UP_STEPS = 3
