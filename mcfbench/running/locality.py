@@ -6,8 +6,9 @@ old ones) numbers neighbours far apart, so that every sparse product, assembly p
 and solver iteration of a large mesh jumps through memory. :func:`locality_order`
 renumbers the vertices by reverse Cuthill-McKee on their adjacency
 (:func:`scipy.sparse.csgraph.reverse_cuthill_mckee`; Cuthill and McKee 1969, George
-1971), and sorts the triangles by their smallest new vertex number (each triangle's
-vertices keep their cyclic order: its orientation). The flow is built and stepped
+1971) and sorts the triangles by their new vertex numbers, smallest first: DDFV's own
+order of its unknowns (:func:`ddfv.topology.locality_order`), the components then
+kept whole. Each triangle's vertices keep their cyclic order (its orientation). The flow is built and stepped
 on the renumbered mesh; :class:`LocalityOrder` gives back everything in the input's
 numbering:
 
@@ -40,7 +41,6 @@ import re
 from dataclasses import replace
 
 import numpy as np
-import scipy.sparse as sp
 
 from mcfbench.geometry.measures import vertex_components
 
@@ -70,16 +70,13 @@ def locality_order(vertices, faces, *, min_vertices=None):
     n = len(vertices)
     if n < (MIN_VERTICES if min_vertices is None else min_vertices):
         return None
-    from scipy.sparse.csgraph import reverse_cuthill_mckee
+    from ddfv.topology import locality_order as reverse_cuthill_mckee_order
 
-    rows = F[:, [0, 1, 2, 1, 2, 0]].ravel()
-    cols = F[:, [1, 2, 0, 0, 1, 2]].ravel()
-    adjacency = sp.csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
-    order = reverse_cuthill_mckee(adjacency, symmetric_mode=True).astype(np.int64)
+    order = reverse_cuthill_mckee_order(F, n)[0]
     labels = vertex_components(F, n)[1]
     order = order[np.argsort(labels[order], kind="stable")]   # components kept whole
-    renamed = _inverse(order)[F]
-    face_order = np.argsort(renamed.min(axis=1), kind="stable")
+    corners = np.sort(_inverse(order)[F], axis=1)
+    face_order = np.lexsort((corners[:, 2], corners[:, 1], corners[:, 0]))
     return LocalityOrder(order, face_order, np.array(F, copy=True))
 
 
