@@ -8,9 +8,9 @@ renumbers the vertices by reverse Cuthill-McKee on their adjacency
 (:func:`scipy.sparse.csgraph.reverse_cuthill_mckee`; Cuthill and McKee 1969, George
 1971) and sorts the triangles by their new vertex numbers, smallest first: DDFV's own
 order of its unknowns (:func:`ddfv.topology.locality_order`), the components then
-kept whole. Each triangle's vertices keep their cyclic order (its orientation). The flow is built and stepped
-on the renumbered mesh; :class:`LocalityOrder` gives back everything in the input's
-numbering:
+kept whole. Each triangle's vertices keep their cyclic order (its orientation).
+The flow is built and stepped on the renumbered mesh (:func:`intake`, a
+:class:`RenumberedRun`), which gives back everything in the input's numbering:
 
 - the frames: mesh vertices in the input's vertex order, DDFV's T-vertices (one per
   triangle) in the input's face order; the trajectory's faces are the input's;
@@ -26,11 +26,16 @@ numbering:
   its own ``fixed``, a displacement from the same flow's initial state), the same
   in any numbering up to the order of the floating-point sums;
 - the sentences of defects and events naming ``vertex <i>`` or ``triangle <j>``
-  (the driver's checks, the schemes' own) renamed into the input's numbering
-  (:meth:`LocalityOrder.sentence`); the components keep their numbers, the
-  new order keeping each component's vertices together, the components in the
-  input's order (:func:`scipy.sparse.csgraph.connected_components` numbers them
-  by their first vertex).
+  (the driver's checks, the schemes' own, a scheme's refusal of the mesh) renamed
+  into the input's numbering (:meth:`LocalityOrder.sentence`); the components keep
+  their numbers, the new order keeping each component's vertices together, the
+  components in the input's order (:func:`scipy.sparse.csgraph.connected_components`
+  numbers them by their first vertex), but the vertex named as a component's
+  example is its first in the new order;
+- a flow rebuilt on the components that remain of a run
+  (:mod:`mcfbench.running.continuation`) is seen by the caller's observers and
+  returned as the flow rebuilt on the input's numbering would be (the kept
+  vertices and triangles in their input order).
 
 Below :data:`MIN_VERTICES` a mesh is left in its order: its vectors fit in the
 cache, and the renumbering only moves the floating-point sums
@@ -118,30 +123,22 @@ class LocalityOrder:
         F = self.vertex_rank[np.asarray(faces)[self.faces]]
         return np.ascontiguousarray(np.asarray(vertices)[self.vertices]), F
 
-    def intake(self, mesh, options, observers):
-        """What a run builds its flow with, renumbered: the mesh (:meth:`mesh`), the
-        flow's options (:meth:`options`), the caller's observers (:meth:`observer`)."""
-        return (self.mesh(*mesh), self.options(options),
-                [self.observer(observer) for observer in observers])
-
     def options(self, options):
         """A flow's options renumbered: ``T0`` (one point per input triangle)."""
         if options.get("T0") is None:
             return options
         return {**options, "T0": np.asarray(options["T0"])[self.faces]}
 
-    def frame(self, frame):
-        """A frame of the renumbered flow (:meth:`SchemeFlow.frame`) in the input's
-        order: ``"vertices"`` by vertex, ``"extra_points"`` by triangle."""
-        return self._undone(frame, 0)
-
-    def _undone(self, frame, axis):
+    def frames(self, frames):
+        """Frames of the renumbered mesh stacked on a first axis (the driver's, in the
+        initial mesh's layout) in the input's order: ``"vertices"`` by vertex,
+        ``"extra_points"`` by triangle."""
         keys = {"vertices": self.vertex_rank, "extra_points": self.face_rank}
-        unknown = set(frame) - set(keys)
+        unknown = set(frames) - set(keys)
         if unknown:
             raise ValueError(f"frame arrays {sorted(unknown)} have no known numbering "
                              "(mcfbench.running.locality)")
-        return {key: np.take(value, keys[key], axis=axis) for key, value in frame.items()}
+        return {key: value[:, keys[key]] for key, value in frames.items()}
 
     def sentence(self, text):
         """``text`` with every ``vertex <i>`` and ``triangle <j>`` of the renumbered
@@ -155,26 +152,100 @@ class LocalityOrder:
 
         return _NAMED.sub(named, text) if isinstance(text, str) else text
 
-    def observer(self, observer):
-        """``observer`` called with the flow in the input's order (:class:`InputOrder`)."""
+
+
+class RenumberedRun:
+    """One execution of a run on the renumbered mesh: what it builds its flow with,
+    and the way back to the input's numbering.
+
+    Parameters
+    ----------
+    order : LocalityOrder
+    scheme : registry entry
+        Its ``make`` builds the flow.
+    mesh : (vertices, faces)
+        The input's.
+    options : dict
+        The flow's options (the input's numbering).
+    observers : sequence of callables
+        The caller's: called with the flow in the input's order (:class:`InputOrder`).
+
+    Attributes
+    ----------
+    mesh : (vertices, faces)
+        Renumbered (:meth:`LocalityOrder.mesh`).
+    options : dict
+        Renumbered (:meth:`LocalityOrder.options`).
+    observers : list of callables
+    kept, kept_faces : int arrays
+        The renumbered mesh's vertices and triangles in the current flow (all of them
+        until a component vanishes and the flow is rebuilt on the rest, :meth:`rebuild`).
+    """
+
+    def __init__(self, order, scheme, mesh, options, observers):
+        self.order, self.scheme = order, scheme
+        self.mesh, self.options = order.mesh(*mesh), order.options(options)
+        self.observers = [self._observer(observer) for observer in observers]
+        self._kept(np.arange(len(order.vertices)), np.arange(len(order.faces)))
+
+    def _kept(self, kept, kept_faces):
+        """The current flow's points and the permutations to the input's order: the
+        kept input vertices and triangles in their own order (as a run on the input's
+        numbering keeps them, :func:`mcfbench.running.continuation.sub_mesh`)."""
+        order = self.order
+        self.kept, self.kept_faces = kept, kept_faces
+        vertex_ids, face_ids = order.vertices[kept], order.faces[kept_faces]
+        self.vertex_take, self.face_take = np.argsort(vertex_ids), np.argsort(face_ids)
+        self.faces = np.searchsorted(vertex_ids[self.vertex_take],
+                                     order.input_faces[face_ids[self.face_take]])
+
+    def make(self, *args, **kwargs):
+        """The scheme's ``make``, its refusal naming vertices and triangles in the
+        input's numbering (:meth:`LocalityOrder.sentence`; the same exception class)."""
+        try:
+            return self.scheme.make(*args, **kwargs)
+        except Exception as err:
+            renamed = self.order.sentence(str(err))
+            if renamed == str(err):
+                raise
+            try:
+                again = type(err)(renamed)
+            except TypeError:           # an exception class of other arguments
+                raise err from None
+            raise again from None
+
+    def rebuild(self, rebuild):
+        """The driver's ``rebuild`` (:func:`mcfbench.running.continuation.sub_flow`),
+        following which points the flow keeps."""
+        def rebuilt(flow, keep):
+            new = rebuild(flow, keep)
+            self._kept(self.kept[keep], self.kept_faces[keep[np.asarray(flow.faces)]
+                                                         .all(axis=1)])
+            return new
+
+        return rebuilt
+
+    def _observer(self, observer):
         return lambda flow: observer(InputOrder(flow, self))
 
     def trajectory(self, traj):
         """The :class:`~mcfbench.running.driver.Trajectory` of the renumbered flow in
-        the input's numbering: frames, faces, defects' and events' sentences, its
-        message, its flow (:class:`InputOrder`), and its continuation's."""
-        if traj.frames["vertices"].shape[1] != len(self.vertices) \
-                or len(traj.faces) != len(self.faces):
+        the input's numbering: frames (the initial mesh's layout), faces, defects' and
+        events' sentences, its message, its flow (:class:`InputOrder`), and its
+        continuation's."""
+        order = self.order
+        if traj.frames["vertices"].shape[1] != len(order.vertices) \
+                or len(traj.faces) != len(order.faces):
             raise ValueError("the run's mesh changed its size: its frames cannot be given "
                              "back in the input's order (mcfbench.running.locality)")
-        named = self.sentence
+        named = order.sentence
 
         def texts(record):
             return {k: named(v) if isinstance(v, str) else v for k, v in record.items()}
 
         continue_with = traj.continue_with
         return replace(
-            traj, frames=self._undone(traj.frames, 1), faces=self.input_faces.copy(),
+            traj, frames=order.frames(traj.frames), faces=order.input_faces.copy(),
             message=named(traj.message), defects=[texts(d) for d in traj.defects],
             events=[texts(e) for e in traj.events], flow=InputOrder(traj.flow, self),
             continue_with=None if continue_with is None else
@@ -184,37 +255,40 @@ class LocalityOrder:
 class InputOrder:
     """A flow seen in its input's numbering: ``vertices``, ``faces``, ``frame()``,
     and the per-point ``X`` (3, points) and ``l2_weights`` (points,) (mesh vertices,
-    then DDFV's T-vertices by triangle); everything else is the flow's.
+    then DDFV's T-vertices by triangle); everything else is the flow's. A flow rebuilt
+    on the components that remain is seen as one rebuilt on the input's numbering.
 
     Parameters
     ----------
     flow : mcfbench.running.flow.SchemeFlow
         Stepped on the renumbered mesh.
-    order : LocalityOrder
+    run : RenumberedRun
     """
 
-    def __init__(self, flow, order):
-        self.stepped, self._order = flow, order
+    def __init__(self, flow, run):
+        self.stepped, self._run = flow, run
 
     def __getattr__(self, name):
         return getattr(self.stepped, name)
 
     @property
     def vertices(self):
-        return np.asarray(self.stepped.vertices)[self._order.vertex_rank]
+        return np.asarray(self.stepped.vertices)[self._run.vertex_take]
 
     @property
     def faces(self):
-        return self._order.input_faces
+        return self._run.faces
 
     def frame(self):
-        return self._order.frame(self.stepped.frame())
+        frame = self.stepped.frame()
+        takes = {"vertices": self._run.vertex_take, "extra_points": self._run.face_take}
+        return {key: value[takes[key]] for key, value in frame.items()}
 
     def _points(self, values):
-        order = self._order
-        n = len(order.vertices)
-        points = order.vertex_rank if values.shape[-1] == n else \
-            np.concatenate([order.vertex_rank, n + order.face_rank])
+        run = self._run
+        n = len(run.kept)
+        points = run.vertex_take if values.shape[-1] == n else \
+            np.concatenate([run.vertex_take, n + run.face_take])
         return values[..., points]
 
     @property
@@ -224,6 +298,28 @@ class InputOrder:
     @property
     def l2_weights(self):
         return self._points(np.asarray(self.stepped.l2_weights))
+
+
+class AsGiven:
+    """One execution of a run on its mesh as given (no renumbering): the interface of
+    :class:`RenumberedRun`, everything passed through."""
+
+    def __init__(self, scheme, mesh, options, observers):
+        self.mesh, self.options, self.observers = mesh, options, list(observers)
+        self.make = scheme.make
+
+    def rebuild(self, rebuild):
+        return rebuild
+
+    def trajectory(self, traj):
+        return traj
+
+
+def intake(order, scheme, mesh, options, observers):
+    """One execution of a run: on the mesh renumbered by ``order``
+    (:class:`RenumberedRun`) or, for None, as given (:class:`AsGiven`)."""
+    return AsGiven(scheme, mesh, options, observers) if order is None else \
+        RenumberedRun(order, scheme, mesh, options, observers)
 
 
 def stepped(flow):

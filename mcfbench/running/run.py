@@ -25,7 +25,7 @@ from mcfbench.geometry.mesh import validate_mesh
 from mcfbench.running.continuation import sub_flow
 from mcfbench.running.cost import check_size
 from mcfbench.running.driver import simulate
-from mcfbench.running.locality import locality_order, stepped
+from mcfbench.running.locality import intake, locality_order, stepped
 from mcfbench.running.monitors import Monitor, Steady
 from mcfbench.running.problems import get_problem
 from mcfbench.running.schemes import get_scheme
@@ -235,24 +235,24 @@ def _timed_run(scheme, problem, mesh, tau, steps, *, solver, integrator, warm_st
     checks, the monitor and the problem's metric observers at every time level, and
     the last quality sample. Not timed: the mesh's construction and validation, the
     warm-up (:func:`warm_up`), the metrics' final values, ``order``'s renumbering and undoing."""
-    (V, F), options, observers = (mesh, options, observers) if order is None else \
-        order.intake(mesh, options, observers)
+    at = intake(order, scheme, mesh, options, observers)    # renumbered for locality
+    V, F = at.mesh
     monitor = Monitor(max(1, steps // max(1, samples)))
     metric_observers = problem.observers()
     until = Steady(problem.steady_speed) if problem.steady_speed else None
     cpu, wall = time.process_time(), time.perf_counter()
-    flow = scheme.make(V, F, tau, threads=threads, **options)
+    flow = at.make(V, F, tau, threads=threads, **at.options)
     traj = simulate(flow, steps, solver=solver, integrator=integrator, warm_start=warm_start,
                     save_every=save_every,
-                    observers=[monitor, *metric_observers, *observers], on_defect=on_defect,
+                    observers=[monitor, *metric_observers, *at.observers], on_defect=on_defect,
                     until=until, progress=progress,
-                    rebuild=partial(sub_flow, scheme, integrator=integrator, threads=threads,
-                                    **options))
+                    rebuild=at.rebuild(partial(sub_flow, scheme, integrator=integrator,
+                                               threads=threads, **at.options)))
     flow = traj.flow                      # rebuilt when a component vanished
     finished = monitor.finished(flow)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
-    traj = traj if order is None else order.trajectory(traj)
-    return _Timed(flow, traj, finished, monitor, metric_observers, until, cpu, wall)
+    return _Timed(flow, at.trajectory(traj), finished, monitor, metric_observers, until, cpu,
+                  wall)
 
 
 def _continued(timed, solver, progress):

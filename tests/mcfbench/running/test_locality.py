@@ -172,3 +172,65 @@ def test_a_run_continued_with_the_robust_solver_is_given_back_in_the_input_order
     np.testing.assert_allclose(traj.flow.vertices, plain.flow.vertices, atol=1e-10)
     np.testing.assert_allclose(traj.flow.frame()["extra_points"],
                                plain.flow.frame()["extra_points"], atol=1e-10)
+
+
+def _two_spheres():
+    """A sphere of radius 0.3 around (3, 0, 0), its vertices numbered after those of
+    the unit sphere around the origin (the continuation's test, level 2)."""
+    V, F = icosphere(2)
+    return np.vstack([V, 0.3 * V + [3.0, 0.0, 0.0]]), np.vstack([F, F + len(V)])
+
+
+def test_a_run_that_goes_on_without_a_component_is_given_back_in_the_input_order(
+        monkeypatch):
+    V, F = _two_spheres()
+    seen = {True: [], False: []}
+
+    def watcher(ordered):
+        return lambda flow: seen[ordered].append((flow.vertices.copy(), flow.faces.copy()))
+
+    monkeypatch.setattr(locality, "MIN_VERTICES", 0)
+    result, traj = run("cotan", "sphere", 2, mesh=(V, F), tau=0.001, t_final=0.2,
+                       save_every=100, observers=[watcher(True)])
+    monkeypatch.setattr(locality, "MIN_VERTICES", 10 ** 12)
+    plain, plain_traj = run("cotan", "sphere", 2, mesh=(V, F), tau=0.001, t_final=0.2,
+                            save_every=100, observers=[watcher(False)])
+    assert result.status == plain.status == "ok"
+    assert [e["component"] for e in traj.events] == [1]            # the small one
+    for event, same in zip(traj.events, plain_traj.events):
+        assert event["step"] == same["step"]
+    np.testing.assert_allclose(traj.frames["vertices"], plain_traj.frames["vertices"],
+                               atol=1e-9)
+    assert len(seen[True]) == len(seen[False])
+    sizes = {len(v) for v, _ in seen[True]}
+    assert sizes == {324, 162}                   # before and after the small one vanished
+    for (v, f), (w, g) in zip(seen[True], seen[False]):
+        assert np.array_equal(f, g)
+        np.testing.assert_allclose(v, w, atol=1e-9)
+    np.testing.assert_allclose(traj.flow.vertices, plain_traj.flow.vertices, atol=1e-9)
+    assert np.array_equal(traj.flow.faces, plain_traj.flow.faces)
+
+
+class _Refusing:
+    """cotan refusing every mesh, naming the vertex nearest ``point``."""
+
+    def __init__(self, point):
+        self.scheme, self.point = get_scheme("cotan"), point
+
+    def __getattr__(self, name):
+        return getattr(self.scheme, name)
+
+    def make(self, vertices, faces, tau, **options):
+        i = int(np.argmin(np.linalg.norm(vertices - self.point, axis=1)))
+        raise ValueError(f"vertex {i} is singular")
+
+
+def test_a_scheme_refusing_the_mesh_names_the_vertex_in_the_input_numbering(monkeypatch):
+    from mcfbench.running.run import framed_run
+
+    V, F = icosphere(2)
+    monkeypatch.setattr(locality, "MIN_VERTICES", 0)
+    result, frames = framed_run(_Refusing(V[100]), "sphere", 2, solver=Solver())
+    assert result.status == "unsupported"
+    assert result.message.endswith("vertex 100 is singular"), result.message
+    assert np.array_equal(frames["vertices"][0], V)
