@@ -9,8 +9,8 @@ the same way).
 
 ``--runs``: the whole run's CPU (:func:`mcfbench.running.run.run`, its ``cpu_seconds``:
 the flow's construction and every step with the checks and observers) of the
-sphere problem at the given levels, with the harness's order and with every mesh
-kept in its own order (:data:`mcfbench.running.locality.MIN_VERTICES` set above the
+sphere problem at the given levels, renumbered by the harness's order and kept in
+its own order (:data:`mcfbench.running.locality.MIN_VERTICES` set to 0 and above the
 mesh's size), alternately, ``--repeats`` times, the best kept; and the renumbering's
 own cost (ordering, renumbering the mesh, undoing two frames), outside the run's
 timed part.
@@ -86,7 +86,8 @@ ORDERS = {"rcm": rcm_order, "morton": morton_order}
 
 def whole_runs(levels, schemes, repeats):
     """Print the whole run's CPU seconds of each scheme on the sphere at each level,
-    with the harness's order and without, and the renumbering's own cost."""
+    renumbered and not (whatever the harness's threshold), and the renumbering's own
+    cost."""
     from mcfbench.geometry.spheres import icosphere
     from mcfbench.running import locality
     from mcfbench.running.run import run
@@ -96,7 +97,7 @@ def whole_runs(levels, schemes, repeats):
         for level in levels:
             for name in schemes:
                 for ordered in (True, False)[:: 1 if repeat % 2 == 0 else -1]:
-                    locality.MIN_VERTICES = default if ordered else 2 ** 62
+                    locality.MIN_VERTICES = 0 if ordered else 2 ** 62
                     result = run(name, "sphere", level)[0]
                     key = (name, level, ordered)
                     best[key] = min(best.get(key, np.inf), result.cpu_seconds)
@@ -114,7 +115,7 @@ def whole_runs(levels, schemes, repeats):
         start = time.process_time()
         order = locality.locality_order(V, F, min_vertices=0)
         order.mesh(V, F)
-        order.frame({"vertices": np.stack([V, V])})
+        order.frames({"vertices": np.stack([V, V])})
         cost = time.process_time() - start
         for name in schemes:
             plain, ordered = best[(name, level, False)], best[(name, level, True)]
