@@ -88,12 +88,15 @@ def locality_order(vertices, faces, *, min_vertices=None):
 
 
 def _inverse(order):
+    """The inverse of the permutation ``order`` (n,)."""
     rank = np.empty_like(order)
     rank[order] = np.arange(len(order))
     return rank
 
 
 _NAMED = re.compile(r"\b(vertex|triangle) (\d+)\b")
+"""A vertex or a triangle named by its number in a sentence (the driver's checks,
+the schemes' defects and refusals: ``"vertex 12"``, ``"triangle 7 folded"``)."""
 
 
 class LocalityOrder:
@@ -108,7 +111,6 @@ class LocalityOrder:
         The input's number of every new triangle.
     input_faces : (m, 3) int array
         The input's triangles.
-
     vertex_rank : (n,) int array
         The new number of every input vertex.
     face_rank : (m,) int array
@@ -153,7 +155,6 @@ class LocalityOrder:
             return f"{kind} {int(numbers[i])}" if i < len(numbers) else match.group(0)
 
         return _NAMED.sub(named, text) if isinstance(text, str) else text
-
 
 
 class RenumberedRun:
