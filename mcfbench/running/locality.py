@@ -6,9 +6,10 @@ old ones) numbers neighbours far apart, so that every sparse product, assembly p
 and solver iteration of a large mesh jumps through memory. :func:`locality_order`
 renumbers the vertices by reverse Cuthill-McKee on their adjacency
 (:func:`scipy.sparse.csgraph.reverse_cuthill_mckee`; Cuthill and McKee 1969, George
-1971) and sorts the triangles by their new vertex numbers, smallest first: DDFV's own
-order of its unknowns (:func:`ddfv.topology.locality_order`), the components then
-kept whole. Each triangle's vertices keep their cyclic order (its orientation).
+1971) and sorts the triangles by their new vertex numbers, smallest first, the
+components kept whole. DDFV orders its own unknowns the same way
+(:func:`ddfv.topology.locality_order`), not imported here: a run's code identity
+(:mod:`mcfbench.running.identity`) would then hold a DDFV module in every scheme's. Each triangle's vertices keep their cyclic order (its orientation).
 The flow is built and stepped on the renumbered mesh (:func:`intake`, a
 :class:`RenumberedRun`), which gives back everything in the input's numbering:
 
@@ -46,6 +47,7 @@ import re
 from dataclasses import replace
 
 import numpy as np
+import scipy.sparse as sp
 
 from mcfbench.geometry.measures import vertex_components
 
@@ -77,9 +79,11 @@ def locality_order(vertices, faces, *, min_vertices=None):
     n = len(vertices)
     if n < (MIN_VERTICES if min_vertices is None else min_vertices):
         return None
-    from ddfv.topology import locality_order as reverse_cuthill_mckee_order
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
 
-    order = reverse_cuthill_mckee_order(F, n)[0]
+    edges = F[:, [0, 1, 2, 1, 2, 0]].ravel(), F[:, [1, 2, 0, 0, 1, 2]].ravel()
+    adjacency = sp.csr_matrix((np.ones(len(edges[0]), dtype=np.int8), edges), shape=(n, n))
+    order = reverse_cuthill_mckee(adjacency, symmetric_mode=True).astype(np.int64)
     labels = vertex_components(F, n)[1]
     order = order[np.argsort(labels[order], kind="stable")]   # components kept whole
     corners = np.sort(_inverse(order)[F], axis=1)
