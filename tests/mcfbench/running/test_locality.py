@@ -1,10 +1,9 @@
 """The locality order at a run's intake (mcfbench.running.locality): a permutation that
 narrows the adjacency's band, undone exactly on everything a run returns."""
 
-from dataclasses import dataclass, field, replace
-
 import numpy as np
 import pytest
+from conftest import FailsAt
 
 from mcfbench.geometry.measures import vertex_components
 from mcfbench.geometry.spheres import icosphere
@@ -143,27 +142,12 @@ def test_a_folded_triangle_is_named_in_the_input_numbering(monkeypatch):
     np.testing.assert_allclose(traj.flow.vertices, plain_traj.flow.vertices, atol=1e-9)
 
 
-@dataclass(frozen=True)
-class _FailsAt(Solver):
-    """The solver, but its ``at``-th solve of ``size`` unknowns stops after one
-    iteration (``solver_failed``)."""
-
-    at: int = 0
-    size: int = 0
-    calls: list = field(default_factory=list)
-
-    def __call__(self, A, b, x0, **kw):
-        self.calls.extend([1] if A.shape[0] == self.size else [])
-        failing = replace(self, maxiter=1) if len(self.calls) == self.at else self
-        return Solver.__call__(failing, A, b, x0, **kw)
-
-
 def test_a_run_continued_with_the_robust_solver_is_given_back_in_the_input_order(
         monkeypatch):
     lu = Solver("direct", rtol=1e-12)
     monkeypatch.setattr(locality, "MIN_VERTICES", 0)
     result, traj, continued = run("ddfv-chord-carried", "sphere", 2, robust=lu,
-                                  solver=_FailsAt(rtol=1e-12, at=5, size=162 + 320))
+                                  solver=FailsAt(rtol=1e-12, at=5, size=162 + 320))
     monkeypatch.setattr(locality, "MIN_VERTICES", 10 ** 12)
     whole, plain = run("ddfv-chord-carried", "sphere", 2, solver=lu)
     assert result.status == "solver_failed" and continued.status == "ok"
