@@ -54,10 +54,16 @@ counted: their bound is left out, their time is in the measured step. The ratio
 is therefore a lower estimate of how far the step is from the hardware only when
 all of its solves go through the run's solver (every scheme of the default list).
 
+The mesh is stepped as a run steps it (``--orders harness``: renumbered for locality
+from :data:`mcfbench.running.locality.MIN_VERTICES` vertices on,
+:func:`mcfbench.running.locality.locality_order`), in the icosphere's own order
+(``input``) or renumbered at every size (``locality``); several orders are
+interleaved in this one process.
+
 Usage::
 
     python benchmarks/bench_bound.py [--levels 5 6 7] [--schemes cotan bgn ...]
-        [--steps N] [--repeats 2] [--triad-mb 1024]
+        [--steps N] [--repeats 2] [--triad-mb 1024] [--orders harness input locality]
 """
 
 import os
@@ -74,6 +80,8 @@ from _harness import footing, machine_line, one_core  # noqa: E402
 
 SCHEMES = ["cotan", "bgn", "ddfv-chord-carried", "cmcf"]
 #: timed steps per level (after one warm-up step) unless ``--steps``
+ORDERS = ("harness", "input", "locality")
+"""The vertex orders a step is measured in (:func:`measure`)."""
 STEPS = {4: 60, 5: 40, 6: 16, 7: 6, 8: 3}
 FACE_FLOPS = 100
 ITERATION_VECTORS = 16
@@ -171,16 +179,21 @@ def step_cost(calls, positions, faces):
     return nbytes, flops
 
 
-def measure(name, level, steps, mesh=None):
+def measure(name, level, steps, mesh=None, order="input"):
     """One run of ``name`` on the sphere at ``level`` (or on ``mesh``, ``(V, F)``, with
-    the sphere's time step of ``level``): ``(ms per step: the median of the timed steps,
-    iterations per timed step, bytes per step, flops per step, vertices)``."""
+    the sphere's time step of ``level``) in ``order`` (:data:`ORDERS`): ``(ms per step:
+    the median of the timed steps, iterations per timed step, bytes per step, flops per
+    step, vertices)``."""
     from mcfbench.geometry.spheres import icosphere
     from mcfbench.running.driver import simulate
+    from mcfbench.running.locality import locality_order
     from mcfbench.running.problems import get_problem
     from mcfbench.running.schemes import get_scheme
 
     V, F = icosphere(level) if mesh is None else mesh
+    renumbered = None if order == "input" else \
+        locality_order(V, F, min_vertices=0 if order == "locality" else None)
+    V, F = (V, F) if renumbered is None else renumbered.mesh(V, F)
     flow = get_scheme(name).make(V, F, get_problem("sphere").tau(level))
     solver = CountingSolver()
     clock = []
@@ -213,6 +226,8 @@ def main(argv=None):
     parser.add_argument("--triad-mb", type=float, default=1024.0,
                         help="MB of each of the triad's three arrays")
     parser.add_argument("--triad-repeats", type=int, default=10)
+    parser.add_argument("--orders", nargs="+", choices=ORDERS, default=["harness"],
+                        help="vertex orders, interleaved (harness: as a run steps it)")
     args = parser.parse_args(argv)
     one_core()
     from mcfbench.storage.memory import tune_malloc
@@ -229,24 +244,26 @@ def main(argv=None):
     best = {}
     for repeat in range(args.repeats):
         for level in args.levels:
-            order = args.schemes if repeat % 2 == 0 else args.schemes[::-1]
-            for name in order:
+            runs = [(name, order) for name in args.schemes for order in args.orders]
+            for name, order in runs if repeat % 2 == 0 else runs[::-1]:
                 steps = args.steps or STEPS.get(level, 3)
-                row = measure(name, level, steps)
-                old = best.get((name, level))
-                best[(name, level)] = row if old is None or row[0] < old[0] else old
+                row = measure(name, level, steps, order=order)
+                old = best.get((name, level, order))
+                best[(name, level, order)] = row if old is None or row[0] < old[0] else old
                 print(f"  [{time.strftime('%H:%M:%S')} load {os.getloadavg()[0]:.2f}] "
-                      f"{name} level {level}: {row[0]:.2f} ms/step, {row[1]:.2f} it/step",
-                      flush=True)
+                      f"{name} level {level} {order}: {row[0]:.2f} ms/step, "
+                      f"{row[1]:.2f} it/step", flush=True)
     print(f"\n{machine_line()}")
-    print(f"{'scheme':>28} {'level':>5} {'vertices':>9} {'ms/step':>9} {'it/step':>7} "
-          f"{'MB/step':>8} {'MFlop/step':>10} {'bound ms':>9} {'ratio':>6}")
+    print(f"{'scheme':>28} {'level':>5} {'order':>8} {'vertices':>9} {'ms/step':>9} "
+          f"{'it/step':>7} {'MB/step':>8} {'MFlop/step':>10} {'bound ms':>9} {'ratio':>6}")
     for name in args.schemes:
         for level in args.levels:
-            ms, it, nbytes, flops, nv = best[(name, level)]
-            bound = 1e3 * max(nbytes / B, flops / F)
-            print(f"{name:>28} {level:>5} {nv:>9} {ms:>9.2f} {it:>7.2f} {nbytes / 1e6:>8.1f} "
-                  f"{flops / 1e6:>10.1f} {bound:>9.3f} {ms / bound:>6.1f}")
+            for order in args.orders:
+                ms, it, nbytes, flops, nv = best[(name, level, order)]
+                bound = 1e3 * max(nbytes / B, flops / F)
+                print(f"{name:>28} {level:>5} {order:>8} {nv:>9} {ms:>9.2f} {it:>7.2f} "
+                      f"{nbytes / 1e6:>8.1f} {flops / 1e6:>10.1f} {bound:>9.3f} "
+                      f"{ms / bound:>6.1f}")
     print("bound = max(bytes / B, flops / F), the counting model of the module docstring; "
           "ms/step: the median CPU ms of the timed steps, the best of the repeats")
     print(footing())

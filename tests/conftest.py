@@ -2,6 +2,7 @@
 
 import functools
 import os
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pytest
@@ -12,13 +13,14 @@ from mcfbench.geometry import surfaces
 from mcfbench.geometry.shapes import flat_lattice
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.geometry.spheres import random_bumpy_sphere as bumpy_sphere
+from mcfbench.running.solver import Solver
 
 # The tests that import ``cylinder`` from here were written for quads all cut
 # along the same diagonal; the positional parameters (around, along, radius,
 # half_height = 0.5) are those of mcfbench.geometry.shapes.cylinder.
 cylinder = functools.partial(surfaces.cylinder, diagonals="parallel")
 
-__all__ = ["approaches_the_catenoid", "bumpy_sphere", "cylinder", "flat_lattice",
+__all__ = ["FailsAt", "approaches_the_catenoid", "bumpy_sphere", "cylinder", "flat_lattice",
            "table_3_1_error", "twin_sphere"]
 
 # hypothesis (tests/mcfbench/running/test_run_properties.py): "ci", the default, draws the same few
@@ -130,3 +132,18 @@ def twin_sphere(n=162, eps=0.1, seed=0):
     flip = (normal * P[F].mean(axis=1)).sum(axis=1) < 0
     F[flip] = F[flip][:, ::-1]
     return P, F
+
+
+@dataclass(frozen=True)
+class FailsAt(Solver):
+    """The solver, but its ``at``-th solve of a system of ``size`` unknowns (the run's,
+    not the warm-up's) stops after one iteration: ``solver_failed``."""
+
+    at: int = 0
+    size: int = 0
+    calls: list = field(default_factory=list)
+
+    def __call__(self, A, b, x0, **kw):
+        self.calls.extend([1] if A.shape[0] == self.size else [])
+        failing = replace(self, maxiter=1) if len(self.calls) == self.at else self
+        return Solver.__call__(failing, A, b, x0, **kw)

@@ -25,6 +25,7 @@ from mcfbench.geometry.mesh import validate_mesh
 from mcfbench.running.continuation import exceeded, sub_flow
 from mcfbench.running.cost import check_size
 from mcfbench.running.driver import simulate
+from mcfbench.running.locality import intake, locality_order, stepped
 from mcfbench.running.monitors import Monitor, Steady
 from mcfbench.running.problems import get_problem
 from mcfbench.running.remeshing import mesh_hook
@@ -88,6 +89,10 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
     **options
         Options of the scheme's flow class (override the registry's).
 
+    A large mesh is stepped renumbered for locality, everything given back in its
+    numbering (:func:`mcfbench.running.locality.locality_order`), but for a run that
+    changes its mesh (``NAME+remesh``, ``NAME+surgery``).
+
     Returns
     -------
     result : RunResult
@@ -126,13 +131,14 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
              "on_defect": on_defect, "threads": threads, "samples": samples,
              "options": options}
     warm_up(scheme, problem, F, progress=progress, **setup)
+    order = locality_order(V, F) if scheme.mesh_strategy == "none" else None
     timed = _timed_run(scheme, problem, (V, F), tau, steps, save_every=save_every,
-                       progress=progress, observers=observers, **setup)
+                       progress=progress, observers=observers, order=order, **setup)
     traj = timed.trajectory
     cpu, wall, repeats, spent = timed.cpu, timed.wall, 1, timed.cpu
     while cpu < SHORT_RUN and repeats < MAX_REPEATS and spent < REPEAT_BUDGET:
         again = _timed_run(scheme, problem, (V, F), tau, steps, save_every=save_every,
-                           progress=False, observers=(), **setup)
+                           progress=False, observers=(), order=order, **setup)
         cpu, wall = min(cpu, again.cpu), min(wall, again.wall)
         repeats, spent = repeats + 1, spent + again.cpu
     h = metrics.mean_edge_length(V, F)
@@ -226,30 +232,31 @@ class _Timed:
 
 
 def _timed_run(scheme, problem, mesh, tau, steps, *, solver, integrator, warm_start,
-               on_defect, threads, samples, options, save_every, progress, observers):
+               on_defect, threads, samples, options, save_every, progress, observers, order=None):
     """The part of a run whose CPU and wall times are recorded: the flow's
-    construction (T-vertex initialisation included), the stepping with the driver's
-    checks, the monitor and the problem's metric observers at every time level, and
-    the last quality sample. Not timed: the mesh's construction and validation, the
-    warm-up (:func:`warm_up`), the metrics' final values."""
-    V, F = mesh
+    construction, the stepping with its checks, monitor and observers, the last
+    quality sample. Not timed: the mesh's construction and validation, the warm-up
+    (:func:`warm_up`), the metrics' final values, ``order``'s renumbering and undoing."""
+    at = intake(order, scheme, mesh, options, observers)    # renumbered for locality
+    V, F = at.mesh
     monitor = Monitor(max(1, steps // max(1, samples)))
     metric_observers = problem.observers()
     until = Steady(problem.steady_speed) if problem.steady_speed else None
     cpu, wall = time.process_time(), time.perf_counter()
-    flow = scheme.make(V, F, tau, threads=threads, **options)
+    flow = at.make(V, F, tau, threads=threads, **at.options)
     traj = simulate(flow, steps, solver=solver, integrator=integrator, warm_start=warm_start,
                     save_every=save_every,
-                    observers=[monitor, *metric_observers, *observers], on_defect=on_defect,
+                    observers=[monitor, *metric_observers, *at.observers], on_defect=on_defect,
                     until=until, progress=progress,
-                    rebuild=partial(sub_flow, scheme, integrator=integrator, threads=threads,
-                                    **options),
+                    rebuild=at.rebuild(partial(sub_flow, scheme, integrator=integrator,
+                                               threads=threads, **at.options)),
                     remesh=mesh_hook(scheme, (V, F), integrator=integrator, threads=threads,
                                      options=options))
     flow = traj.flow                      # rebuilt when a component vanished
     finished = monitor.finished(flow)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
-    return _Timed(flow, traj, finished, monitor, metric_observers, until, cpu, wall)
+    return _Timed(flow, at.trajectory(traj), finished, monitor, metric_observers, until, cpu,
+                  wall)
 
 
 def _continued(timed, solver, progress):
@@ -258,10 +265,10 @@ def _continued(timed, solver, progress):
     its monitor and observers going on; timed alone."""
     cpu, wall = time.process_time(), time.perf_counter()
     traj = timed.trajectory.continue_with(solver, progress=progress)
-    finished = timed.running.finished(traj.flow)
+    flow = stepped(traj.flow)               # not the view in the input's order
+    finished = timed.running.finished(flow)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
-    return replace(timed, flow=traj.flow, trajectory=traj, monitor=finished, cpu=cpu,
-                   wall=wall)
+    return replace(timed, flow=flow, trajectory=traj, monitor=finished, cpu=cpu, wall=wall)
 
 
 WARM_UP_STEPS = 3
@@ -347,12 +354,10 @@ def _metric_values(timed, problem):
 
 
 def pinch_time_error(traj, pinch_time):
-    """Relative error ``t / pinch_time - 1`` of the time ``t`` a run stopped against the
-    reference ``pinch_time``: the first cut's ``pinch_time`` for a run that cut a neck,
-    else the ``extinction_time`` of one that ended ``extinct`` (the torus's tube round
-    onto its core circle; :attr:`mcfbench.running.driver.Trajectory.extinction_time`,
-    not moved by the step at which the check stops the run), else ``t_failed`` (a state
-    defect or a solver failing: the status says which); NaN for a run that finished."""
+    """Relative error ``t / pinch_time - 1`` of ``t``: the first cut's ``pinch_time``
+    (a run that cut a neck), the ``extinction_time`` of a run that ended ``extinct``
+    (:attr:`mcfbench.running.driver.Trajectory.extinction_time`), else ``t_failed``;
+    NaN for a run that finished."""
     if traj.surgeries:
         return traj.surgeries[0]["pinch_time"] / pinch_time - 1.0
     if traj.ok:
@@ -439,15 +444,11 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
     -------
     pandas.DataFrame
         Columns ``tau, N, error, eoc, volume_error, volume_eoc, <metrics>, status``:
-        ``error`` is ``sqrt(sum_i w_i |X_i - X_i^ref|^2)`` at ``t_final`` over
-        every point of the state, ``w`` the scheme's quadrature weights of
-        the reference (DDFV: the covolumes chi / 2); ``volume_error`` is
-        ``|vol(X) - vol(X^ref)|`` of the mesh (the volume between the two
-        surfaces: with the boundary held fixed it does not depend on the
-        origin), blind to tangential motion, which BGN's scheme
-        (:mod:`baselines.bgn`) sets anew at every step, so that its points
-        do not follow one time-continuous path; ``eoc``, ``volume_eoc``
-        their orders (3.1) between successive rows.
+        ``error`` and ``volume_error`` at ``t_final``
+        (:func:`mcfbench.geometry.metrics.final_state_distance`: the weighted distance
+        of every point, and the volume between the surfaces, blind to the tangential
+        motion BGN sets anew at every step); ``eoc``, ``volume_eoc`` their orders (3.1)
+        between successive rows.
 
     Raises
     ------
@@ -462,9 +463,8 @@ def time_convergence(scheme, problem, level, taus, *, reference_factor=8, t_fina
         result, traj = run(scheme, problem, level, tau=tau, t_final=t_final, solver=solver,
                            integrator=integrator, **options)
         if traj.frame_faces is not None:          # remeshed: other vertices than the input's
-            raise ValueError(f"{result.scheme} remeshed the run at tau = {tau:g} "
-                             f"(mcfbench.running.remeshing): its final state is not on the "
-                             f"input's mesh, which the time study compares point by point")
+            raise ValueError(f"{result.scheme} remeshed the run at tau = {tau:g}: its final "
+                             "state is not on the input's mesh, which the time study compares")
         return result, {**traj.frames, "faces": traj.faces}
 
     ref_result, ref = final(min(taus) / reference_factor)

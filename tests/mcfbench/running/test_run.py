@@ -6,10 +6,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-from dataclasses import dataclass, field, replace
-
 import numpy as np
 import pytest
+from conftest import FailsAt
 
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.problems import get_problem
@@ -164,21 +163,6 @@ def test_a_short_run_is_timed_as_the_best_of_repeats_a_long_one_once():
     assert short.steps_done == 2 and short.iterations == 4
 
 
-@dataclass(frozen=True)
-class _FailsAt(Solver):
-    """The solver, but its ``at``-th solve of a system of ``size`` unknowns (the run's,
-    not the warm-up's) stops after one iteration: ``solver_failed``."""
-
-    at: int = 0
-    size: int = 0
-    calls: list = field(default_factory=list)
-
-    def __call__(self, A, b, x0, **kw):
-        self.calls.extend([1] if A.shape[0] == self.size else [])
-        failing = replace(self, maxiter=1) if len(self.calls) == self.at else self
-        return Solver.__call__(failing, A, b, x0, **kw)
-
-
 def test_a_run_continued_with_the_robust_solver_is_the_robust_run():
     """DDFV with carried T-vertices and BDF2 on the level-2 sphere (162 F-, 320
     T-vertices, 8 steps), BiCGStab failing at step 5, continued with the sparse LU:
@@ -187,7 +171,7 @@ def test_a_run_continued_with_the_robust_solver_is_the_robust_run():
     (measured: the l2_error agrees to 3e-13 relative)."""
     scheme, lu = "ddfv-chord-carried@bdf2", Solver("direct", rtol=1e-12)
     whole, _ = run(scheme, "sphere", 2, solver=lu)
-    failing = _FailsAt(rtol=1e-12, at=5, size=whole.nV)
+    failing = FailsAt(rtol=1e-12, at=5, size=whole.nV)
     result, traj, continued = run(scheme, "sphere", 2, solver=failing, robust=lu)
     assert result.status == "solver_failed" and result.steps_done == 4
     assert traj.steps[-1] == 4 and np.isnan(result.metrics["l2_error"])
