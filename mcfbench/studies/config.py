@@ -69,6 +69,14 @@ def check_threads(config):
     return threads
 
 
+def listed(value, every):
+    """A config value naming several things: ``"all"`` (or None) for every one of
+    ``every``, one name, or a list of names; as a list."""
+    if value in ("all", None):
+        return list(every)
+    return [value] if isinstance(value, str) else list(value)
+
+
 def check_mesh_runs(section, study, defaults=None):
     """The settings of a study that runs every scheme on mesh files for a number of
     steps (the gallery, the survival study), each bad value named ``<study>.<key>``.
@@ -99,10 +107,7 @@ def check_mesh_runs(section, study, defaults=None):
 
     section = {"schemes": "all", "C": 0.1, "steps": 40, "solver": "robust", "rtol": 1e-9,
                "maxiter": 1000, **(defaults or {}), **(section or {})}
-    chosen = section["schemes"]
-    chosen = list(SCHEMES) if chosen in ("all", None) else \
-        [chosen] if isinstance(chosen, str) else list(chosen)
-    check_schemes(f"{study}.schemes", chosen)
+    chosen = check_schemes(f"{study}.schemes", listed(section["schemes"], SCHEMES))
     method = _solver.ROBUST if section["solver"] == "robust" else section["solver"]
     if method not in _solver.METHODS:
         raise ConfigError(f"config key '{study}.solver': unknown solver {method!r}; choose "

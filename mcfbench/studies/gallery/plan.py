@@ -21,7 +21,7 @@ MOVIE_FRAMES = 20
 and the first and last) for its animation (:func:`run_movie`)."""
 
 
-def plan(section=None, meshes=None, schemes=None):
+def plan(section=None, meshes=None):
     """The config key ``gallery`` (and ``meshes``) checked and normalised.
 
     Parameters
@@ -40,17 +40,7 @@ def plan(section=None, meshes=None, schemes=None):
         path), ``generated`` (file name -> ``(kind, name, level)``, kind
         ``problem``, ``surface`` or ``packaged``).
     """
-    if schemes is None:
-        from mcfbench.running.schemes import SCHEMES as schemes
-    section = dict(section or {})
-    chosen = section.get("schemes", "all")
-    chosen = list(schemes) if chosen in ("all", None) else \
-        [chosen] if isinstance(chosen, str) else list(chosen)
-    unknown = [s for s in chosen if s not in schemes]
-    if unknown:
-        raise ConfigError(f"config key 'gallery.schemes': unknown scheme(s) {unknown}; the "
-                          f"registry mcfbench.running.schemes.SCHEMES has {list(schemes)}")
-    plan = check_mesh_runs({**section, "schemes": chosen}, "gallery")
+    plan = check_mesh_runs(section, "gallery")
     if meshes:
         folder = Path(meshes)
         if not folder.is_dir():

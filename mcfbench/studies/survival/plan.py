@@ -1,7 +1,7 @@
 """The plan of the survival study: the config key ``survival`` checked (:func:`plan`) and
 one run-store spec per readable raw mesh and scheme (:func:`survival_specs`)."""
 
-from mcfbench.studies.config import ConfigError, check_mesh_runs
+from mcfbench.studies.config import ConfigError, check_mesh_runs, listed
 
 
 def plan(section=None):
@@ -33,8 +33,7 @@ def plan(section=None):
     chosen = section.pop("meshes", "all")
     settings = check_mesh_runs(section, "survival")
     manifest = raw_manifest()
-    names = list(manifest) if chosen in ("all", None) else \
-        [chosen] if isinstance(chosen, str) else list(chosen)
+    names = listed(chosen, manifest)
     unknown = [n for n in names if n not in manifest]
     if unknown:
         raise ConfigError(f"config key 'survival.meshes': unknown mesh(es) {unknown}; the "
