@@ -87,3 +87,30 @@ def test_each_scheme_of_a_batch_is_warmed_up_before_its_first_run_is_timed(tmp_p
          ("bgn", run_module.WARM_UP_STEPS), ("bgn", 2)]
     text = (tmp_path / "batch.log").read_text()
     assert "cotan on sphere level 1" in text and "bgn on sphere level 1" in text
+
+
+def test_a_remeshed_run_of_a_user_mesh_is_stored_with_its_frames_own_faces(tmp_path):
+    """A run that remeshes (cotan+remesh on a sphere with 0.5-degree slivers, a mesh
+    file) is stored like any: its frames carry each frame's faces, and no final
+    quadrature weights (the time study's, of a run on one mesh: its last state is on
+    another). The batch job once failed here, building those weights on the input's
+    faces."""
+    import igl
+
+    from mcfbench.running.batch import compute, mesh_spec
+    from mcfbench.storage.frames import frame_mesh
+    from mcfbench.storage.run_store import mesh_sha256
+    from test_remeshing import _sliver_sphere
+
+    V, F = _sliver_sphere()
+    path = tmp_path / "slivers.obj"
+    igl.write_triangle_mesh(str(path), V, F)
+    root = str(tmp_path / "runs")
+    spec = mesh_spec("cotan+remesh", str(path), mesh_sha256(path), tau_edge=0.1, steps=10,
+                     solver={"method": "direct", "rtol": 1e-9, "maxiter": 1000}, frames=10)
+    record = compute(spec, "c0de", root)
+    assert record["status"] == "ok", record["message"]
+    frames = load_frames(run_store.frames_path(spec, root))
+    assert "l2_weights" not in frames
+    first, last = frame_mesh(frames, 0), frame_mesh(frames, -1)
+    assert len(first[0]) == len(V) and not np.array_equal(first[1], last[1])
