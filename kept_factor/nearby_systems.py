@@ -238,6 +238,8 @@ class KeptFactorSolver:
         (n,) float array
         """
         b = np.asarray(b, dtype=float)
+        if not len(b):              # no unknown (every vertex fixed): nothing to factorise
+            return b.copy()
         history = [x for x in self._history.get(sequence, []) if len(x) == len(b)]
         converged = False
         if (self._factor is not None and self._factor[1] == len(b)

@@ -46,6 +46,15 @@ def test_slowly_moving_sequence_keeps_one_cholesky_factor():
     assert 5 <= solver.iterations <= 5 * solver.max_iterations
 
 
+def test_a_system_without_unknowns_is_solved_without_a_factor():
+    """Every vertex fixed (a small open mesh all of whose vertices are on its boundary,
+    met in the raw corpus): the empty solution, no factorisation (scipy's norm of an
+    empty matrix raised)."""
+    solver = KeptFactorSolver(rtol=1e-10)
+    x = _solve(solver, sp.csr_matrix((0, 0)), np.zeros(0), sequence="x")
+    assert x.shape == (0,) and solver.factorisations == 0
+
+
 def test_a_jump_of_the_matrix_factorises_again():
     """The matrix of a sphere moved by 0.3 (a third of the radius) is too far from
     the kept one for four CG iterations: a second factorisation, then kept again."""
