@@ -75,8 +75,8 @@ def test_the_tables_count_reached_runs_by_thin_features():
     assert "| x | 2/2 (100 %) | 0/1 (0 %) | 2/3 (67 %) |" in text
     words = survival_findings.findings(summary.reset_index(), {"meshes": MESHES, "steps": 40,
                                                                "C": 0.1})
-    assert "**Without thin features**: the most are taken to the end by x (2 of 2, 100 %): " \
-        "it meets the target of 90%." in words
+    assert "**Without thin features**: of the mean curvature flows, the most are taken to " \
+        "the end by x (2 of 2, 100 %): it meets the target of 90%." in words
     assert "**With thin features** (the flow pinches them; no scheme here goes through a " \
         "pinch): y (1 of 1, 100 %)." in words
 
@@ -102,3 +102,16 @@ def test_a_study_is_its_folder_its_rule_file_and_its_config_key():
     config["survivl"] = config.pop("survival")
     with pytest.raises(ConfigError, match=r"unknown config key\(s\) \['survivl'\]"):
         check_config(config, schema)
+
+
+def test_conformalized_mcf_is_no_mean_curvature_flow_in_the_verdict():
+    """cmcf (its stiffness the initial mesh's) is named apart: the target is a mean
+    curvature flow's."""
+    records = [("a", _record("cmcf", "ok", 40)), ("b", _record("cmcf", "ok", 40)),
+               ("a", _record("bgn", "ok", 40)), ("b", _record("bgn", "inverted", 3, 0.03))]
+    summary = survival_tables.survival_table(survival_tables.runs_table(records, MESHES),
+                                             ["cmcf", "bgn"])
+    words = survival_findings.findings(summary, {"meshes": MESHES, "steps": 40, "C": 0.1})
+    assert "the most are taken to the end by bgn (1 of 2, 50 %): it misses" in words
+    assert "Conformalized MCF, whose stiffness is the initial mesh's (not a mean curvature " \
+        "flow): cmcf (2 of 2, 100 %)." in words
