@@ -101,26 +101,29 @@ def test_editing_a_presentation_module_reruns_no_run(edited):
     assert records(work) == before
 
 
-def test_editing_bgn_rewrites_only_bgns_records(edited):
+def _rewritten_by(edited, source, comment):
+    """The records rewritten when ``source`` (a path below the copy) gets ``comment``
+    appended and the three-scheme matrix is run again: ``(changed paths, every path
+    before, every path after)``."""
     work, env = edited
     before = records(work)
-    with open(work / "baselines" / "bgn.py", "a") as source:
-        source.write("\n# a change of the scheme's source\n")
+    with open(work / source, "a") as file:
+        file.write(f"\n# {comment}\n")
     code, out = snakemake(work, env, "--cores", "2", "matrix", "--config", THREE)
     assert code == 0, out[-3000:]
     after = records(work)
-    changed = sorted(p for p in before if after[p] != before[p])
-    assert schemes_of(work, changed) == ["bgn"] and len(changed) == 2
-    assert after.keys() == before.keys()
+    return sorted(p for p in before if after[p] != before[p]), before.keys(), after.keys()
+
+
+def test_editing_bgn_rewrites_only_bgns_records(edited):
+    changed, before, after = _rewritten_by(edited, "baselines/bgn.py",
+                                           "a change of the scheme's source")
+    assert schemes_of(edited[0], changed) == ["bgn"] and len(changed) == 2
+    assert after == before
 
 
 def test_editing_ddfv_rewrites_only_ddfv_records(edited):
-    work, env = edited
-    before = records(work)
-    with open(work / "ddfv" / "flow.py", "a") as source:
-        source.write("\n# a change of the paper's scheme\n")
-    code, out = snakemake(work, env, "--cores", "2", "matrix", "--config", THREE)
-    assert code == 0, out[-3000:]
-    after = records(work)
-    changed = sorted(p for p in before if after[p] != before[p])
-    assert schemes_of(work, changed) == ["ddfv-chord-carried"] and len(changed) == 2
+    changed, before, after = _rewritten_by(edited, "ddfv/flow.py",
+                                           "a change of the paper's scheme")
+    assert schemes_of(edited[0], changed) == ["ddfv-chord-carried"] and len(changed) == 2
+    assert after == before
