@@ -79,9 +79,20 @@ abstract we could read; the area is checked at every step by the harness
 import numpy as np
 
 from .bgn import BGNFlow
+from .bgn_equilibrium import equilibrium, tangential_increment
 
 ORDERS = (2, 3)
-STARTS = ("bgn", "richardson")
+STARTS = ("bgn", "richardson", "equilibrium")
+
+EQUILIBRIUM_TOL = 1e-10
+"""``start="equilibrium"``: (E3) has converged when no vertex moves by more than this
+fraction of the length ``sqrt(area / vertices)`` (:mod:`baselines.bgn_equilibrium`)."""
+
+EQUILIBRIUM_MAXIT = 100
+"""``start="equilibrium"``: the iterations of (E3) before the start falls back to
+``"bgn"`` from ``X^0`` (measured: the level-1 to 3 icospheres converge in 9-38, the
+catenoid's meshes are at it; the real nut's tangential motion without normal motion
+diverges)."""
 
 VANISHED = 1e-3
 """A predictor whose area is below this fraction of the current surface's ends the step
@@ -161,6 +172,9 @@ class BGNBDFFlow(BGNFlow):
         super().__init__(vertices, faces, tau, scaling=scaling)
         self.order = int(order)
         self._past = ()              # X^{m-1}, X^{m-2}: newest first
+        self.equilibrated = None
+        """``start="equilibrium"``: whether (E3) converged at the first step (None
+        before it); False: the run started as ``"bgn"`` from ``X^0``."""
 
     def step(self, solve_system):
         """Advance one time step (J5), the start-up steps included.
@@ -172,18 +186,39 @@ class BGNBDFFlow(BGNFlow):
             :meth:`system` ``(at, base, dt)`` from the initial guess ``x0``. When it
             raises, the flow stays at ``n``.
         """
-        X, past = self.state, self._past
-        if self.start == "richardson" and self.order == 3 and not past:
-            x = self._richardson_start(solve_system)
+        X, past, at = self.state, self._past, None
+        extrapolated = self.start == "richardson"
+        if self.start == "equilibrium" and not past:
+            X = self._equilibrium(X)
+            extrapolated = self.equilibrated
+            at = X if self.equilibrated else None
+        if extrapolated and self.order == 3 and not past:
+            x = self._richardson_start(X, at, solve_system)
         else:
-            x = self._predicted_step(min(len(past) + 1, self.order), solve_system)
+            x = self._predicted_step(X, at, min(len(past) + 1, self.order), solve_system)
         self._past = (X, *past)[:self.order - 1]
         self.advance(x)
 
-    def _predicted_step(self, k, solve_system):
-        """``X^{m+1}`` of (J5) with ``k``: BGN/BDF-1, ..., BGN/BDF-k, each on the
-        previous one's solution (the first on ``Gamma^m``)."""
-        X, past, at = self.state, self._past, None
+    def _equilibrium(self, X):
+        """``X^0`` moved tangentially to BGN's equilibrium (E2) (``start=
+        "equilibrium"``); ``X`` itself when (E3) does not converge."""
+        scale = np.sqrt(self.mass.sum() / X.shape[1])
+        free = ~self.fixed
+
+        def increment(at):
+            g = self.geometry_at(at)
+            return tangential_increment(self.assembler.laplacian(g.L_data),
+                                        self._normals(g), at, free)
+
+        relaxed, self.equilibrated, _ = equilibrium(
+            increment, np.array(X), EQUILIBRIUM_TOL * scale, EQUILIBRIUM_MAXIT)
+        return relaxed if self.equilibrated else X
+
+    def _predicted_step(self, X, at, k, solve_system):
+        """``X^{m+1}`` of (J5) with ``k`` from ``X^m = X``: BGN/BDF-1, ..., BGN/BDF-k,
+        each on the previous one's solution (the first on ``Gamma^m``: ``at``, None
+        when ``X`` is the current state, whose operators are cached)."""
+        past = self._past
         guess = 2.0 * X - past[0] if past else X.copy()
         for j in range(1, k + 1):
             base, dt = bdf_base(j, X, past, self.tau)
@@ -193,12 +228,13 @@ class BGNBDFFlow(BGNFlow):
             at = guess
         return guess
 
-    def _richardson_start(self, solve_system):
-        """``X^1 = 2 Z - W`` (``start="richardson"``): ``W`` one BGN step, ``Z`` two
-        half steps; fixed vertices keep ``X^0`` exactly."""
-        X, tau = self.state, self.tau
-        W = solve_system((None, X, tau), X.copy())
-        Y = solve_system((None, X, tau / 2), X.copy())
+    def _richardson_start(self, X, at, solve_system):
+        """``X^1 = 2 Z - W`` from ``X^0 = X`` (``start="richardson"``, ``"equilibrium"``;
+        ``at`` as in :meth:`_predicted_step`): ``W`` one BGN step, ``Z`` two half steps;
+        fixed vertices keep ``X^0`` exactly."""
+        tau = self.tau
+        W = solve_system((at, X, tau), X.copy())
+        Y = solve_system((at, X, tau / 2), X.copy())
         Z = solve_system((Y, Y, tau / 2), 2.0 * Y - X)
         x = np.multiply(Z, 2.0)
         x -= W
