@@ -36,6 +36,11 @@ from scipy.sparse.linalg import spsolve
 MEMORY = 6
 """Anderson mixing's window: the last ``MEMORY`` increments (Walker and Ni's ``m``)."""
 
+STALL = 10
+""":func:`equilibrium` gives up when this many iterations have not halved the increment
+(measured: the level-3 icosphere's falls from 1e-2 to 1e-11 in 38, a factor 0.58 an
+iteration on average; the real nut's does not fall)."""
+
 
 def tangent_frames(omega):
     """Two unit vectors per vertex, orthonormal and orthogonal to ``omega``.
@@ -90,7 +95,7 @@ def tangential_increment(L, omega, X, free):
     return (e[0] * t[:n, None] + e[1] * t[n:, None]).T
 
 
-def equilibrium(increment, X, tol, maxit):
+def equilibrium(increment, X, tol, maxit, reach):
     """The state (E2) from ``X`` by (E3) with Anderson mixing.
 
     Parameters
@@ -101,6 +106,11 @@ def equilibrium(increment, X, tol, maxit):
     tol : float
         Converged when the largest coordinate of the increment is below it.
     maxit : int
+    reach : float
+        Given up (not converged) once an iterate has a coordinate this far from
+        ``X``'s (an equilibrium that far along the surface is another mesh, no
+        relaxation of this one), or once ``STALL`` iterations have not halved the
+        increment.
 
     Returns
     -------
@@ -109,14 +119,19 @@ def equilibrium(increment, X, tol, maxit):
     converged : bool
     iterations : int
     """
-    x = np.asarray(X, float).ravel().copy()
-    xs, fs = [], []
+    x0 = np.asarray(X, float).ravel()
+    x = x0.copy()
+    xs, fs, sizes = [], [], []
     for it in range(maxit):
         f = increment(x.reshape(X.shape)).ravel()
-        if not np.all(np.isfinite(f)):
+        sizes.append(np.abs(f).max())
+        if not np.isfinite(sizes[-1]):
             return x.reshape(X.shape), False, it
-        if np.abs(f).max() < tol:
+        if sizes[-1] < tol:
             return x.reshape(X.shape), True, it
+        if np.abs(x - x0).max() > reach or \
+                (it >= STALL and sizes[-1] > 0.5 * sizes[-1 - STALL]):
+            return x.reshape(X.shape), False, it
         xs, fs = (xs + [x.copy()])[-MEMORY - 1:], (fs + [f])[-MEMORY - 1:]
         if len(fs) > 1:
             dF, dX = np.diff(fs, axis=0).T, np.diff(xs, axis=0).T
