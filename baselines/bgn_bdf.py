@@ -46,26 +46,34 @@ amplifies a step-to-step alternation of it three- (k = 2) or sevenfold (k = 3),
 whereas a BGN/BDF solve puts ``X~`` where BGN's own equidistribution puts it.
 Cost: ``k`` linear systems per step (``k`` assemblies, ``k`` solves).
 
-Start (an interpretation: not in what we could read of the paper): ``X^j``, ``j <
-k``, is the step (J5) of order ``j`` (``start="bgn"``, the registry's): ``X^1`` one BGN
-step, ``X^2`` (``k = 3``) one BGN/BDF2 step. A stable k-step method keeps order k when
-its starting values are O(tau^k) accurate (HNW I, Section III.4); BGN's ``X^1`` is
-O(tau^2) only, so BGN/BDF3's order is 2 in the limit, its error that of its first
-step where nothing else dominates (level-1 sphere to ``t = 0.04``: EOC 2.04, 2.00,
-2.01 from tau 0.01). ``start="richardson"``: ``X^1 = 2 Z - W``, the Richardson
-extrapolation (HNW I, Section II.4) of one BGN step ``W`` and two half steps ``Z``
-(the harness's BDF3 start), O(tau^3) where BGN moves no vertex tangentially (the
-level-1 icosphere, by symmetry: EOC 3.06, 3.02, 3.01, 3.01). Where it does (level
->= 2), every O(tau^3) start we tried leaves an error that falls with first order or
-not at all: this one, the same extrapolating only the normal part of ``Z - W``, from
-the tangentially relaxed ``X^0`` (the tangential part of ``W - X^0`` added first),
-and ``ceil(tau^(-1/2))`` BGN/BDF2 substeps (level-2 sphere to ``t = 0.04``, final
-volume: Richardson moves by 2.0e-5, 1.8e-5, 1.0e-5, 5.1e-6, 2.6e-6 per halving of tau
-from 0.0025, the substeps' drifts away from BGN/BDF2's limit; level-3 time study:
-Richardson volume errors 3.1e-4, 2.1e-5, 4.9e-5, 3.8e-5, 2.2e-5); cause not found
-(our reading: BGN's tangential positions are set anew at every step by the surface
-the operators are taken on, and a start that is not BGN's own step puts ``X^1``'s
-where the later steps would not, a jump the BDF differences divide by tau).
+Start (an interpretation: not in what we could read of the paper). A stable k-step
+method keeps order k when its starting values are O(tau^k) accurate (HNW I, Section
+III.4). ``start="bgn"`` (BGN/BDF2's, the registry's): ``X^j``, ``j < k``, by the step
+(J5) of order ``j``: ``X^1`` one BGN step, ``X^2`` (``k = 3``) one BGN/BDF2 step.
+``X^1`` is O(tau^2) only, so BGN/BDF3's order with it is 2 in the limit (level-1
+sphere to ``t = 0.04``: EOC 2.04, 2.00, 2.01 from tau 0.01). ``start="richardson"``:
+``X^1 = 2 Z - W``, the Richardson extrapolation (HNW I, Section II.4) of one BGN step
+``W`` and two half steps ``Z``, O(tau^3); then ``X^2`` by BGN/BDF2. It gives order 3
+on the level-1 icosphere (EOC 3.06, 3.02, 3.01, 3.01), which BGN does not move
+tangentially (symmetry), but where BGN does (level >= 2) an error that falls with
+first order or not at all; so does a start from a fine run of the scheme itself
+(level-2 sphere to ``t = 0.04``, ``X^1, X^2`` from 16 steps of ``tau / 16`` each:
+volume errors 3.0e-5, 1.8e-5, 9.3e-6 from tau 0.005). The cause (derived in
+:mod:`baselines.bgn_equilibrium`): BGN's tangential positions approach the
+equilibrium (E2) one lagged iteration a step, by 1.6 % a step on the level-2 sphere,
+so where a mesh is not at it they depend on the number of steps taken, not on the
+time; any start but the run's own steps puts ``X^1`` elsewhere along the surface,
+and the BDF base ``B_k`` takes that jump's normal part at the predictor's normals (a
+curvature times its square), which does not vanish with tau. ``start="equilibrium"``
+(BGN/BDF3's in the registry): ``X^0`` first moved along the surface to (E2)
+(:func:`baselines.bgn_equilibrium.equilibrium`, to 1e-10 of the edge scale, at most
+``EQUILIBRIUM_MAXIT`` iterations), then Richardson's ``X^1`` from there, ``X^2`` by
+BGN/BDF2; the history is the relaxed ``X^0``. Order 3 where the steps' tangential
+positions no longer depend on their number: level-2 sphere to ``t = 0.04``, volume
+EOC 3.08, 3.32 (from ``X^0`` -0.85, 0.64, 1.01); the level-3 time study 3.04, 3.04,
+3.09, 3.39. Where (E3) diverges (the real nut: BGN's tangential motion without the
+normal motion that smooths the surface) the start is ``"bgn"``'s from ``X^0``
+(``equilibrated`` False, order 2).
 
 Energy: BGN's Euler step decreases the area (test (B1) with ``chi = kappa^{m+1}``,
 (B2) with ``eta = X^{m+1} - X^m``: ``|Gamma^{m+1}| <= |Gamma^m|``, BGN 2008,
@@ -79,9 +87,21 @@ abstract we could read; the area is checked at every step by the harness
 import numpy as np
 
 from .bgn import BGNFlow
+from .bgn_equilibrium import equilibrium, tangential_increment
 
 ORDERS = (2, 3)
-STARTS = ("bgn", "richardson")
+STARTS = ("bgn", "richardson", "equilibrium")
+
+EQUILIBRIUM_TOL = 1e-10
+"""``start="equilibrium"``: (E3) has converged when no vertex moves by more than this
+fraction of the length ``sqrt(area / vertices)`` (:mod:`baselines.bgn_equilibrium`)."""
+
+EQUILIBRIUM_MAXIT = 100
+"""``start="equilibrium"``: the iterations of (E3) before the start falls back to
+``"bgn"`` from ``X^0``, which it also does once a vertex has moved by the length
+``sqrt(area / vertices)`` (measured: the level-2 and 3 icospheres converge in 9 and 38
+iterations, moving vertices by 0.017 and 0.018, a tenth of that length and less; the
+catenoid's meshes are at it; on the real nut (E3) diverges)."""
 
 VANISHED = 1e-3
 """A predictor whose area is below this fraction of the current surface's ends the step
@@ -143,9 +163,10 @@ class BGNBDFFlow(BGNFlow):
     tau : float
     order : {2, 3}
         ``k`` of BDF-k.
-    start : {"bgn", "richardson"}
-        ``X^1`` of ``k = 3``: one BGN step, or the Richardson extrapolation of BGN
-        steps (module docstring, "Start").
+    start : {"bgn", "richardson", "equilibrium"}
+        ``X^1`` of ``k = 3``: one BGN step, the Richardson extrapolation of BGN steps,
+        or that from ``X^0`` relaxed to BGN's tangential equilibrium (module
+        docstring, "Start"; ``k = 2``: BGN's step from the relaxed ``X^0``).
     scaling : {"mass", "none"}
         Row scaling of (J4), as :class:`baselines.bgn.BGNFlow`'s.
     """
@@ -161,6 +182,9 @@ class BGNBDFFlow(BGNFlow):
         super().__init__(vertices, faces, tau, scaling=scaling)
         self.order = int(order)
         self._past = ()              # X^{m-1}, X^{m-2}: newest first
+        self.equilibrated = None
+        """``start="equilibrium"``: whether (E3) converged at the first step (None
+        before it); False: the run started as ``"bgn"`` from ``X^0``."""
 
     def step(self, solve_system):
         """Advance one time step (J5), the start-up steps included.
@@ -172,18 +196,39 @@ class BGNBDFFlow(BGNFlow):
             :meth:`system` ``(at, base, dt)`` from the initial guess ``x0``. When it
             raises, the flow stays at ``n``.
         """
-        X, past = self.state, self._past
-        if self.start == "richardson" and self.order == 3 and not past:
-            x = self._richardson_start(solve_system)
+        X, past, at = self.state, self._past, None
+        extrapolated = self.start == "richardson"
+        if self.start == "equilibrium" and not past:
+            X = self._equilibrium(X)
+            extrapolated = self.equilibrated
+            at = X if self.equilibrated else None
+        if extrapolated and self.order == 3 and not past:
+            x = self._richardson_start(X, at, solve_system)
         else:
-            x = self._predicted_step(min(len(past) + 1, self.order), solve_system)
+            x = self._predicted_step(X, at, min(len(past) + 1, self.order), solve_system)
         self._past = (X, *past)[:self.order - 1]
         self.advance(x)
 
-    def _predicted_step(self, k, solve_system):
-        """``X^{m+1}`` of (J5) with ``k``: BGN/BDF-1, ..., BGN/BDF-k, each on the
-        previous one's solution (the first on ``Gamma^m``)."""
-        X, past, at = self.state, self._past, None
+    def _equilibrium(self, X):
+        """``X^0`` moved tangentially to BGN's equilibrium (E2) (``start=
+        "equilibrium"``); ``X`` itself when (E3) does not converge."""
+        scale = np.sqrt(self.mass.sum() / X.shape[1])
+        free = ~self.fixed
+
+        def increment(at):
+            g = self.geometry_at(at)
+            return tangential_increment(self.assembler.laplacian(g.L_data),
+                                        self._normals(g), at, free)
+
+        relaxed, self.equilibrated, _ = equilibrium(
+            increment, np.array(X), EQUILIBRIUM_TOL * scale, EQUILIBRIUM_MAXIT, scale)
+        return relaxed if self.equilibrated else X
+
+    def _predicted_step(self, X, at, k, solve_system):
+        """``X^{m+1}`` of (J5) with ``k`` from ``X^m = X``: BGN/BDF-1, ..., BGN/BDF-k,
+        each on the previous one's solution (the first on ``Gamma^m``: ``at``, None
+        when ``X`` is the current state, whose operators are cached)."""
+        past = self._past
         guess = 2.0 * X - past[0] if past else X.copy()
         for j in range(1, k + 1):
             base, dt = bdf_base(j, X, past, self.tau)
@@ -193,12 +238,13 @@ class BGNBDFFlow(BGNFlow):
             at = guess
         return guess
 
-    def _richardson_start(self, solve_system):
-        """``X^1 = 2 Z - W`` (``start="richardson"``): ``W`` one BGN step, ``Z`` two
-        half steps; fixed vertices keep ``X^0`` exactly."""
-        X, tau = self.state, self.tau
-        W = solve_system((None, X, tau), X.copy())
-        Y = solve_system((None, X, tau / 2), X.copy())
+    def _richardson_start(self, X, at, solve_system):
+        """``X^1 = 2 Z - W`` from ``X^0 = X`` (``start="richardson"``, ``"equilibrium"``;
+        ``at`` as in :meth:`_predicted_step`): ``W`` one BGN step, ``Z`` two half steps;
+        fixed vertices keep ``X^0`` exactly."""
+        tau = self.tau
+        W = solve_system((at, X, tau), X.copy())
+        Y = solve_system((at, X, tau / 2), X.copy())
         Z = solve_system((Y, Y, tau / 2), 2.0 * Y - X)
         x = np.multiply(Z, 2.0)
         x -= W

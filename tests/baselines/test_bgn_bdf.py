@@ -5,8 +5,10 @@ import pytest
 
 from baselines.bgn import BGNFlow
 from baselines.bgn_bdf import VANISHED, BGNBDFFlow, bdf_base
+from baselines.bgn_equilibrium import tangential_increment
+from mcfbench.geometry.committed_meshes import read_committed_mesh
 from mcfbench.geometry.exact import eoc
-from mcfbench.geometry.metrics import area
+from mcfbench.geometry.metrics import area, volume
 from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.driver import simulate
 from mcfbench.running.integrators import BDF2, Euler
@@ -58,6 +60,78 @@ def test_time_order_on_the_sphere(order, start, low, high):
     errors = np.array([abs(final(tau) - reference) for tau in taus])
     orders = eoc(errors)[1:]
     assert np.all((orders > low) & (orders < high)), (errors, orders)
+
+
+def test_third_order_from_bgn_s_tangential_equilibrium():
+    """The level-2 icosphere, which BGN moves along the surface (the level-1 one it does
+    not), to t = 0.04, the volume against a tau / 8 reference: from ``X^0`` (Richardson's
+    O(tau^3) start) the order falls to about 1 (measured volume EOCs -0.85, 0.64, 1.01
+    from tau 0.005), from BGN's tangential equilibrium it is 3 (3.08, 3.32); every run's
+    area decreases at every step."""
+    V, F = icosphere(2)
+    taus = [0.005, 0.0025, 0.00125]
+
+    def final(tau):
+        flow = BGNBDFFlow(V, F, tau, order=3, start="equilibrium")
+        shrinking(flow, round(0.04 / tau))
+        assert flow.equilibrated
+        return volume(flow.vertices, F)
+
+    reference = final(taus[-1] / 8)
+    errors = np.array([abs(final(tau) - reference) for tau in taus])
+    orders = eoc(errors)[1:]
+    assert np.all((orders > 2.7) & (orders < 3.6)), (errors, orders)
+
+
+def test_the_equilibrium_start_relaxes_x0_along_the_surface_and_then_extrapolates():
+    """``start="equilibrium"``: ``X^0`` moved along the surface to (E2) (the next
+    iteration (E3) moves no vertex by 1e-10 of the edge scale; the area not grown),
+    ``X^1`` Richardson's ``2 Z - W`` from there, which is the history of step 2; a mesh at
+    the equilibrium already (the level-1 icosphere, by symmetry) starts as
+    ``"richardson"``, bitwise."""
+    V, F = icosphere(2)
+    flow = BGNBDFFlow(V, F, 0.001, order=3, start="equilibrium")
+    Euler().step(flow, EXACT)
+    assert flow.equilibrated
+    X0 = flow._past[0]
+    moved = X0 - V.T
+    assert 1e-3 < np.abs(moved).max() < 0.05
+    nu = V / np.linalg.norm(V, axis=1, keepdims=True)
+    # along the surface: the radial part is of second order in the moves (measured
+    # 2.7e-4 for moves of up to 0.017, each iterate's tangential to its own normals)
+    radial = np.abs(np.einsum("kc,ck->k", nu, moved))
+    assert radial.max() < 0.05 * np.abs(moved).max()
+    g = flow.geometry_at(X0)
+    D = tangential_increment(flow.assembler.laplacian(g.L_data), flow._normals(g), X0,
+                             ~flow.fixed)
+    assert np.abs(D).max() < 1e-10 * np.sqrt(area(X0.T, F) / len(V))
+    assert area(X0.T, F) <= area(V, F)
+    W = BGNBDFFlow(X0.T, F, 0.001, order=3, start="richardson")
+    Euler().step(W, EXACT)
+    np.testing.assert_allclose(flow.state, W.state, rtol=0, atol=1e-13)
+    V1, F1 = icosphere(1)
+    a = BGNBDFFlow(V1, F1, 0.01, order=3, start="equilibrium")
+    b = BGNBDFFlow(V1, F1, 0.01, order=3, start="richardson")
+    for _ in range(3):
+        Euler().step(a, EXACT)
+        Euler().step(b, EXACT)
+    assert a.equilibrated
+    np.testing.assert_array_equal(a.state, b.state)
+
+
+def test_the_equilibrium_start_falls_back_to_bgn_where_it_diverges():
+    """The committed nut: BGN's tangential motion without normal motion (E3) does not
+    converge (its iterates move vertices by more than a unit); the run starts as
+    ``"bgn"`` from ``X^0``, bitwise, and says so (``equilibrated`` False)."""
+    V, F = read_committed_mesh("nut")
+    h = np.linalg.norm(V[F[:, 1]] - V[F[:, 0]], axis=1).mean()
+    a = BGNBDFFlow(V, F, 0.1 * h * h, order=3, start="equilibrium")
+    b = BGNBDFFlow(V, F, 0.1 * h * h, order=3, start="bgn")
+    for _ in range(2):
+        Euler().step(a, EXACT)
+        Euler().step(b, EXACT)
+    assert a.equilibrated is False
+    np.testing.assert_array_equal(a.state, b.state)
 
 
 @pytest.mark.parametrize("order", [2, 3])
@@ -137,6 +211,7 @@ def test_registry_entries():
         entry = get_scheme(f"bgn-bdf{k}")
         flow = entry.make(V, F, 0.01)
         assert isinstance(flow, BGNBDFFlow) and flow.order == k and flow.scaling == "mass"
+        assert flow.start == {2: "bgn", 3: "equilibrium"}[k]
         assert entry.integrates_itself and entry.integrator == "euler"
         with pytest.raises(ValueError, match="integrates in time itself"):
             get_scheme(f"bgn-bdf{k}@bdf2")

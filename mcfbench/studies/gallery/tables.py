@@ -3,6 +3,7 @@
 import numpy as np
 
 from mcfbench.presentation.formats import formatted
+from mcfbench.storage.frames import frame_mesh, surface_points
 from mcfbench.presentation.tables import Table, markdown
 from mcfbench.studies.matrix.tables import TIMING_BASE
 
@@ -12,8 +13,26 @@ GALLERY_COLUMNS = ["mesh", "scheme", "status", "steps_done", "steps", "t_failed"
                    "triangles", "h", "tau", "solver", "message"]
 
 
-def gallery_table(records):
-    """Mesh x scheme: one row per record (:data:`GALLERY_COLUMNS`)."""
+def initial_triangles(frames):
+    """The triangles of a run's first frame (its mesh as the scheme took it), NaN for a
+    run that kept no frame (its mesh refused). ``frames``: a frames file's arrays."""
+    if surface_points(frames)[0] is None:
+        return np.nan
+    return len(frame_mesh(frames, 0)[1])
+
+
+def gallery_table(records, triangles):
+    """Mesh x scheme: one row per record (:data:`GALLERY_COLUMNS`).
+
+    Parameters
+    ----------
+    records : list of dict
+        Run records.
+    triangles : list of int or float
+        Each record's triangle count (:func:`initial_triangles` of its frames; NaN
+        without frames). Not the record's ``nT``: that counts DDFV's T-vertices and
+        is 0 for a vertex scheme.
+    """
     import pandas as pd
 
     rows = [{"mesh": r["mesh"], "scheme": r["scheme"], "status": r["status"],
@@ -21,8 +40,9 @@ def gallery_table(records):
              "t_failed": r["t_failed"], "min_angle": r["min_angle"],
              "max_flipped": r["max_flipped"], "t_min_barycentric": r["t_min_barycentric"],
              "cpu_seconds": r["cpu_seconds"], "vertices": int(r["nF"]),
-             "triangles": int(r["nT"]) if r["nT"] else np.nan, "h": r["h"], "tau": r["tau"],
-             "solver": r["solver"], "message": r["message"]} for r in records]
+             "triangles": nt, "h": r["h"], "tau": r["tau"],
+             "solver": r["solver"], "message": r["message"]}
+            for r, nt in zip(records, triangles, strict=True)]
     return pd.DataFrame(rows, columns=GALLERY_COLUMNS)
 
 

@@ -13,7 +13,8 @@ from mcfbench.geometry.spheres import icosphere
 from mcfbench.running.batch import compute
 from mcfbench.running.problems import PROBLEMS
 from mcfbench.running.schemes import SCHEMES
-from mcfbench.storage.run_store import read_runs
+from mcfbench.storage.frames import load_frames
+from mcfbench.storage.run_store import frames_path, read_runs
 from mcfbench.studies.config import ConfigError
 from mcfbench.studies.gallery import MESH, job, plan, plots, tables
 from mcfbench.studies.matrix import is_real_world
@@ -86,18 +87,22 @@ def test_every_scheme_runs_on_every_file_and_the_table_reads_the_records(tmp_pat
     for spec in specs.values():
         compute(spec, "test", root)
     records = list(read_runs(dict.fromkeys(specs.values(), "test"), root=root).values())
-    table = tables.gallery_table(records)
+    triangles = [tables.initial_triangles(load_frames(frames_path(spec, root)))
+                 for spec in specs.values()]
+    table = tables.gallery_table(records, triangles)
     assert list(table.columns) == tables.GALLERY_COLUMNS
     ball = table[table["mesh"] == "ball.obj"]
     assert ball["status"].tolist() == ["ok", "ok"] and ball["steps_done"].tolist() == [3, 3]
-    # the level-2 icosphere: 162 vertices, 320 triangles, counted by DDFV's record (nT,
-    # its T-vertices); a vertex scheme's record holds no triangle count (nT = 0): none
-    assert ball["vertices"].tolist() == [162, 162] and ball["triangles"].iloc[0] == 320
-    assert math.isnan(ball["triangles"].iloc[1])
+    # the level-2 icosphere: 162 vertices, 320 triangles for DDFV and for the vertex
+    # scheme alike (its record's nT, DDFV's T-vertex count, is 0); the refused mesh: none
+    assert ball["vertices"].tolist() == [162, 162]
+    assert ball["triangles"].tolist() == [320, 320]
+    assert [r["nT"] for r in records[:2]] == [320, 0]
     h = ball["h"].iloc[0]
     assert ball["tau"].iloc[0] == pytest.approx(0.1 * h * h)
     broken = table[table["mesh"] == "broken.off"]
     assert (broken["status"] == "unsupported").all() and (broken["steps_done"] == 0).all()
+    assert broken["triangles"].isna().all()
     assert broken["message"].str.contains("the mesh was refused").all()
     text = tables.gallery_markdown(table, p)
     assert "same footing" in text and "| ball.obj | ddfv | ok | 3/3 |" in text
@@ -112,8 +117,9 @@ def test_the_table_of_given_records_cell_by_cell():
                 "nT": triangles, "h": 0.5, "tau": 0.025, "solver": "jacobi-direct",
                 "message": "" if status == "ok" else "inverted at step 7"}
 
-    table = tables.gallery_table([record("ico.obj", "cotan", "ok", 40, 20, float("nan")),
-                                  record("bad.off", "bgn", "inverted", 7, 0, 0.175)])
+    table = tables.gallery_table([record("ico.obj", "cotan", "ok", 40, 0, float("nan")),
+                                  record("bad.off", "bgn", "inverted", 7, 0, 0.175)],
+                                 [20, float("nan")])
     assert table["steps"].tolist() == [40, 40] and table["vertices"].tolist() == [12, 12]
     assert table["triangles"].iloc[0] == 20 and math.isnan(table["triangles"].iloc[1])
     text = tables.gallery_markdown(table, {"C": 0.1, "steps": 40, "solver": "jacobi-direct",

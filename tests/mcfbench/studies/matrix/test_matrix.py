@@ -251,6 +251,17 @@ def _record(scheme, problem, level, value, status="ok", t_failed=float("nan"),
     return row
 
 
+def test_a_scheme_whose_runs_reach_extinction_has_a_summary_cell():
+    """The torus's BGN runs end ``extinct`` (reached, no level failed: the failed level
+    is NaN): the cell says so, with the finest value, instead of ending the tables' job."""
+    records = [_record("a", "torus", k + 1, e, "extinct") for k, e in enumerate([4e-2, 1e-2])]
+    table = matrix_tables.long_table(records)
+    summary = matrix_tables.with_levels(matrix_tables.summary_table(table), table)
+    row = summary.iloc[0]
+    assert row["status"] == "extinct" and math.isnan(row["failed_level"])
+    assert matrix_tables.summary_cell(row) == "EOC 2.00; 1.000e-02 (L2); extinct"
+
+
 def test_eoc_is_log2_of_the_error_ratio(tmp_path):
     errors = {"a": [1.0e-2, 2.5e-3, 6.0e-4], "b": [2.0e-2, 1.8e-2, 2.1e-2]}
     records = [_record(s, "sphere", k + 1, e) for s, es in errors.items()
