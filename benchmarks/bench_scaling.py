@@ -28,7 +28,8 @@ the level) and of the growing memory against the vertices, fitted per problem on
 three largest meshes measured (:func:`mcfbench.studies.beyond.scaling.power_fit`): the
 sphere's levels 6-8 and the real mesh's levels 4-6 (64 000, 256 000, 1 024 000 vertices).
 
-The machine is shared: the load average is printed with every run; ``--repeats``
+The machine is shared: the load average is printed with every run (and the run's
+numbers as a JSON line, kept if the script is stopped before its table); ``--repeats``
 runs each (scheme, mesh) again, the meshes in reverse order, keeping the fastest step.
 
 Usage::
@@ -135,7 +136,8 @@ def main(argv=None):
                 old = best.get((scheme, mesh))
                 best[(scheme, mesh)] = row if old is None or row["ms"] < old["ms"] else old
                 print(f"  [{time.strftime('%H:%M:%S')} load {load:.2f}] {scheme} {mesh}: "
-                      f"{row['ms']:.1f} ms/step, peak {row['peak_mb']:.0f} MB", flush=True)
+                      f"{row['ms']:.1f} ms/step, peak {row['peak_mb']:.0f} MB "
+                      f"{json.dumps({'scheme': scheme, 'mesh': mesh, **row})}", flush=True)
     print(f"\n{machine_line()}")
     print(f"{'scheme':>32} {'mesh':>11} {'vertices':>9} {'unknowns':>9} {'ms/step':>9} "
           f"{'it/step':>7} {'bound ms':>9} {'ratio':>6} {'peak MB':>8} {'est. MB':>8} "
