@@ -96,7 +96,9 @@ def run_child(scheme, mesh, steps):
                           str(ROOT / "benchmarks"), str(steps)],
                          cwd=ROOT, env=env, capture_output=True, text=True)
     if out.returncode:
-        raise RuntimeError(f"{scheme} on {mesh}: {out.stderr.strip().splitlines()[-1]}")
+        last = (out.stderr.strip().splitlines() or [f"ended by signal {-out.returncode}"
+                                                    if out.returncode < 0 else "no message"])
+        raise RuntimeError(f"{scheme} on {mesh}: exit {out.returncode}: {last[-1]}")
     return json.loads(out.stdout.splitlines()[-1])
 
 
