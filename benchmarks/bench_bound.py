@@ -130,16 +130,17 @@ def flop_rate(size=2000, repeats=3):
 
 
 class CountingSolver:
-    """The run's solver (:class:`mcfbench.running.solver.Solver`, defaults) recording,
+    """The run's solver (:class:`mcfbench.running.solver.Solver`, defaults but its
+    ``threads``) recording,
     per call, ``(step, iterations, Z, m, k, index bytes)``; ``step`` is read from
     :attr:`step` (set by the observer)."""
 
     can_overwrite_x0 = True
 
-    def __init__(self):
+    def __init__(self, threads=1):
         from mcfbench.running.solver import Solver
 
-        self._solver = Solver()
+        self._solver = Solver(threads=threads)
         self.calls = []
         self.step = 0
 
@@ -179,10 +180,13 @@ def step_cost(calls, positions, faces):
     return nbytes, flops
 
 
-def measure(name, level, steps, mesh=None, order="input"):
+def measure(name, level, steps, mesh=None, order="input", tau=None, threads=1,
+            clock=time.process_time):
     """One run of ``name`` on the sphere at ``level`` (or on ``mesh``, ``(V, F)``, with
-    the sphere's time step of ``level``) in ``order`` (:data:`ORDERS`): ``(ms per step:
-    the median of the timed steps, iterations per timed step, bytes per step, flops per
+    the sphere's time step of ``level`` unless ``tau``) in ``order`` (:data:`ORDERS`),
+    the flow made and its solves run with ``threads`` threads, each step timed by
+    ``clock`` (CPU seconds; the wall's for several threads): ``(ms per step: the
+    median of the timed steps, iterations per timed step, bytes per step, flops per
     step, vertices)``."""
     from mcfbench.geometry.spheres import icosphere
     from mcfbench.running.driver import simulate
@@ -194,18 +198,19 @@ def measure(name, level, steps, mesh=None, order="input"):
     renumbered = None if order == "input" else \
         locality_order(V, F, min_vertices=0 if order == "locality" else None)
     V, F = (V, F) if renumbered is None else renumbered.mesh(V, F)
-    flow = get_scheme(name).make(V, F, get_problem("sphere").tau(level))
-    solver = CountingSolver()
-    clock = []
+    tau = get_problem("sphere").tau(level) if tau is None else tau
+    flow = get_scheme(name).make(V, F, tau, threads=threads)
+    solver = CountingSolver(threads)
+    times = []
 
     def observer(_flow):
-        clock.append(time.process_time())
-        solver.step = len(clock)           # the solves that follow are of this step
+        times.append(clock())
+        solver.step = len(times)           # the solves that follow are of this step
 
     traj = simulate(flow, steps + 1, solver=solver, save_every=0, observers=[observer])
     if not traj.ok:
         raise RuntimeError(f"{name} level {level}: {traj.message}")
-    per_step = np.diff(clock)[1:]          # the first step is the warm-up
+    per_step = np.diff(times)[1:]          # the first step is the warm-up
     timed = [c for c in solver.calls if c[0] >= 2]
     costs = [step_cost([c for c in timed if c[0] == s], flow.vertices.shape,
                        (flow.faces.shape[0], flow.faces.dtype.itemsize))

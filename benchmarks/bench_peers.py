@@ -7,7 +7,9 @@ one thread, interleaved (the order reversed every other repeat), the best of
 
 * ``suite``: ``get_scheme("cotan")`` stepped by :func:`mcfbench.running.driver.simulate`
   (:func:`bench_bound.measure`: BiCGStab from the extrapolated start, rtol 1e-9, the
-  driver's checks);
+  driver's checks) on the mesh as a run steps it (renumbered for locality from
+  :data:`mcfbench.running.locality.MIN_VERTICES` vertices on; the peers' factorisations
+  order the unknowns themselves);
 * ``libigl``: the libigl tutorial's implicit step (its 205 example): ``L =
   igl.cotmatrix(V, F)``, ``M = igl.massmatrix(V, F, barycentric)`` rebuilt at every
   step, ``V = scipy.sparse.linalg.spsolve(M - tau L, M V)`` (SuperLU, a new
@@ -93,7 +95,7 @@ def main(argv=None):
     for repeat in range(args.repeats):
         for level in args.levels:
             for kind in (kinds if repeat % 2 == 0 else kinds[::-1]):
-                ms = (measure("cotan", level, args.steps)[0] if kind == "suite"
+                ms = (measure("cotan", level, args.steps, order="harness")[0] if kind == "suite"
                       else peer(kind, level, args.steps))
                 best[(kind, level)] = min(ms, best.get((kind, level), np.inf))
                 print(f"  [{time.strftime('%H:%M:%S')} load {os.getloadavg()[0]:.2f}] "

@@ -204,3 +204,17 @@ def test_a_problem_mesh_is_built_once_and_handed_out_as_copies(monkeypatch):
 def test_has_boundary():
     assert not has_boundary(icosphere(1)[1])
     assert has_boundary(icosphere(1)[1][1:])
+
+
+@pytest.mark.parametrize("scheme", ["cotan", "bgn", "ddfv-chord-carried"])
+def test_a_two_thread_run_is_the_one_thread_run_to_round_off(scheme):
+    """threads=2 (the solver's products and vector passes, DDFV's per-element passes,
+    split in blocks; issue 46): the same steps and iterations, positions equal up to the
+    inner products' summation order."""
+    one, traj_one = run(scheme, "sphere", 3, t_final=0.01)
+    two, traj_two = run(scheme, "sphere", 3, t_final=0.01, threads=2)
+    assert one.status == two.status == "ok"
+    assert traj_one.steps_done == traj_two.steps_done == 4
+    np.testing.assert_array_equal(traj_one.iterations, traj_two.iterations)
+    X1, X2 = traj_one.frames["vertices"], traj_two.frames["vertices"]
+    assert np.abs(X1 - X2).max() <= 1e-13 * np.abs(X1).max()
