@@ -22,6 +22,19 @@ It is the input's mean edge on a uniform mesh; on the anisotropic sphere (edges
 ``angle`` degrees (a sliver before it folds), or a fixed interval of *time*
 ``every`` (not of steps: with ``tau ~ h^2``, a remesh every ``k`` steps is
 ``O(h^-2)`` remeshes whose ``O(h^2)`` projection errors add up to ``O(1)``).
+
+**What the compiled remesher is given** (:func:`remesh`). gpytoolbox's binding
+builds a half-edge structure and has no checks of its own beyond non-manifold
+edges: a non-finite coordinate, a non-manifold vertex, a duplicate or zero-area
+triangle or an unreferenced vertex can crash the process (two crashes, SIGSEGV and
+SIGABRT, in a survival pass). The input is checked first, by the intake's own
+:func:`mcfbench.geometry.mesh.validate_mesh`, and so is the output, and the arrays
+are passed as the binding wants them (contiguous ``float64`` and ``int32``); a
+bad one raises :class:`RemeshRefused` naming the problem, which the run reports
+(the driver ends it ``degenerated`` with that sentence) instead of a dead batch.
+Checking rather than isolating each call in a child process: a check costs
+milliseconds against a child's start and the copying of the mesh both ways, and
+it names the defect, where a crashed child only says that it died.
 """
 
 import math
@@ -31,6 +44,7 @@ import numpy as np
 from mcfbench.geometry import metrics
 from mcfbench.geometry.collapse import component_topology
 from mcfbench.geometry.measures import vertex_components
+from mcfbench.geometry.mesh import MeshError, validate_mesh
 from mcfbench.geometry.surface_distance import mean_surface_distance
 
 PASSES = 3
@@ -58,6 +72,11 @@ def boundary_vertices(faces):
     return np.unique(edges[seen == 1])
 
 
+class RemeshRefused(ValueError):
+    """The remesher's input or output is not a valid surface (module docstring: what
+    the compiled remesher is given); the message names the problem."""
+
+
 def remesh(vertices, faces, h, passes=PASSES):
     """The surface ``(vertices, faces)`` remeshed to edge length ``h`` (module docstring).
 
@@ -73,13 +92,34 @@ def remesh(vertices, faces, h, passes=PASSES):
     vertices : (n', 3) float array
         The boundary vertices first, in their input order, at their input positions.
     faces : (m', 3) int array
+
+    Raises
+    ------
+    RemeshRefused
+        The input is not a valid surface (:func:`~mcfbench.geometry.mesh.validate_mesh`:
+        non-finite coordinates, a repeated, duplicate or zero-area triangle, an
+        unreferenced vertex, a non-manifold edge or vertex, ...), ``h`` is not a
+        positive number or ``passes`` not a whole number >= 1, or the output is not
+        a valid surface; the compiled remesher is not called on a bad input.
     """
+    if not (np.isfinite(h) and h > 0) or int(passes) != passes or passes < 1:
+        raise RemeshRefused(f"the remesher needs an edge length > 0 and whole passes >= 1, "
+                            f"got h={h!r}, passes={passes!r}")
+    try:
+        V, F = validate_mesh(vertices, faces)
+    except MeshError as err:
+        raise RemeshRefused(f"the remesher refused its input ({err.kind}): {err}") from None
     import gpytoolbox  # on first use: the flows that never remesh do not load it
 
-    V = np.ascontiguousarray(vertices, dtype=np.float64)
-    F = np.ascontiguousarray(faces, dtype=np.int32)
-    fixed = boundary_vertices(F)
+    V = np.ascontiguousarray(V, dtype=np.float64)
+    F = np.ascontiguousarray(F, dtype=np.int32)
+    fixed = np.ascontiguousarray(boundary_vertices(F), dtype=np.int32)
     U, G = gpytoolbox.remesh_botsch(V, F, int(passes), float(h), True, feature=fixed)
+    try:
+        U, G = validate_mesh(U, G)
+    except MeshError as err:
+        raise RemeshRefused(f"the remesher's output is not a valid surface ({err.kind}): "
+                            f"{err}") from None
     return np.ascontiguousarray(U, dtype=float), np.ascontiguousarray(G, dtype=np.int64)
 
 
