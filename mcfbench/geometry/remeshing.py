@@ -22,6 +22,13 @@ It is the input's mean edge on a uniform mesh; on the anisotropic sphere (edges
 ``angle`` degrees (a sliver before it folds), or a fixed interval of *time*
 ``every`` (not of steps: with ``tau ~ h^2``, a remesh every ``k`` steps is
 ``O(h^-2)`` remeshes whose ``O(h^2)`` projection errors add up to ``O(1)``).
+A remesh that could not lift the smallest angle to ``angle`` (the boundary's
+vertices are held, so a sliver on the boundary stays; a folded input stays folded)
+is not repeated until the smallest angle has fallen to :data:`RELAPSE` times what
+that remesh left: otherwise every step remeshes, each adding its projection error
+for no gain (on the raw corpus's flat strip ``narrow_triangles``, smallest angle
+0.03 degrees on its boundary: 37 remeshes in 37 steps, then a fold, where the
+schemes without remeshing reach the end).
 
 **What the compiled remesher is given** (:func:`remesh`). gpytoolbox's binding
 builds a half-edge structure and has no checks of its own beyond non-manifold
@@ -56,6 +63,12 @@ ANGLE = 10.0
 """Degrees: a mesh whose smallest angle is below this is remeshed (a fresh remesh
 has its smallest angle at 20-35 degrees; the registry's meshes start above 10
 except the slivered ones: the anisotropic sphere 2.8)."""
+
+
+RELAPSE = 0.5
+"""After a remesh that left the smallest angle below the trigger's ``angle``, the next
+quality remesh waits until the smallest angle is below this share of what it left
+(module docstring)."""
 
 
 def target_edge(vertices, faces):
@@ -163,8 +176,9 @@ def remesh_change(before, after):
 
 
 class RemeshTrigger:
-    """When a run remeshes: the smallest angle below ``angle`` degrees, or ``every``
-    time units since the last remesh (module docstring).
+    """When a run remeshes: the smallest angle below ``angle`` degrees (or below
+    :data:`RELAPSE` times what the last remesh left, when that was below ``angle``),
+    or ``every`` time units since the last remesh (module docstring).
 
     Parameters
     ----------
@@ -179,17 +193,21 @@ class RemeshTrigger:
             raise ValueError(f"a remesh trigger needs angle >= 0 and every > 0 or None, got "
                              f"angle={angle!r}, every={every!r}")
         self.angle, self.every, self.last = float(angle), every, 0.0
+        self.threshold = self.angle
 
     def __call__(self, vertices, faces, t):
         """Why the state at time ``t`` is to be remeshed (a sentence), or None."""
         if self.every is not None and t - self.last >= self.every * (1 - 1e-9):
             return f"{t - self.last:.4g} time units since the last remesh"
-        if self.angle > 0:
+        if self.threshold > 0:
             smallest = metrics.min_angle(vertices, faces)
-            if smallest < self.angle:
-                return f"smallest angle {smallest:.3g} degrees < {self.angle:g}"
+            if smallest < self.threshold:
+                return f"smallest angle {smallest:.3g} degrees < {self.threshold:.3g}"
         return None
 
-    def done(self, t):
-        """A remesh happened at time ``t``."""
+    def done(self, t, min_angle=None):
+        """A remesh happened at time ``t``, leaving the smallest angle ``min_angle``
+        degrees (None: not known, the threshold stays ``angle``)."""
         self.last = t
+        self.threshold = self.angle if min_angle is None or min_angle >= self.angle \
+            else RELAPSE * float(min_angle)

@@ -111,7 +111,7 @@ class Remesher:
                  **remesh_change((V, F), (U, G))}
         self.seconds += time.perf_counter() - start
         self.calls += 1
-        self.trigger.done(t)
+        self.trigger.done(t, event["min_angle_after"])
         return rebuilt_flow(self.scheme, flow, U, G, threads=self.threads,
                             **self.options), event
 

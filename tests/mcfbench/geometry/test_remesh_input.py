@@ -118,3 +118,23 @@ def test_a_run_whose_state_the_remesher_refuses_ends_degenerated_naming_it():
     assert traj.status == "degenerated" and traj.failed_step == 2, traj.message
     assert "refused its input (non-finite coordinate)" in traj.message
     assert hook.calls == 1           # step 1 (every tau) remeshed, step 2 refused
+
+
+def test_a_remesh_that_could_not_lift_the_angle_waits_until_the_angle_halves():
+    """After a remesh that left 4 degrees (< 10), the trigger waits for 2 degrees; after
+    one that left 30, it is back at 10 (mcfbench.geometry.remeshing.RELAPSE)."""
+    from mcfbench.geometry.remeshing import RELAPSE, RemeshTrigger
+
+    def mesh(angle):
+        """A right-angled triangle whose smallest angle is ``angle`` degrees."""
+        return (np.array([[0.0, 0, 0], [1, 0, 0], [1, np.tan(np.radians(angle)), 0]]),
+                np.array([[0, 1, 2]]))
+
+    trigger = RemeshTrigger(10.0)
+    assert "smallest angle 5 degrees < 10" in trigger(*mesh(5.0), 0.0)
+    trigger.done(0.0, 4.0)
+    assert trigger.threshold == RELAPSE * 4.0 == 2.0
+    assert trigger(*mesh(3.0), 0.1) is None
+    assert "< 2" in trigger(*mesh(1.9), 0.2)
+    trigger.done(0.2, 30.0)
+    assert trigger.threshold == 10.0 and "< 10" in trigger(*mesh(9.0), 0.3)
