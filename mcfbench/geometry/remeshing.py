@@ -22,6 +22,26 @@ It is the input's mean edge on a uniform mesh; on the anisotropic sphere (edges
 ``angle`` degrees (a sliver before it folds), or a fixed interval of *time*
 ``every`` (not of steps: with ``tau ~ h^2``, a remesh every ``k`` steps is
 ``O(h^-2)`` remeshes whose ``O(h^2)`` projection errors add up to ``O(1)``).
+A remesh that could not lift the smallest angle to ``angle`` (the boundary's
+vertices are held, so a sliver on the boundary stays; a folded input stays folded)
+is not repeated until the smallest angle has fallen to :data:`RELAPSE` times what
+that remesh left: otherwise every step remeshes, each adding its projection error
+for no gain (on the raw corpus's flat strip ``narrow_triangles``, smallest angle
+0.03 degrees on its boundary: 37 remeshes in 37 steps, then a fold, where the
+schemes without remeshing reach the end).
+
+**What the compiled remesher is given** (:func:`remesh`). gpytoolbox's binding
+builds a half-edge structure and has no checks of its own beyond non-manifold
+edges: a non-finite coordinate, a non-manifold vertex, a duplicate or zero-area
+triangle or an unreferenced vertex can crash the process (two crashes, SIGSEGV and
+SIGABRT, in a survival pass). The input is checked first, by the intake's own
+:func:`mcfbench.geometry.mesh.validate_mesh`, and so is the output, and the arrays
+are passed as the binding wants them (contiguous ``float64`` and ``int32``); a
+bad one raises :class:`RemeshRefused` naming the problem, which the run reports
+(the driver ends it ``degenerated`` with that sentence) instead of a dead batch.
+Checking rather than isolating each call in a child process: a check costs
+milliseconds against a child's start and the copying of the mesh both ways, and
+it names the defect, where a crashed child only says that it died.
 """
 
 import math
@@ -31,6 +51,7 @@ import numpy as np
 from mcfbench.geometry import metrics
 from mcfbench.geometry.collapse import component_topology
 from mcfbench.geometry.measures import vertex_components
+from mcfbench.geometry.mesh import MeshError, validate_mesh
 from mcfbench.geometry.surface_distance import mean_surface_distance
 
 PASSES = 3
@@ -42,6 +63,12 @@ ANGLE = 10.0
 """Degrees: a mesh whose smallest angle is below this is remeshed (a fresh remesh
 has its smallest angle at 20-35 degrees; the registry's meshes start above 10
 except the slivered ones: the anisotropic sphere 2.8)."""
+
+
+RELAPSE = 0.5
+"""After a remesh that left the smallest angle below the trigger's ``angle``, the next
+quality remesh waits until the smallest angle is below this share of what it left
+(module docstring)."""
 
 
 def target_edge(vertices, faces):
@@ -56,6 +83,11 @@ def boundary_vertices(faces):
     edges, seen = np.unique(np.sort(F[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1),
                             axis=0, return_counts=True)
     return np.unique(edges[seen == 1])
+
+
+class RemeshRefused(ValueError):
+    """The remesher's input or output is not a valid surface (module docstring: what
+    the compiled remesher is given); the message names the problem."""
 
 
 def remesh(vertices, faces, h, passes=PASSES):
@@ -73,13 +105,34 @@ def remesh(vertices, faces, h, passes=PASSES):
     vertices : (n', 3) float array
         The boundary vertices first, in their input order, at their input positions.
     faces : (m', 3) int array
+
+    Raises
+    ------
+    RemeshRefused
+        The input is not a valid surface (:func:`~mcfbench.geometry.mesh.validate_mesh`:
+        non-finite coordinates, a repeated, duplicate or zero-area triangle, an
+        unreferenced vertex, a non-manifold edge or vertex, ...), ``h`` is not a
+        positive number or ``passes`` not a whole number >= 1, or the output is not
+        a valid surface; the compiled remesher is not called on a bad input.
     """
+    if not (np.isfinite(h) and h > 0) or int(passes) != passes or passes < 1:
+        raise RemeshRefused(f"the remesher needs an edge length > 0 and whole passes >= 1, "
+                            f"got h={h!r}, passes={passes!r}")
+    try:
+        V, F = validate_mesh(vertices, faces)
+    except MeshError as err:
+        raise RemeshRefused(f"the remesher refused its input ({err.kind}): {err}") from None
     import gpytoolbox  # on first use: the flows that never remesh do not load it
 
-    V = np.ascontiguousarray(vertices, dtype=np.float64)
-    F = np.ascontiguousarray(faces, dtype=np.int32)
-    fixed = boundary_vertices(F)
+    V = np.ascontiguousarray(V, dtype=np.float64)
+    F = np.ascontiguousarray(F, dtype=np.int32)
+    fixed = np.ascontiguousarray(boundary_vertices(F), dtype=np.int32)
     U, G = gpytoolbox.remesh_botsch(V, F, int(passes), float(h), True, feature=fixed)
+    try:
+        U, G = validate_mesh(U, G)
+    except MeshError as err:
+        raise RemeshRefused(f"the remesher's output is not a valid surface ({err.kind}): "
+                            f"{err}") from None
     return np.ascontiguousarray(U, dtype=float), np.ascontiguousarray(G, dtype=np.int64)
 
 
@@ -123,8 +176,9 @@ def remesh_change(before, after):
 
 
 class RemeshTrigger:
-    """When a run remeshes: the smallest angle below ``angle`` degrees, or ``every``
-    time units since the last remesh (module docstring).
+    """When a run remeshes: the smallest angle below ``angle`` degrees (or below
+    :data:`RELAPSE` times what the last remesh left, when that was below ``angle``),
+    or ``every`` time units since the last remesh (module docstring).
 
     Parameters
     ----------
@@ -139,17 +193,21 @@ class RemeshTrigger:
             raise ValueError(f"a remesh trigger needs angle >= 0 and every > 0 or None, got "
                              f"angle={angle!r}, every={every!r}")
         self.angle, self.every, self.last = float(angle), every, 0.0
+        self.threshold = self.angle
 
     def __call__(self, vertices, faces, t):
         """Why the state at time ``t`` is to be remeshed (a sentence), or None."""
         if self.every is not None and t - self.last >= self.every * (1 - 1e-9):
             return f"{t - self.last:.4g} time units since the last remesh"
-        if self.angle > 0:
+        if self.threshold > 0:
             smallest = metrics.min_angle(vertices, faces)
-            if smallest < self.angle:
-                return f"smallest angle {smallest:.3g} degrees < {self.angle:g}"
+            if smallest < self.threshold:
+                return f"smallest angle {smallest:.3g} degrees < {self.threshold:.3g}"
         return None
 
-    def done(self, t):
-        """A remesh happened at time ``t``."""
+    def done(self, t, min_angle=None):
+        """A remesh happened at time ``t``, leaving the smallest angle ``min_angle``
+        degrees (None: not known, the threshold stays ``angle``)."""
         self.last = t
+        self.threshold = self.angle if min_angle is None or min_angle >= self.angle \
+            else RELAPSE * float(min_angle)

@@ -75,8 +75,9 @@ class Trajectory:
         round (:mod:`mcfbench.geometry.collapse`): ``time`` the state's, ``kind``
         ``"point"`` or ``"circle"``, ``area`` and ``volume`` the component's then,
         ``extinction_time`` the state's time plus the time the round component
-        had left; one ``{"event": "remeshed", "step", "time", "why", ...}`` per remesh
-        (``remesh``'s :class:`~mcfbench.running.remeshing.Remesher`; the fields of
+        had left; one ``{"event": "remeshed", "step", "time", "why", "seconds", ...}``
+        per remesh (``remesh``'s :class:`~mcfbench.running.remeshing.Remesher`;
+        ``seconds`` the remesh's wall time; the fields of
         :func:`mcfbench.geometry.remeshing.remesh_change`: the distance between the
         surfaces before and after, the changes of area and volume, the vertex counts,
         whether the components or genus changed); one ``{"event": "surgery", "step",

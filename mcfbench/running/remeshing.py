@@ -85,7 +85,8 @@ class Remesher:
         The target edge length.
     calls : int
     seconds : float
-        Wall seconds spent remeshing and measuring the change.
+        Wall seconds spent remeshing and measuring the change (an event's
+        ``seconds``: the remesh alone, its checks included).
     """
 
     before_checks = False
@@ -107,11 +108,12 @@ class Remesher:
             return None
         start = time.perf_counter()
         U, G = remesh(V, F, self.h, self.passes)
+        seconds = time.perf_counter() - start
         event = {"event": "remeshed", "step": flow.n, "time": t, "why": why,
-                 **remesh_change((V, F), (U, G))}
+                 "seconds": seconds, **remesh_change((V, F), (U, G))}
         self.seconds += time.perf_counter() - start
         self.calls += 1
-        self.trigger.done(t)
+        self.trigger.done(t, event["min_angle_after"])
         return rebuilt_flow(self.scheme, flow, U, G, threads=self.threads,
                             **self.options), event
 

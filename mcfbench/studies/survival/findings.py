@@ -54,9 +54,35 @@ def findings(summary, plan):
     if thin is not None:
         lines.append(f"- **With thin features** (the flow pinches them; no scheme here goes "
                      f"through a pinch): {named(thin, 'thin_')}.")
+    lines += strategy_findings(summary, plan.get("strategies", []))
     median = np.nanmedian(summary["defect_fraction_median"]) \
         if np.isfinite(summary["defect_fraction_median"]).any() else np.nan
     if np.isfinite(median):
         lines.append(f"- The runs that did not reach the end broke down early: the median "
                      f"scheme's median first defect came at {median:.0%} of the final time.")
     return "\n".join(lines) + "\n"
+
+
+def strategy_findings(summary, strategies):
+    """One sentence per mesh strategy: on the meshes without thin features, for how many
+    schemes ``NAME+STRATEGY`` took more, fewer or as many meshes to the end as ``NAME``,
+    and the largest gain (read from the table's pairs,
+    :func:`mcfbench.studies.survival.tables.paired_rows`)."""
+    from mcfbench.studies.survival.tables import paired_rows
+
+    lines = []
+    for strategy in strategies:
+        diffs = [(name, int(rows["none"]["plain_reached"]), int(rows[strategy]["plain_reached"]))
+                 for name, rows in paired_rows(summary, [strategy])
+                 if rows[strategy] is not None and rows["none"]["plain_meshes"]
+                 and rows[strategy]["plain_meshes"] == rows["none"]["plain_meshes"]]
+        if not diffs:
+            continue
+        more = sum(b > a for _, a, b in diffs)
+        fewer = sum(b < a for _, a, b in diffs)
+        name, a, b = max(diffs, key=lambda d: d[2] - d[1])
+        gain = f"; the largest gain: {name} ({a} -> {b})" if b > a else ""
+        lines.append(f"- **+{strategy}** beside each scheme, without thin features: more "
+                     f"meshes taken to the end for {more} of {len(diffs)} schemes, fewer "
+                     f"for {fewer}, as many for {len(diffs) - more - fewer}{gain}.")
+    return lines

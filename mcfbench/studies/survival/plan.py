@@ -1,7 +1,32 @@
 """The plan of the survival study: the config key ``survival`` checked (:func:`plan`) and
-one run-store spec per readable raw mesh and scheme (:func:`survival_specs`)."""
+one run-store spec per readable raw mesh and scheme (:func:`survival_specs`).
+
+Every scheme is run as it is and with each mesh strategy of ``strategies`` (default
+``[remesh]``: issue #44 asks for every scheme with and without remeshing), the
+variant ``NAME+STRATEGY`` right after ``NAME`` (:func:`paired_schemes`); the tables
+show them side by side (:func:`mcfbench.studies.survival.tables.paired_markdown`).
+"""
 
 from mcfbench.studies.config import ConfigError, check_mesh_runs, listed
+
+STRATEGIES = ("remesh",)
+"""The mesh strategies every scheme of the study is also run with by default."""
+
+
+def paired_schemes(schemes, strategies):
+    """``schemes`` with ``NAME+STRATEGY`` after each ``NAME`` that has no strategy yet,
+    for every strategy of ``strategies`` (in order; a name given twice once).
+
+    Examples
+    --------
+    >>> paired_schemes(["bgn", "mdr+remesh"], ["remesh"])
+    ['bgn', 'bgn+remesh', 'mdr+remesh']
+    """
+    out = []
+    for name in schemes:
+        variants = [name] if "+" in name else [name, *(f"{name}+{s}" for s in strategies)]
+        out += [v for v in variants if v not in out]
+    return out
 
 
 def plan(section=None):
@@ -11,16 +36,19 @@ def plan(section=None):
     ----------
     section : dict, optional
         ``schemes``, ``C``, ``steps``, ``solver``, ``rtol``, ``maxiter``
-        (:func:`mcfbench.studies.config.check_mesh_runs`) and ``meshes`` ("all" or
-        names of the raw corpus).
+        (:func:`mcfbench.studies.config.check_mesh_runs`), ``meshes`` ("all" or
+        names of the raw corpus) and ``strategies`` (mesh strategies of
+        :data:`mcfbench.running.scheme.MESH_STRATEGIES` every scheme is also run
+        with; default :data:`STRATEGIES`, ``[]`` for none, ``all`` for every one).
 
     Returns
     -------
     dict
-        Those settings and ``meshes``: name -> ``{"file", "sha256", "thin_features",
-        "kind"}`` of the chosen meshes that the intake reads (the refused ones name
-        their defect in the manifest: the intake's verdict, not a run's), and
-        ``refused``: their names.
+        Those settings (``schemes`` with their variants, :func:`paired_schemes`),
+        ``strategies`` (list) and ``meshes``: name -> ``{"file", "sha256",
+        "thin_features", "kind"}`` of the chosen meshes that the intake reads (the
+        refused ones name their defect in the manifest: the intake's verdict, not a
+        run's), and ``refused``: their names.
 
     Raises
     ------
@@ -28,10 +56,17 @@ def plan(section=None):
         A bad value, or a mesh name not in the corpus, naming the key.
     """
     from mcfbench.geometry.committed_meshes import RAW_DIR, raw_manifest
+    from mcfbench.running.scheme import MESH_STRATEGIES
 
     section = dict(section or {})
     chosen = section.pop("meshes", "all")
+    strategies = listed(section.pop("strategies", list(STRATEGIES)), MESH_STRATEGIES)
+    bad = [s for s in strategies if s not in MESH_STRATEGIES]
+    if bad:
+        raise ConfigError(f"config key 'survival.strategies': unknown mesh strategy(ies) "
+                          f"{bad}; choose among {', '.join(MESH_STRATEGIES)}")
     settings = check_mesh_runs(section, "survival")
+    settings["schemes"] = paired_schemes(settings["schemes"], strategies)
     manifest = raw_manifest()
     names = listed(chosen, manifest)
     unknown = [n for n in names if n not in manifest]
@@ -39,7 +74,7 @@ def plan(section=None):
         raise ConfigError(f"config key 'survival.meshes': unknown mesh(es) {unknown}; the "
                           f"raw corpus (mcfbench/data/raw_meshes) has {', '.join(manifest)}")
     read = [n for n in names if manifest[n]["intake"] == "read"]
-    return {**settings,
+    return {**settings, "strategies": strategies,
             "meshes": {n: {"file": str(RAW_DIR / manifest[n]["file"]),
                            "sha256": manifest[n]["sha256"],
                            "thin_features": bool(manifest[n]["thin_features"]),

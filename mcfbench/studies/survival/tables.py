@@ -110,4 +110,38 @@ def survival_markdown(summary, plan):
              "invariants (the area never grows, no fold) holding at every step. Thin "
              "features: the corpus manifest's verdict (share of area thinner than 2 h "
              "above 2 %), decided before any run."]
-    return f"# Survival on raw meshes\n\n{markdown(Table.of_frame(view, notes=notes))}\n"
+    paired = paired_markdown(summary, plan.get("strategies", []))
+    return (f"# Survival on raw meshes\n\n{markdown(Table.of_frame(view, notes=notes))}\n"
+            + (f"\n## Every scheme beside its variants\n\n{paired}\n" if paired else ""))
+
+
+def paired_rows(summary, strategies):
+    """``[(scheme, {strategy or "none": row of summary or None})]``: every scheme that
+    has no strategy in its name, with its ``NAME+STRATEGY`` rows (None when not run)."""
+    rows = {r["scheme"]: r for _, r in summary.iterrows()}
+    return [(name, {"none": row, **{s: rows.get(f"{name}+{s}") for s in strategies}})
+            for name, row in rows.items() if "+" not in name]
+
+
+def paired_markdown(summary, strategies):
+    """Every scheme beside its variants ``NAME+STRATEGY`` (issue #44: every scheme with
+    and without remeshing): the meshes taken to the end without and with thin features,
+    one column per strategy; ``""`` without strategies."""
+    if not strategies:
+        return ""
+
+    def count(row, prefix):
+        if row is None:
+            return "not run"
+        k, n = row[f"{prefix}reached"], row[f"{prefix}meshes"]
+        return f"{k}/{n}" if n else "–"
+
+    kinds = ["none", *strategies]
+    header = ["scheme", *(f"{k if k == 'none' else '+' + k}, {part}"
+                          for part in ("without thin features", "with thin features")
+                          for k in kinds)]
+    cells = [[name, *(count(rows[k], prefix) for prefix in ("plain_", "thin_") for k in kinds)]
+             for name, rows in paired_rows(summary, strategies)]
+    notes = ["Meshes taken to the end (reached / run) by each scheme as it is (none) and "
+             "with each mesh strategy (NAME+STRATEGY), on the same meshes and settings."]
+    return markdown(Table(header, cells, notes=notes))

@@ -22,9 +22,12 @@ def test_the_plan_takes_the_meshes_the_intake_reads():
     read = [n for n, m in manifest.items() if m["intake"] == "read"]
     assert list(plan["meshes"]) == read and len(read) >= 30
     assert plan["refused"] == [n for n in manifest if n not in read]
-    assert plan["schemes"] == list(SCHEMES) and (plan["C"], plan["steps"]) == (0.1, 40)
+    # every scheme, each beside its remeshed variant (issue #44)
+    assert plan["schemes"] == [n for s in SCHEMES for n in (s, f"{s}+remesh")]
+    assert plan["strategies"] == ["remesh"] and (plan["C"], plan["steps"]) == (0.1, 40)
     assert {m["thin_features"] for m in plan["meshes"].values()} == {True, False}
-    specs = survival_plan.survival_specs(survival_plan.plan({"schemes": ["cotan", "bgn"]}))
+    specs = survival_plan.survival_specs(survival_plan.plan({"schemes": ["cotan", "bgn"],
+                                                             "strategies": []}))
     assert len(specs) == 2 * len(read)
     spec = specs[("drop", "bgn")]
     assert spec.mesh_sha256 == manifest["drop"]["sha256"] and spec.steps == 40
@@ -37,6 +40,7 @@ def test_the_plan_takes_the_meshes_the_intake_reads():
     ({"C": 0}, "'survival.C': must be > 0"),
     ({"steps": 0}, "'survival.steps': must be >= 1"),
     ({"solver": "nonesuch"}, "'survival.solver': unknown solver"),
+    ({"strategies": ["nonesuch"]}, "'survival.strategies': unknown mesh strategy"),
 ])
 def test_a_bad_key_is_named(section, message):
     with pytest.raises(ConfigError, match=message):
@@ -79,6 +83,32 @@ def test_the_tables_count_reached_runs_by_thin_features():
         "the end by x (2 of 2, 100 %): it meets the target of 90%." in words
     assert "**With thin features** (the flow pinches them; no scheme here goes through a " \
         "pinch): y (1 of 1, 100 %)." in words
+
+
+def test_every_scheme_is_paired_with_its_variants_once():
+    chosen = survival_plan.plan({"schemes": ["bgn", "mdr+remesh", "mdr", "bgn"],
+                                 "strategies": ["remesh", "surgery"]})["schemes"]
+    assert chosen == ["bgn", "bgn+remesh", "bgn+surgery", "mdr+remesh", "mdr", "mdr+surgery"]
+    assert survival_plan.plan({"schemes": "cotan", "strategies": []})["schemes"] == ["cotan"]
+
+
+def test_the_paired_table_and_findings_show_each_scheme_beside_its_remeshed_variant():
+    records = [("a", _record("x", "inverted", 2, 0.02)), ("b", _record("x", "ok", 40)),
+               ("c", _record("x", "inverted", 1, 0.01)),
+               ("a", _record("x+remesh", "ok", 40)), ("b", _record("x+remesh", "ok", 40)),
+               ("c", _record("x+remesh", "inverted", 3, 0.03)),
+               ("a", _record("y", "ok", 40)), ("b", _record("y", "ok", 40)),
+               ("c", _record("y", "ok", 40))]
+    summary = survival_tables.survival_table(survival_tables.runs_table(records, MESHES),
+                                             ["x", "x+remesh", "y"])
+    text = survival_tables.paired_markdown(summary, ["remesh"])
+    assert "| scheme | none, without thin features | +remesh, without thin features | "         "none, with thin features | +remesh, with thin features |" in text
+    assert "| x | 1/2 | 2/2 | 0/1 | 0/1 |" in text
+    assert "| y | 2/2 | not run | 1/1 | not run |" in text
+    assert survival_tables.paired_markdown(summary, []) == ""
+    words = survival_findings.findings(summary, {"meshes": MESHES, "steps": 40, "C": 0.1,
+                                                 "strategies": ["remesh"]})
+    assert "**+remesh** beside each scheme, without thin features: more meshes taken to "         "the end for 1 of 1 schemes, fewer for 0, as many for 0; the largest gain: x "         "(1 -> 2)." in words
 
 
 def test_a_study_is_its_folder_its_rule_file_and_its_config_key():
