@@ -11,7 +11,7 @@ from mcfbench.geometry.spheres import icosphere
 from mcfbench.running import continuation
 from mcfbench.running.continuation import (MAX_REMOVED_SHARE, STATE_ONLY, exceeded,
                                            sub_flow, sub_mesh, why_not)
-from mcfbench.running.surgery import neck_surgery
+from mcfbench.running.surgery import ESCAPED_RESOLUTION, escaped_t_vertices, neck_surgery
 from mcfbench.running.driver import simulate
 from mcfbench.running.problems import Problem, get_problem
 from mcfbench.running.run import run
@@ -197,3 +197,22 @@ def test_a_run_whose_cuts_remove_too_much_does_not_reach_its_end(monkeypatch):
     result, _ = run("cotan+surgery", problem, 1)
     assert result.status == "ok" and result.removed_area_share > 1e-4
     assert result.surgery_exceeded
+
+
+def test_ddfv_t_vertices_out_of_the_necks_triangles_have_the_neck_cut_earlier():
+    """DDFV chord's uncarried T-vertices leave the neck's triangles at step 26 (level 1,
+    the neck's radius 0.10 = 0.9 h): all of them in the part the cut removes, so the neck
+    is cut then (below ESCAPED_RESOLUTION h, not h / 2) and the run goes on to both bulbs'
+    extinction; without the rule it ends t_escaped at step 26."""
+    problem = get_problem("dumbbell").with_settings(to_extinction=True, t_final=0.3)
+    result, traj = run("ddfv-chord+surgery", problem, 1, save_every=0)
+    cut, *extinct = traj.events
+    assert result.status == "extinct", result.message
+    assert cut["step"] == 26 and cut["why"].startswith("T-vertices out of their triangles")
+    assert 0.5 * result.h < cut["neck_radius"] < ESCAPED_RESOLUTION * result.h
+    assert [e["event"] for e in extinct] == ["extinct", "extinct"]
+    assert 0.0 < result.metrics["extinction_time_error"] < 0.06        # 0.0461
+    assert result.removed_area_share < MAX_REMOVED_SHARE               # 6.4e-3
+    V, F = get_problem("dumbbell").mesh(1)
+    assert len(escaped_t_vertices(SCHEMES["cotan"].make(V, F, 0.004))) == 0
+    assert len(escaped_t_vertices(SCHEMES["ddfv-chord"].make(V, F, 0.004))) == 0
