@@ -1,4 +1,4 @@
-"""The dumbbell through its pinch in the matrix (issue #45): every scheme run as
+"""The matrix's plan of the dumbbell through its pinch (issue #45): every scheme run as
 NAME+surgery and filed under NAME."""
 
 import pytest
