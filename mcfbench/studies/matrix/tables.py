@@ -266,11 +266,12 @@ def levels_text(levels):
 
 
 def breakdown_text(status, t_failed, level=None):
-    """``"t_escaped at t = 0.052 (level 3)"``."""
+    """``"t_escaped at t = 0.052 (level 3)"``; ``"extinct"`` for a row whose runs all
+    reached the flow's end (no level failed)."""
     text = str(status)
     if t_failed is not None and np.isfinite(t_failed):
         text += f" at t = {t_failed:.4g}"
-    if level is not None:
+    if level is not None and np.isfinite(level):
         text += f" (level {int(level)})"
     return text
 

@@ -57,3 +57,13 @@ def test_the_section_says_who_goes_through(table):
     assert "### pinch" in text and "1 of the 3 schemes go through at every level (cotan)" in text
     assert "ddfv (L1 t_escaped, L2 t_escaped, L3 t_escaped)" in text
     assert "| cotan | 3 | +0.0049 | 1.67 | +0.0091 | 1.98 |" in text
+
+
+def test_a_summary_row_whose_runs_all_went_extinct_reads_extinct():
+    """The summary's cell of a series that reached the flow's end at every level (status
+    ``extinct``, no level failed) names it instead of a breakdown (it raised on the NaN
+    level before)."""
+    from mcfbench.studies.matrix.tables import breakdown_text
+
+    assert breakdown_text("extinct", np.nan, np.nan) == "extinct"
+    assert breakdown_text("t_escaped", 0.052, 3.0) == "t_escaped at t = 0.052 (level 3)"
