@@ -76,8 +76,9 @@ def neck_surgery(scheme, flow, *, h, integrator=None, threads=1, **options):
     """
     V, F = np.asarray(flow.vertices), np.asarray(flow.faces)
     neck = find_neck(V, F)
-    escaped = escaped_t_vertices(flow)
-    early = not pinched(neck, h) and len(escaped) and pinched(neck, h, ESCAPED_RESOLUTION)
+    early = not pinched(neck, h) and pinched(neck, h, ESCAPED_RESOLUTION)
+    escaped = escaped_t_vertices(flow) if early else None      # asked near a pinch only
+    early = early and len(escaped) > 0
     if not (pinched(neck, h) or early):
         return None
     reason = why_not(scheme, integrator)
