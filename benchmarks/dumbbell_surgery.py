@@ -5,7 +5,7 @@ axisymmetric reference continued through the pinch (``problems/dumbbell.py``).
     python benchmarks/dumbbell_surgery.py                        # levels 1-2, 3 schemes
     python benchmarks/dumbbell_surgery.py --levels 1 2 3 --schemes cotan+surgery
 
-Prints one row per run: status, the cut (time, neck radius, area share removed), the
+Prints one row per run: status (and the time of a breakdown), the cut (time, neck radius, area share removed), the
 relative errors of the pinch time (the cut's ``t + r^2 / 2``), of the bulbs' extinction
 time (the last component's) and of one bulb's volume at t = 0.12, 0.16, 0.2 (the larger
 of the two bulbs' errors), and the CPU seconds. A run whose solver fails is continued
@@ -62,6 +62,8 @@ def row(scheme, level):
     cut = (f"{cuts[0]['time']:.4f} {cuts[0]['neck_radius']:.4f} {len(cuts)}" if cuts
            else "-")
     status = result.status + (" (robust)" if robust else "")
+    if result.status not in ("ok", "extinct"):
+        status += f" t={result.t_failed:.4g}"
     return (f"{scheme:28s} {level:2d} {result.nF:6d} {status:20s} "
             f"{cut:>22s} {result.removed_area_share:9.2e} "
             f"{m.get('pinch_time_error', np.nan):+9.4f} "

@@ -19,9 +19,15 @@ current state alone; :func:`why_not` names the others, whose runs end
 - an integrator with past states (BDF2, BDF3: ``X^{n-1}, ...`` of the vanished
   vertices, in each flow's own numbering).
 
+A run of ``NAME+remesh`` or ``NAME+surgery`` is none of those: it restarts its scheme
+at every change of its mesh (:mod:`mcfbench.running.remeshing`'s rule: the integrator
+from its first step, the initial-state strategies from the new surface), a vanished
+component's as a remesh's or a cut's.
+
 A run of ``NAME+surgery`` (:attr:`mcfbench.running.scheme.Scheme.mesh_strategy`)
-goes on through a neck pinch the same way (:func:`mcfbench.running.surgery.neck_surgery`,
-the driver's mesh hook :class:`mcfbench.running.surgery.Surgeon`): once a neck's
+goes on through a neck pinch the same way, every scheme restarted as after a remesh
+(:func:`mcfbench.running.surgery.neck_surgery`, the driver's mesh hook
+:class:`mcfbench.running.surgery.Surgeon`): once a neck's
 radius falls below half the run's resolution
 (:func:`mcfbench.geometry.mesh_surgery.pinched`), the neck is cut and both sides
 capped (:func:`mcfbench.geometry.mesh_surgery.cut_neck`) and the scheme's flow is
@@ -51,7 +57,8 @@ rebuilt flow reads from ``T0``."""
 
 
 def why_not(scheme, integrator=None):
-    """Why a run of ``scheme`` cannot go on without a vanished component, or None.
+    """Why a run of ``scheme`` cannot go on without a vanished component, or None
+    (always None for a ``NAME+STRATEGY``: module docstring).
 
     Parameters
     ----------
@@ -63,6 +70,8 @@ def why_not(scheme, integrator=None):
     -------
     str or None
     """
+    if scheme.mesh_strategy != "none":     # restarted at every change of its mesh
+        return None
     integrator = scheme.integrator if integrator is None else integrator
     if scheme.tangential not in STATE_ONLY:
         return (f"{scheme.name}'s tangential strategy {scheme.tangential!r} keeps something "

@@ -12,6 +12,7 @@ from pathlib import Path
 
 from mcfbench.geometry import metrics as _metrics
 from mcfbench.running import observers as _observers
+from mcfbench.running.scheme import MESH_STRATEGIES
 
 KINDS = {
     "exact": "a mesh the suite makes well of a surface whose flow has an exact answer",
@@ -66,7 +67,14 @@ class Problem:
         Runs may go past ``t_max`` to the flow's end: they end ``extinct`` when the
         surface vanishes round (:mod:`mcfbench.geometry.collapse`), e.g.
         ``get_problem("sphere").with_settings(to_extinction=True, t_final=0.3)``.
-        Off in every registry entry: their metrics are measured at ``t_final``.
+        On only where the problem's runs go on past a singularity
+        (``mesh_strategy``); elsewhere the metrics are measured at ``t_final``.
+    mesh_strategy : str
+        ``"none"``, or a key of :data:`mcfbench.running.scheme.MESH_STRATEGIES` that
+        every run of the problem takes: the matrix runs each scheme ``NAME`` as
+        ``NAME+STRATEGY`` and files the run under ``NAME``
+        (:func:`mcfbench.studies.matrix.plan.run_scheme`): the dumbbell through its
+        pinch (``"surgery"``).
     reference : dict
         Reference values of a problem without a closed-form answer, from the
         axisymmetric meridian solver on fine meshes with Richardson
@@ -109,6 +117,7 @@ class Problem:
     exact: str = ""
     t_max: float | None = None
     to_extinction: bool = False
+    mesh_strategy: str = "none"
     reference: dict = field(default_factory=dict, compare=False)
     description: str = field(default="", compare=False)
     main_metric: str | None = field(default=None, compare=False)
@@ -121,6 +130,10 @@ class Problem:
         if self.kind not in KINDS:
             raise ValueError(f"problem {self.name!r}: unknown kind {self.kind!r}; choose one "
                              f"of {', '.join(KINDS)}")
+        if self.mesh_strategy != "none" and self.mesh_strategy not in MESH_STRATEGIES:
+            raise ValueError(f"problem {self.name!r}: unknown mesh strategy "
+                             f"{self.mesh_strategy!r}; choose none or one of "
+                             f"{', '.join(MESH_STRATEGIES)}")
         if not self.name or any(c in self.name for c in "/@ "):
             raise ValueError(f"problem {self.name!r}: a name is a non-empty word without "
                              "'/', '@' or spaces (it is a folder of the results)")

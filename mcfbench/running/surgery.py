@@ -25,10 +25,35 @@ from mcfbench.geometry.mesh_surgery import NECK_RESOLUTION, cut_neck, find_neck,
 from mcfbench.running.continuation import why_not
 
 
+ESCAPED_RESOLUTION = 2.0
+"""A neck below this many times the resolution ``h`` is cut before it is below ``h / 2``
+when DDFV's T-vertices have left their triangles there, all of them in the triangles the
+cut removes (:func:`neck_surgery`): the uncarried variants' T-vertices leave the neck's
+triangles when its radius is 0.9 h (level 1) to 1.4 h (level 2), before the cut
+(``mcfbench/README.md``)."""
+
+
+def escaped_t_vertices(flow):
+    """The triangles whose T-vertex's projection has left them (a negative barycentric
+    coordinate, DDFV's ``t_escaped``; Section 2.2.2), an empty array for a flow without
+    T-vertices.
+
+    Returns
+    -------
+    (k,) int array
+    """
+    barycentric = getattr(flow, "barycentric", None)
+    if barycentric is None:
+        return np.zeros(0, int)
+    return np.flatnonzero(~(np.asarray(barycentric).min(axis=1) >= 0.0))
+
+
 def neck_surgery(scheme, flow, *, h, integrator=None, threads=1, **options):
     """The cut of a ``NAME+surgery`` run (:class:`Surgeon`'s): None while no neck of
-    ``flow``'s mesh has pinched (below ``h / 2``), else the cut and the flow of
-    ``scheme`` rebuilt on the operated mesh at the same time level (module docstring).
+    ``flow``'s mesh has pinched (below ``h / 2``, or below :data:`ESCAPED_RESOLUTION`
+    ``h`` with T-vertices out of their triangles in the part the cut removes and
+    nowhere else), else the cut and the flow of ``scheme`` rebuilt on the operated mesh
+    at the same time level (module docstring).
 
     Parameters
     ----------
@@ -51,11 +76,16 @@ def neck_surgery(scheme, flow, *, h, integrator=None, threads=1, **options):
     """
     V, F = np.asarray(flow.vertices), np.asarray(flow.faces)
     neck = find_neck(V, F)
-    if not pinched(neck, h):
+    early = not pinched(neck, h) and pinched(neck, h, ESCAPED_RESOLUTION)
+    escaped = escaped_t_vertices(flow) if early else None      # asked near a pinch only
+    early = early and len(escaped) > 0
+    if not (pinched(neck, h) or early):
         return None
     reason = why_not(scheme, integrator)
     if reason is None:
         cut, reason = cut_neck(V, F, neck)
+    if early and (reason or cut.keep_faces[escaped].any()):
+        return None           # not all in the neck's thin part: the state's checks say so
     if reason:
         raise ValueError(f"the neck at {np.round(V[neck.vertex], 4).tolist()} (radius "
                          f"{neck.radius:.3g} < {NECK_RESOLUTION:g} h = "
@@ -124,6 +154,9 @@ class Surgeon:
             "event": "surgery", "step": flow.n, "time": t,
             "where": [float(x) for x in cut.where], "neck_radius": cut.radius,
             "pinch_time": t + cut.radius ** 2 / 2.0,
+            "why": (f"neck radius below {NECK_RESOLUTION:g} h" if cut.radius < NECK_RESOLUTION
+                    * self.h else f"T-vertices out of their triangles in the neck (radius "
+                    f"below {ESCAPED_RESOLUTION:g} h)"),
             "components_before": cut.components_before,
             "components_after": cut.components_after, "area_removed": cut.area_removed,
             "volume_removed": cut.volume_removed, "band_area": cut.band_area,

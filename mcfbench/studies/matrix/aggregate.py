@@ -7,7 +7,7 @@ from mcfbench.presentation.formats import tex_escape
 from mcfbench.presentation.tables import Table, csv, latex, markdown
 from mcfbench.storage.run_store import STORE, read_runs
 from mcfbench.studies.matrix import reference_accuracies
-from mcfbench.studies.matrix.plan import solver_method
+from mcfbench.studies.matrix.plan import matrix_scheme, solver_method
 from mcfbench.studies.matrix.tables import (
     BELOW_ACCURACY,
     FLOAT_FORMAT,
@@ -79,7 +79,10 @@ def aggregate(expected, plan, out_dir, root=STORE):
     """The records of every planned run (``expected``: spec -> code digest; a bad or
     stale record refused, :func:`mcfbench.storage.run_store.read_runs`; ``root``: the
     run store) into the long table and its views (:func:`write_tables`); returns
-    ``(table, summary)``."""
-    table = long_table(list(read_runs(expected, root=root).values()), plan["schemes"],
+    ``(table, summary)``. A run of ``NAME+STRATEGY`` on a problem whose runs all take
+    that strategy is ``NAME``'s (:func:`~mcfbench.studies.matrix.plan.matrix_scheme`)."""
+    records = [{**r, "scheme": matrix_scheme(r["scheme"], r["problem"])}
+               for r in read_runs(expected, root=root).values()]
+    table = long_table(records, plan["schemes"],
                        list(plan["problems"]), reference_accuracies(plan))
     return table, write_tables(table, out_dir, plan)

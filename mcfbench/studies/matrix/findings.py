@@ -16,6 +16,7 @@ import numpy as np
 from mcfbench.presentation.formats import formatted
 from mcfbench.presentation.tables import Table, markdown
 from mcfbench.studies.matrix import mesh_problems
+from mcfbench.studies.matrix.singularities import singularity_section
 from mcfbench.studies.matrix.tables import (
     BELOW_ACCURACY,
     is_error,
@@ -193,6 +194,7 @@ def matrix_findings(table, summary=None, labels=None, mesh_problems=(),
     if work_precision:
         lines += work_precision_section(work_precision)
     lines += real_mesh_section(summary, verdict, problems, schemes)
+    lines += singularity_section(table)
     lines += tangential_lines(table, summary, problems, schemes)
     solver = summary[[bool(fixed) for fixed in summary["solver_only"]]]
     if len(solver):

@@ -190,13 +190,38 @@ def solver_method(plan, problem):
     return own or (plan["mesh_solver"] if is_mesh_problem(problem) else plan["solver"])
 
 
+def run_scheme(scheme, problem):
+    """The scheme name a run of ``scheme`` on ``problem`` takes: ``NAME+STRATEGY`` on a
+    problem whose runs take a mesh strategy (its ``mesh_strategy``: the dumbbell through
+    its pinch, ``NAME+surgery``) when the name has none, else ``scheme``; the tables
+    file it under ``scheme`` (:func:`matrix_scheme`)."""
+    from mcfbench.running.problems import get_problem
+    from mcfbench.running.scheme import parse_name
+
+    problem = get_problem(problem) if isinstance(problem, str) else problem
+    if problem.mesh_strategy == "none" or parse_name(scheme).strategy != "none":
+        return scheme
+    return f"{scheme}+{problem.mesh_strategy}"
+
+
+def matrix_scheme(scheme, problem):
+    """The matrix's name of a run's ``scheme`` on ``problem``: :func:`run_scheme`
+    undone (``cotan+surgery`` on the dumbbell through its pinch is ``cotan``'s row)."""
+    from mcfbench.running.problems import get_problem
+
+    strategy = get_problem(problem).mesh_strategy
+    suffix = f"+{strategy}"
+    return scheme[:-len(suffix)] if strategy != "none" and scheme.endswith(suffix) else scheme
+
+
 def matrix_spec(plan, scheme, problem, level):
     """The spec of one run: the problem's own time rule (:func:`mcfbench.running.batch.spec_of`),
     its solver (:func:`solver_method`, the plan's ``rtol`` and ``maxiter``), one
-    thread, the first and the last frame."""
+    thread, the first and the last frame; the scheme the problem's mesh strategy's
+    (:func:`run_scheme`)."""
     from mcfbench.running.batch import spec_of
 
-    return spec_of(scheme, problem, level,
+    return spec_of(run_scheme(scheme, problem), problem, level,
                    solver={"method": solver_method(plan, problem), "rtol": plan["rtol"],
                            "maxiter": plan["maxiter"]})
 

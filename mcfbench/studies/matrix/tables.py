@@ -199,10 +199,10 @@ def main_runs(table, problem):
 def solver_only(row):
     """A run (a row of the long table) that ended with a ``solver_*`` status whose
     re-run with the robust solver finished: the failure is the solver's, not the
-    scheme's."""
-    from mcfbench.storage.statuses import SOLVER_STATUSES
+    scheme's (the re-run reaching its end, the flow's extinction included)."""
+    from mcfbench.storage.statuses import REACHED, SOLVER_STATUSES
 
-    return row["status"] in SOLVER_STATUSES and row.get("robust_status", "") == "ok"
+    return row["status"] in SOLVER_STATUSES and row.get("robust_status", "") in REACHED
 
 
 def _ordered(table, schemes, problems):

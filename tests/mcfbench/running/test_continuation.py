@@ -11,7 +11,7 @@ from mcfbench.geometry.spheres import icosphere
 from mcfbench.running import continuation
 from mcfbench.running.continuation import (MAX_REMOVED_SHARE, STATE_ONLY, exceeded,
                                            sub_flow, sub_mesh, why_not)
-from mcfbench.running.surgery import neck_surgery
+from mcfbench.running.surgery import ESCAPED_RESOLUTION, escaped_t_vertices, neck_surgery
 from mcfbench.running.driver import simulate
 from mcfbench.running.problems import Problem, get_problem
 from mcfbench.running.run import run
@@ -136,16 +136,22 @@ def test_the_flow_is_rebuilt_on_the_cut_mesh_at_its_time_level(pinched_dumbbell,
         assert np.linalg.norm(T - centroid, axis=1).max() < h
 
 
-def test_a_scheme_that_cannot_be_rebuilt_ends_at_the_pinch_saying_why(pinched_dumbbell):
+def test_a_surgery_run_restarts_every_scheme_as_a_remesh_does(pinched_dumbbell):
+    """A scheme that keeps something of its initial state (DeTurck's map onto the initial
+    mesh) or past states (BDF2) takes the operated surface as its initial one, as after a
+    remesh, and goes on to both bulbs' extinction; the plain scheme still cannot drop a
+    vanished component."""
     V, F, h = pinched_dumbbell
+    assert why_not(get_scheme("cotan@bdf2+surgery")) is None
+    assert why_not(get_scheme("deturck+surgery")) is None and why_not(get_scheme("deturck"))
     entry = get_scheme("cotan@bdf2+surgery")
-    with pytest.raises(ValueError, match="bdf2 integrator's past states"):
-        neck_surgery(entry, entry.make(V, F, 0.004), h=h, integrator="bdf2")
+    cut, new = neck_surgery(entry, entry.make(V, F, 0.004), h=h, integrator="bdf2")
+    assert cut.components_after == 2 and len(new.vertices) == len(cut.vertices)
     problem = get_problem("dumbbell").with_settings(to_extinction=True, t_final=0.3)
-    result, traj = run("cotan@bdf2+surgery", problem, 1, save_every=0)
-    assert result.status == "degenerated" and "a neck pinched and the run cannot go on" \
-        in result.message and "past states" in result.message
-    assert not traj.surgeries
+    result, traj = run("deturck+surgery", problem, 1, save_every=0)
+    assert result.status == "extinct", result.message
+    assert [e["event"] for e in traj.events] == ["surgery", "extinct", "extinct"]
+    assert 0.0 < result.metrics["extinction_time_error"] < 0.06         # 0.0436
 
 
 def test_cotan_surgery_goes_through_the_dumbbell_pinch_to_both_bulbs_extinction(
@@ -191,3 +197,22 @@ def test_a_run_whose_cuts_remove_too_much_does_not_reach_its_end(monkeypatch):
     result, _ = run("cotan+surgery", problem, 1)
     assert result.status == "ok" and result.removed_area_share > 1e-4
     assert result.surgery_exceeded
+
+
+def test_ddfv_t_vertices_out_of_the_necks_triangles_have_the_neck_cut_earlier():
+    """DDFV chord's uncarried T-vertices leave the neck's triangles at step 26 (level 1,
+    the neck's radius 0.10 = 0.9 h): all of them in the part the cut removes, so the neck
+    is cut then (below ESCAPED_RESOLUTION h, not h / 2) and the run goes on to both bulbs'
+    extinction; without the rule it ends t_escaped at step 26."""
+    problem = get_problem("dumbbell").with_settings(to_extinction=True, t_final=0.3)
+    result, traj = run("ddfv-chord+surgery", problem, 1, save_every=0)
+    cut, *extinct = traj.events
+    assert result.status == "extinct", result.message
+    assert cut["step"] == 26 and cut["why"].startswith("T-vertices out of their triangles")
+    assert 0.5 * result.h < cut["neck_radius"] < ESCAPED_RESOLUTION * result.h
+    assert [e["event"] for e in extinct] == ["extinct", "extinct"]
+    assert 0.0 < result.metrics["extinction_time_error"] < 0.06        # 0.0461
+    assert result.removed_area_share < MAX_REMOVED_SHARE               # 6.4e-3
+    V, F = get_problem("dumbbell").mesh(1)
+    assert len(escaped_t_vertices(SCHEMES["cotan"].make(V, F, 0.004))) == 0
+    assert len(escaped_t_vertices(SCHEMES["ddfv-chord"].make(V, F, 0.004))) == 0

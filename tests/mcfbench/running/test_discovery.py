@@ -78,10 +78,10 @@ def test_the_builtins_come_in_their_documented_order():
                         "kll")]
     assert list(SCHEMES)[:2] == ["ddfv", "ddfv-chord"] and list(SCHEMES)[-1] == "kll"
     names = list(problems.PROBLEMS)
-    assert names[:7] == ["sphere", "catenoid", "hemisphere", "torus", "dumbbell", "angenent",
-                         "enneper"]
-    assert {problems.PROBLEMS[n].module for n in names[13:]} == {"mcfbench.problems.real_meshes"}
-    assert all(problems.PROBLEMS[n].module == f"mcfbench.problems.{n}" for n in names[:13])
+    assert names[:8] == ["sphere", "catenoid", "hemisphere", "torus", "dumbbell",
+                         "dumbbell_through_pinch", "angenent", "enneper"]
+    assert {problems.PROBLEMS[n].module for n in names[14:]} == {"mcfbench.problems.real_meshes"}
+    assert all(problems.PROBLEMS[n].module == f"mcfbench.problems.{n}" for n in names[:14])
 
 
 def test_a_module_that_declares_nothing_is_refused(tmp_path, monkeypatch):
