@@ -52,11 +52,35 @@ def findings(summary, plan):
         lines.append(f"- **The best DDFV variant** there: {named(top, 'plain_')}.")
     thin = best(summary, "thin_share")
     if thin is not None:
-        lines.append(f"- **With thin features** (the flow pinches them; no scheme here goes "
-                     f"through a pinch): {named(thin, 'thin_')}.")
+        lines.append(f"- **With thin features** (the flow pinches them): "
+                     f"{named(thin, 'thin_')}.")
+    lines += through(summary)
     median = np.nanmedian(summary["defect_fraction_median"]) \
         if np.isfinite(summary["defect_fraction_median"]).any() else np.nan
     if np.isfinite(median):
         lines.append(f"- The runs that did not reach the end broke down early: the median "
                      f"scheme's median first defect came at {median:.0%} of the final time.")
     return "\n".join(lines) + "\n"
+
+
+def through(summary):
+    """The findings' lines on the ``NAME+surgery`` schemes (the continuation through a
+    neck pinch and the thin parts' singularities): which took meshes with thin features
+    to the end, and which none; nothing when the study ran none."""
+    from mcfbench.running.continuation import MAX_REMOVED_SHARE
+
+    continued = summary[summary["scheme"].str.endswith("+surgery")
+                        & (summary["thin_meshes"] > 0)]
+    if not len(continued):
+        return []
+    went = continued[continued["thin_reached"] > 0].sort_values("thin_reached",
+                                                                ascending=False)
+    names = ", ".join(f"{r.scheme} ({int(r.thin_reached)} of {int(r.thin_meshes)})"
+                      for r in went.itertuples())
+    stuck = ", ".join(continued.loc[continued["thin_reached"] == 0, "scheme"])
+    return [f"- **Through the singularities** (`NAME+surgery`: a pinched neck cut, the "
+            f"parts thinner than the mesh re-extracted, a run counted only when its "
+            f"continuations removed at most {MAX_REMOVED_SHARE:.0%} of the area): "
+            + (f"{names} took meshes with thin features to the end" if len(went) else
+               "none took a mesh with thin features to the end")
+            + (f"; {stuck} none." if stuck else ".")]

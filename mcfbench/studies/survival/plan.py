@@ -11,8 +11,10 @@ def plan(section=None):
     ----------
     section : dict, optional
         ``schemes``, ``C``, ``steps``, ``solver``, ``rtol``, ``maxiter``
-        (:func:`mcfbench.studies.config.check_mesh_runs`) and ``meshes`` ("all" or
-        names of the raw corpus).
+        (:func:`mcfbench.studies.config.check_mesh_runs`), ``meshes`` ("all" or
+        names of the raw corpus) and ``surgery`` (scheme names also run as
+        ``NAME+surgery``, after ``schemes``: the continuation through the thin parts'
+        singularities, :mod:`mcfbench.running.surgery`).
 
     Returns
     -------
@@ -31,7 +33,14 @@ def plan(section=None):
 
     section = dict(section or {})
     chosen = section.pop("meshes", "all")
+    continued = section.pop("surgery", [])
+    if not isinstance(continued, list) or any("+" in str(n) for n in continued):
+        raise ConfigError("config key 'survival.surgery': a list of scheme names without "
+                          f"'+' (each run also as NAME+surgery), got {continued!r}")
     settings = check_mesh_runs(section, "survival")
+    settings["schemes"] = [*settings["schemes"],
+                           *check_mesh_runs({"schemes": [f"{n}+surgery" for n in continued]},
+                                            "survival.surgery")["schemes"]]
     manifest = raw_manifest()
     names = listed(chosen, manifest)
     unknown = [n for n in names if n not in manifest]

@@ -34,7 +34,9 @@ def runs_table(records, meshes):
     pandas.DataFrame
         :data:`RUN_COLUMNS`: ``reached`` when the run ended ``ok`` after every step or
         ``extinct`` (the flow's end), its invariants holding at every step (the driver
-        checks them; any other status names what broke); ``defect_fraction`` the time
+        checks them; any other status names what broke) and its continuations
+        (``NAME+surgery``) removing at most
+        :data:`mcfbench.running.continuation.MAX_REMOVED_SHARE` of the area; ``defect_fraction`` the time
         of its first defect over the run's final time (NaN when it reached the end).
     """
     import pandas as pd
@@ -42,7 +44,8 @@ def runs_table(records, meshes):
     rows = []
     for mesh, r in records:
         steps, done = int(r["N"]), int(r["steps_done"])
-        end = reached(r["status"]) and (done == steps or r["status"] != "ok")
+        end = reached(r["status"]) and (done == steps or r["status"] != "ok") \
+            and not r.get("surgery_exceeded", False)
         t_end = steps * float(r["tau"])
         rows.append({"mesh": mesh, "kind": meshes[mesh]["kind"],
                      "thin_features": bool(meshes[mesh]["thin_features"]),
