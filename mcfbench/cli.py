@@ -88,7 +88,8 @@ def _level(text):
 def _common(parser, default_solver):
     parser.add_argument("--scheme", default="ddfv", type=_scheme_name, metavar="SCHEME",
                         help="scheme (default: ddfv; see `schemes`): a name of the registry, "
-                             "NAME@INTEGRATOR, NAME+remesh or NAME@INTEGRATOR+remesh")
+                             "NAME@INTEGRATOR, NAME+remesh, NAME@INTEGRATOR+remesh or "
+                             "NAME+surgery")
     parser.add_argument("--variant", choices=list(VARIANTS),
                         help="DDFV variant: same as --scheme ddfv-VARIANT")
     parser.add_argument("--solver", choices=METHODS, default=default_solver,
