@@ -32,8 +32,7 @@ more than :data:`MAX_REMOVED_SHARE` of the initial area does not count as reachi
 its end (:func:`exceeded`; the record's ``removed_area_share`` and
 ``surgery_exceeded``). The same run re-extracts its surface without the parts thinner
 than the mesh once they are about to fold (:class:`mcfbench.running.surgery.Reextractor`,
-:mod:`mcfbench.geometry.reextraction`), its removed area counted alike, and ends
-``extinct`` when nothing is left (:class:`SurfaceVanished`).
+:mod:`mcfbench.geometry.reextraction`), its removed area counted alike.
 """
 
 import numpy as np
@@ -135,16 +134,6 @@ def sub_flow(scheme, flow, keep, *, integrator=None, threads=1, **options):
                       **options)
     new.n = flow.n
     return new
-
-
-class SurfaceVanished(Exception):
-    """A continuation left nothing of the surface (:class:`mcfbench.running.surgery.Reextractor`:
-    every part thinner than the opening): the run ends ``extinct``, ``event`` its last
-    event (the driver records it)."""
-
-    def __init__(self, message, event):
-        super().__init__(message)
-        self.event = event
 
 
 def rebuilt_flow(scheme, flow, vertices, faces, *, threads=1, **options):

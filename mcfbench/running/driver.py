@@ -20,7 +20,6 @@ import numpy as np
 from mcfbench.geometry.collapse import CollapseCheck
 from mcfbench.geometry.invariants import FlowInvariants
 from mcfbench.geometry.measures import StateMeasures
-from mcfbench.running.continuation import SurfaceVanished
 from mcfbench.running.flow import FlowBreakdown
 from mcfbench.running.integrators import get_integrator
 from mcfbench.running.solver import Solver, SolverFailure
@@ -91,8 +90,9 @@ class Trajectory:
         "sharpness", "components_before", "components_after", "area_removed",
         "volume_removed", "area_share", ...}`` per re-extraction of the thin parts
         (:class:`~mcfbench.running.surgery.Reextractor`, with the remesh's
-        :func:`~mcfbench.geometry.remeshing.remesh_change` fields), the last one with
-        ``extinction_time`` when nothing was left (the run ``extinct``).
+        :func:`~mcfbench.geometry.remeshing.remesh_change` fields); one ``{"event":
+        "refused", "step", "time", "by", "why"}`` the first time a ``NAME+surgery``
+        part refuses a continuation, the run going on without it.
     flow : mcfbench.running.flow.SchemeFlow
         The flow at the run's end: the one stepped, or the one rebuilt on the
         components that remained (``rebuild``).
@@ -338,18 +338,13 @@ class _Stepping:
         return False
 
     def operated(self, hook, before_checks):
-        """Ask one hook (:meth:`remeshed`); True when it gave a new flow. A hook's
-        :class:`~mcfbench.running.continuation.SurfaceVanished` ends the run ``extinct``
-        (its event recorded), its ``ValueError`` ``degenerated``."""
+        """Ask one hook (:meth:`remeshed`); True when it gave a new flow, its event
+        recorded (a ``(None, event)`` is a refusal: the event alone). A hook's
+        ``ValueError`` ends the run ``degenerated``."""
         flow = self.flow
         t = flow.n * flow.tau
         try:
             found = hook(flow)
-        except SurfaceVanished as err:
-            self.events.append(err.event)
-            self.defects.append({"status": "extinct", "step": flow.n, "time": t,
-                                 "detail": str(err)})
-            raise FlowBreakdown("extinct", flow.n, t, str(err)) from None
         except ValueError as err:
             self.defects.append({"status": "degenerated", "step": flow.n, "time": t,
                                  "detail": str(err)})

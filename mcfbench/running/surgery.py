@@ -24,7 +24,7 @@ from mcfbench.geometry import metrics
 from mcfbench.geometry.mesh_surgery import NECK_RESOLUTION, cut_neck, find_neck, pinched
 from mcfbench.geometry.reextraction import SHARPNESS, open_surface, sharpness
 from mcfbench.geometry.remeshing import boundary_vertices, remesh, remesh_change, target_edge
-from mcfbench.running.continuation import SurfaceVanished, rebuilt_flow, why_not
+from mcfbench.running.continuation import rebuilt_flow, why_not
 
 
 class CutRefused(ValueError):
@@ -171,11 +171,11 @@ class Reextractor:
     (the ``remesh`` strategy's :func:`~mcfbench.geometry.remeshing.remesh`) and the
     scheme's flow rebuilt there (:func:`mcfbench.running.remeshing.rebuilt_flow`'s
     carry-over); at most once per step (the remeshed surface's sharpness is about 2,
-    below the criterion: the raw corpus's fox, ant and cow). Nothing left: the run ends
-    ``extinct`` (:class:`~mcfbench.running.continuation.SurfaceVanished`). Not on an
-    open mesh (its inside is not defined): its run goes on as the scheme's own; a
-    re-extraction refused (marching cubes' failure, too large a grid) is a
-    ``"refused"`` event, the first time, and the run goes on without it.
+    below the criterion: the raw corpus's fox, ant and cow). Not on an open mesh (its
+    inside is not defined): its run goes on as the scheme's own; a re-extraction
+    refused (the whole surface thinner than the opening: the flow's to take to its
+    extinction; marching cubes' failure, too large a grid) is a ``"refused"`` event, the first time, and the run
+    goes on without it, not asked again until its mesh changes.
 
     Parameters
     ----------
@@ -198,7 +198,7 @@ class Reextractor:
         self.h = metrics.mean_edge_length(*mesh)
         self.edge = target_edge(*mesh)
         self.initial_area = metrics.area(*mesh)
-        self.last_step, self.refused = None, False
+        self.last_step, self.refused, self.unchanged = None, False, None
         self.open = bool(len(boundary_vertices(mesh[1])))
 
     def __call__(self, flow):
@@ -207,13 +207,11 @@ class Reextractor:
 
         Raises
         ------
-        SurfaceVanished
-            Nothing was left.
         ValueError
             The scheme cannot be rebuilt (:func:`~mcfbench.running.continuation.why_not`).
         """
         V, F = np.asarray(flow.vertices), np.asarray(flow.faces)
-        if self.open or flow.n == self.last_step:
+        if self.open or flow.n == self.last_step or len(V) == self.unchanged:
             return None
         sharp, v = sharpness(V, F, self.h)
         if sharp <= SHARPNESS:
@@ -226,6 +224,7 @@ class Reextractor:
                              f"on: {reason}")
         opened, reason = open_surface(V, F, self.h)
         if reason:
+            self.unchanged = len(V)          # not asked again until the mesh changes
             return refusal(self, flow, CutRefused(
                 f"a thin part is about to fold {where}; not re-extracted: {reason}"))
         self.last_step = flow.n
@@ -236,10 +235,6 @@ class Reextractor:
                  "area_removed": opened.area_removed,
                  "volume_removed": opened.volume_removed,
                  "area_share": opened.area_removed / self.initial_area}
-        if not len(opened.faces):
-            event["extinction_time"] = t
-            raise SurfaceVanished(f"every part of the surface was thinner than the mesh "
-                                  f"{where}: re-extracted, nothing was left", event)
         U, G = remesh(opened.vertices, opened.faces, self.edge)
         event.update(remesh_change((V, F), (U, G)))
         return rebuilt_flow(self.scheme, flow, U, G, threads=self.threads,

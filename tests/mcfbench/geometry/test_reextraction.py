@@ -60,22 +60,43 @@ def test_an_open_mesh_is_refused(sphere):
     assert opened is None and "open" in reason
 
 
-def test_a_sheet_thinner_than_the_mesh_vanishes_and_the_run_ends_extinct():
+def test_a_sheet_thinner_than_the_mesh_is_left_to_the_flow():
     """A flat ellipsoid (half-thickness 0.05 against h = 0.3) is thinner than the mesh
-    everywhere: bgn+surgery re-extracts it at step 0, nothing is left, the run ends
-    extinct, its event naming the area removed (all of it)."""
+    everywhere: the opening would leave nothing, so it is refused (the flow takes the
+    surface to its own extinction), once, and not asked again on the same mesh."""
     V, F = icosphere(2)
     V = V * [1.0, 1.0, 0.05]
     h = metrics.mean_edge_length(V, F)
     assert sharpness(V, F, h)[0] > SHARPNESS
+    opened, reason = open_surface(V, F, h)
+    assert opened is None and "left to the flow" in reason
     scheme = get_scheme("bgn+surgery")
-    traj = simulate(scheme.make(V, F, 0.1 * h * h), 5,
-                    remesh=mesh_hook(scheme, (V, F)))
-    assert traj.status == "extinct" and traj.steps_done == 0, traj.message
-    event = traj.events[-1]
-    assert event["event"] == "reextracted" and event["components_after"] == 0
-    assert event["area_share"] == pytest.approx(1.0)
-    assert event["extinction_time"] == 0.0 and traj.removed_area_share == pytest.approx(1.0)
+    traj = simulate(scheme.make(V, F, 0.1 * h * h), 3, remesh=mesh_hook(scheme, (V, F)))
+    refused = [e for e in traj.events if e["event"] == "refused" and e["by"] == "Reextractor"]
+    assert [e["step"] for e in refused] == [0]
+    assert "left to the flow" in refused[0]["why"]
+    assert not [e for e in traj.events if e["event"] == "reextracted"]
+
+
+def test_a_thin_fin_is_removed_and_the_body_kept():
+    """The unit ball with a flat fin (a disk 0.1 thick, reaching out to x = 1.9)
+    joined to it, meshed by marching cubes: the fin, thinner than 2 h, is removed, the
+    ball's far side kept within 0.5 h of the unit sphere (the grid h)."""
+    from mcfbench.geometry.implicit import isosurface
+
+    def field(x, y, z):
+        fin = 1 - ((x - 1.3) / 0.6) ** 2 - (y / 0.6) ** 2 - (z / 0.05) ** 2
+        return np.maximum(1 - np.sqrt(x * x + y * y + z * z), 0.05 * fin)
+
+    V, F = isosurface(field, [-1.2, -1.2, -1.2], [2.1, 1.2, 1.2], 50)
+    h = metrics.mean_edge_length(V, F)
+    assert 0.1 < 2 * h and V[:, 0].max() > 1.8
+    opened, reason = open_surface(V, F, h, grid=1.0)     # a coarser grid: a quick test
+    assert reason == "" and (opened.components_before, opened.components_after) == (1, 1)
+    assert opened.vertices[:, 0].max() < 1.0 + h
+    far = opened.vertices[opened.vertices[:, 0] < 0]
+    assert np.abs(np.linalg.norm(far, axis=1) - 1).max() < 0.5 * h
+    assert opened.area_removed > 0.5 * np.pi * 0.6 ** 2 * 0.3    # part of the fin's faces
 
 
 def test_a_vanishing_small_part_is_removed_and_the_run_goes_on(sphere):
