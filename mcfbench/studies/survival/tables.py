@@ -36,8 +36,9 @@ def runs_table(records, meshes):
         ``extinct`` (the flow's end), its invariants holding at every step (the driver
         checks them; any other status names what broke) and its continuations
         (``NAME+surgery``) removing at most
-        :data:`mcfbench.running.continuation.MAX_REMOVED_SHARE` of the area; ``defect_fraction`` the time
-        of its first defect over the run's final time (NaN when it reached the end).
+        :data:`mcfbench.running.continuation.MAX_REMOVED_SHARE` of the area;
+        ``defect_fraction`` the time of its first defect over the run's final time
+        (NaN when it reached the end).
     """
     import pandas as pd
 
