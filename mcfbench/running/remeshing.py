@@ -116,6 +116,10 @@ class Strategies:
         As every hook's (:func:`mesh_hook`).
     """
 
+    modules = ("mcfbench.running.remeshing", "mcfbench.running.surgery")
+    """Its parts' modules: the roots of its runs' code identity
+    (:func:`mcfbench.running.identity.scheme_roots`)."""
+
     def __init__(self, scheme, mesh, *, integrator=None, threads=1, options=None):
         kwargs = {"integrator": integrator, "threads": threads, "options": options}
         surgeon = Surgeon(scheme, mesh, strict=False, **kwargs)
