@@ -44,8 +44,7 @@ MAX_REMOVED_SHARE = 0.01
 removed|`` summed over its neck cuts and re-extractions) for the run to count as
 reaching its end: the dumbbell's cuts remove 1.2e-3 to 1.5e-3 of it at level 1,
 3.9e-4 to 4.3e-4 at level 2, with the caps' re-extraction 5.2e-3 to 5.4e-3 and 3.8e-4
-to 1.9e-3
-(cotan, BGN, DDFV chord carried; ``benchmarks/dumbbell_surgery.py``)."""
+to 1.9e-3 (cotan, BGN, DDFV chord carried; ``benchmarks/dumbbell_surgery.py``)."""
 
 STATE_ONLY = ("none", "eliminate", "bgn", "mdr", "intrinsic-delaunay")
 """The tangential strategies (:data:`mcfbench.running.schemes.TANGENTIAL`) whose step
