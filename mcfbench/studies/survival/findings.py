@@ -78,9 +78,15 @@ def through(summary):
     names = ", ".join(f"{r.scheme} ({int(r.thin_reached)} of {int(r.thin_meshes)})"
                       for r in went.itertuples())
     stuck = ", ".join(continued.loc[continued["thin_reached"] == 0, "scheme"])
+    through = continued[continued["thin_through"] > 0].sort_values("thin_through",
+                                                                   ascending=False)
+    past = ", ".join(f"{r.scheme} ({int(r.thin_through)})" for r in through.itertuples())
     return [f"- **Through the singularities** (`NAME+surgery`: a pinched neck cut, the "
             f"parts thinner than the mesh re-extracted, a run counted only when its "
             f"continuations removed at most {MAX_REMOVED_SHARE:.0%} of the area): "
             + (f"{names} took meshes with thin features to the end" if len(went) else
                "none took a mesh with thin features to the end")
-            + (f"; {stuck} none." if stuck else ".")]
+            + (f"; {stuck} none." if stuck else ".")
+            + (f" Runs that went on past a continuation to the end, whatever the share "
+               f"removed: {past}." if past else
+               " No run went on past a continuation to the end.")]
