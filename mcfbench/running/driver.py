@@ -86,13 +86,8 @@ class Trajectory:
         :class:`~mcfbench.running.surgery.Surgeon`): ``where`` the neck's point on its
         axis, ``pinch_time`` the state's time plus ``r^2 / 2`` (a neck of radius ``r``
         shrinks as a cylinder, ``r r' = -1``), ``area_share`` the area removed over the
-        initial area; one ``{"event": "reextracted", "step", "time", "where",
-        "sharpness", "components_before", "components_after", "area_removed",
-        "volume_removed", "area_share", ...}`` per re-extraction of the thin parts
-        (:class:`~mcfbench.running.surgery.Reextractor`, with the remesh's
-        :func:`~mcfbench.geometry.remeshing.remesh_change` fields); one ``{"event":
-        "refused", "step", "time", "by", "why"}`` the first time a ``NAME+surgery``
-        part refuses a continuation, the run going on without it.
+        initial area; ``"reextracted"`` and ``"refused"`` likewise
+        (:class:`~mcfbench.running.surgery.Reextractor`, ``surgery.refusal``).
     flow : mcfbench.running.flow.SchemeFlow
         The flow at the run's end: the one stepped, or the one rebuilt on the
         components that remained (``rebuild``).
@@ -328,9 +323,8 @@ class _Stepping:
         """Go on with the flow on a new mesh when the mesh strategy's hook (``simulate``'s
         ``remesh``) gives one, asked where its ``before_checks`` says: the checks start
         again from it, the integrator afresh; the new state is checked (an invalid mesh
-        ends the run as any state does). A hook with ``parts`` (``NAME+surgery``'s,
-        :class:`mcfbench.running.remeshing.Strategies`) asks its parts in order, the first
-        that operates winning. True when one did."""
+        ends the run as any state does); a hook's ``parts`` in order
+        (:class:`mcfbench.running.remeshing.Strategies`). True when one operated."""
         for hook in getattr(self.remesh, "parts", (self.remesh,)):
             if hook is not None and bool(hook.before_checks) == before_checks \
                     and self.operated(hook, before_checks):
@@ -338,9 +332,8 @@ class _Stepping:
         return False
 
     def operated(self, hook, before_checks):
-        """Ask one hook (:meth:`remeshed`); True when it gave a new flow, its event
-        recorded (a ``(None, event)`` is a refusal: the event alone). A hook's
-        ``ValueError`` ends the run ``degenerated``."""
+        """Ask one hook (:meth:`remeshed`): True for a new flow; ``(None, event)`` a
+        refusal, recorded; its ``ValueError`` ends the run ``degenerated``."""
         flow = self.flow
         t = flow.n * flow.tau
         try:

@@ -54,7 +54,7 @@ def findings(summary, plan):
     if thin is not None:
         lines.append(f"- **With thin features** (the flow pinches them): "
                      f"{named(thin, 'thin_')}.")
-    lines += through(summary)
+    lines += through(summary, plan)
     median = np.nanmedian(summary["defect_fraction_median"]) \
         if np.isfinite(summary["defect_fraction_median"]).any() else np.nan
     if np.isfinite(median):
@@ -63,12 +63,12 @@ def findings(summary, plan):
     return "\n".join(lines) + "\n"
 
 
-def through(summary):
+def through(summary, plan):
     """The findings' lines on the ``NAME+surgery`` schemes (the continuation through a
     neck pinch and the thin parts' singularities): which took meshes with thin features
-    to the end, and which none; nothing when the study ran none."""
-    from mcfbench.running.continuation import MAX_REMOVED_SHARE
-
+    to the end, and which none; nothing when the study ran none. ``plan``'s
+    ``max_removed_share``: the share of the area a counted run's continuations may
+    remove (:func:`mcfbench.studies.survival.plan.plan`)."""
     continued = summary[summary["scheme"].str.endswith("+surgery")
                         & (summary["thin_meshes"] > 0)]
     if not len(continued):
@@ -83,7 +83,7 @@ def through(summary):
     past = ", ".join(f"{r.scheme} ({int(r.thin_through)})" for r in through.itertuples())
     return [f"- **Through the singularities** (`NAME+surgery`: a pinched neck cut, the "
             f"parts thinner than the mesh re-extracted, a run counted only when its "
-            f"continuations removed at most {MAX_REMOVED_SHARE:.0%} of the area): "
+            f"continuations removed at most {plan['max_removed_share']:.0%} of the area): "
             + (f"{names} took meshes with thin features to the end" if len(went) else
                "none took a mesh with thin features to the end")
             + (f"; {stuck} none." if stuck else ".")

@@ -22,7 +22,8 @@ def plan(section=None):
         Those settings and ``meshes``: name -> ``{"file", "sha256", "thin_features",
         "kind"}`` of the chosen meshes that the intake reads (the refused ones name
         their defect in the manifest: the intake's verdict, not a run's), and
-        ``refused``: their names.
+        ``refused``: their names, and ``max_removed_share`` (the share of the area a
+        counted ``NAME+surgery`` run's continuations may remove).
 
     Raises
     ------
@@ -48,7 +49,9 @@ def plan(section=None):
         raise ConfigError(f"config key 'survival.meshes': unknown mesh(es) {unknown}; the "
                           f"raw corpus (mcfbench/data/raw_meshes) has {', '.join(manifest)}")
     read = [n for n in names if manifest[n]["intake"] == "read"]
-    return {**settings,
+    from mcfbench.running.continuation import MAX_REMOVED_SHARE
+
+    return {**settings, "max_removed_share": MAX_REMOVED_SHARE,
             "meshes": {n: {"file": str(RAW_DIR / manifest[n]["file"]),
                            "sha256": manifest[n]["sha256"],
                            "thin_features": bool(manifest[n]["thin_features"]),

@@ -93,7 +93,8 @@ def test_the_findings_name_the_schemes_that_go_through_the_thin_parts():
     assert runs["through"].tolist() == [False, True, False, False]
     summary = survival_tables.survival_table(runs, ["x+surgery", "y+surgery"])
     assert summary["thin_through"].tolist() == [0, 1]
-    words = survival_findings.findings(summary, {"meshes": MESHES, "steps": 40, "C": 0.1})
+    words = survival_findings.findings(summary, {"meshes": MESHES, "steps": 40, "C": 0.1,
+                                                 "max_removed_share": 0.01})
     assert "x+surgery (1 of 1) took meshes with thin features to the end; y+surgery " \
         "none." in words and "at most 1% of the area" in words
     assert "Runs that went on past a continuation to the end, whatever the share " \
