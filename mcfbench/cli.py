@@ -88,7 +88,8 @@ def _level(text):
 def _common(parser, default_solver):
     parser.add_argument("--scheme", default="ddfv", type=_scheme_name, metavar="SCHEME",
                         help="scheme (default: ddfv; see `schemes`): a name of the registry, "
-                             "NAME@INTEGRATOR, NAME+remesh or NAME@INTEGRATOR+remesh")
+                             "NAME@INTEGRATOR, NAME+remesh, NAME@INTEGRATOR+remesh or "
+                             "NAME+surgery")
     parser.add_argument("--variant", choices=list(VARIANTS),
                         help="DDFV variant: same as --scheme ddfv-VARIANT")
     parser.add_argument("--solver", choices=METHODS, default=default_solver,
@@ -317,6 +318,22 @@ OUTPUTS = (".npz", ".pvd")
 """What ``run --out`` writes, by suffix."""
 
 
+CONTINUATIONS = ("surgery", "reextracted", "refused")
+"""The events of a ``NAME+surgery`` run that ``run`` prints (the driver's ``events``)."""
+
+
+def _continuation(event):
+    """One line of a continuation's event: when, what, where, the components before
+    and after, the share of the area removed (or why it was refused)."""
+    head = f"step {event['step']} (t = {event['time']:.4g}): {event['event']}"
+    if event["event"] == "refused":
+        return f"{head} by {event['by']}: {event['why']}"
+    where = ", ".join(f"{x:.4g}" for x in event["where"])
+    return (f"{head} at ({where}), components {event['components_before']} -> "
+            f"{event['components_after']}, {100 * event['area_share']:.3g} % of the "
+            "initial area removed")
+
+
 def _run(args):
     from mcfbench.geometry.mesh import summarize
     from mcfbench.geometry.mesh_files import read_mesh
@@ -368,6 +385,9 @@ def _run(args):
 
         write_movie(arrays, args.movie, title=f"{scheme.label} on {args.mesh.name}")
         print(f"wrote {args.movie}: {len(traj.t)} frames")
+    for event in traj.events:
+        if event["event"] in CONTINUATIONS:
+            print(_continuation(event))
     if traj.status == "extinct":         # the flow's own end, not an error
         print(f"the flow ended: {traj.message}")
     elif traj.status != "ok":

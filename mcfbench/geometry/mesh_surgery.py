@@ -200,7 +200,7 @@ def _edges(F):
 
 def find_neck(vertices, faces):
     """The neck of a closed mesh (module docstring), or None when no vertex has a
-    negative angle defect or the neck vertex's ring is no ring (fewer than
+    negative angle defect (and a finite, nonzero ``|H|``) or the neck vertex's ring is no ring (fewer than
     :data:`MIN_RING` vertices, or not around the axis: a dimple, a fold).
 
     Parameters
@@ -215,7 +215,8 @@ def find_neck(vertices, faces):
     V, F = np.asarray(vertices, dtype=float), np.asarray(faces, dtype=np.int64)
     Hn = mean_curvature_vectors(V, F)
     H = np.linalg.norm(Hn, axis=1)
-    saddle = angle_defects(V, F) < 0
+    H = np.where(np.isfinite(H), H, 0.0)    # a vertex of no area (a raw mesh's) is no neck
+    saddle = (angle_defects(V, F) < 0) & (H > 0)
     if not saddle.any():
         return None
     v0 = int(np.flatnonzero(saddle)[np.argmax(H[saddle])])

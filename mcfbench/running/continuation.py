@@ -36,7 +36,9 @@ built anew on the operated mesh, DDFV's T-vertices placed anew by its own rule
 that every T-vertex of the new flow is placed alike). A run whose surgeries removed
 more than :data:`MAX_REMOVED_SHARE` of the initial area does not count as reaching
 its end (:func:`exceeded`; the record's ``removed_area_share`` and
-``surgery_exceeded``).
+``surgery_exceeded``). The same run re-extracts its surface without the parts thinner
+than the mesh once they are about to fold (:class:`mcfbench.running.surgery.Reextractor`,
+:mod:`mcfbench.geometry.reextraction`), its removed area counted alike.
 """
 
 import numpy as np
@@ -44,10 +46,11 @@ import numpy as np
 from mcfbench.running.integrators import INTEGRATORS
 
 MAX_REMOVED_SHARE = 0.01
-"""The largest share of the initial area a run's surgeries may remove (``|area
-removed|`` summed over its cuts) for the run to count as reaching its end: the
-dumbbell's cuts remove 1.2e-3 to 1.5e-3 of it at level 1, 3.9e-4 to 4.3e-4 at level 2
-(cotan, BGN, DDFV chord carried; ``benchmarks/dumbbell_surgery.py``)."""
+"""The largest share of the initial area a run's continuations may remove (``|area
+removed|`` summed over its neck cuts and re-extractions) for the run to count as
+reaching its end: the dumbbell's cuts remove 1.2e-3 to 1.5e-3 of it at level 1,
+3.9e-4 to 4.3e-4 at level 2, with the caps' re-extraction 5.2e-3 to 5.4e-3 and 3.8e-4
+to 1.9e-3 (cotan, BGN, DDFV chord carried; ``benchmarks/dumbbell_surgery.py``)."""
 
 STATE_ONLY = ("none", "eliminate", "bgn", "mdr", "intrinsic-delaunay")
 """The tangential strategies (:data:`mcfbench.running.schemes.TANGENTIAL`) whose step
@@ -139,6 +142,26 @@ def sub_flow(scheme, flow, keep, *, integrator=None, threads=1, **options):
         options = {**options, "T0": flow.frame()["extra_points"][kept_faces]}
     new = scheme.make(np.asarray(flow.vertices)[keep], faces, flow.tau, threads=threads,
                       **options)
+    new.n = flow.n
+    return new
+
+
+def rebuilt_flow(scheme, flow, vertices, faces, *, threads=1, **options):
+    """The flow of ``scheme`` on a new mesh of the surface, at ``flow``'s time level
+    (what is carried over: :mod:`mcfbench.running.remeshing`'s docstring; the
+    remesh's, a neck cut's and a re-extraction's).
+
+    Parameters
+    ----------
+    scheme : mcfbench.running.schemes.Scheme
+    flow : mcfbench.running.flow.SchemeFlow
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+    threads : int
+    **options
+        The run's options of the flow class.
+    """
+    new = scheme.make(vertices, faces, flow.tau, threads=threads, **options)
     new.n = flow.n
     return new
 

@@ -87,7 +87,8 @@ class Trajectory:
         :class:`~mcfbench.running.surgery.Surgeon`): ``where`` the neck's point on its
         axis, ``pinch_time`` the state's time plus ``r^2 / 2`` (a neck of radius ``r``
         shrinks as a cylinder, ``r r' = -1``), ``area_share`` the area removed over the
-        initial area.
+        initial area; ``"reextracted"`` and ``"refused"`` likewise
+        (:class:`~mcfbench.running.surgery.Reextractor`, ``surgery.refusal``).
     flow : mcfbench.running.flow.SchemeFlow
         The flow at the run's end: the one stepped, or the one rebuilt on the
         components that remained (``rebuild``).
@@ -133,13 +134,14 @@ class Trajectory:
 
     @property
     def surgeries(self):
-        """The ``surgery`` events (:attr:`events`)."""
-        return [e for e in self.events if e["event"] == "surgery"]
+        """The continuations' events (:attr:`events`): ``surgery`` (a neck cut) and
+        ``reextracted`` (the thin parts removed)."""
+        return [e for e in self.events if e["event"] in ("surgery", "reextracted")]
 
     @property
     def removed_area_share(self):
-        """The area the surgeries removed (``|area_removed|`` summed) over the initial
-        area, 0 without one."""
+        """The area the continuations removed (``|area_removed|`` summed) over the
+        initial area, 0 without one."""
         return float(sum(abs(e["area_share"]) for e in self.surgeries))
 
     @property
@@ -322,21 +324,31 @@ class _Stepping:
         """Go on with the flow on a new mesh when the mesh strategy's hook (``simulate``'s
         ``remesh``) gives one, asked where its ``before_checks`` says: the checks start
         again from it, the integrator afresh; the new state is checked (an invalid mesh
-        ends the run as any state does). True when it did."""
-        hook = self.remesh
-        if hook is None or bool(hook.before_checks) != before_checks:
-            return False
+        ends the run as any state does); a hook's ``parts`` in order
+        (:class:`mcfbench.running.remeshing.Strategies`). True when one operated."""
+        for hook in getattr(self.remesh, "parts", (self.remesh,)):
+            if hook is not None and bool(hook.before_checks) == before_checks \
+                    and self.operated(hook, before_checks):
+                return True
+        return False
+
+    def operated(self, hook, before_checks):
+        """Ask one hook (:meth:`remeshed`): True for a new flow; ``(None, event)`` a
+        refusal, recorded; its ``ValueError`` ends the run ``degenerated``."""
         flow = self.flow
+        t = flow.n * flow.tau
         try:
             found = hook(flow)
         except ValueError as err:
-            self.defects.append({"status": "degenerated", "step": flow.n,
-                                 "time": flow.n * flow.tau, "detail": str(err)})
-            raise FlowBreakdown("degenerated", flow.n, flow.n * flow.tau, str(err)) from None
+            self.defects.append({"status": "degenerated", "step": flow.n, "time": t,
+                                 "detail": str(err)})
+            raise FlowBreakdown("degenerated", flow.n, t, str(err)) from None
         if found is None:
             return False
         new, event = found
         self.events.append(event)
+        if new is None:                     # a refusal: the run goes on without it
+            return False
         if hook.kept is not None:          # the frames keep their layout
             self.full = self.full_frame()   # the removed points stay where they were
             keep_vertices, keep_faces = hook.kept

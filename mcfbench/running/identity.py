@@ -68,7 +68,8 @@ def scheme_roots(scheme):
     """The modules of ``scheme`` (a registry name, ``NAME@INTEGRATOR`` and
     ``NAME+STRATEGY`` included): its flow's, for another integrator than Euler the
     integrator's, and for a mesh strategy its hook's class's
-    (:data:`mcfbench.running.remeshing.STRATEGIES`)."""
+    (:data:`mcfbench.running.remeshing.STRATEGIES`; a composed hook's ``modules``: its
+    parts')."""
     from mcfbench.running.integrators import INTEGRATORS
     from mcfbench.running.remeshing import STRATEGIES
     from mcfbench.running.schemes import get_scheme
@@ -78,7 +79,8 @@ def scheme_roots(scheme):
     if entry.integrator != "euler":
         roots.append(INTEGRATORS[entry.integrator].__module__)
     if entry.mesh_strategy != "none":
-        roots.append(STRATEGIES[entry.mesh_strategy].__module__)
+        hook = STRATEGIES[entry.mesh_strategy]
+        roots.extend(getattr(hook, "modules", (hook.__module__,)))
     return tuple(roots)
 
 

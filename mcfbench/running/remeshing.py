@@ -6,8 +6,11 @@ the driver (:func:`mcfbench.running.driver.simulate`, its ``remesh``) applies to
 state: ``hook(flow) -> None or (new flow, event)``, asked before the state's checks
 when ``hook.before_checks``, else after them; the new flow's frames keep the previous
 layout where ``hook.kept`` names the points and triangles kept, else carry their own
-faces. :class:`mcfbench.running.surgery.Surgeon`, the ``surgery`` strategy, cuts a
-pinched neck. :class:`Remesher`, the ``remesh`` strategy, remeshes the
+faces. The ``surgery`` strategy (:class:`Strategies`) cuts a pinched neck
+(:class:`mcfbench.running.surgery.Surgeon`), re-extracts the surface without its parts
+thinner than the mesh once they are about to fold
+(:class:`mcfbench.running.surgery.Reextractor`) and remeshes as ``remesh`` does.
+:class:`Remesher`, the ``remesh`` strategy, remeshes the
 current surface when :class:`mcfbench.geometry.remeshing.RemeshTrigger` says so
 (:func:`mcfbench.geometry.remeshing.remesh`: Botsch and Kobbelt's isotropic
 remeshing, the target edge that keeps the input's vertex count) and rebuilds the
@@ -34,27 +37,9 @@ What the new flow carries over:
 
 from mcfbench.geometry.remeshing import (
     ANGLE, PASSES, RemeshTrigger, remesh, remesh_change, target_edge)
+from mcfbench.running.continuation import rebuilt_flow
 from mcfbench.running.scheme import parse_name
-from mcfbench.running.surgery import Surgeon
-
-
-def rebuilt_flow(scheme, flow, vertices, faces, *, threads=1, **options):
-    """The flow of ``scheme`` on a new mesh of the surface, at ``flow``'s time level
-    (module docstring: what is carried over).
-
-    Parameters
-    ----------
-    scheme : mcfbench.running.schemes.Scheme
-    flow : mcfbench.running.flow.SchemeFlow
-    vertices : (n, 3) float array
-    faces : (m, 3) int array
-    threads : int
-    **options
-        The run's options of the flow class.
-    """
-    new = scheme.make(vertices, faces, flow.tau, threads=threads, **options)
-    new.n = flow.n
-    return new
+from mcfbench.running.surgery import NeckWait, Reextractor, Surgeon
 
 
 class Remesher:
@@ -118,7 +103,33 @@ class Remesher:
                             **self.options), event
 
 
-STRATEGIES = {"remesh": Remesher, "surgery": Surgeon}
+class Strategies:
+    """Several hooks as one (``NAME+surgery``'s): the driver asks its ``parts`` in
+    order (:meth:`mcfbench.running.driver.Runner.remeshed`), each where its own
+    ``before_checks`` says, the first that operates winning: the neck cut
+    (:class:`~mcfbench.running.surgery.Surgeon`, before the checks), then the thin
+    parts' re-extraction (:class:`~mcfbench.running.surgery.Reextractor`) and the
+    remesh (:class:`Remesher`, waiting while a neck is near its cut:
+    :class:`~mcfbench.running.surgery.NeckWait`), both after them.
+
+    Parameters
+    ----------
+    scheme, mesh, integrator, threads, options
+        As every hook's (:func:`mesh_hook`).
+    """
+
+    modules = ("mcfbench.running.remeshing", "mcfbench.running.surgery")
+    """Its parts' modules: the roots of its runs' code identity
+    (:func:`mcfbench.running.identity.scheme_roots`)."""
+
+    def __init__(self, scheme, mesh, *, integrator=None, threads=1, options=None):
+        kwargs = {"integrator": integrator, "threads": threads, "options": options}
+        surgeon = Surgeon(scheme, mesh, strict=False, **kwargs)
+        self.parts = (surgeon, Reextractor(scheme, mesh, **kwargs),
+                      NeckWait(Remesher(scheme, mesh, **kwargs), surgeon.h))
+
+
+STRATEGIES = {"remesh": Remesher, "surgery": Strategies}
 """A mesh strategy (a key of :data:`mcfbench.running.scheme.MESH_STRATEGIES`) -> the
 class of its hook, built as ``cls(scheme, mesh, integrator=, threads=, options=)``."""
 

@@ -44,8 +44,9 @@ moves its vertices along the surface, the grouping of the findings' comparison
 MESH_STRATEGIES = {
     "remesh": "isotropic remeshing when the mesh's quality fails (Botsch, Kobbelt 2004; "
               "mcfbench.running.remeshing)",
-    "surgery": "a neck pinched below half an edge is cut and both sides capped, the run "
-               "going on (mcfbench.running.surgery)",
+    "surgery": "a neck pinched below half an edge is cut and both sides capped, the parts "
+               "thinner than an edge re-extracted once a tip or rim is about to fold, the "
+               "mesh remeshed as +remesh does; the run going on (mcfbench.running.surgery)",
 }
 """Suffixes of a scheme name ``NAME[@INTEGRATOR][+STRATEGY]`` -> description: what a run
 does to its mesh besides stepping it (:attr:`Scheme.mesh_strategy`, :func:`parse_name`;

@@ -22,7 +22,25 @@ import numpy as np
 
 from mcfbench.geometry import metrics
 from mcfbench.geometry.mesh_surgery import NECK_RESOLUTION, cut_neck, find_neck, pinched
-from mcfbench.running.continuation import why_not
+from mcfbench.geometry.reextraction import SHARPNESS, open_surface, sharpness
+from mcfbench.geometry.remeshing import boundary_vertices, remesh, remesh_change, target_edge
+from mcfbench.running.continuation import rebuilt_flow, why_not
+
+
+class CutRefused(ValueError):
+    """A continuation's geometry was refused (a neck whose cut does not leave two
+    loops, an open mesh's re-extraction): in ``NAME+surgery``'s run the scheme goes on
+    without it (:class:`Surgeon`'s ``strict``), the refusal an event."""
+
+
+def refusal(hook, flow, err):
+    """``(None, the "refused" event)`` the first time ``hook`` refuses a continuation
+    in a run, None afterwards (the same neck is refused at every step)."""
+    if hook.refused:
+        return None
+    hook.refused = True
+    return None, {"event": "refused", "step": flow.n, "time": flow.n * flow.tau,
+                  "by": type(hook).__name__, "why": str(err)}
 
 
 ESCAPED_RESOLUTION = 2.0
@@ -81,19 +99,19 @@ def neck_surgery(scheme, flow, *, h, integrator=None, threads=1, **options):
     early = early and len(escaped) > 0
     if not (pinched(neck, h) or early):
         return None
+    where = (f"the neck at {np.round(V[neck.vertex], 4).tolist()} (radius "
+             f"{neck.radius:.3g} < {NECK_RESOLUTION:g} h = {NECK_RESOLUTION * h:.3g})")
     reason = why_not(scheme, integrator)
-    if reason is None:
-        cut, reason = cut_neck(V, F, neck)
-    if early and (reason or cut.keep_faces[escaped].any()):
+    cut, refused = (None, None) if reason else cut_neck(V, F, neck)
+    if early and (reason or refused or cut.keep_faces[escaped].any()):
         return None           # not all in the neck's thin part: the state's checks say so
     if reason:
-        raise ValueError(f"the neck at {np.round(V[neck.vertex], 4).tolist()} (radius "
-                         f"{neck.radius:.3g} < {NECK_RESOLUTION:g} h = "
-                         f"{NECK_RESOLUTION * h:.3g}): {reason}")
+        raise ValueError(f"{where}: {reason}")
+    if refused:
+        raise CutRefused(f"{where}: {refused}")
     options = {k: v for k, v in options.items() if k != "T0"}
-    new = scheme.make(cut.vertices, cut.faces, flow.tau, threads=threads, **options)
-    new.n = flow.n
-    return cut, new
+    return cut, rebuilt_flow(scheme, flow, cut.vertices, cut.faces, threads=threads,
+                             **options)
 
 
 class Surgeon:
@@ -111,6 +129,11 @@ class Surgeon:
     threads : int
     options : dict
         The run's options of the flow class.
+    strict : bool
+        A refused cut (:class:`CutRefused`) ends the run (True) or the run goes on
+        without it, the first refusal an event (False: ``NAME+surgery``'s
+        :class:`mcfbench.running.remeshing.Strategies`, where the re-extraction may
+        still take the thin part).
 
     Attributes
     ----------
@@ -122,17 +145,20 @@ class Surgeon:
 
     before_checks = True
 
-    def __init__(self, scheme, mesh, *, integrator=None, threads=1, options=None):
+    def __init__(self, scheme, mesh, *, integrator=None, threads=1, options=None,
+                 strict=True):
         self.scheme, self.integrator, self.threads = scheme, integrator, threads
         self.options = dict(options or {})
         self.h = metrics.mean_edge_length(*mesh)
         self.initial_area = metrics.area(*mesh)
         self.kept = None
+        self.strict, self.refused = strict, False
 
     def __call__(self, flow):
         """None while no neck has pinched, else the flow rebuilt on the operated mesh
         and the ``"surgery"`` event (:class:`mcfbench.running.driver.Trajectory`'s
-        ``events``).
+        ``events``); ``(None, "refused" event)`` the first time a cut is refused when
+        not ``strict``.
 
         Raises
         ------
@@ -143,6 +169,10 @@ class Surgeon:
         try:
             done = neck_surgery(self.scheme, flow, h=self.h, integrator=self.integrator,
                                 threads=self.threads, **self.options)
+        except CutRefused as err:
+            if not self.strict:
+                return refusal(self, flow, err)
+            raise ValueError(f"a neck pinched and the run cannot go on: {err}") from None
         except ValueError as err:
             raise ValueError(f"a neck pinched and the run cannot go on: {err}") from None
         if done is None:
@@ -161,3 +191,116 @@ class Surgeon:
             "components_after": cut.components_after, "area_removed": cut.area_removed,
             "volume_removed": cut.volume_removed, "band_area": cut.band_area,
             "area_share": cut.area_removed / self.initial_area}
+
+
+class Reextractor:
+    """The thin parts' continuation of ``NAME+surgery``: ``reextractor(flow) -> (new
+    flow, event)`` or None, asked after a state passed its checks.
+
+    Once the surface's sharpness ``max H h`` exceeds
+    :data:`~mcfbench.geometry.reextraction.SHARPNESS` (a part about to fold within a
+    step), the surface is re-extracted without its parts thinner than the mesh
+    (:func:`mcfbench.geometry.reextraction.open_surface`), remeshed to the run's edge
+    (the ``remesh`` strategy's :func:`~mcfbench.geometry.remeshing.remesh`) and the
+    scheme's flow rebuilt there (:func:`mcfbench.running.continuation.rebuilt_flow`'s
+    carry-over); at most once per step (the remeshed surface's sharpness is about 2,
+    below the criterion: the raw corpus's fox, ant and cow). Not on an open mesh (its
+    inside is not defined): its run goes on as the scheme's own; a re-extraction
+    refused (the whole surface thinner than the opening: the flow's to take to its
+    extinction; marching cubes' failure, too large a grid) is a ``"refused"`` event,
+    the first time, and the run goes on without it, not asked again until its mesh
+    changes.
+
+    Parameters
+    ----------
+    As :class:`Surgeon`'s.
+
+    Attributes
+    ----------
+    before_checks : bool
+        False: the re-extraction follows a valid state.
+    kept : None
+        The frames after it carry their own faces.
+    """
+
+    before_checks = False
+    kept = None
+
+    def __init__(self, scheme, mesh, *, integrator=None, threads=1, options=None):
+        self.scheme, self.integrator, self.threads = scheme, integrator, threads
+        self.options = {k: v for k, v in dict(options or {}).items() if k != "T0"}
+        self.h = metrics.mean_edge_length(*mesh)
+        self.edge = target_edge(*mesh)
+        self.initial_area = metrics.area(*mesh)
+        self.last_step, self.refused, self.unchanged = None, False, None
+        self.open = bool(len(boundary_vertices(mesh[1])))
+
+    def __call__(self, flow):
+        """None while the surface is not sharper than the criterion, else the flow on
+        the re-extracted surface and the ``"reextracted"`` event.
+
+        Raises
+        ------
+        ValueError
+            The scheme cannot be rebuilt (:func:`~mcfbench.running.continuation.why_not`).
+        """
+        V, F = np.asarray(flow.vertices), np.asarray(flow.faces)
+        if self.open or flow.n == self.last_step or len(V) == self.unchanged:
+            return None
+        sharp, v = sharpness(V, F, self.h)
+        if sharp <= SHARPNESS:
+            return None
+        t = flow.n * flow.tau
+        where = f"at {np.round(V[v], 4).tolist()} (max H h = {sharp:.3g} > {SHARPNESS:g})"
+        reason = why_not(self.scheme, self.integrator)
+        if reason:
+            raise ValueError(f"a thin part is about to fold {where} and the run cannot go "
+                             f"on: {reason}")
+        opened, reason = open_surface(V, F, self.h)
+        if reason:
+            self.unchanged = len(V)          # not asked again until the mesh changes
+            return refusal(self, flow, CutRefused(
+                f"a thin part is about to fold {where}; not re-extracted: {reason}"))
+        self.last_step = flow.n
+        event = {"event": "reextracted", "step": flow.n, "time": t,
+                 "where": [float(x) for x in opened.where], "sharpness": opened.sharpness,
+                 "components_before": opened.components_before,
+                 "components_after": opened.components_after,
+                 "area_removed": opened.area_removed,
+                 "volume_removed": opened.volume_removed,
+                 "area_share": opened.area_removed / self.initial_area}
+        U, G = remesh(opened.vertices, opened.faces, self.edge)
+        event.update(remesh_change((V, F), (U, G)))
+        return rebuilt_flow(self.scheme, flow, U, G, threads=self.threads,
+                            **self.options), event
+
+
+WAIT = 1.0
+"""``NAME+surgery``'s remesh waits while a neck's radius is below this many ``h``."""
+
+
+class NeckWait:
+    """``NAME+surgery``'s remesh (:class:`mcfbench.running.remeshing.Remesher`), not
+    while a neck's radius is below :data:`WAIT` ``h``: a neck whose circumference holds
+    fewer than about six edges of the run's length is not remeshed but cut (remeshed
+    there, the dumbbell's neck at level 1 lost its shape at step 26, the cut's criterion
+    never held and the run ended ``inverted`` at step 30).
+
+    Parameters
+    ----------
+    remesher : mcfbench.running.remeshing.Remesher
+    h : float
+        The run's resolution.
+    """
+
+    before_checks = False
+    kept = None
+
+    def __init__(self, remesher, h):
+        self.remesher, self.h = remesher, h
+
+    def __call__(self, flow):
+        neck = find_neck(np.asarray(flow.vertices), np.asarray(flow.faces))
+        if pinched(neck, self.h, WAIT):
+            return None
+        return self.remesher(flow)

@@ -433,3 +433,15 @@ def test_a_remeshed_run_writes_frames_with_their_faces_and_schemes_lists_the_suf
     capsys.readouterr()
     assert main(["schemes"]) == 0
     assert "+remesh  isotropic remeshing" in capsys.readouterr().out
+
+
+def test_run_prints_each_continuation_with_its_time_place_components_and_area():
+    from mcfbench.cli import _continuation
+
+    cut = {"event": "reextracted", "step": 4, "time": 0.0027285, "where": [0.0, -0.25, -1.5],
+           "components_before": 1, "components_after": 2, "area_share": 0.167}
+    assert _continuation(cut) == ("step 4 (t = 0.002729): reextracted at (0, -0.25, -1.5), "
+                                  "components 1 -> 2, 16.7 % of the initial area removed")
+    refused = {"event": "refused", "step": 0, "time": 0.0, "by": "Reextractor",
+               "why": "the mesh is open"}
+    assert _continuation(refused) == "step 0 (t = 0): refused by Reextractor: the mesh is open"

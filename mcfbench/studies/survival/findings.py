@@ -52,9 +52,10 @@ def findings(summary, plan):
         lines.append(f"- **The best DDFV variant** there: {named(top, 'plain_')}.")
     thin = best(summary, "thin_share")
     if thin is not None:
-        lines.append(f"- **With thin features** (the flow pinches them; no scheme here goes "
-                     f"through a pinch): {named(thin, 'thin_')}.")
+        lines.append(f"- **With thin features** (the flow pinches them): "
+                     f"{named(thin, 'thin_')}.")
     lines += strategy_findings(summary, plan.get("strategies", []))
+    lines += through(summary, plan)
     median = np.nanmedian(summary["defect_fraction_median"]) \
         if np.isfinite(summary["defect_fraction_median"]).any() else np.nan
     if np.isfinite(median):
@@ -86,3 +87,32 @@ def strategy_findings(summary, strategies):
                      f"meshes taken to the end for {more} of {len(diffs)} schemes, fewer "
                      f"for {fewer}, as many for {len(diffs) - more - fewer}{gain}.")
     return lines
+
+
+def through(summary, plan):
+    """The findings' lines on the ``NAME+surgery`` schemes (the continuation through a
+    neck pinch and the thin parts' singularities): which took meshes with thin features
+    to the end, and which none; nothing when the study ran none. ``plan``'s
+    ``max_removed_share``: the share of the area a counted run's continuations may
+    remove (:func:`mcfbench.studies.survival.plan.plan`)."""
+    continued = summary[summary["scheme"].str.endswith("+surgery")
+                        & (summary["thin_meshes"] > 0)]
+    if not len(continued):
+        return []
+    went = continued[continued["thin_reached"] > 0].sort_values("thin_reached",
+                                                                ascending=False)
+    names = ", ".join(f"{r.scheme} ({int(r.thin_reached)} of {int(r.thin_meshes)})"
+                      for r in went.itertuples())
+    stuck = ", ".join(continued.loc[continued["thin_reached"] == 0, "scheme"])
+    through = continued[continued["thin_through"] > 0].sort_values("thin_through",
+                                                                   ascending=False)
+    past = ", ".join(f"{r.scheme} ({int(r.thin_through)})" for r in through.itertuples())
+    return [f"- **Through the singularities** (`NAME+surgery`: a pinched neck cut, the "
+            f"parts thinner than the mesh re-extracted, a run counted only when its "
+            f"continuations removed at most {plan['max_removed_share']:.0%} of the area): "
+            + (f"{names} took meshes with thin features to the end" if len(went) else
+               "none took a mesh with thin features to the end")
+            + (f"; {stuck} none." if stuck else ".")
+            + (f" Runs that went on past a continuation to the end, whatever the share "
+               f"removed: {past}." if past else
+               " No run went on past a continuation to the end.")]

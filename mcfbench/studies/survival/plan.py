@@ -37,9 +37,12 @@ def plan(section=None):
     section : dict, optional
         ``schemes``, ``C``, ``steps``, ``solver``, ``rtol``, ``maxiter``
         (:func:`mcfbench.studies.config.check_mesh_runs`), ``meshes`` ("all" or
-        names of the raw corpus) and ``strategies`` (mesh strategies of
+        names of the raw corpus), ``strategies`` (mesh strategies of
         :data:`mcfbench.running.scheme.MESH_STRATEGIES` every scheme is also run
-        with; default :data:`STRATEGIES`, ``[]`` for none, ``all`` for every one).
+        with; default :data:`STRATEGIES`, ``[]`` for none, ``all`` for every one) and
+        ``surgery`` (scheme names also run as ``NAME+surgery``, after the pairs: the
+        continuation through the thin parts' singularities,
+        :mod:`mcfbench.running.surgery`).
 
     Returns
     -------
@@ -48,7 +51,8 @@ def plan(section=None):
         ``strategies`` (list) and ``meshes``: name -> ``{"file", "sha256",
         "thin_features", "kind"}`` of the chosen meshes that the intake reads (the
         refused ones name their defect in the manifest: the intake's verdict, not a
-        run's), and ``refused``: their names.
+        run's), ``refused``: their names, and ``max_removed_share`` (the share of the
+        area a counted ``NAME+surgery`` run's continuations may remove).
 
     Raises
     ------
@@ -56,6 +60,7 @@ def plan(section=None):
         A bad value, or a mesh name not in the corpus, naming the key.
     """
     from mcfbench.geometry.committed_meshes import RAW_DIR, raw_manifest
+    from mcfbench.running.continuation import MAX_REMOVED_SHARE
     from mcfbench.running.scheme import MESH_STRATEGIES
 
     section = dict(section or {})
@@ -65,8 +70,15 @@ def plan(section=None):
     if bad:
         raise ConfigError(f"config key 'survival.strategies': unknown mesh strategy(ies) "
                           f"{bad}; choose among {', '.join(MESH_STRATEGIES)}")
+    continued = section.pop("surgery", [])
+    if not isinstance(continued, list) or any("+" in str(n) for n in continued):
+        raise ConfigError("config key 'survival.surgery': a list of scheme names without "
+                          f"'+' (each run also as NAME+surgery), got {continued!r}")
     settings = check_mesh_runs(section, "survival")
     settings["schemes"] = paired_schemes(settings["schemes"], strategies)
+    extra = check_mesh_runs({"schemes": [f"{n}+surgery" for n in continued]},
+                            "survival.surgery")["schemes"]
+    settings["schemes"] += [s for s in extra if s not in settings["schemes"]]
     manifest = raw_manifest()
     names = listed(chosen, manifest)
     unknown = [n for n in names if n not in manifest]
@@ -74,7 +86,7 @@ def plan(section=None):
         raise ConfigError(f"config key 'survival.meshes': unknown mesh(es) {unknown}; the "
                           f"raw corpus (mcfbench/data/raw_meshes) has {', '.join(manifest)}")
     read = [n for n in names if manifest[n]["intake"] == "read"]
-    return {**settings, "strategies": strategies,
+    return {**settings, "strategies": strategies, "max_removed_share": MAX_REMOVED_SHARE,
             "meshes": {n: {"file": str(RAW_DIR / manifest[n]["file"]),
                            "sha256": manifest[n]["sha256"],
                            "thin_features": bool(manifest[n]["thin_features"]),

@@ -9,12 +9,12 @@ from mcfbench.presentation.tables import Table, markdown
 from mcfbench.storage.statuses import reached
 
 RUN_COLUMNS = ["mesh", "kind", "thin_features", "scheme", "status", "steps_done", "steps",
-               "reached", "t_failed", "t_end", "defect_fraction", "min_angle", "cpu_seconds",
-               "message"]
+               "reached", "through", "removed_area_share", "t_failed", "t_end",
+               "defect_fraction", "min_angle", "cpu_seconds", "message"]
 """The columns of :func:`runs_table`."""
 
 SUMMARY_COLUMNS = ["scheme", "meshes", "reached", "share", "plain_meshes", "plain_reached",
-                   "plain_share", "thin_meshes", "thin_reached", "thin_share",
+                   "plain_share", "thin_meshes", "thin_reached", "thin_share", "thin_through",
                    "defect_fraction_q1", "defect_fraction_median", "defect_fraction_q3"]
 """The columns of :func:`survival_table`: ``plain`` the meshes without thin features."""
 
@@ -34,20 +34,29 @@ def runs_table(records, meshes):
     pandas.DataFrame
         :data:`RUN_COLUMNS`: ``reached`` when the run ended ``ok`` after every step or
         ``extinct`` (the flow's end), its invariants holding at every step (the driver
-        checks them; any other status names what broke); ``defect_fraction`` the time
-        of its first defect over the run's final time (NaN when it reached the end).
+        checks them; any other status names what broke) and its continuations
+        (``NAME+surgery``) removing at most
+        :data:`mcfbench.running.continuation.MAX_REMOVED_SHARE` of the area;
+        ``through`` when it ended so after a continuation removed some area, whatever
+        the share (``removed_area_share``, the record's);
+        ``defect_fraction`` the time of its first defect over the run's final time
+        (NaN when it reached the end).
     """
     import pandas as pd
 
     rows = []
     for mesh, r in records:
         steps, done = int(r["N"]), int(r["steps_done"])
-        end = reached(r["status"]) and (done == steps or r["status"] != "ok")
+        ended = reached(r["status"]) and (done == steps or r["status"] != "ok")
+        removed = float(r.get("removed_area_share", 0.0))
+        end = ended and not r.get("surgery_exceeded", False)
         t_end = steps * float(r["tau"])
         rows.append({"mesh": mesh, "kind": meshes[mesh]["kind"],
                      "thin_features": bool(meshes[mesh]["thin_features"]),
                      "scheme": r["scheme"], "status": r["status"], "steps_done": done,
-                     "steps": steps, "reached": bool(end), "t_failed": r["t_failed"],
+                     "steps": steps, "reached": bool(end),
+                     "through": bool(ended and removed > 0),
+                     "removed_area_share": removed, "t_failed": r["t_failed"],
                      "t_end": t_end,
                      "defect_fraction": np.nan if end else float(r["t_failed"]) / t_end,
                      "min_angle": r["min_angle"], "cpu_seconds": r["cpu_seconds"],
@@ -63,7 +72,8 @@ def survival_table(runs, schemes):
     pandas.DataFrame
         :data:`SUMMARY_COLUMNS`: the meshes run and reached, over all, without thin
         features (``plain``) and with them (``thin``), the shares (NaN without such
-        meshes), and the quartiles of the first defect's time over the final time
+        meshes), ``thin_through`` the meshes with thin features whose run ended after a
+        continuation removed some area (counted as reached or not), and the quartiles of the first defect's time over the final time
         among the runs that did not reach the end.
     """
     import pandas as pd
@@ -80,7 +90,8 @@ def survival_table(runs, schemes):
             else (np.nan,) * 3
         rows.append(dict(zip(SUMMARY_COLUMNS, (
             scheme, *share(own), *share(own[~own["thin_features"]]),
-            *share(own[own["thin_features"]]), q1, median, q3))))
+            *share(own[own["thin_features"]]),
+            int((own["through"] & own["thin_features"]).sum()), q1, median, q3))))
     return pd.DataFrame(rows, columns=SUMMARY_COLUMNS)
 
 

@@ -94,8 +94,9 @@ def test_a_surgery_scheme_s_identity_has_the_surgery_modules_and_its_name(fresh,
     so; cut out of the harness's closure, they stay in the surgery run's alone."""
     for scheme in ("cotan+surgery", "ddfv-chord-carried+surgery", "bgn+surgery"):
         modules = _modules(scheme, "dumbbell")
-        assert {"mcfbench/geometry/mesh_surgery.py", "mcfbench/running/continuation.py"} \
-            <= modules
+        assert {"mcfbench/geometry/mesh_surgery.py", "mcfbench/running/continuation.py",
+                "mcfbench/geometry/reextraction.py", "mcfbench/running/surgery.py",
+                "mcfbench/geometry/remeshing.py"} <= modules
         assert run_identity(scheme, "dumbbell")["scheme"]["mesh_strategy"] == "surgery"
     assert "mesh_strategy" not in run_identity("cotan", "dumbbell")["scheme"]
     assert identity_digest(run_identity("cotan+surgery", "dumbbell")) != \
@@ -104,6 +105,7 @@ def test_a_surgery_scheme_s_identity_has_the_surgery_modules_and_its_name(fresh,
     monkeypatch.setattr(identity, "HARNESS", ())
     assert "mcfbench/geometry/mesh_surgery.py" in _modules("cotan+surgery", "dumbbell")
     assert "mcfbench/geometry/mesh_surgery.py" not in _modules("cotan", "dumbbell")
+    assert "mcfbench/geometry/reextraction.py" not in _modules("cotan", "dumbbell")
 
 
 def test_the_registries_are_not_followed_from_the_harness():

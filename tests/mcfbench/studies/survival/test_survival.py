@@ -81,8 +81,29 @@ def test_the_tables_count_reached_runs_by_thin_features():
                                                                "C": 0.1})
     assert "**Without thin features**: of the mean curvature flows, the most are taken to " \
         "the end by x (2 of 2, 100 %): it meets the target of 90%." in words
-    assert "**With thin features** (the flow pinches them; no scheme here goes through a " \
-        "pinch): y (1 of 1, 100 %)." in words
+    assert "**With thin features** (the flow pinches them): y (1 of 1, 100 %)." in words
+    assert "Through the singularities" not in words              # no NAME+surgery run
+
+
+def test_the_findings_name_the_schemes_that_go_through_the_thin_parts():
+    """x+surgery reaches the thin mesh c, y+surgery reaches it too but its
+    continuations removed more than the stated share of the area: not counted."""
+    exceeded = {**_record("y+surgery", "ok", 40), "surgery_exceeded": True,
+                "removed_area_share": 0.17}
+    records = [("c", _record("x+surgery", "ok", 40)), ("c", exceeded),
+               ("a", _record("x+surgery", "ok", 40)), ("a", _record("y+surgery", "ok", 40))]
+    runs = survival_tables.runs_table(records, MESHES)
+    assert runs["reached"].tolist() == [True, False, True, True]
+    assert runs["through"].tolist() == [False, True, False, False]
+    summary = survival_tables.survival_table(runs, ["x+surgery", "y+surgery"])
+    assert summary["thin_through"].tolist() == [0, 1]
+    words = survival_findings.findings(summary, {"meshes": MESHES, "steps": 40, "C": 0.1,
+                                                 "max_removed_share": 0.01})
+    assert "x+surgery (1 of 1) took meshes with thin features to the end; y+surgery " \
+        "none." in words and "at most 1% of the area" in words
+    assert "Runs that went on past a continuation to the end, whatever the share " \
+        "removed: y+surgery (1)." in words
+    assert "no scheme here goes through a pinch" not in words
 
 
 def test_every_scheme_is_paired_with_its_variants_once():
