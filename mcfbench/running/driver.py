@@ -134,8 +134,7 @@ class Trajectory:
 
     @property
     def surgeries(self):
-        """The continuations' events (:attr:`events`): ``surgery`` (a neck cut) and
-        ``reextracted`` (the thin parts removed)."""
+        """The continuations' events: ``surgery`` (a cut), ``reextracted`` (thin parts)."""
         return [e for e in self.events if e["event"] in ("surgery", "reextracted")]
 
     @property
