@@ -223,32 +223,53 @@ def eliminated_kernel(indptr, indices, data, X, B, N, dt, out):
 
 
 @numba.njit("void(int32[::1], int32[::1], float64[::1], float64[:, :], float64[:, :], "
-            "float64, float64[::1])", **_OPTIONS)
-def squared_normal_speed_kernel(indptr, indices, data, X, N, dt, out):
+            "float64, float64[::1], float64[::1], float64[::1])", **_OPTIONS)
+def squared_normal_speed_kernel(indptr, indices, data, X, N, dt, chi, out, K_data):
     """``out = (h . N)^2`` with ``h = (X - A X) / dt``, the ``h . V = H^2`` of the
     redistribution's source (R3) (:meth:`ddfv.flow.Flow._potential_of`), in one pass
     over the rows of ``A`` (the products summed in storage order, as scipy's; the dot
     product with ``N`` in the order of the components: numpy's ``einsum`` may sum it
-    otherwise, by an ulp).
+    otherwise, by an ulp); in the same pass, when ``K_data`` is not empty, the values
+    of the stiffness ``K`` of ``A = I + dt diag(1/chi) K`` in ``A``'s pattern
+    (:func:`ddfv.redistribution.potential_operators`: a closed surface, no
+    Dirichlet row): off the diagonal ``(chi_i / dt) A_ij``, on it minus the sum of the row's
+    others (``K``'s rows sum to zero; the ``1`` of ``A_ii`` never subtracted).
 
     Parameters
     ----------
     indptr, indices, data : int32, int32, float64 arrays
         ``A`` (n, n) in CSR (the assembler's: its column indices are in range by
-        construction and not checked here).
+        construction and not checked here; each row's diagonal stored).
     X, N : (3, n) float64 arrays
         The state of the operators ``X*`` and the unit vertex normals.
     dt : float
+    chi : (n,) float64 array
+        The covolume areas of ``A``'s rows (read only for ``K_data``).
     out : (n,) float64 array, output
+    K_data : (nnz,) or (0,) float64 array, output
     """
     n = X.shape[1]
     if indptr.shape[0] != n + 1 or N.shape[1] != n or out.shape[0] != n:
         raise ValueError("the matrix, state, normals and output do not fit")
+    stiffness = K_data.shape[0] > 0
+    if stiffness and (K_data.shape[0] != data.shape[0] or chi.shape[0] != n):
+        raise ValueError("the stiffness's values or the covolumes do not fit the matrix")
     for i in range(n):
         y0, y1, y2 = _row_product(indptr, indices, data, X, i)  # (A X)_i
         hN = (((X[0, i] - y0) / dt) * N[0, i] + ((X[1, i] - y1) / dt) * N[1, i]) \
             + ((X[2, i] - y2) / dt) * N[2, i]
         out[i] = hN * hN
+        if stiffness:
+            c, total, diagonal = chi[i] / dt, 0.0, -1
+            for p in range(indptr[i], indptr[i + 1]):
+                if indices[p] == i:
+                    diagonal = p
+                else:
+                    K_data[p] = c * data[p]
+                    total += K_data[p]
+            if diagonal < 0:
+                raise ValueError("a row of the matrix has no diagonal entry")
+            K_data[diagonal] = -total
 
 
 def moved_t_vertices(F, T, faces, lam, carry):
