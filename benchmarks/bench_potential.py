@@ -140,8 +140,8 @@ PARTS = {
     "baselines": [
         ("baselines.cotan", None, "redistribution_source", "potential: source (R2)"),
         ("baselines.redistribution", "PotentialSolver", "__call__", "potential: solve (R2)"),
-        ("baselines.cotan", None, "drift_laplacian", "drift (R4) + its D X"),
-        ("baselines.cotan", "CotanFlow", "_normal_drift", "normal part (R5)"),
+        ("baselines.cotan", "CotanFlow", "_drifted_system",
+         "drift (R4), normal part (R5), system (C3)"),
         ("baselines.laplacian", "CotanAssembler", "row_scaled", "system matrix (C3)"),
     ],
     "ddfv": [
@@ -149,7 +149,7 @@ PARTS = {
         ("ddfv.assembly", "Assembler", "system", "system matrix (2.10)"),
         ("ddfv.flow", None, "vertex_normals", "vertex normals"),
         ("ddfv.flow", None, "redistribution_source", "potential: source (R3)"),
-        ("ddfv.flow", None, "neumann_stiffness", "potential: stiffness K"),
+        ("ddfv.flow", None, "potential_operators", "potential: h.V and stiffness K"),
         ("ddfv.redistribution", "TangentialPotential", "__call__", "potential: solve (R3)"),
         ("ddfv.flow", None, "drift_system", "drift (R7) + its D X"),
         ("ddfv.flow", None, "carry_t_vertices", "T-vertices carried"),
