@@ -220,8 +220,9 @@ def potential_operators(assembler, geom, A, chi, dt, X, N):
 
     closed = not assembler._mesh.has_boundary
     hV, K_data = np.empty(A.shape[0]), np.empty(A.nnz if closed else 0)
-    squared_normal_speed_kernel(A.indptr, A.indices, A.data, np.asarray(X, dtype=np.float64),
-                                N, float(dt), np.asarray(chi, dtype=np.float64), hV, K_data)
+    squared_normal_speed_kernel(A.indptr, A.indices, A.data, assembler._diag,
+                                np.asarray(X, dtype=np.float64), N, float(dt),
+                                np.asarray(chi, dtype=np.float64), hV, K_data)
     return hV, assembler.in_pattern(K_data) if closed else neumann_stiffness(assembler, geom)
 
 
