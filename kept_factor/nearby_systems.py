@@ -45,8 +45,9 @@ def cholesky_solve(A):
     Returns
     -------
     callable or None
-        ``solve(b)`` for (n,) ``b``; None when ``A`` is not numerically
-        positive definite.
+        ``solve(b, out=None)`` for (n,) ``b`` (into ``out``, a contiguous (n,)
+        float64 array, when given); None when ``A`` is not numerically positive
+        definite.
     """
     from cholespy import CholeskySolverD, MatrixType
 
@@ -58,8 +59,8 @@ def cholesky_solve(A):
     except ValueError:                                   # not positive definite
         return None
 
-    def solve(b):
-        x = np.empty(len(b))
+    def solve(b, out=None):
+        x = np.empty(len(b)) if out is None else out
         factor.solve(np.ascontiguousarray(b, dtype=np.float64), x)
         return x
     return solve
@@ -117,7 +118,10 @@ def family_blocks(split):
             second = cholesky_solve(A[split:, split:])
             if first is not None and second is not None:
                 def solve(b):
-                    return np.concatenate([first(b[:split]), second(b[split:])])
+                    x = np.empty(len(b))        # each block's solve written in place
+                    first(b[:split], x[:split])
+                    second(b[split:], x[split:])
+                    return x
                 return "cg", solve
         return factorise(A)
     return factorise_blocks
@@ -145,9 +149,17 @@ def pinned(K, keep):
         ``A``.
     """
     K = sp.csr_matrix(K)
+    keep = np.asarray(keep, dtype=float)
+    if not np.all((keep == 0.0) | (keep == 1.0)):
+        raise ValueError("keep must hold only 0 (pinned) and 1 (kept)")
+    pins = np.flatnonzero(keep == 0.0)
 
-    def apply(x):
-        return keep * (K @ (keep * x)) + (1.0 - keep) * x
+    def apply(x):          # keep * (K @ (keep * x)) + (1 - keep) * x, two fewer passes
+        kept = np.array(x, dtype=float)
+        kept[pins] = 0.0
+        y = K @ kept
+        y[pins] = x[pins]
+        return y
 
     def matrix():
         P = sp.diags(keep)
