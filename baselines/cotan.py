@@ -59,7 +59,8 @@ shared by every vertex-based baseline.
 import time
 
 import numpy as np
-import scipy.sparse as sp
+
+from kept_factor import as_csr
 
 from .kernels import vertex_normals
 from .tangential_kernels import drifted_system, normal_parts
@@ -202,7 +203,7 @@ class CotanFlow(VertexFlow):
             g = self.geometry_at(at)
             return self.assembler.row_scaled(self._laplacian_data(g), g.mass, dt,
                                              self.fixed), base
-        L = sp.csr_matrix(self.laplacian(at))
+        L = as_csr(self.laplacian(at))
         mass = self._system_mass(at)
         psi = self._potential(at, L, mass)                                            # (R2)
         if self.assembly == "igl":

@@ -120,7 +120,7 @@ from types import SimpleNamespace
 import numpy as np
 import scipy.sparse as sp
 
-from kept_factor import KeptFactorSolver, factorise, family_blocks, pinned
+from kept_factor import KeptFactorSolver, as_csr, factorise, family_blocks, pinned
 
 from .assembly import flux_coefficients
 
@@ -337,7 +337,7 @@ class TangentialPotential(KeptFactorSolver):
         (n,) float array
         """
         n_f, faces, keep = self.mesh.n_f, self.mesh.faces, self._keep
-        K = sp.csr_matrix(K)
+        K = as_csr(K)
         system = pinned(K, keep)
         psi = self.solve(-np.asarray(source, dtype=float) * keep, *system, sequence="psi")
 
@@ -489,7 +489,7 @@ def drift_system(assembler, A, geom, chi, dt, psi, peclet=np.inf, X=None):
                  np.ascontiguousarray(psi, dtype=np.float64), scale, float(peclet),
                  np.zeros((3, n)) if X is None else np.ascontiguousarray(X, dtype=np.float64),
                  mesh.n_f, data, DX)
-    A_psi = sp.csr_matrix((data, A.indices, A.indptr), shape=A.shape)
+    A_psi = assembler.in_pattern(data)
     return A_psi if X is None else (A_psi, DX)
 
 

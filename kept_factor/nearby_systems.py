@@ -31,6 +31,14 @@ SYMMETRY = 1e-12
 EXTRAPOLATION = {0: (1.0,), 1: (2.0, -1.0), 2: (3.0, -3.0, 1.0)}
 
 
+def as_csr(A):
+    """``A`` as a scipy CSR matrix: itself when it is one (``scipy.sparse.csr_matrix(A)``
+    of a CSR matrix builds a new one and checks its index arrays, an ``O(nnz)`` scan:
+    about 0.1 ms at the 276 482 entries of DDFV's step matrix at level 5 of the sphere,
+    three times a redistributing step), else converted."""
+    return A if sp.issparse(A) and A.format == "csr" else sp.csr_matrix(A)
+
+
 def cholesky_solve(A):
     """``b -> A^{-1} b`` by the sparse Cholesky factorisation of ``A``, or None.
 
@@ -148,7 +156,7 @@ def pinned(K, keep):
     matrix : callable () -> (n, n) scipy.sparse.csr_matrix
         ``A``.
     """
-    K = sp.csr_matrix(K)
+    K = as_csr(K)
     keep = np.asarray(keep, dtype=float)
     if not np.all((keep == 0.0) | (keep == 1.0)):
         raise ValueError("keep must hold only 0 (pinned) and 1 (kept)")
