@@ -257,8 +257,12 @@ def redistribution_source(chi, hV, n_f, fixed=None, omega=OMEGA):
         hV[:n_f][~driven[:n_f]] = 0.0
     for family in (slice(0, n_f), slice(n_f, len(chi))):
         m, d = chi[family], driven[family]
-        mean_hV = np.dot(m, hV[family]) / m.sum()                      # <h.V>  (R2)
-        target[family] = np.where(d, m[d].sum() / max(d.sum(), 1), m)  # A / N  (R2)
+        area = m.sum()
+        mean_hV = np.dot(m, hV[family]) / area                         # <h.V>  (R2)
+        if d.all():                         # a closed surface: the same sums, no copies
+            target[family] = area / max(len(m), 1)                     # A / N  (R2)
+        else:
+            target[family] = np.where(d, m[d].sum() / max(d.sum(), 1), m)
         hV[family] -= mean_hV
     return chi * hV + omega * (target - chi)
 
