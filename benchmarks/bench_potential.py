@@ -362,9 +362,10 @@ def check(pairs, levels, steps, repeats):
     interleaved, medians of ``repeats``; printed with the absolute CPU ms and the
     verdict against :data:`TARGET` (issue 46: "drift" when a change makes a ratio pass
     it). A whole run's ratio is measured; a partial run's (level 7: 64 of 8 192 steps)
-    is that of the whole run it begins, from its first step (the potential's first
-    factorisation, 2.8 s for cotan and 6.8 s for DDFV at level 7, most of a 64-step
-    window) and its later steps' mean: ``(first + (N - 1) later)`` of each scheme,
+    is that of the whole run it begins, from its first step (the run's set-up and the
+    potential's first factorisation: at level 7 3.5 s for cotan and 7.4 s for DDFV
+    against 1.1 s for the plain schemes, most of a 64-step window) and its later
+    steps' mean: ``(first + (N - 1) later)`` of each scheme,
     ``N`` the run's steps; the window's own ratio and the later steps' are printed
     beside it. Returns the verdict's ratios, ``{(redistributing, level): ratio}``."""
     names = [name for pair in pairs for name in pair]
