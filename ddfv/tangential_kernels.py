@@ -222,6 +222,24 @@ def eliminated_kernel(indptr, indices, data, X, B, N, dt, out):
         out[2, i] = B[2, i] - dt * (h2 - hN * N[2, i])
 
 
+@numba.njit(**_OPTIONS, inline="always")
+def _off_diagonal_run(indices, data, X, lo, hi, c, K_data, y0, y1, y2, total):
+    """Entries ``lo:hi`` of a row of :func:`squared_normal_speed_kernel` (none its
+    diagonal): their products with ``X`` added to ``y0, y1, y2`` in storage order and,
+    when ``K_data`` is not empty, ``c`` times their values written to it and added to
+    ``total``; returns ``(y0, y1, y2, total)``."""
+    stiffness = K_data.shape[0] > 0
+    for p in range(lo, hi):
+        j, a = indices[p], data[p]
+        y0 += a * X[0, j]
+        y1 += a * X[1, j]
+        y2 += a * X[2, j]
+        if stiffness:
+            K_data[p] = c * a
+            total += K_data[p]
+    return y0, y1, y2, total
+
+
 @numba.njit("void(int32[::1], int32[::1], float64[::1], uint32[::1], float64[:, :], "
             "float64[:, :], float64, float64[::1], float64[::1], float64[::1])", **_OPTIONS)
 def squared_normal_speed_kernel(indptr, indices, data, diagonal, X, N, dt, chi, out, K_data):
@@ -265,27 +283,12 @@ def squared_normal_speed_kernel(indptr, indices, data, diagonal, X, N, dt, chi, 
         if not indptr[i] <= d < indptr[i + 1] or indices[d] != i:
             raise ValueError("a diagonal position is not its row's diagonal entry")
         c = chi[i] / dt if stiffness else 0.0
-        y0 = y1 = y2 = total = 0.0
-        for p in range(indptr[i], d):                       # (A X)_i in storage order
-            j, a = indices[p], data[p]
-            y0 += a * X[0, j]
-            y1 += a * X[1, j]
-            y2 += a * X[2, j]
-            if stiffness:
-                K_data[p] = c * a
-                total += K_data[p]
+        y0, y1, y2, total = _off_diagonal_run(indices, data, X, indptr[i], d, c, K_data,
+                                              0.0, 0.0, 0.0, 0.0)  # (A X)_i in storage order
         a = data[d]
-        y0 += a * X[0, i]
-        y1 += a * X[1, i]
-        y2 += a * X[2, i]
-        for p in range(d + 1, indptr[i + 1]):
-            j, a = indices[p], data[p]
-            y0 += a * X[0, j]
-            y1 += a * X[1, j]
-            y2 += a * X[2, j]
-            if stiffness:
-                K_data[p] = c * a
-                total += K_data[p]
+        y0, y1, y2 = y0 + a * X[0, i], y1 + a * X[1, i], y2 + a * X[2, i]
+        y0, y1, y2, total = _off_diagonal_run(indices, data, X, d + 1, indptr[i + 1], c, K_data,
+                                              y0, y1, y2, total)
         if stiffness:
             K_data[d] = -total
         hN = (((X[0, i] - y0) / dt) * N[0, i] + ((X[1, i] - y1) / dt) * N[1, i]) \
