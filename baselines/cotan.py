@@ -59,10 +59,11 @@ shared by every vertex-based baseline.
 import time
 
 import numpy as np
-import scipy.sparse as sp
+
+from kept_factor import as_csr
 
 from .kernels import vertex_normals
-from .tangential_kernels import normal_parts
+from .tangential_kernels import drifted_system, normal_parts
 from .laplacian import cotangent_laplacian, lumped_mass, row_scaled_matrix
 from .redistribution import (OMEGA, PECLET, REDISTRIBUTIONS, PotentialSolver, drift_laplacian,
                              redistribution_source, surface_components, tangential_velocity,
@@ -202,21 +203,40 @@ class CotanFlow(VertexFlow):
             g = self.geometry_at(at)
             return self.assembler.row_scaled(self._laplacian_data(g), g.mass, dt,
                                              self.fixed), base
-        L = sp.csr_matrix(self.laplacian(at))
+        L = as_csr(self.laplacian(at))
         mass = self._system_mass(at)
-        drift, DX = drift_laplacian(L, self._potential(at, L, mass), self.peclet, at)  # (R4)
-        rhs = base + dt * self._normal_drift(at, DX, mass)                          # (R5)
+        psi = self._potential(at, L, mass)                                            # (R2)
         if self.assembly == "igl":
+            drift, DX = drift_laplacian(L, psi, self.peclet, at)                      # (R4)
+            rhs = base + dt * self._normal_drift(at, DX, mass)                        # (R5)
             return row_scaled_matrix(drift, mass, dt, self.fixed), rhs
-        return self.assembler.row_scaled(drift.data, mass, dt, self.fixed), rhs
+        return self._drifted_system(at, base, dt, L, mass, psi)
+
+    def _vertex_normals(self, at):
+        """(n, 3) the area-weighted vertex normals of ``at``, not normalised."""
+        normals = np.empty((self.mesh.n_vertices, 3))
+        vertex_normals(self.faces, self.geometry_at(at).area_vectors, self.mesh.n_vertices,
+                       normals)
+        return normals
+
+    def _drifted_system(self, at, base, dt, L, mass, psi):
+        """``(A, b)`` of a redistributing step with the cached assembly: ``A = I + dt
+        diag(1/M*) L_psi`` (C3), (R4) and ``b = base + dt g*`` (R5) in one compiled pass
+        over the rows of ``L`` (:func:`baselines.tangential_kernels.drifted_system`: the
+        numbers of :func:`drift_laplacian`, :meth:`CotanAssembler.row_scaled
+        <baselines.laplacian.CotanAssembler.row_scaled>` and :meth:`_normal_drift` bit
+        for bit)."""
+        A_data, rhs = np.empty(L.nnz), np.empty((3, self.mesh.n_vertices))
+        drifted_system(L.indptr, L.indices, L.data, self.assembler.pattern.diag_slots,
+                       np.ascontiguousarray(psi, dtype=np.float64), self.peclet,
+                       np.asarray(at, dtype=np.float64), self._vertex_normals(at), mass,
+                       float(dt), self.fixed, np.asarray(base, dtype=np.float64), A_data, rhs)
+        return self.assembler.csr(A_data), rhs
 
     def _normal_drift(self, at, DX, mass):
         """``g* = N N . (D X*) / m`` (3, n) (R5): the normal part of the drift's
         ``-(L_psi - L) X* / m`` at ``at``, to be added back, from ``DX = (L_psi - L) X*``
         (3, n); zero at fixed vertices."""
-        normals = np.empty((self.mesh.n_vertices, 3))
-        vertex_normals(self.faces, self.geometry_at(at).area_vectors, self.mesh.n_vertices,
-                       normals)
         g = np.empty((3, self.mesh.n_vertices))
-        normal_parts(normals, np.ascontiguousarray(DX), mass, self.fixed, g)
+        normal_parts(self._vertex_normals(at), np.ascontiguousarray(DX), mass, self.fixed, g)
         return g

@@ -127,7 +127,7 @@ i.e. no point crosses the fixed boundary.
 import numpy as np
 import scipy.sparse as sp
 
-from kept_factor import KeptFactorSolver, pinned
+from kept_factor import KeptFactorSolver, as_csr, pinned
 
 from .tangential_kernels import drift_weights, squared_curvature_normals, vertex_gradients
 
@@ -187,7 +187,7 @@ def redistribution_source(L, mass, X, fixed, omega, shares=None):
     -------
     (n,) float array
     """
-    L = sp.csr_matrix(L)
+    L = as_csr(L)
     hV = np.empty(len(mass))                            # |h_i|^2, h_i = -(L X)_i / m_i,
     squared_curvature_normals(L.indptr, L.indices,      # zero where m_i = 0 or fixed
                               np.asarray(L.data, dtype=np.float64),
@@ -320,7 +320,7 @@ def drift_laplacian(L, psi, peclet=np.inf, X=None):
     drift : (3, n) float array
         ``(L_psi - L) X``, from the same pass; only when ``X`` is given.
     """
-    L = sp.csr_matrix(L)
+    L = as_csr(L)
     data = np.empty(L.nnz)
     n = L.shape[0]
     DX = np.empty((3, n))

@@ -170,6 +170,29 @@ def bernoulli_weight(x):
     return x / np.expm1(x)
 
 
+@njit(cache=True, inline="always")
+def _drift_row(indptr, indices, L_data, psi, peclet, X, i, out):
+    """Row ``i`` of :func:`drift_weights`: its off-diagonal values written into ``out``;
+    returns ``(minus their sum, the diagonal's position or -1, ((L_psi - L) X)_i)``."""
+    total = 0.0
+    diagonal = -1
+    d0 = d1 = d2 = 0.0
+    for p in range(indptr[i], indptr[i + 1]):
+        j = indices[p]
+        if j == i:
+            diagonal = p
+            continue
+        x = min(max(psi[i] - psi[j], -peclet), peclet)
+        w = L_data[p] * bernoulli_weight(x)
+        out[p] = w
+        total += w
+        c = w - L_data[p]
+        d0 += c * (X[0, j] - X[0, i])
+        d1 += c * (X[1, j] - X[1, i])
+        d2 += c * (X[2, j] - X[2, i])
+    return -total, diagonal, d0, d1, d2
+
+
 @njit(cache=True)
 def drift_weights(indptr, indices, L_data, psi, peclet, X, out, DX):
     """Values of the drift stiffness (R4) of :mod:`baselines.redistribution` in the
@@ -194,25 +217,62 @@ def drift_weights(indptr, indices, L_data, psi, peclet, X, out, DX):
         ``(L_psi - L) X``.
     """
     for i in range(len(indptr) - 1):
-        total = 0.0
-        diagonal = -1
-        d0 = d1 = d2 = 0.0
-        for p in range(indptr[i], indptr[i + 1]):
-            j = indices[p]
-            if j == i:
-                diagonal = p
-                continue
-            x = min(max(psi[i] - psi[j], -peclet), peclet)
-            w = L_data[p] * bernoulli_weight(x)
-            out[p] = w
-            total += w
-            c = w - L_data[p]
-            d0 += c * (X[0, j] - X[0, i])
-            d1 += c * (X[1, j] - X[1, i])
-            d2 += c * (X[2, j] - X[2, i])
+        diagonal_value, diagonal, d0, d1, d2 = _drift_row(indptr, indices, L_data, psi,
+                                                          peclet, X, i, out)
         if diagonal >= 0:
-            out[diagonal] = -total
+            out[diagonal] = diagonal_value
         DX[0, i], DX[1, i], DX[2, i] = d0, d1, d2
+
+
+@njit(cache=True)
+def drifted_system(indptr, indices, L_data, diag_slots, psi, peclet, X, omega, mass, tau,
+                   fixed, base, A_data, rhs):
+    """The system of a redistributing cotangent step in one pass over the rows of ``L``:
+    the values of ``I + tau diag(1/m) L_psi`` ((C3) of :mod:`baselines.cotan` with the
+    drift stiffness (R4), :func:`drift_weights`) and ``rhs = base + tau g`` with ``g``
+    the normal part (R5) of the drift (:func:`normal_parts`), the numbers of
+    :func:`drift_weights`, :func:`baselines.kernels.row_scaled_system` and
+    :func:`normal_parts` bit for bit without their arrays ``L_psi`` and ``(L_psi - L)
+    X`` and two more passes. Rows ``fixed`` or of zero mass: identity, ``rhs = base``.
+
+    Parameters
+    ----------
+    indptr, indices : CSR pattern of ``L`` (n, n), each row's diagonal stored
+    L_data : (nnz,) float64 array
+    diag_slots : (n,) int array
+    psi : (n,) float64 array
+    peclet : float
+    X : (3, n) float64 array
+        The state of ``L`` (its drift is the normal part's).
+    omega : (n, 3) float64 array
+        Vertex normals, any length (:func:`baselines.kernels.vertex_normals`).
+    mass : (n,) float64 array
+    tau : float
+    fixed : (n,) bool array
+    base : (3, n) float64 array
+    A_data : (nnz,) float64 array, output
+    rhs : (3, n) float64 array, output
+    """
+    for i in range(len(indptr) - 1):
+        lo, hi = indptr[i], indptr[i + 1]
+        if fixed[i] or not mass[i] > 0.0:
+            for p in range(lo, hi):
+                A_data[p] = 0.0
+            A_data[diag_slots[i]] = 1.0
+            rhs[0, i], rhs[1, i], rhs[2, i] = base[0, i], base[1, i], base[2, i]
+            continue
+        diagonal_value, diagonal, d0, d1, d2 = _drift_row(indptr, indices, L_data, psi,
+                                                          peclet, X, i, A_data)
+        if diagonal >= 0:
+            A_data[diagonal] = diagonal_value
+        s = tau / mass[i]
+        for p in range(lo, hi):
+            A_data[p] = A_data[p] * s
+        A_data[diag_slots[i]] += 1.0
+        g = _normal_part(omega, d0, d1, d2, mass, fixed, i)
+        rhs[0, i] = base[0, i] + tau * (g * omega[i, 0])
+        rhs[1, i] = base[1, i] + tau * (g * omega[i, 1])
+        rhs[2, i] = base[2, i] + tau * (g * omega[i, 2])
 
 
 @njit(cache=True)
@@ -241,6 +301,16 @@ def squared_curvature_normals(indptr, indices, data, X, mass, fixed, out):
         out[i] = 0.0 if fixed[i] or not m > 0.0 else ((y0 * y0 + y1 * y1) + y2 * y2) / (m * m)
 
 
+@njit(cache=True, inline="always")
+def _normal_part(omega, d0, d1, d2, mass, fixed, i):
+    """``s`` with ``g_i = s omega_i`` in :func:`normal_parts`, from ``D_i = (d0, d1, d2)``."""
+    nx, ny, nz = omega[i, 0], omega[i, 1], omega[i, 2]
+    squared = nx * nx + ny * ny + nz * nz
+    if not fixed[i] and squared > 0.0 and mass[i] > 0.0:
+        return (nx * d0 + ny * d1 + nz * d2) / (squared * mass[i])
+    return 0.0
+
+
 @njit(cache=True)
 def normal_parts(omega, D, mass, fixed, g):
     """``g_i = N_i N_i . D_i / m_i`` (the normal part (R5) of the drift of
@@ -257,9 +327,5 @@ def normal_parts(omega, D, mass, fixed, g):
     g : (3, n) float64 array, output
     """
     for i in range(mass.shape[0]):
-        nx, ny, nz = omega[i, 0], omega[i, 1], omega[i, 2]
-        squared = nx * nx + ny * ny + nz * nz
-        s = 0.0
-        if not fixed[i] and squared > 0.0 and mass[i] > 0.0:
-            s = (nx * D[0, i] + ny * D[1, i] + nz * D[2, i]) / (squared * mass[i])
-        g[0, i], g[1, i], g[2, i] = s * nx, s * ny, s * nz
+        s = _normal_part(omega, D[0, i], D[1, i], D[2, i], mass, fixed, i)
+        g[0, i], g[1, i], g[2, i] = s * omega[i, 0], s * omega[i, 1], s * omega[i, 2]

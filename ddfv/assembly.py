@@ -215,6 +215,11 @@ class Assembler:
         for_threads(system_kernel, threads)(
             self._inner, *factors, slots, self._rows, order, starts, untouched, scale,
             float(shift), data)
+        return self.in_pattern(data)
+
+    def in_pattern(self, data):
+        """The (n, n) CSR matrix of the values ``data`` (nnz,) in this pattern (its
+        arrays shared, no check of the pattern: see ``_pattern``)."""
         A = copy.copy(self._pattern)
         A.data = data
         return A

@@ -40,7 +40,7 @@ from .assembly import Assembler
 from .geometry import diamond_geometry, t_barycentric, vertex_normals
 from .threads import check_threads
 from .redistribution import (OMEGA, PECLET, TangentialPotential, carry_t_vertices,
-                             drift_system, neumann_stiffness, redistribution_source,
+                             drift_system, potential_operators, redistribution_source,
                              surface_components, vertex_gradients)
 from .t_vertices import initial_t_vertices
 from .tangential_motion import KINDS, TangentialMotion, follow_triangles
@@ -412,14 +412,10 @@ class Flow:
         """(n,) ``psi`` of (R3) at the state ``at``; ``A`` the scheme's step matrix at
         ``at`` with step ``dt`` (its discrete Laplacian gives ``h``, as in (3.6)), ``N``
         the vertex normals of ``geometry`` (3, n) when the caller has them."""
-        from .tangential_kernels import squared_normal_speed_kernel
-
         clock = time.perf_counter()
         mesh = self._mesh
         N = vertex_normals(mesh, geometry) if N is None else N
-        hV = np.empty(A.shape[0])                                # h.V = H^2 (V = H N),
-        squared_normal_speed_kernel(A.indptr, A.indices, A.data,  # h* = (at - A at) / dt
-                                    np.asarray(at, dtype=np.float64), N, float(dt), hV)
+        hV, K = potential_operators(self._assembler, geometry, A, covolumes, dt, at, N)
         if self._area_0 is None:                                 # the first step's state
             self._area_0 = float(covolumes[:mesh.n_f].sum())
         rate = self.omega * 4.0 * np.pi / self._area_0           # scale-covariant omega
@@ -427,7 +423,7 @@ class Flow:
                                        rate)                     # (R3)
         if self._potential is None:
             self._potential = TangentialPotential(mesh)
-        psi = self._potential(neumann_stiffness(self._assembler, geometry), source, covolumes)
+        psi = self._potential(K, source, covolumes)
         self._tick("potential", clock)
         return psi
 

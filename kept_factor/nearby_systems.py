@@ -31,6 +31,14 @@ SYMMETRY = 1e-12
 EXTRAPOLATION = {0: (1.0,), 1: (2.0, -1.0), 2: (3.0, -3.0, 1.0)}
 
 
+def as_csr(A):
+    """``A`` as a scipy CSR matrix: itself when it is one (``scipy.sparse.csr_matrix(A)``
+    of a CSR matrix builds a new one and checks its index arrays, an ``O(nnz)`` scan:
+    about 0.1 ms at the 276 482 entries of DDFV's step matrix at level 5 of the sphere,
+    three times a redistributing step), else converted."""
+    return A if sp.issparse(A) and A.format == "csr" else sp.csr_matrix(A)
+
+
 def cholesky_solve(A):
     """``b -> A^{-1} b`` by the sparse Cholesky factorisation of ``A``, or None.
 
@@ -45,8 +53,9 @@ def cholesky_solve(A):
     Returns
     -------
     callable or None
-        ``solve(b)`` for (n,) ``b``; None when ``A`` is not numerically
-        positive definite.
+        ``solve(b, out=None)`` for (n,) ``b`` (into ``out``, a contiguous (n,)
+        float64 array, when given); None when ``A`` is not numerically positive
+        definite.
     """
     from cholespy import CholeskySolverD, MatrixType
 
@@ -58,8 +67,8 @@ def cholesky_solve(A):
     except ValueError:                                   # not positive definite
         return None
 
-    def solve(b):
-        x = np.empty(len(b))
+    def solve(b, out=None):
+        x = np.empty(len(b)) if out is None else out
         factor.solve(np.ascontiguousarray(b, dtype=np.float64), x)
         return x
     return solve
@@ -117,7 +126,10 @@ def family_blocks(split):
             second = cholesky_solve(A[split:, split:])
             if first is not None and second is not None:
                 def solve(b):
-                    return np.concatenate([first(b[:split]), second(b[split:])])
+                    x = np.empty(len(b))        # each block's solve written in place
+                    first(b[:split], x[:split])
+                    second(b[split:], x[split:])
+                    return x
                 return "cg", solve
         return factorise(A)
     return factorise_blocks
@@ -144,10 +156,18 @@ def pinned(K, keep):
     matrix : callable () -> (n, n) scipy.sparse.csr_matrix
         ``A``.
     """
-    K = sp.csr_matrix(K)
+    K = as_csr(K)
+    keep = np.asarray(keep, dtype=float)
+    if not np.all((keep == 0.0) | (keep == 1.0)):
+        raise ValueError("keep must hold only 0 (pinned) and 1 (kept)")
+    pins = np.flatnonzero(keep == 0.0)
 
-    def apply(x):
-        return keep * (K @ (keep * x)) + (1.0 - keep) * x
+    def apply(x):          # keep * (K @ (keep * x)) + (1 - keep) * x, two fewer passes
+        kept = np.array(x, dtype=float)
+        kept[pins] = 0.0
+        y = K @ kept
+        y[pins] = x[pins]
+        return y
 
     def matrix():
         P = sp.diags(keep)

@@ -245,6 +245,29 @@ def test_normal_parts_of_the_drift():
 
 # -- invariances -----------------------------------------------------------------
 
+@pytest.mark.parametrize("surface", ["noisy sphere", "hemisphere"])
+def test_drifted_system_is_the_three_passes_bit_for_bit(surface):
+    """The cached assembly's system of a redistributing step in one compiled pass
+    (``drifted_system``): the numbers of ``drift_laplacian``, the row-scaled form (C3)
+    and the normal part (R5) added to ``base``, bit for bit; identity rows and ``b =
+    base`` at the hemisphere's fixed boundary."""
+    V, F = noisy_sphere() if surface == "noisy sphere" else hemisphere(rings=4)
+    flow = redistributing(V, F, 0.01)
+    rng = np.random.default_rng(3)
+    at = flow.X + 0.01 * rng.standard_normal(flow.X.shape)
+    base = flow.X + 0.01 * rng.standard_normal(flow.X.shape)
+    A, b = flow.system(at, base, 0.003)
+    L, mass = flow.laplacian(at), flow._system_mass(at)
+    drift, DX = drift_laplacian(L, flow.psi, flow.peclet, at)
+    expected = flow.assembler.row_scaled(drift.data, mass, 0.003, flow.fixed)
+    np.testing.assert_array_equal(A.data, expected.data)
+    np.testing.assert_array_equal(A.indices, expected.indices)
+    np.testing.assert_array_equal(b, base + 0.003 * flow._normal_drift(at, DX, mass))
+    assert flow.fixed.any() == (surface == "hemisphere")
+    np.testing.assert_array_equal(b[:, flow.fixed], base[:, flow.fixed])
+    assert not np.array_equal(b, base)
+
+
 def test_one_step_is_invariant_under_rigid_motions():
     V, F = noisy_sphere()
     Q, _ = np.linalg.qr(np.random.default_rng(3).standard_normal((3, 3)))

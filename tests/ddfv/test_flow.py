@@ -229,7 +229,8 @@ def test_squared_normal_speed_is_numpys(surface, request):
     A, _ = flow.system(at, at, 0.0013)
     N = vertex_normals(flow._mesh, flow._geometry_at(at)[0])
     out = np.empty(A.shape[0])
-    squared_normal_speed_kernel(A.indptr, A.indices, A.data, at, N, 0.0013, out)
+    squared_normal_speed_kernel(A.indptr, A.indices, A.data, flow._assembler._diag, at, N,
+                                0.0013, np.empty(0), out, np.empty(0))
     h = (at - (A @ at.T).T) / 0.0013
     assert np.array_equal(out, ((h[0] * N[0] + h[1] * N[1]) + h[2] * N[2]) ** 2)
     fixed = flow._mesh.boundary_vertices

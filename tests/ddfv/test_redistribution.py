@@ -17,7 +17,7 @@ from ddfv.assembly import Assembler, flux_coefficients
 from ddfv.geometry import covolume_areas, diamond_geometry, vertex_normals
 from ddfv.redistribution import (TangentialPotential, carry_t_vertices,
                                  diamond_gradients, drift_system, neumann_stiffness,
-                                 redistribution_source, tangential_potential,
+                                 potential_operators, redistribution_source, tangential_potential,
                                  vertex_gradients)
 from ddfv.t_vertices import initial_t_vertices
 from ddfv.topology import diamond_mesh
@@ -98,6 +98,41 @@ def test_neumann_stiffness_kills_a_constant_per_family_on_a_closed_surface(noisy
     K = neumann_stiffness(Assembler(mesh), geom)
     psi = np.r_[np.full(mesh.n_f, 1.0), np.full(mesh.n_t, -2.5)]
     np.testing.assert_allclose(K @ psi, 0.0, atol=1e-12 * np.abs(K).max())
+
+
+@pytest.mark.parametrize("dual_length", ["chord", "broken"])
+def test_stiffness_read_off_the_step_matrix_is_the_assembled_one(noisy_sphere, dual_length):
+    """On a closed surface ``K`` of (R3) is read off the step's matrix ``A = I + dt
+    diag(1/chi) K`` (``potential_operators``): the assembled ``K`` to rounding, in
+    ``A``'s pattern, with rows that sum to zero to rounding of their entries; for a
+    tiny ``dt`` too (the diagonal is minus the row's others, never ``(A_ii - 1) chi /
+    dt``); ``h.V`` is the kernel's without ``K``."""
+    V, F = noisy_sphere
+    mesh, T, geom, chi = _setup(V, F, dual_length=dual_length)
+    assembler = Assembler(mesh)
+    X = np.ascontiguousarray(np.r_[V, T].T)
+    N = vertex_normals(mesh, geom)
+    assembled = neumann_stiffness(assembler, geom).toarray()
+    scale = np.abs(assembled).max()
+    for dt in (1e-3, 1e-11):
+        A = assembler.system(geom, chi, dt)
+        hV, K = potential_operators(assembler, geom, A, chi, dt, X, N)
+        assert K.indptr is A.indptr and K.indices is A.indices
+        np.testing.assert_allclose(K.toarray(), assembled, rtol=0, atol=1e-13 * scale)
+        assert np.abs(K @ np.ones(len(chi))).max() <= 1e-14 * scale
+        h = (X - (A @ X.T).T) / dt
+        np.testing.assert_array_equal(hV, ((h[0] * N[0] + h[1] * N[1]) + h[2] * N[2]) ** 2)
+
+
+def test_stiffness_of_a_surface_with_boundary_is_the_neumann_one():
+    """With a boundary ``A`` has Dirichlet rows: ``K`` of (R3) is :func:`neumann_stiffness`."""
+    V, F = surfaces.hemisphere(rings=4)
+    mesh, T, geom, chi = _setup(V, F)
+    assembler = Assembler(mesh)
+    A = assembler.system(geom, chi, 1e-3)
+    _, K = potential_operators(assembler, geom, A, chi, 1e-3, np.r_[V, T].T,
+                               vertex_normals(mesh, geom))
+    np.testing.assert_array_equal(K.toarray(), neumann_stiffness(assembler, geom).toarray())
 
 
 def _sphere_operators(level):

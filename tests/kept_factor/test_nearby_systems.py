@@ -207,8 +207,12 @@ def test_pinned_system():
     x = np.random.default_rng(1).standard_normal(len(V))
     A = matrix()
     np.testing.assert_allclose(apply(x), A @ x, atol=1e-14)
+    np.testing.assert_array_equal(apply(x), keep * (K @ (keep * x)) + (1.0 - keep) * x)
+    assert apply(x)[3] == x[3] and x[3] != 0.0
     assert A[3, 3] == 1.0 and A[3].nnz == 1 and A[:, 3].nnz == 1
     assert factorise(A)[0] == "cg"
+    with pytest.raises(ValueError, match="keep must hold only 0"):
+        pinned(K, np.full(len(V), 0.5))
 
 
 def test_preconditioned_cg_exact_in_n_steps_and_stops_where_not_positive_definite():
