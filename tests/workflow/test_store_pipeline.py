@@ -151,3 +151,24 @@ def test_changing_a_registry_option_recomputes_exactly_its_runs(edited):
         new = json.loads((work / path).read_text())
         assert new["settings"]["code"] != old[path]["settings"]["code"]
         assert new["l2_error"] != old[path]["l2_error"]       # run again, not copied
+
+
+def test_the_jobs_run_the_code_that_snakemake_planned_with(tmp_path, env):
+    """``python -m snakemake`` in a checkout whose packages are not those of
+    ``PYTHONPATH`` (a worktree beside an editable install; here the copy against the
+    repository) plans with the checkout's, the current directory coming first; its jobs
+    import them too (``mcfbench.pipeline.jobs_pythonpath``): bgn's runs with the copy's
+    changed option, whose records the views read (the jobs imported the repository's
+    before, and the pictures stopped on a record stale to their code)."""
+    work = copy_workflow(tmp_path / "work")
+    for name in ("ddfv", "baselines", "kept_factor", "mcfbench"):
+        shutil.copytree(REPO / name, work / name, ignore=IGNORE)
+    source = work / "mcfbench" / "schemes" / "bgn.py"
+    text = source.read_text()
+    assert text.count('{"scaling": "mass"}') == 1
+    source.write_text(text.replace('{"scaling": "mass"}', '{"scaling": "none"}'))
+    assert str(work) not in env["PYTHONPATH"]
+    code, out = snakemake(work, env, "--cores", "2", "matrix", "--config",
+                          "matrix={select: {schemes: [bgn], problems: {sphere: [1]}}}")
+    assert code == 0, out[-3000:]
+    assert len(records(work)) == 1
