@@ -332,13 +332,13 @@ def jobs_pythonpath(pythonpath=None):
     out of it).
 
     Snakemake plans the runs, their code digests (a batch's params) included, with
-    the packages it imports; a job's script runs in another process, whose import
-    path has no current directory. Without this, ``python -m snakemake`` run in a
-    checkout with no ``PYTHONPATH`` plans with the checkout's code (the current
-    directory comes first) while its jobs run another copy (an editable install's):
-    a batch is not rerun after an edit and the views' digests differ from the
-    records' (a stale-record error), or a run computed by the other copy is recorded
-    under the checkout's digest.
+    the packages it imports, the Snakefile's folder first on its import path; a job's
+    script runs in another process, whose import path has neither. Without this,
+    Snakemake run in a checkout whose ``PYTHONPATH`` does not name it plans with the
+    checkout's code while its jobs run another copy (an editable install's): a batch
+    is not rerun after an edit and the views' digests differ from the records' (a
+    stale-record error), or a run computed by the other copy is recorded under the
+    checkout's digest.
 
     Parameters
     ----------

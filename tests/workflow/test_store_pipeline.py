@@ -154,10 +154,9 @@ def test_changing_a_registry_option_recomputes_exactly_its_runs(edited):
 
 
 def test_the_jobs_run_the_code_that_snakemake_planned_with(tmp_path, env):
-    """``python -m snakemake`` in a checkout whose packages are not those of
-    ``PYTHONPATH`` (a worktree beside an editable install; here the copy against the
-    repository) plans with the checkout's, the current directory coming first; its jobs
-    import them too (``mcfbench.pipeline.jobs_pythonpath``): bgn's runs with the copy's
+    """Snakemake in a checkout whose packages are not those of ``PYTHONPATH`` (a
+    worktree beside an editable install; here the copy against the repository) plans
+    with the checkout's, the Snakefile's folder coming first; its jobs import them too (``mcfbench.pipeline.jobs_pythonpath``): bgn's runs with the copy's
     changed option, whose records the views read (the jobs imported the repository's
     before, and the pictures stopped on a record stale to their code)."""
     work = copy_workflow(tmp_path / "work")
