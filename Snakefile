@@ -19,7 +19,7 @@ from snakemake.utils import min_version
 
 from mcfbench.pipeline import (
     check_config,
-    jobs_pythonpath,
+    jobs_environment,
     message_only,
     study_rule_files,
 )
@@ -31,7 +31,7 @@ from mcfbench.storage.provenance import BLAS_THREAD_VARIABLES
 os.environ.update(dict.fromkeys(BLAS_THREAD_VARIABLES, "1"))
 # The jobs import the packages this workflow planned their runs with (the code
 # digests of the batches' params), not another copy (mcfbench.pipeline.jobs_pythonpath).
-os.environ["PYTHONPATH"] = jobs_pythonpath(os.environ.get("PYTHONPATH"))
+os.environ.update(jobs_environment())
 
 min_version("9.0")
 

@@ -355,6 +355,12 @@ def jobs_pythonpath(pythonpath=None):
     return os.pathsep.join([str(root), *rest])
 
 
+def jobs_environment():
+    """``{"PYTHONPATH": ...}`` for the Snakefile to set: :func:`jobs_pythonpath` of this
+    process's."""
+    return {"PYTHONPATH": jobs_pythonpath(os.environ.get("PYTHONPATH"))}
+
+
 def code_digests(specs):
     """``{spec: code digest}``: the digest of each spec's run identity
     (:func:`mcfbench.running.identity.run_identity` of its scheme and problem), the
