@@ -17,13 +17,21 @@ import os
 
 from snakemake.utils import min_version
 
-from mcfbench.pipeline import check_config, message_only, study_rule_files
+from mcfbench.pipeline import (
+    check_config,
+    jobs_environment,
+    message_only,
+    study_rule_files,
+)
 from mcfbench.storage.provenance import BLAS_THREAD_VARIABLES
 
 # One BLAS thread per job, set once here: every job inherits it (local or
 # Slurm), before any of them imports numpy. The jobs' run records store these
 # variables (mcfbench.storage.provenance.BLAS_THREAD_VARIABLES).
 os.environ.update(dict.fromkeys(BLAS_THREAD_VARIABLES, "1"))
+# The jobs import the packages this workflow planned their runs with (the code
+# digests of the batches' params), not another copy (mcfbench.pipeline.jobs_pythonpath).
+os.environ.update(jobs_environment())
 
 min_version("9.0")
 

@@ -17,7 +17,8 @@ their slopes, and the largest fixed part.
 Usage::
 
     python benchmarks/bench_cost.py [--levels 2 3 4 5] [--fit-from 4]
-        [--schemes cotan cotan-redistribute ddfv ddfv-chord-redistribute-carried bgn kll]
+        [--schemes cotan deturck dual-mdr cotan-redistribute ddfv ddfv-chord-bgn-carried
+                   ddfv-chord-redistribute-carried bgn kll]
 """
 
 import argparse
@@ -62,7 +63,8 @@ def main():
     parser.add_argument("--fit-from", type=int, default=4,
                         help="the memory fit's first level (below it, the fixed part)")
     parser.add_argument("--schemes", nargs="+", default=[
-        "cotan", "cotan-redistribute", "ddfv", "ddfv-chord-redistribute-carried", "bgn", "kll"])
+        "cotan", "deturck", "dual-mdr", "cotan-redistribute", "ddfv", "ddfv-chord-bgn-carried",
+        "ddfv-chord-redistribute-carried", "bgn", "kll"])
     args = parser.parse_args()
     print(machine_line())
     print(f"{'scheme':32} {'level':>5} {'unknowns':>9} {'fixed MB':>9} {'memory MB':>10} "

@@ -35,6 +35,7 @@ import hashlib
 import importlib
 import json
 import math
+import os
 import re
 import time
 from contextlib import contextmanager
@@ -323,6 +324,41 @@ class RunStore:
         """``[(spec dict, code digest)]`` of ``specs``: a view's params, read back
         by :func:`expected_runs`."""
         return [(spec.to_dict(), self.digest(spec)) for spec in specs]
+
+
+def jobs_pythonpath(pythonpath=None):
+    """``PYTHONPATH`` for the jobs: the folder holding the ``mcfbench`` that the
+    workflow imported first, then ``pythonpath`` (the current value; that folder left
+    out of it).
+
+    Snakemake plans the runs, their code digests (a batch's params) included, with
+    the packages it imports, the Snakefile's folder first on its import path; a job's
+    script runs in another process, whose import path has neither. Without this,
+    Snakemake run in a checkout whose ``PYTHONPATH`` does not name it plans with the
+    checkout's code while its jobs run another copy (an editable install's): a batch
+    is not rerun after an edit and the views' digests differ from the records' (a
+    stale-record error), or a run computed by the other copy is recorded under the
+    checkout's digest.
+
+    Parameters
+    ----------
+    pythonpath : str, optional
+
+    Returns
+    -------
+    str
+    """
+    import mcfbench
+
+    root = Path(mcfbench.__file__).resolve().parents[1]
+    rest = [p for p in (pythonpath or "").split(os.pathsep) if p and Path(p).resolve() != root]
+    return os.pathsep.join([str(root), *rest])
+
+
+def jobs_environment():
+    """``{"PYTHONPATH": ...}`` for the Snakefile to set: :func:`jobs_pythonpath` of this
+    process's."""
+    return {"PYTHONPATH": jobs_pythonpath(os.environ.get("PYTHONPATH"))}
 
 
 def code_digests(specs):

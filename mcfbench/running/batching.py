@@ -46,7 +46,9 @@ matrix's series take more solver iterations a step (larger steps, real meshes,
 the anisotropic sphere) and the redistributing ones mostly stop early. Within a
 kind, a series is still within a factor 2.5 of its measured time in the median,
 a factor 7-15 in one case out of ten; the factor brings the heavy series out (1 for
-a kind not measured)."""
+a kind not measured: ``"dual-mdr"`` and ``"ddfv, tangential"``, kinds since
+2026-12-07, whose series that matrix counted with ``"vertex"`` and ``"ddfv"``; their
+own time fits are 4.7 and 2.8 x those kinds' at level 5)."""
 
 
 def spec_seconds(spec):

@@ -16,7 +16,28 @@ blocks (one n x n matrix for four right-hand sides), refitted 2026-11-26 beside
 ``cotan`` and ``bgn`` at load average 13-15: 17.0 MB and 4.4 ms against 13.8 MB
 and 3.5 ms for ``cotan``, 16.3 MB and 6.3 ms for ``bgn``; a second run beside
 ``cotan``, 17.0 MB and 6.0 ms against 14.1 MB and 2.6 ms; before the block
-solve it took 25.4 MB and 6.7 ms):
+solve it took 25.4 MB and 6.7 ms).
+
+Refitted 2026-12-07 (memory is load-independent; load average 0.6-8): the level-8
+sphere and a 1 024 000-vertex mesh (``benchmarks/bench_scaling.py``) had put
+``dual-mdr``'s peak at 2.4 x its estimate (3.6 and 5.5 GB against 1.5 and 2.3 GB)
+and ``deturck``'s at 1.06 x. ``bench_cost.py --levels 2 3 4 5`` (and ``--levels 4
+5`` for the others) on every scheme, at level 5: cotan, ``cmcf``, ``cotan-voronoi``
+15.6-15.7 MB; ``mdr`` 20.5, ``bgn-bdf2`` 21.5, ``cotan-intrinsic`` 22.6, ``deturck``
+23.4 MB; ``dual-mdr`` 67.4 MB (its ``(X, R)`` block system: twice the unknowns, and its
+Krylov vectors) and 13.8 ms a step;
+``ddfv`` 30.8 MB, ``ddfv-chord-carried`` 33.8 MB; ``ddfv-chord-bgn-carried`` and
+``ddfv-chord-mdr-carried`` 69.2 and 69.0 MB (the kept factors of their tangential
+motions) and 16.1 and 11.9 ms; the fixed part 110-127 MB (168-223 MB for a
+scheme's first run in a fresh checkout: numba compiling into an empty cache).
+Hence ``"dual-mdr"`` and ``"ddfv, tangential"`` are kinds of their own (memory and
+time fitted on levels 4-5, the largest of their schemes), and the memory of
+``"vertex"`` is refitted on the largest of its schemes (``deturck``; its time kept,
+the batching's factor was measured against it): at level 8 (655 362 vertices) it
+estimates 2.15 GB against ``deturck``'s 1.55 GB and ``mdr``'s 1.30 GB peak, and
+``dual-mdr`` 4.82 GB against 3.57 GB (7.53 against 5.50 GB at 1 024 000 vertices).
+Every other kind's estimate was above its schemes' peaks at level 5 and at level 8
+and is kept.
 
 * the peak resident memory that grows with the mesh (mesh, flow, solver), above
   a process that made a level-1 run first, ``a n^p`` (slopes 1.06-1.12), plus
@@ -49,9 +70,11 @@ from mcfbench.running.schemes import find_scheme, get_scheme, parse_name
 from mcfbench.storage.memory import available_mb
 
 COSTS = {
-    "vertex": ((5.825e-4, 1.093), (6.696e-6, 0.660)),
+    "vertex": ((1.179e-3, 1.072), (6.696e-6, 0.660)),
+    "dual-mdr": ((5.473e-3, 1.020), (6.485e-6, 0.830)),
     "vertex, redistributing": ((1.402e-3, 1.079), (2.671e-6, 1.113)),
     "ddfv": ((4.547e-4, 1.064), (1.143e-6, 0.825)),
+    "ddfv, tangential": ((2.062e-3, 1.009), (2.096e-7, 1.089)),
     "ddfv, redistributing": ((7.923e-4, 1.122), (2.134e-6, 0.947)),
     "bgn": ((9.613e-4, 1.055), (9.14e-6, 0.661)),
     "kll": ((5.815e-4, 1.113), (3.848e-6, 0.763)),
@@ -59,26 +82,32 @@ COSTS = {
 """Kind of scheme (:func:`cost_class`) -> ``((a, p), (b, q))``: memory ``a n^p`` MB above
 a warmed-up process and ``b n^q`` CPU seconds per step (module docstring;
 ``benchmarks/bench_cost.py``: ``cotan``, ``cotan-redistribute``, ``ddfv``,
-``ddfv-chord-redistribute-carried``, ``bgn``, ``kll``)."""
+``ddfv-chord-redistribute-carried``, ``bgn``, ``kll``; refitted 2026-12-07: the
+memory of ``vertex`` on ``deturck``, ``dual-mdr`` on itself, ``ddfv, tangential`` on
+``ddfv-chord-bgn-carried`` and ``ddfv-chord-mdr-carried``)."""
 FIXED_MB = 135.0
 """The memory a process takes on for its first run, whatever its size: numba, the
 compiled kernels, scipy's solvers (the level-1 run after the imports)."""
 
 def cost_class(scheme):
     """The kind of a scheme (a name or a registry entry) in :data:`COSTS`: ``"bgn"``
-    (a coupled 3n x 3n system), ``"kll"`` (a 7n x 7n one, solved by blocks), ``"ddfv"`` or
-    ``"vertex"`` (the other vertex
-    schemes), with ``", redistributing"`` for a scheme with a tangential
-    redistribution (a potential solved at every step)."""
+    (a coupled 3n x 3n system), ``"kll"`` (a 7n x 7n one, solved by blocks),
+    ``"dual-mdr"`` (its ``(X, R)`` block system: 3-4 x the memory of the other vertex
+    schemes), ``"ddfv"`` or ``"vertex"`` (the other vertex schemes), with ``",
+    redistributing"`` for a scheme with a tangential redistribution (a potential solved
+    at every step) and, for DDFV, ``", tangential"`` for BGN's or MDR's tangential
+    motion (their kept factors: twice the memory)."""
     entry = get_scheme(scheme) if isinstance(scheme, str) else scheme
     entry = find_scheme(entry.name) or entry      # a study's wrapper -> the registry's entry
-    if parse_name(entry.name).base in ("bgn", "kll"):
+    if parse_name(entry.name).base in ("bgn", "kll", "dual-mdr"):
         return parse_name(entry.name).base
     options = getattr(entry, "options", {})
-    redistributing = options.get("redistribution") is not None or \
-        options.get("tangential") == "redistribute"
     kind = entry.family                           # "ddfv" or "vertex": a key of COSTS
-    return f"{kind}, redistributing" if redistributing else kind
+    if options.get("redistribution") is not None or options.get("tangential") == "redistribute":
+        return f"{kind}, redistributing"
+    if kind == "ddfv" and options.get("tangential") in ("bgn", "mdr"):
+        return f"{kind}, tangential"
+    return kind
 
 
 @dataclass(frozen=True)

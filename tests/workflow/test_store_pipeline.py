@@ -7,7 +7,7 @@ at levels 1-2. The edit tests copy the packages too (``PYTHONPATH`` puts the cop
 first): a run's code identity is the import closure of its scheme, its problem and the
 harness's stepping code (``mcfbench.running.identity``), so an edit of the findings
 reruns no run, one of ``baselines/bgn.py`` bgn's alone among cotan, bgn and DDFV, one
-of ``ddfv/`` DDFV's alone.
+of ``ddfv/`` DDFV's alone, and so does a changed option of bgn's registry entry.
 """
 
 import json
@@ -101,14 +101,20 @@ def test_editing_a_presentation_module_reruns_no_run(edited):
     assert records(work) == before
 
 
-def _rewritten_by(edited, source, comment):
+def _rewritten_by(edited, source, comment=None, replace=None):
     """The records rewritten when ``source`` (a path below the copy) gets ``comment``
-    appended and the three-scheme matrix is run again: ``(changed paths, every path
-    before, every path after)``."""
+    appended, or ``replace`` (``(old, new)``, old found once) made in it, and the
+    three-scheme matrix is run again (its views, the tables and pictures, read every
+    record against the current code's digest): ``(changed paths, every path before,
+    every path after)``."""
     work, env = edited
     before = records(work)
-    with open(work / source, "a") as file:
-        file.write(f"\n# {comment}\n")
+    text = (work / source).read_text()
+    if replace is not None:
+        assert text.count(replace[0]) == 1, replace
+        (work / source).write_text(text.replace(*replace))
+    else:
+        (work / source).write_text(f"{text}\n# {comment}\n")
     code, out = snakemake(work, env, "--cores", "2", "matrix", "--config", THREE)
     assert code == 0, out[-3000:]
     after = records(work)
@@ -127,3 +133,41 @@ def test_editing_ddfv_rewrites_only_ddfv_records(edited):
                                            "a change of the paper's scheme")
     assert schemes_of(edited[0], changed) == ["ddfv-chord-carried"] and len(changed) == 2
     assert after == before
+
+
+def test_changing_a_registry_option_recomputes_exactly_its_runs(edited):
+    """A value of the scheme's registry entry (bgn's row scaling, ``mcfbench/schemes/``:
+    a listing, not hashed as code, its options part of the identity as values) reruns
+    bgn's two runs alone, with the new option: their records carry the new settings and
+    numbers, and the views read them (the matrix ends)."""
+    work, _ = edited
+    old = {p: json.loads(text) for p, (_, text) in records(work).items()}
+    changed, before, after = _rewritten_by(
+        edited, "mcfbench/schemes/bgn.py",
+        replace=('{"scaling": "mass"}', '{"scaling": "none"}'))
+    assert schemes_of(work, changed) == ["bgn"] and len(changed) == 2
+    assert after == before
+    for path in changed:
+        new = json.loads((work / path).read_text())
+        assert new["settings"]["code"] != old[path]["settings"]["code"]
+        assert new["l2_error"] != old[path]["l2_error"]       # run again, not copied
+
+
+def test_the_jobs_run_the_code_that_snakemake_planned_with(tmp_path, env):
+    """Snakemake in a checkout whose packages are not those of ``PYTHONPATH`` (a
+    worktree beside an editable install; here the copy against the repository) plans
+    with the checkout's, the Snakefile's folder coming first; its jobs import them too (``mcfbench.pipeline.jobs_pythonpath``): bgn's runs with the copy's
+    changed option, whose records the views read (the jobs imported the repository's
+    before, and the pictures stopped on a record stale to their code)."""
+    work = copy_workflow(tmp_path / "work")
+    for name in ("ddfv", "baselines", "kept_factor", "mcfbench"):
+        shutil.copytree(REPO / name, work / name, ignore=IGNORE)
+    source = work / "mcfbench" / "schemes" / "bgn.py"
+    text = source.read_text()
+    assert text.count('{"scaling": "mass"}') == 1
+    source.write_text(text.replace('{"scaling": "mass"}', '{"scaling": "none"}'))
+    assert str(work) not in env["PYTHONPATH"]
+    code, out = snakemake(work, env, "--cores", "2", "matrix", "--config",
+                          "matrix={select: {schemes: [bgn], problems: {sphere: [1]}}}")
+    assert code == 0, out[-3000:]
+    assert len(records(work)) == 1

@@ -216,3 +216,15 @@ def test_a_user_mesh_run_s_identity_is_its_scheme_s_and_the_problem_definitions(
     assert not any(m.startswith("mcfbench/problems/") for m in gallery["modules"])
     assert {"mcfbench/running/problem.py", "baselines/cotan.py"} <= set(gallery["modules"])
     assert "baselines/bgn.py" not in gallery["modules"]
+
+
+def test_the_jobs_import_the_packages_the_workflow_planned_with_first():
+    """The Snakefile's ``PYTHONPATH`` for the jobs: the folder of the ``mcfbench`` whose
+    digests the batches' params carry, then the rest, that folder once."""
+    import mcfbench
+    from mcfbench.pipeline import jobs_pythonpath
+
+    root = os.path.dirname(os.path.dirname(os.path.realpath(mcfbench.__file__)))
+    assert jobs_pythonpath(None) == root
+    assert jobs_pythonpath(os.pathsep.join(["/elsewhere", root, ""])) == \
+        os.pathsep.join([root, "/elsewhere"])
