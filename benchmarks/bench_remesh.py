@@ -6,7 +6,7 @@
 For each scheme and problem with an exact answer where remeshing fires (the
 anisotropic and the remeshed sphere, the catenoid), levels 1-3: the problem's error
 and its order (EOC between levels) of ``NAME`` and ``NAME+remesh``, the remesh calls
-and the vertices before -> after per level, and the wall milliseconds of a remesh
+(the rollbacks among them) and the vertices before -> after per level, and the wall milliseconds of a remesh
 (the event's ``seconds``, its checks included) against the run's per step, both
 measured in the same run.
 
@@ -40,12 +40,13 @@ def row(scheme, problem):
         result, traj = run(scheme, problem, level)
         metric = next(iter(result.metrics))
         errors.append(result.metrics[metric] if result.status == "ok" else np.nan)
-        fired = [e for e in traj.events if e["event"] == "remeshed"]
+        fired = [e for e in traj.events if e["event"] in ("remeshed", "rolled_back")]
+        rollbacks = sum(e["event"] == "rolled_back" for e in fired)
         step = result.wall_seconds / max(1, result.steps_done)
         if fired:
             moved = "/".join(f"{e['vertices_before']}->{e['vertices_after']}" for e in fired[:2])
             call = np.mean([e["seconds"] for e in fired])
-            notes.append(f"L{level}: {len(fired)} calls ({moved}), max dist "
+            notes.append(f"L{level}: {len(fired)} calls ({rollbacks} rollbacks; {moved}), max dist "
                          f"{max(e['distance'] for e in fired):.2g}, {call * 1e3:.2g} ms a "
                          f"call against {step * 1e3:.2g} ms a step")
         elif result.status != "ok":
