@@ -7,9 +7,8 @@ For each scheme and problem with an exact answer where remeshing fires (the
 anisotropic and the remeshed sphere, the catenoid), levels 1-3: the problem's error
 and its order (EOC between levels) of ``NAME`` and ``NAME+remesh``, the remesh calls
 (the rollbacks among them) and the vertices before -> after per level, and the wall
-milliseconds of a remesh
-(the event's ``seconds``, its checks included) against the run's per step, both
-measured in the same run.
+milliseconds of a remesh (the event's ``seconds``, its checks included) against the
+run's per step, both measured in the same run.
 
 With ``--raw``: ``NAME+remesh`` on every mesh of the raw corpus without thin features,
 as the survival study runs it (40 steps of 0.1 h^2, its robust solver
@@ -48,8 +47,7 @@ def row(scheme, problem):
             moved = "/".join(f"{e['vertices_before']}->{e['vertices_after']}" for e in fired[:2])
             call = np.mean([e["seconds"] for e in fired])
             notes.append(f"L{level}: {len(fired)} calls ({rollbacks} rollbacks; {moved}), "
-                         f"max dist "
-                         f"{max(e['distance'] for e in fired):.2g}, {call * 1e3:.2g} ms a "
+                         f"max dist {max(e['distance'] for e in fired):.2g}, {call * 1e3:.2g} ms a "
                          f"call against {step * 1e3:.2g} ms a step")
         elif result.status != "ok":
             notes.append(f"L{level}: {result.status}")
