@@ -62,8 +62,9 @@ class Rollback:
         self.count, self.state, self.level = 0, None, None
 
     def keep(self, flow):
-        """Keep ``flow``'s state, valid, before a step: its mesh and time level."""
-        self.state = (np.array(flow.vertices, dtype=float), np.array(flow.faces), flow.n)
+        """Keep ``flow``'s state, valid, before a step: its mesh (the positions copied;
+        the faces do not change within a step) and time level."""
+        self.state = (np.array(flow.vertices, dtype=float), np.asarray(flow.faces), flow.n)
 
     def __call__(self, flow, breakdown):
         """What to do after ``breakdown``, the step from the kept state to ``flow``'s.
