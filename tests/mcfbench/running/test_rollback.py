@@ -92,14 +92,15 @@ def test_a_run_that_records_its_defects_does_not_roll_back():
 
 
 class _Remesher:
-    """A stand-in whose remesh returns a marker flow and counts its calls."""
+    """A stand-in whose remesh returns a marker flow and the smallest angle it is told
+    to leave, and counts its calls."""
 
     def __init__(self):
-        self.asked = []
+        self.asked, self.angle = [], 20.0
 
     def remeshed(self, flow, V, F, n, why):
         self.asked.append(n)
-        return f"flow at {n}", {"event": "remeshed", "step": n, "distance": 0.0}
+        return f"flow at {n}", {"event": "remeshed", "step": n, "min_angle_after": self.angle}
 
 
 class _Flow:
@@ -111,23 +112,38 @@ def _fold(step, status="inverted"):
     return FlowBreakdown(status, step, 0.1 * step, "a triangle folded")
 
 
-def test_never_twice_in_a_row_to_one_level_and_the_cap():
+def test_again_to_one_level_only_while_the_remesh_raises_the_smallest_angle():
     remesher = _Remesher()
-    rollback = Rollback(remesher, cap=2)
+    rollback = Rollback(remesher)
     rollback.keep(_Flow(3))
     new, event = rollback(_Flow(4), _fold(4, "t_escaped"))
     assert new == "flow at 3" and event["event"] == "rolled_back"
     assert (event["step"], event["to_step"], event["status"]) == (4, 3, "t_escaped")
-    rollback.keep(_Flow(3))                    # the redone step folds again
+    remesher.angle = 25.0                      # the redone step folds again: progress
+    rollback.keep(_Flow(3))
+    assert rollback(_Flow(4), _fold(4))[0] == "flow at 3"
+    rollback.keep(_Flow(3))                    # and again: no progress (25 <= 25)
     new, event = rollback(_Flow(4), _fold(4))
     assert new is None and event["event"] == "rollback_refused"
     assert "folded again after a rollback to it" in event["why"]
-    rollback.keep(_Flow(7))                    # progress: allowed, the second
+    assert "did not raise the smallest angle (25 <= 25 degrees)" in event["why"]
+    assert event["min_angle_after"] == 25.0 and rollback.count == 2
+    remesher.angle = 10.0                      # another level: allowed at any angle
+    rollback.keep(_Flow(7))
     assert rollback(_Flow(8), _fold(8))[0] == "flow at 7"
-    rollback.keep(_Flow(9))                    # the cap
+    assert remesher.asked == [3, 3, 3, 7] and rollback.count == 3
+
+
+def test_the_cap():
+    remesher = _Remesher()
+    rollback = Rollback(remesher, cap=2)
+    for n in (3, 5):
+        rollback.keep(_Flow(n))
+        assert rollback(_Flow(n + 1), _fold(n + 1))[0] == f"flow at {n}"
+    rollback.keep(_Flow(9))
     new, event = rollback(_Flow(10), _fold(10))
     assert new is None and "2 rollbacks in the run already" in event["why"]
-    assert remesher.asked == [3, 7] and rollback.count == 2
+    assert remesher.asked == [3, 5] and rollback.count == 2
 
 
 def test_a_breakdown_that_is_not_a_fold_is_not_rolled_back():
