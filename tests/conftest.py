@@ -101,7 +101,7 @@ def table_3_1_error(flow, level, solver=None):
     -------
     error : float
         The L2 error (3.2) against the exact radius ``sqrt(1 - 4t)``.
-    trajectory : mcfbench.running.driver.Trajectory
+    trajectory : mcfbench.running.trajectory.Trajectory
     """
     from mcfbench.geometry.exact import SphereL2Error
     from mcfbench.running.driver import simulate

@@ -13,7 +13,7 @@ with one message format, ``"{status} at step {n} (t = {t}): {detail}"``.
 """
 
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 import numpy as np
 
@@ -23,131 +23,13 @@ from mcfbench.geometry.measures import StateMeasures
 from mcfbench.running.flow import FlowBreakdown
 from mcfbench.running.integrators import get_integrator
 from mcfbench.running.solver import Solver, SolverFailure
+from mcfbench.running.trajectory import Trajectory
 from mcfbench.storage.frames import changing_frames
 
 ON_DEFECT = ("stop", "record")
 
 PROGRESS_DELAY = 2.0
 """Seconds a run goes before its progress bar appears (short runs show none)."""
-
-
-@dataclass
-class Trajectory:
-    """What :func:`simulate` computed.
-
-    Attributes
-    ----------
-    frames : dict of str -> (frames, ...) float arrays
-        The arrays of :meth:`SchemeFlow.frame` stacked over the kept frames
-        (``"vertices"``, and ``"extra_points"`` for DDFV). Frame 0 is the
-        initial state, the last frame the last state computed.
-    steps : (frames,) int array
-        Time level of each frame.
-    t : (frames,) float array
-    faces : (m, 3) int array
-        The initial mesh's (frame 0's).
-    frame_faces : list of (m_k, 3) int arrays, or None
-        Each frame's faces, for a run whose mesh changed (``remesh``): then
-        ``frames`` holds the frames of :func:`mcfbench.storage.frames.changing_frames`
-        (read them with :func:`~mcfbench.storage.frames.frame_mesh`); None when every
-        frame has ``faces``.
-    iterations : (n_steps,) int array
-        Solver iterations of each completed step.
-    status : str
-        ``"ok"`` or the status of the first breakdown or defect
-        (:data:`mcfbench.storage.statuses.STATUSES`).
-    message : str
-        Empty when ``status == "ok"``.
-    failed_step : int
-        Time level of the breakdown or first defect, ``-1`` when ``ok``.
-    steps_done : int
-        Time steps completed (in ``"record"`` mode possibly all of them
-        although ``status`` is not ``ok``).
-    defects : list of dict
-        Every defect seen (``"record"`` mode: one per status, its first
-        occurrence): ``status``, ``step``, ``time``, ``detail``.
-    wall_seconds, cpu_seconds : float
-        Time of the stepping, observers included.
-    events : list of dict
-        What happened to the surface without ending the run, and what ended it
-        ``extinct``: one ``{"event": "extinct", "step", "time", "component",
-        "kind", "area", "volume", "extinction_time"}`` per component that vanished
-        round (:mod:`mcfbench.geometry.collapse`): ``time`` the state's, ``kind``
-        ``"point"`` or ``"circle"``, ``area`` and ``volume`` the component's then,
-        ``extinction_time`` the state's time plus the time the round component
-        had left; one ``{"event": "remeshed", "step", "time", "why", "seconds", ...}``
-        per remesh (``remesh``'s :class:`~mcfbench.running.remeshing.Remesher`;
-        ``seconds`` the remesh's wall time; the fields of
-        :func:`mcfbench.geometry.remeshing.remesh_change`: the distance between the
-        surfaces before and after, the changes of area and volume, the vertex counts,
-        whether the components or genus changed); one ``{"event": "surgery", "step",
-        "time", "where", "neck_radius", "pinch_time", "components_before",
-        "components_after", "area_removed", "volume_removed", "band_area",
-        "area_share"}`` per neck cut (``remesh``'s
-        :class:`~mcfbench.running.surgery.Surgeon`): ``where`` the neck's point on its
-        axis, ``pinch_time`` the state's time plus ``r^2 / 2`` (a neck of radius ``r``
-        shrinks as a cylinder, ``r r' = -1``), ``area_share`` the area removed over the
-        initial area; ``"reextracted"`` and ``"refused"`` likewise
-        (:class:`~mcfbench.running.surgery.Reextractor`, ``surgery.refusal``).
-    flow : mcfbench.running.flow.SchemeFlow
-        The flow at the run's end: the one stepped, or the one rebuilt on the
-        components that remained (``rebuild``).
-    continue_with : callable or None
-        For a run that ended with a solver failure (a ``solver_*`` status; not one
-        turned into ``degenerated`` by a collapsed mesh), ``continue_with(solver,
-        progress=False) -> Trajectory``: the same run continued from its last
-        accepted state, the failed step tried again with ``solver`` (the flow,
-        its integrator's past states, the checks and the observers exactly as
-        the run left them; the failure is forgotten). The returned trajectory is
-        the whole run's, from step 0, its times added up. The objects are those
-        of this run, which is thereby used up: it can be continued once (the
-        continued run, if its solver fails too, once more). None otherwise.
-    """
-
-    frames: dict
-    steps: np.ndarray
-    t: np.ndarray
-    faces: np.ndarray
-    iterations: np.ndarray
-    frame_faces: list | None = None
-    status: str = "ok"
-    message: str = ""
-    failed_step: int = -1
-    steps_done: int = 0
-    defects: list = field(default_factory=list)
-    wall_seconds: float = 0.0
-    cpu_seconds: float = 0.0
-    events: list = field(default_factory=list)
-    flow: object = field(default=None, repr=False, compare=False)
-    continue_with: object = field(default=None, repr=False, compare=False)
-
-    @property
-    def ok(self):
-        return self.status == "ok"
-
-    @property
-    def extinction_time(self):
-        """The time the last component vanished (:attr:`events`'s
-        ``extinction_time``) of a run that ended ``extinct``, NaN otherwise."""
-        return float(self.events[-1]["extinction_time"]) if self.status == "extinct" \
-            and self.events else float("nan")
-
-    @property
-    def surgeries(self):
-        """The continuations' events: ``surgery`` (a cut), ``reextracted`` (thin parts)."""
-        return [e for e in self.events if e["event"] in ("surgery", "reextracted")]
-
-    @property
-    def removed_area_share(self):
-        """The area the continuations removed (``|area_removed|`` summed) over the
-        initial area, 0 without one."""
-        return float(sum(abs(e["area_share"]) for e in self.surgeries))
-
-    @property
-    def t_failed(self):
-        """Time of the breakdown or first defect, NaN when ``ok``."""
-        return float("nan") if self.ok else float(self.defects[0]["time"]) \
-            if self.defects else float("nan")
 
 
 class _NoBar:
@@ -231,20 +113,17 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
         ends ``degenerated`` saying why (the event's ``why_not``).
     remesh : callable, optional
         A mesh strategy's hook (:func:`mcfbench.running.remeshing.mesh_hook`):
-        ``remesh(flow) -> (flow, event)`` or None, asked about every state (the
-        initial one included) before its checks when ``remesh.before_checks``, else
-        after it passed them: the flow rebuilt on a new mesh of its surface at the
-        same time level, and what changed (an event of :attr:`Trajectory.events`).
-        The run goes on with it: the integrator starts afresh, the checks start again
-        from the new mesh (the invariants hold between changes; the event records the
-        change across one). The frames: where ``remesh.kept`` names the previous
-        flow's points and triangles the new one keeps (in order, then new ones), the
-        initial mesh's layout, the removed points where they were then, the new ones
-        left out (:class:`~mcfbench.running.surgery.Surgeon`: the neck's cut); where
-        it is None, each frame its own faces (:attr:`Trajectory.frame_faces`;
-        :class:`~mcfbench.running.remeshing.Remesher`). A ``ValueError`` of the hook
-        (a neck pinched that cannot be cut, or a scheme that cannot be rebuilt) ends
-        the run ``degenerated`` saying why.
+        ``remesh(flow) -> (flow, event)`` or None, asked about every state (the initial
+        one included) before its checks when ``remesh.before_checks``, else after it
+        passed them: the flow on a new mesh of its surface at the same time level and
+        what changed (an event). The run goes on with it, the integrator afresh, the
+        checks from the new mesh. Its frames keep the layout where ``remesh.kept`` names
+        the previous flow's points and triangles kept (in order, then new ones: the
+        removed points where they were, the new ones left out), else carry their own
+        faces (:attr:`Trajectory.frame_faces`). Its ``rollback``, if any, redoes a step
+        that folded from the state before it remeshed (``on_defect="stop"``;
+        :mod:`mcfbench.running.rollback`). A ``ValueError`` of the hook (a neck that
+        cannot be cut, a scheme that cannot be rebuilt) ends the run ``degenerated``.
 
     Returns
     -------
@@ -282,6 +161,7 @@ class _Stepping:
         self.frames, self.steps_kept, self.iterations, self.defects = [], [], [], []
         self.events = []
         self.rebuild, self.remesh, self.faces = rebuild, remesh, np.asarray(flow.faces)
+        self.rollback = getattr(remesh, "rollback", None) if on_defect == "stop" else None
         self.frame_faces = []
         # the frame layout's number of every point and triangle of the flow (all until
         # a component vanishes or a neck is cut; -1 for a cap's), and the last full frame
@@ -502,8 +382,11 @@ class _Stepping:
             observer(self.flow)
 
     def step(self, solver):
-        """One time step, checked; raises :class:`FlowBreakdown`."""
+        """One time step, checked; raises :class:`FlowBreakdown`. False when the step
+        folded and was rolled back (:meth:`rolled_back`)."""
         flow = self.flow
+        if self.rollback is not None:
+            self.rollback.keep(flow)
         try:
             info = self.stepper.step(flow, solver)
         except SolverFailure as err:
@@ -518,7 +401,28 @@ class _Stepping:
             self.solver_failed = collapse is None
             raise FlowBreakdown(status, step, step * flow.tau, detail) from None
         self.iterations.append(info.iterations)
+        try:
+            self.check()
+        except FlowBreakdown as err:
+            return self.rolled_back(err)
+        return True
+
+    def rolled_back(self, err):
+        """After ``err`` of a step's new state: go on from the state before the step
+        remeshed when the hook's ``rollback`` gives it (a fold,
+        :mod:`mcfbench.running.rollback`), the step's defect and iterations forgotten
+        (False); its event recorded; else raise ``err``."""
+        found = self.rollback(self.flow, err) if self.rollback is not None else None
+        if found is not None:
+            self.events.append(found[1])
+        if found is None or found[0] is None:
+            raise err
+        self.defects.pop()
+        self.seen.discard(err.status)
+        self.iterations.pop()
+        self.new_mesh(found[0])
         self.check()
+        return False
 
     def go(self, solver, progress=False):
         """Step with ``solver`` until the run's end, a breakdown or ``until``; the
@@ -533,9 +437,10 @@ class _Stepping:
         else:
             bar = _NoBar()
         with bar:
-            for _ in range(self.steps - len(self.iterations) if self.broken is None else 0):
+            while self.broken is None and len(self.iterations) < self.steps:
                 try:
-                    self.step(solver)
+                    if not self.step(solver):
+                        continue                # rolled back: the step again
                 except FlowBreakdown as err:
                     self.broken = err
                     break

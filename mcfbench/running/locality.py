@@ -236,7 +236,7 @@ class RenumberedRun:
         return lambda flow: observer(InputOrder(flow, self))
 
     def trajectory(self, traj):
-        """The :class:`~mcfbench.running.driver.Trajectory` of the renumbered flow in
+        """The :class:`~mcfbench.running.trajectory.Trajectory` of the renumbered flow in
         the input's numbering: frames (the initial mesh's layout), faces, defects' and
         events' sentences, its message, its flow (:class:`InputOrder`), and its
         continuation's."""

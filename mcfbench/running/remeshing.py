@@ -33,11 +33,16 @@ What the new flow carries over:
   (``deturck``'s map onto the initial mesh, ``conformal``'s initial stiffness,
   ``redistribute``'s initial area): the remeshed surface becomes their initial one
   (:data:`mcfbench.running.continuation.STATE_ONLY` names those that lose nothing).
+
+A step whose new state folds is rolled back, the state before it remeshed and the step
+redone (:attr:`Remesher.rollback`, :mod:`mcfbench.running.rollback`; ``NAME+surgery``'s
+through its remesher).
 """
 
 from mcfbench.geometry.remeshing import (
     ANGLE, PASSES, RemeshTrigger, remesh, remesh_change, target_edge)
 from mcfbench.running.continuation import rebuilt_flow
+from mcfbench.running.rollback import Rollback
 from mcfbench.running.scheme import parse_name
 from mcfbench.running.surgery import NeckWait, Reextractor, Surgeon
 
@@ -72,6 +77,9 @@ class Remesher:
     seconds : float
         Wall seconds spent remeshing and measuring the change (an event's
         ``seconds``: the remesh alone, its checks included).
+    rollback : mcfbench.running.rollback.Rollback
+        The driver's ``rollback`` after a step that folds (the state before the step
+        remeshed by :meth:`remeshed`).
     """
 
     before_checks = False
@@ -83,24 +91,42 @@ class Remesher:
         self.h, self.passes = target_edge(*mesh), passes
         self.trigger = RemeshTrigger(angle, every)
         self.calls, self.seconds = 0, 0.0
+        self.rollback = Rollback(self)
 
     def __call__(self, flow):
+        V, F = flow.vertices, flow.faces
+        why = self.trigger(V, F, flow.n * flow.tau)
+        return None if why is None else self.remeshed(flow, V, F, flow.n, why)
+
+    def remeshed(self, flow, V, F, n, why):
+        """The flow of the surface ``(V, F)`` of time level ``n`` remeshed (``flow``'s
+        scheme and time step) and the ``"remeshed"`` event saying ``why``; the trigger
+        told (also for a :class:`~mcfbench.running.rollback.Rollback`'s remesh). The
+        event: ``{"event": "remeshed", "step", "time", "why", "seconds", ...}``,
+        ``seconds`` the remesh's wall time, then the fields of
+        :func:`mcfbench.geometry.remeshing.remesh_change` (the distance between the
+        surfaces before and after, the changes of area and volume, the vertex counts,
+        whether the components or genus changed).
+
+        Raises
+        ------
+        mcfbench.geometry.remeshing.RemeshRefused
+            ``(V, F)`` or the remesh is not a valid surface.
+        """
         import time
 
-        V, F, t = flow.vertices, flow.faces, flow.n * flow.tau
-        why = self.trigger(V, F, t)
-        if why is None:
-            return None
+        t = n * flow.tau
         start = time.perf_counter()
         U, G = remesh(V, F, self.h, self.passes)
         seconds = time.perf_counter() - start
-        event = {"event": "remeshed", "step": flow.n, "time": t, "why": why,
+        event = {"event": "remeshed", "step": n, "time": t, "why": why,
                  "seconds": seconds, **remesh_change((V, F), (U, G))}
         self.seconds += time.perf_counter() - start
         self.calls += 1
         self.trigger.done(t, event["min_angle_after"])
-        return rebuilt_flow(self.scheme, flow, U, G, threads=self.threads,
-                            **self.options), event
+        new = rebuilt_flow(self.scheme, flow, U, G, threads=self.threads, **self.options)
+        new.n = n
+        return new, event
 
 
 class Strategies:
@@ -125,8 +151,10 @@ class Strategies:
     def __init__(self, scheme, mesh, *, integrator=None, threads=1, options=None):
         kwargs = {"integrator": integrator, "threads": threads, "options": options}
         surgeon = Surgeon(scheme, mesh, strict=False, **kwargs)
+        remesher = Remesher(scheme, mesh, **kwargs)
         self.parts = (surgeon, Reextractor(scheme, mesh, **kwargs),
-                      NeckWait(Remesher(scheme, mesh, **kwargs), surgeon.h))
+                      NeckWait(remesher, surgeon.h))
+        self.rollback = remesher.rollback         # the remesher's (Remesher.rollback)
 
 
 STRATEGIES = {"remesh": Remesher, "surgery": Strategies}

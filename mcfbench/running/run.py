@@ -79,7 +79,7 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
     robust : mcfbench.running.solver.Solver, optional
         A run that ends with a solver failure (a ``solver_*`` status) is
         continued with this solver from its last accepted state (the failed step
-        tried again with it; :attr:`mcfbench.running.driver.Trajectory.continue_with`):
+        tried again with it; :attr:`mcfbench.running.trajectory.Trajectory.continue_with`):
         the flow with its T-vertices, the integrator's past states (BDF2, BDF3),
         the monitors, the metric observers and the driver's checks are exactly
         those of the run at that step, so that the result is that of the whole run
@@ -101,7 +101,7 @@ def run(scheme, problem, level, *, tau=None, t_final=None, solver=None, integrat
         timed again, up to :data:`MAX_REPEATS` times in about
         :data:`REPEAT_BUDGET` seconds, the best kept (``timing_repeats``); its
         numbers are those of the first execution.
-    trajectory : mcfbench.running.driver.Trajectory
+    trajectory : mcfbench.running.trajectory.Trajectory
         The run's (not the continued run's).
     continued : RunResult or None
         Only with ``robust``: the continued run (None when there was none): its
@@ -261,7 +261,7 @@ def _timed_run(scheme, problem, mesh, tau, steps, *, solver, integrator, warm_st
 
 def _continued(timed, solver, progress):
     """The run of ``timed`` (ended with a solver failure) continued with ``solver`` from
-    its last accepted state (:attr:`mcfbench.running.driver.Trajectory.continue_with`),
+    its last accepted state (:attr:`mcfbench.running.trajectory.Trajectory.continue_with`),
     its monitor and observers going on; timed alone."""
     cpu, wall = time.process_time(), time.perf_counter()
     traj = timed.trajectory.continue_with(solver, progress=progress)
@@ -356,7 +356,7 @@ def _metric_values(timed, problem):
 def pinch_time_error(traj, pinch_time):
     """Relative error ``t / pinch_time - 1`` of ``t``: the first cut's ``pinch_time``
     (a run that cut a neck), the ``extinction_time`` of a run that ended ``extinct``
-    (:attr:`mcfbench.running.driver.Trajectory.extinction_time`), else ``t_failed``;
+    (:attr:`mcfbench.running.trajectory.Trajectory.extinction_time`), else ``t_failed``;
     NaN for a run that finished."""
     if traj.surgeries:
         return traj.surgeries[0]["pinch_time"] / pinch_time - 1.0

@@ -156,9 +156,14 @@ class Surgeon:
 
     def __call__(self, flow):
         """None while no neck has pinched, else the flow rebuilt on the operated mesh
-        and the ``"surgery"`` event (:class:`mcfbench.running.driver.Trajectory`'s
+        and the ``"surgery"`` event (:class:`mcfbench.running.trajectory.Trajectory`'s
         ``events``); ``(None, "refused" event)`` the first time a cut is refused when
-        not ``strict``.
+        not ``strict``. The event: ``{"event": "surgery", "step", "time", "where",
+        "neck_radius", "pinch_time", "why", "components_before", "components_after",
+        "area_removed", "volume_removed", "band_area", "area_share"}``: ``where`` the
+        neck's point on its axis, ``pinch_time`` the state's time plus ``r^2 / 2`` (a
+        neck of radius ``r`` shrinks as a cylinder, ``r r' = -1``), ``area_share`` the
+        area removed over the initial area.
 
         Raises
         ------
