@@ -211,8 +211,9 @@ def test_ddfv_t_vertices_out_of_the_necks_triangles_have_the_neck_cut_earlier():
     """DDFV chord's uncarried T-vertices leave the neck's triangles at step 26 (level 1,
     the neck's radius 0.10 = 0.9 h, 22 of them, all in the part the cut removes): the
     neck is cut at that state (below ESCAPED_RESOLUTION h, not h / 2). (In a whole
-    ddfv-chord+surgery run the remesh now fires first, at step 25, and the run ends
-    t_escaped at a cap one step after the regular cut: ddfv/README.md, item 25.)"""
+    ddfv-chord+surgery run the remesh now fires first, at step 25, the neck is cut at
+    h / 2 and a cap's T-vertex that leaves its triangle a step later is rolled back:
+    ddfv/README.md, item 25.)"""
     problem = get_problem("dumbbell").with_settings(to_extinction=True, t_final=0.3)
     result, traj = run("ddfv-chord", problem, 1, save_every=0)
     assert (result.status, traj.flow.n) == ("t_escaped", 26), result.message
