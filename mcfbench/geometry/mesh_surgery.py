@@ -200,8 +200,9 @@ def _edges(F):
 
 def find_neck(vertices, faces):
     """The neck of a closed mesh (module docstring), or None when no vertex has a
-    negative angle defect (and a finite, nonzero ``|H|``) or the neck vertex's ring is no ring (fewer than
-    :data:`MIN_RING` vertices, or not around the axis: a dimple, a fold).
+    negative angle defect (and a finite, nonzero ``|H|``) or the neck vertex's ring is
+    no ring (fewer than :data:`MIN_RING` vertices, or not around the axis: a dimple, a
+    fold).
 
     Parameters
     ----------
