@@ -87,8 +87,11 @@ discrete surface, not from a problem's exact solution; a closed mesh is
 stepped as before, bit for bit.
 """
 
+from types import SimpleNamespace
+
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 from numba import njit
 
 from .vertex_flow import VertexFlow
@@ -97,6 +100,28 @@ from .mdr import unit_vertex_normals
 
 ROWS = 7
 """The state ``(X, nu, H)``: 3 + 3 + 1 rows."""
+
+SPREAD = 4.0
+"""``max_i S_ii`` above which the flow keeps an incomplete LU of ``S`` for the solver
+(:func:`incomplete_lu`). ``S = I + dt diag(1/m) L`` has its eigenvalues in ``[1, 2
+max_i S_ii - 1]`` (Gershgorin; cotangent weights positive), so plain BiCGStab's
+iterations follow ``max_i S_ii``: 1.6 on every icosphere level and 1.9 on the catenoid
+(left as they were: 1-5 iterations a step), but 23, 40, 71 on bob refined by Loop to
+64 000, 256 000 and 1 024 000 vertices (``benchmarks/README.md``, "KLL's step"), where
+the one-rings of the base mesh's valence-4 vertices shrink by Loop's subdominant
+eigenvalue 3/8 a level instead of 1/2, their ``dt / h^2`` growing by (1/2 / 3/8)^2 =
+1.78 a level, and BiCGStab's iterations with it (21-22, 27, 30-37 at a run's steps 2-4)."""
+
+ILU = {"drop_tol": 1e-3, "fill_factor": 1.5}
+"""``scipy.sparse.linalg.spilu``'s settings of :func:`incomplete_lu`: 2-4 BiCGStab
+iterations a step on bob's three levels (``benchmarks/README.md``, "KLL's step"); drop
+tolerances 1e-2 and 1e-1 (fill 1) take 6-8."""
+
+DRIFT = 1.0
+"""The kept factor is made anew when a diagonal entry of ``S`` has moved from the
+factor's by more than this times the factor's (``|S_ii - P_ii| > DRIFT P_ii``), and for
+another shape. On bob's level 4 the factor of the first step still takes BiCGStab to
+2-3 iterations 100 steps and a drift of 1 later, 3-4 at a drift of 3.8."""
 
 
 def curvature_weights(vertices, faces, nu):
@@ -326,6 +351,40 @@ def quadric_normals_kernel(vertices, centres, ring, member, rough, out):
     return singular
 
 
+def incomplete_lu(S):
+    """The incomplete LU factor of ``S`` that :class:`KLLFlow` keeps for the solver's
+    BiCGStab (right preconditioner: the residual, hence the stopping test and the
+    solution to its tolerance, are those of plain BiCGStab; ``mcfbench/running/solver.py``,
+    "Systems").
+
+    ``scipy.sparse.linalg.spilu`` with :data:`ILU` in the matrix's own order (the run's
+    locality order; with the solver's minimum-degree order and fill 2, bob at 256 000
+    vertices took 4 iterations of 90 ms, in this order 2 of 33 ms) and no row pivoting
+    (``diag_pivot_thresh=0``: both permutations the identity).
+
+    Parameters
+    ----------
+    S : (n, n) scipy.sparse matrix
+
+    Returns
+    -------
+    SimpleNamespace
+        ``L``, ``U`` (n, n) CSR with ``S ~ L U`` (``L`` unit lower triangular), ``perm_r``,
+        ``perm_c`` (n,) int arrays, the identity; ``diagonal`` (n,) ``S``'s diagonal,
+        against which the flow measures the drift (:data:`DRIFT`).
+
+    Examples
+    --------
+    >>> S = sp.csr_matrix(np.array([[2.0, -1, 0], [-1, 2, -1], [0, -1, 2]]))
+    >>> P = incomplete_lu(S)                        # tridiagonal: no fill, exact
+    >>> bool(np.allclose((P.L @ P.U).toarray(), S.toarray())), P.perm_c.tolist()
+    (True, [0, 1, 2])
+    """
+    lu = spla.spilu(sp.csc_matrix(S), permc_spec="NATURAL", diag_pivot_thresh=0.0, **ILU)
+    return SimpleNamespace(L=lu.L.tocsr(), U=lu.U.tocsr(), perm_r=lu.perm_r,
+                           perm_c=lu.perm_c, diagonal=S.diagonal())
+
+
 class BlockSystem:
     """(KL6) by its blocks, ``[[I, D], [0, I_4 (x) S]]`` (``baselines/README.md``, "The
     block solve"): the rows of ``(nu, H)`` are four systems with the one matrix ``S``,
@@ -339,11 +398,17 @@ class BlockSystem:
         ``dt H*``, the diagonal block of ``X_c`` against ``nu_c``.
     dtnu : (3, n) float array
         ``dt nu*``, the diagonal blocks of ``X_c`` against ``H``.
+    preconditioner : SimpleNamespace, optional
+        An :func:`incomplete_lu` of ``S`` (or of a nearby ``S``), for the solver's
+        BiCGStab.
 
     Attributes
     ----------
     shared : (n, n) scipy.sparse.csr_matrix
         ``S``.
+    preconditioner : SimpleNamespace or None
+        The solver's plain ``bicgstab`` takes it as its right preconditioner
+        (``mcfbench/running/solver.py``, "Systems").
     rows : int
         4: the last rows of ``b`` (7, n) that ``shared`` solves.
     shape : tuple
@@ -359,8 +424,9 @@ class BlockSystem:
 
     rows = ROWS - 3
 
-    def __init__(self, S, dtH, dtnu):
+    def __init__(self, S, dtH, dtnu, preconditioner=None):
         self.shared, self._dtH, self._dtnu = S, dtH, dtnu
+        self.preconditioner = preconditioner
         self.shape = (ROWS * S.shape[0],) * 2
 
     def substitute(self, y, b):
@@ -415,6 +481,19 @@ class KLLFlow(VertexFlow):
             nu[self._boundary] = self.boundary_values(self._X, g.area_vectors)
             H[self._boundary] = 0.0
         self._adopt(np.vstack([self._X, nu.T, H[None]]))
+        self._factor = None                        # the kept incomplete_lu, if any
+
+    def preconditioner(self, S):
+        """The kept :func:`incomplete_lu` for ``S``, made anew for another shape or a drift
+        beyond :data:`DRIFT`; None (and none kept) while ``max_i S_ii <=`` :data:`SPREAD`.
+        """
+        d = S.diagonal()
+        if d.max() <= SPREAD:
+            self._factor = None
+        elif (self._factor is None or self._factor.diagonal.shape != d.shape
+              or (np.abs(d - self._factor.diagonal) > DRIFT * self._factor.diagonal).any()):
+            self._factor = incomplete_lu(S)
+        return self._factor
 
     def boundary_values(self, X, area_vectors):
         """``nu`` at the boundary vertices of the surface ``X`` (3, n) with the triangle
@@ -484,7 +563,7 @@ class KLLFlow(VertexFlow):
             b[6, self._boundary] = 0.0
         b[:3] += dtH * nu
         b[3:] += source * at[3:]
-        return BlockSystem(S, dtH, dtnu), b
+        return BlockSystem(S, dtH, dtnu, self.preconditioner(S)), b
 
     def advance(self, U):
         """Accept ``U`` (7, n) as the state ``n + 1``."""

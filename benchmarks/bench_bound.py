@@ -40,6 +40,12 @@ coupled ``(3n, 3n)`` one), ``V = 8 k m`` the bytes of one vector block:
   two products and the vector passes ``(r_hat, v)`` 1, ``s = r - alpha v`` 3, ``(t,
   s), (t, t)`` 1, ``x, r`` and their sums 7, ``p`` 4: ``16 V`` besides the
   products, ``26 k m`` flops besides them;
+* with a kept incomplete LU (``ilu-bicgstab``: KLL's ``S`` where its diagonal spreads,
+  ``baselines.kll.SPREAD``), its two applications an iteration: the factors' ``F``
+  stored entries, ``F (8 + i) + 2 (m + 1) i`` bytes, and the passes of
+  ``krylov.precondition`` (scaled copy, forward, backward, permuted copy): ``8 V +
+  8 m``; ``2 k F + k m`` flops. The factor's making (amortised over the steps it
+  is kept, not in the timed steps unless made anew there) is not counted;
 * the assembly: the state read (``V``), the mesh's faces read once (``3 i`` per
   face) and the matrix values (``8 Z``) and the right-hand side (``V``) written;
   ``100`` flops per face (a triangle's cotangents, areas, normals: counted
@@ -132,7 +138,8 @@ def flop_rate(size=2000, repeats=3):
 class CountingSolver:
     """The run's solver (:class:`mcfbench.running.solver.Solver`, defaults but its
     ``threads``) recording,
-    per call, ``(step, iterations, Z, m, k, index bytes)``; ``step`` is read from
+    per call, ``(step, iterations, Z, m, k, index bytes, F)`` (``F`` the stored entries
+    of the incomplete LU the solve applied, 0 for none); ``step`` is read from
     :attr:`step` (set by the observer)."""
 
     can_overwrite_x0 = True
@@ -148,20 +155,25 @@ class CountingSolver:
         x, info = self._solver(A, b, x0, overwrite_x0=overwrite_x0)
         shared = A.shared if hasattr(A, "substitute") else A
         k = np.shape(b)[0] if shared.shape[0] == np.shape(b)[-1] else 1
+        factor = getattr(A, "preconditioner", None) if info.method == "ilu-bicgstab" else None
         self.calls.append((self.step, info.iterations, shared.nnz, shared.shape[0], k,
-                           shared.indices.dtype.itemsize))
+                           shared.indices.dtype.itemsize,
+                           0 if factor is None else factor.L.nnz + factor.U.nnz))
         return x, info
 
 
-def solve_cost(iterations, Z, m, k, i):
-    """``(bytes, flops)`` of one solve (module docstring)."""
+def solve_cost(iterations, Z, m, k, i, F=0):
+    """``(bytes, flops)`` of one solve (module docstring); ``F`` the incomplete LU's
+    stored entries (0: none)."""
     V = 8 * k * m
     product = Z * (8 + i) + (m + 1) * i + 2 * V
     nbytes = product + 2 * V
     flops = 2 * k * Z
     if iterations:
-        nbytes += 3 * V + iterations * (2 * product + ITERATION_VECTORS * V)
-        flops += iterations * (4 * k * Z + ITERATION_FLOPS * k * m)
+        applied = (F * (8 + i) + 2 * (m + 1) * i + 8 * V + 8 * m) if F else 0
+        nbytes += 3 * V + iterations * (2 * product + ITERATION_VECTORS * V + 2 * applied)
+        flops += iterations * (4 * k * Z + ITERATION_FLOPS * k * m
+                               + (2 * (2 * k * F + k * m) if F else 0))
     return nbytes, flops
 
 
@@ -171,8 +183,8 @@ def step_cost(calls, positions, faces):
     shapes ``(n_v, n_f)``, the faces' index bytes."""
     n_v, n_f, fi = positions[0], faces[0], faces[1]
     nbytes = flops = 0
-    for _, iterations, Z, m, k, i in calls:
-        sb, sf = solve_cost(iterations, Z, m, k, i)
+    for _, iterations, Z, m, k, i, F in calls:
+        sb, sf = solve_cost(iterations, Z, m, k, i, F)
         V = 8 * k * m
         nbytes += sb + V + 3 * fi * n_f + 8 * Z + V + 3 * V
         flops += sf + FACE_FLOPS * n_f

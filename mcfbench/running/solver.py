@@ -21,6 +21,12 @@ coordinate x, y, z) from an initial guess ``x0``:
   ``x0[-A.rows:]`` (``direct`` factorises ``A.shared`` once for its rows),
   ``[A.substitute(y, b); y]`` returned; iterations, residual and stopping
   test are the shared system's (the substituted rows' residual is round-off).
+  ``A.preconditioner``, when not None, is an incomplete LU of ``A.shared`` (or
+  of a nearby matrix) that the system keeps (``L``, ``U``, ``perm_r``,
+  ``perm_c``, as ``spilu``'s): plain ``bicgstab`` takes it as its right
+  preconditioner (``ilu-bicgstab`` with it: the same residual and stopping
+  test, ``SolveInfo.method`` says which ran; KLL's ``S`` on meshes whose
+  diagonal spreads, ``baselines.kll.SPREAD``).
 
 Iteration count
 ---------------
@@ -372,6 +378,10 @@ def _by_blocks(A, b, x0, **options):
     if x0 is not None and np.shape(x0) != b.shape:
         raise ValueError(f"x0 has shape {np.shape(x0)}, b has {b.shape}")
     rows = slice(b.shape[0] - A.rows, None)
+    kept = getattr(A, "preconditioner", None)
+    if kept is not None and options["method"] == "bicgstab" and options["factor"] is None:
+        options.update(method="ilu-bicgstab", factor=(np.ones(A.shared.shape[0]),
+                                                      ilu_arrays(kept)))
     y, info = solve(A.shared, b[rows], None if x0 is None else np.asarray(x0)[rows],
                     **options)
     return np.vstack([A.substitute(y, b), y]), info
