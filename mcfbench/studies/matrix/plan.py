@@ -3,7 +3,7 @@ registries (:func:`plan`) and the spec of every run (:func:`planned_specs`, in t
 store: :mod:`mcfbench.storage.run_store`)."""
 
 from mcfbench.studies.config import ConfigError
-from mcfbench.studies.matrix import is_mesh_problem
+from mcfbench.studies.matrix import is_mesh_problem, remeshed_name
 
 EXACT_SOLVER = "bicgstab"
 """Solver of the problems with a refinement series: the paper's comparison."""
@@ -89,7 +89,7 @@ def plan(section=None, schemes=None, problems=None):
                               f"{integrator!r}; choose one of "
                               f"{', '.join(i for i in INTEGRATORS if i != 'euler')}")
         stepped.update({joined_name(name, integrator): name for name in names})
-    stepped.update({f"{n}+remesh": n for n in section.get("with_remeshing") or ()})  # NAME+remesh
+    stepped.update({remeshed_name(n): n for n in section.get("with_remeshing") or ()})
     select = section.get("select") or {}
     if not isinstance(select, dict) or set(select) - {"schemes", "problems"}:
         raise ConfigError(f"config key 'matrix.select': a mapping with the keys schemes "
