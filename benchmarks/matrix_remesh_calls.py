@@ -80,7 +80,7 @@ def main(argv=None):
                 for p, levels in (item.split(":") for item in args.problems)}
     print(f"{'problem':22} {'scheme':32} {'L':>2} {'status':10} {'metric':>11} "
           f"{'stored status':14} {'stored':>11} {'calls':>5} {'rollbacks':>9} "
-          f"{"remesh wall s":>13} {"run wall s":>10}", flush=True)
+          f"{'remesh wall s':>13} {'run wall s':>10}", flush=True)
     for (problem, scheme, level), spec in remeshed_specs(args.schemes, problems).items():
         metric = get_problem(problem).main_metric
         result, hook = counted_run(spec)
