@@ -15,9 +15,8 @@ every number read from that frame.
 import numpy as np
 
 from mcfbench.presentation.tables import Table, markdown
-from mcfbench.storage.statuses import reached
 from mcfbench.studies.matrix import remeshed_name
-from mcfbench.studies.matrix.tables import is_error, main_runs, summary_cell
+from mcfbench.studies.matrix.tables import is_error, main_runs, robust_values, summary_cell
 
 COLUMNS = ["problem", "metric", "scheme", "remeshed", "without", "with",
            "finished_without", "finished_with", "runs", "error_level", "error_without",
@@ -51,10 +50,12 @@ def remeshing_frame(table, summary, pairs):
     pandas.DataFrame
         One row per problem (summary order) and pair whose two schemes both ran it,
         columns :data:`COLUMNS`: ``without``, ``with`` (the summary's cells),
-        ``finished_without``, ``finished_with`` (runs that reached their end, of
-        ``runs``, the levels both ran), ``error_level`` (the finest level both
-        finished with a finite error; NaN when none or the main metric is no
-        error), ``error_without``, ``error_with`` (their magnitudes there),
+        ``finished_without``, ``finished_with`` (runs that reached their end with a
+        finite value, of ``runs``, the levels both ran; a run whose failure the
+        robust solver removes counts with the re-run's value, as in the verdicts:
+        :func:`~mcfbench.studies.matrix.tables.robust_values`), ``error_level`` (the
+        finest level both finished; NaN when none or the main metric is no error),
+        ``error_without``, ``error_with`` (their magnitudes there),
         ``error_ratio`` (with / without), ``cpu_without``, ``cpu_with`` (CPU
         seconds summed over the levels both ran), ``cpu_ratio``.
     """
@@ -71,14 +72,12 @@ def remeshing_frame(table, summary, pairs):
             b = runs[runs["scheme"] == remeshed].set_index("level")
             both = sorted(set(a.index) & set(b.index))
             a, b = a.loc[both], b.loc[both]
-            done_a = a["status"].map(reached).astype(bool).to_numpy()
-            done_b = b["status"].map(reached).astype(bool).to_numpy()
-            usable = done_a & done_b & np.isfinite(a["value"].to_numpy()) \
-                & np.isfinite(b["value"].to_numpy())
-            level = both[np.flatnonzero(usable)[-1]] if is_error(metric) and usable.any() \
-                else None
-            error_a = abs(a.loc[level, "value"]) if level is not None else np.nan
-            error_b = abs(b.loc[level, "value"]) if level is not None else np.nan
+            values_a, values_b = robust_values(a), robust_values(b)
+            done_a, done_b = np.isfinite(values_a), np.isfinite(values_b)
+            usable = np.flatnonzero(done_a & done_b)
+            level = both[usable[-1]] if is_error(metric) and len(usable) else None
+            error_a = abs(values_a[usable[-1]]) if level is not None else np.nan
+            error_b = abs(values_b[usable[-1]]) if level is not None else np.nan
             cpu_a, cpu_b = a["cpu_seconds"].sum(), b["cpu_seconds"].sum()
             rows.append({
                 "problem": problem, "metric": metric, "scheme": scheme, "remeshed": remeshed,

@@ -91,6 +91,18 @@ def test_no_common_finished_level_gives_no_ratio(matrix):
     assert np.isnan(frame.loc["real_nut", "error_ratio"])
 
 
+def test_a_run_the_robust_solver_finishes_counts_with_its_value_as_in_the_verdicts():
+    records = [_record(s, "sphere", level, e) for s in ("cotan", "cotan+remesh")
+               for level, e in ((1, 1e-2), (2, 2.5e-3))]
+    records[-1].update(status="solver_failed", t_failed=0.5, area_error=math.nan,
+                       robust_status="ok", robust_metrics={"area_error": 4e-3})
+    table = matrix_tables.long_table(records)
+    summary = scheme_view(matrix_tables.with_levels(matrix_tables.summary_table(table), table))
+    (row,) = remeshing_frame(table, summary, [("cotan", "cotan+remesh")]).to_dict("records")
+    assert (row["error_level"], row["finished_with"], row["error_with"]) == (2, 2, 4e-3)
+    assert row["error_ratio"] == pytest.approx(1.6)             # 4e-3 / 2.5e-3
+
+
 def test_every_number_of_the_section_comes_from_the_frame(matrix):
     table, summary = matrix
     frame = remeshing_frame(table, summary, [("cotan", "cotan+remesh")])
