@@ -57,7 +57,8 @@ def remeshing_frame(table, summary, pairs):
         finest level both finished; NaN when none or the main metric is no error),
         ``error_without``, ``error_with`` (their magnitudes there),
         ``error_ratio`` (with / without), ``cpu_without``, ``cpu_with`` (CPU
-        seconds summed over the levels both ran), ``cpu_ratio``.
+        seconds summed over the levels both ran, the long table's ``cpu_seconds``:
+        without a robust re-run's), ``cpu_ratio``.
     """
     import pandas as pd
 
@@ -153,6 +154,8 @@ def remeshing_section(frame):
             "`mcfbench.running.remeshing`), on every problem both ran: the summary's cells "
             "(EOC between the two finest finished levels and the finest value, or the "
             "breakdown), the ratio of the error magnitudes on the finest level both "
-            "finished (below 1: remeshing is more accurate), and the ratio of the CPU "
-            "seconds summed over the levels both ran.", "",
+            "finished (below 1: remeshing is more accurate; a run whose failure the robust "
+            "solver removes counts with the re-run's value), and the ratio of the CPU "
+            "seconds summed over the levels both ran (the runs' own: a robust re-run's "
+            "time is not in the long table).", "",
             *scheme_lines(frame), "", markdown(remeshing_table(frame)), ""]
