@@ -8,7 +8,7 @@ import pytest
 
 from mcfbench.studies.matrix import findings as matrix_findings
 from mcfbench.studies.matrix import tables as matrix_tables
-from mcfbench.studies.matrix.plan import plan
+from mcfbench.studies.matrix.plan import picture_specs, plan, planned_specs, runs_on
 from mcfbench.studies.matrix.remeshed import (
     remeshed_pairs,
     remeshing_frame,
@@ -58,6 +58,21 @@ def test_the_plan_names_the_remeshed_variants_as_the_pairs_find_them():
                   "with_integrators": {}})["schemes"]
     assert names == ["cotan", "bgn", "bgn+remesh"]          # mdr is not run: nor remeshed
     assert remeshed_pairs(names) == [("bgn", "bgn+remesh")]
+
+
+def test_no_remeshed_variant_where_every_run_already_takes_a_mesh_strategy():
+    """On the dumbbell through its pinch every scheme runs as NAME+surgery (remeshing
+    included): NAME+remesh is not run there, its scheme's run is."""
+    chosen = plan({"select": {"schemes": ["cotan", "cotan+remesh"],
+                              "problems": {"dumbbell_through_pinch": [1], "sphere": [1]}}})
+    specs = planned_specs(chosen)
+    assert sorted(specs) == [("dumbbell_through_pinch", "cotan", 1), ("sphere", "cotan", 1),
+                             ("sphere", "cotan+remesh", 1)]
+    assert specs[("dumbbell_through_pinch", "cotan", 1)].scheme == "cotan+surgery"
+    assert sorted(picture_specs(chosen)) == [("dumbbell_through_pinch", "cotan"),
+                                             ("sphere", "cotan"), ("sphere", "cotan+remesh")]
+    assert runs_on("cotan+surgery", "dumbbell_through_pinch")
+    assert not runs_on("cotan+remesh", "dumbbell_through_pinch")
 
 
 def test_frame_on_numbers_worked_out_by_hand(matrix):
