@@ -115,7 +115,7 @@ def _geometric_mean(values):
     return float(np.exp(np.log(values).mean())) if len(values) else np.nan
 
 
-def scheme_lines(frame):
+def pair_lines(frame):
     """One line per scheme of ``frame``: the problems where its remeshed variant's
     error is smaller, equal or larger, their geometric mean ratio, the finished runs
     of both, and the CPU time of both over all their runs."""
@@ -144,7 +144,7 @@ def scheme_lines(frame):
 
 
 def remeshing_section(frame):
-    """The section "With remeshing against without": :func:`scheme_lines` and the table
+    """The section "With remeshing against without": :func:`pair_lines` and the table
     (:func:`remeshing_table`); empty without a pair that ran."""
     if not len(frame):
         return []
@@ -158,4 +158,4 @@ def remeshing_section(frame):
             "solver removes counts with the re-run's value), and the ratio of the CPU "
             "seconds summed over the levels both ran (the runs' own: a robust re-run's "
             "time is not in the long table).", "",
-            *scheme_lines(frame), "", markdown(remeshing_table(frame)), ""]
+            *pair_lines(frame), "", markdown(remeshing_table(frame)), ""]
