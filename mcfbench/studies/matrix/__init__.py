@@ -12,7 +12,8 @@ meshes (``tau_rule = "mesh"``). The study's modules
   :mod:`mcfbench.storage.run_store`; computed by :mod:`mcfbench.running.batch`);
 * :mod:`.aggregate`: the records into the tables (:mod:`.tables`);
 * :mod:`.findings`: ``findings.md`` from the summary table only, in words, the
-  verdicts' data from :mod:`.verdicts`;
+  verdicts' data from :mod:`.verdicts`, each scheme beside its remeshed variant
+  from :mod:`.remeshed`;
 * :mod:`.plots`: the figures; :mod:`.page`: the results page (``index.html``).
 
 The presentation modules (:mod:`.tables`, :mod:`.findings`, :mod:`.plots`,
@@ -52,6 +53,13 @@ def figure_files():
     """``{name}_{png|pdf}`` -> path of every figure of :data:`FIGURE_NAMES`."""
     return {f"{name}_{ext}": f"{ROOT}/figures/{name}.{ext}" for name in FIGURE_NAMES
             for ext in ("png", "pdf")}
+
+
+def remeshed_name(scheme):
+    """The name of ``scheme`` run with remeshing (``matrix.with_remeshing``):
+    ``NAME+remesh``, the mesh strategy after the integrator (``cotan@bdf2`` ->
+    ``cotan@bdf2+remesh``, :func:`mcfbench.running.schemes.joined_name`'s order)."""
+    return f"{scheme}+remesh"
 
 
 def is_mesh_problem(problem):

@@ -16,6 +16,7 @@ import numpy as np
 from mcfbench.presentation.formats import formatted
 from mcfbench.presentation.tables import Table, markdown
 from mcfbench.studies.matrix import mesh_problems
+from mcfbench.studies.matrix.remeshed import remeshed_pairs, remeshing_frame, remeshing_section
 from mcfbench.studies.matrix.singularities import singularity_section
 from mcfbench.studies.matrix.tables import (
     BELOW_ACCURACY,
@@ -194,6 +195,7 @@ def matrix_findings(table, summary=None, labels=None, mesh_problems=(),
     if work_precision:
         lines += work_precision_section(work_precision)
     lines += real_mesh_section(summary, verdict, problems, schemes)
+    lines += remeshing_section(remeshing_frame(table, summary, remeshed_pairs(schemes)))
     lines += singularity_section(table)
     lines += tangential_lines(table, summary, problems, schemes)
     solver = summary[[bool(fixed) for fixed in summary["solver_only"]]]
@@ -328,12 +330,15 @@ def real_meshes(problems):
 def tangential_lines(table, summary, problems, schemes):
     """The section "Tangential strategies" (:mod:`mcfbench.studies.matrix.tangential`)
     of the registry's schemes among ``schemes``, grouped by their
-    :attr:`~mcfbench.running.schemes.Scheme.tangential`."""
+    :attr:`~mcfbench.running.schemes.Scheme.tangential`; the schemes that change
+    their mesh (``NAME+remesh``: :func:`remeshing_section`) are left out, their
+    tangential motion being their scheme's."""
     from mcfbench.running.schemes import TANGENTIAL, find_scheme
     from mcfbench.studies.matrix.tangential import strategy_frame, tangential_section
 
     entries = {s: find_scheme(s) for s in schemes}
-    strategy_of = {s: e.tangential for s, e in entries.items() if e is not None}
+    strategy_of = {s: e.tangential for s, e in entries.items()
+                   if e is not None and e.mesh_strategy == "none"}
     frame = strategy_frame(table, summary, strategy_of, real_meshes(problems), ROUNDOFF)
     return tangential_section(frame, TANGENTIAL)
 

@@ -3,7 +3,7 @@ registries (:func:`plan`) and the spec of every run (:func:`planned_specs`, in t
 store: :mod:`mcfbench.storage.run_store`)."""
 
 from mcfbench.studies.config import ConfigError
-from mcfbench.studies.matrix import is_mesh_problem
+from mcfbench.studies.matrix import is_mesh_problem, remeshed_name
 
 EXACT_SOLVER = "bicgstab"
 """Solver of the problems with a refinement series: the paper's comparison."""
@@ -89,7 +89,7 @@ def plan(section=None, schemes=None, problems=None):
                               f"{integrator!r}; choose one of "
                               f"{', '.join(i for i in INTEGRATORS if i != 'euler')}")
         stepped.update({joined_name(name, integrator): name for name in names})
-    stepped.update({f"{n}+remesh": n for n in section.get("with_remeshing") or ()})  # NAME+remesh
+    stepped.update({remeshed_name(n): n for n in section.get("with_remeshing") or ()})
     select = section.get("select") or {}
     if not isinstance(select, dict) or set(select) - {"schemes", "problems"}:
         raise ConfigError(f"config key 'matrix.select': a mapping with the keys schemes "
@@ -204,6 +204,19 @@ def run_scheme(scheme, problem):
     return f"{scheme}+{problem.mesh_strategy}"
 
 
+def runs_on(scheme, problem):
+    """Whether the matrix runs ``scheme`` on ``problem``: not when the name carries a
+    mesh strategy other than the problem's own (its ``mesh_strategy``). On the dumbbell
+    through its pinch every scheme runs as ``NAME+surgery``, which remeshes as
+    ``+remesh`` does (:mod:`mcfbench.running.remeshing`): ``NAME+remesh`` there would
+    stop at the pinch, and its scheme's row is already remeshed."""
+    from mcfbench.running.problems import get_problem
+    from mcfbench.running.scheme import parse_name
+
+    own = (get_problem(problem) if isinstance(problem, str) else problem).mesh_strategy
+    return own == "none" or parse_name(scheme).strategy in ("none", own)
+
+
 def matrix_scheme(scheme, problem):
     """The matrix's name of a run's ``scheme`` on ``problem``: :func:`run_scheme`
     undone (``cotan+surgery`` on the dumbbell through its pinch is ``cotan``'s row)."""
@@ -228,17 +241,18 @@ def matrix_spec(plan, scheme, problem, level):
 
 def planned_specs(plan):
     """``{(problem, scheme, level): spec}`` of every run, problems then schemes then
-    levels."""
+    levels (the schemes each problem runs: :func:`runs_on`)."""
     return {(p, s, level): matrix_spec(plan, s, p, level)
             for p, levels in plan["problems"].items() for s in plan["schemes"]
-            for level in levels}
+            if runs_on(s, p) for level in levels}
 
 
 def picture_specs(plan):
     """``{(problem, scheme): spec}`` of the picture grid: the coarsest level of each
-    problem."""
+    problem (the schemes it runs: :func:`runs_on`)."""
     return {(p, s): matrix_spec(plan, s, p, min(levels))
-            for p, levels in plan["problems"].items() for s in plan["schemes"]}
+            for p, levels in plan["problems"].items() for s in plan["schemes"]
+            if runs_on(s, p)}
 
 
 def run_specs(plans):

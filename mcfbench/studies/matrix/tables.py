@@ -343,7 +343,7 @@ def summary_table(table, problems=None, schemes=None):
     return pd.DataFrame(rows)
 
 
-def _robust_values(runs):
+def robust_values(runs):
     """The values of ``runs`` (one scheme on one problem, its main metric, by level),
     each run whose failure the robust solver removes (:func:`solver_only`) replaced by
     its re-run, NaN for the other runs that did not finish."""
@@ -358,7 +358,7 @@ def _robust_summary(runs, metric):
     """The summary's ``robust_*`` columns of one scheme on one problem (its runs of the
     main metric, by level): each run whose failure the robust solver removes replaced
     by its re-run."""
-    values = _robust_values(runs)
+    values = robust_values(runs)
     fixed = sum(solver_only(r) for _, r in runs.iterrows())
     levels = runs["level"].to_numpy()
     eocs, cut = eocs_above_accuracy(values, levels, runs["reference_accuracy"]) \
@@ -440,7 +440,7 @@ def with_levels(summary, table):
                                      if solver_only(r._asdict())])
         lists["robust_failed"].append([(int(r.level), r.robust_status, r.robust_t_failed)
                                        for r in rows if r.robust_status not in ("", "ok")])
-        lists["robust_values"].append([float(v) for v in _robust_values(runs)])
+        lists["robust_values"].append([float(v) for v in robust_values(runs)])
     return summary.assign(**{name: pd.Series(values, index=summary.index, dtype=object)
                              for name, values in lists.items()})
 
