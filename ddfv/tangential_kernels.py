@@ -1,5 +1,6 @@
 """Compiled (numba) kernels of the tangential motions of a step: (TM1)-(TM4), the
-carried T-vertices and the right-hand side of the elimination (3.6).
+carried T-vertices, the right-hand side of the elimination (3.6), and the
+redistribution's ``h.V`` and the sweeps of its potential's start.
 
 The formulas are those of :mod:`ddfv.tangential_motion`,
 :func:`ddfv.redistribution.carry_t_vertices` and :meth:`ddfv.flow.Flow.system`,
@@ -294,6 +295,60 @@ def squared_normal_speed_kernel(indptr, indices, data, diagonal, X, N, dt, chi, 
         hN = (((X[0, i] - y0) / dt) * N[0, i] + ((X[1, i] - y1) / dt) * N[1, i]) \
             + ((X[2, i] - y2) / dt) * N[2, i]
         out[i] = hN * hN
+
+
+@numba.njit("float64(int32[::1], int32[::1], float64[::1], float64[::1], float64[::1], "
+            "float64[::1], int64, int64)", **_OPTIONS)
+def pinned_gauss_seidel_kernel(indptr, indices, data, keep, b, x, lo, hi):
+    """One forward Gauss-Seidel sweep over the rows ``lo:hi`` of the pinned system
+    ``A = P K P + I - P``, ``P = diag(keep)`` (:func:`kept_factor.pinned`), ``x`` updated
+    in place: for each kept row ``i`` in order, ``x_i = (b_i - sum_{j != i} K_ij keep_j
+    x_j) / K_ii`` with the values already updated (Saad, Iterative Methods for Sparse
+    Linear Systems, 2nd ed., SIAM 2003, Section 4.1, (4.6)); pinned rows (``keep_i =
+    0``) are left alone. The start's smoothing of
+    :class:`ddfv.redistribution.TangentialPotential`.
+
+    Parameters
+    ----------
+    indptr, indices, data : int32, int32, float64 arrays
+        ``K`` (n, n) in CSR, a nonzero diagonal entry in every kept row of ``lo:hi``
+        (its column indices are in range by construction and not checked here).
+    keep : (n,) float64 array
+        1 where kept, 0 where pinned.
+    b : (n,) float64 array
+    x : (n,) float64 array, updated
+    lo, hi : int
+        ``0 <= lo <= hi <= n``.
+
+    Returns
+    -------
+    float
+        ``sum_i r_i^2`` of the residuals ``r_i = b_i - (A x)_i`` of the kept rows, each
+        taken just before its row's update (the residual of the sweep's start where no
+        earlier row of the sweep changed a value it reads).
+    """
+    n = x.shape[0]
+    if indptr.shape[0] != n + 1 or keep.shape[0] != n or b.shape[0] != n:
+        raise ValueError("the matrix, mask, right-hand side and iterate do not fit")
+    if not 0 <= lo <= hi <= n:
+        raise ValueError("the rows of the sweep are not within the matrix")
+    squares = 0.0
+    for i in range(lo, hi):
+        if keep[i] == 0.0:
+            continue
+        s, diagonal = b[i], 0.0
+        for p in range(indptr[i], indptr[i + 1]):
+            j = indices[p]
+            if j == i:
+                diagonal = data[p]
+            else:
+                s -= data[p] * keep[j] * x[j]
+        if diagonal == 0.0:
+            raise ValueError("a kept row of the sweep has no diagonal entry")
+        r = s - diagonal * x[i]
+        squares += r * r
+        x[i] = s / diagonal
+    return squares
 
 
 def moved_t_vertices(F, T, faces, lam, carry):

@@ -236,7 +236,7 @@ class KeptFactorSolver:
         self.method = self._factor = None
         self._history = {}                              # sequence -> its last two solutions
 
-    def solve(self, b, apply, matrix, start=None, sequence=None):
+    def solve(self, b, apply, matrix, start=None, sequence=None, smooth=None):
         """``x`` (n,) with ``|b - A x| <= rtol |b|``.
 
         Parameters
@@ -252,6 +252,12 @@ class KeptFactorSolver:
         sequence : hashable, optional
             Name of the sequence of solutions ``x`` belongs to (its last two are
             kept for the next start).
+        smooth : callable, optional
+            ``smooth(x, b)``: improves a start ``x`` (n,) in place before the kept
+            factor's iteration (e.g. a relaxation sweep over the rows where the
+            start's residual is known to gather); the iteration then checks the
+            residual of the smoothed start as of any other, so a poor smoothing costs
+            iterations, never accuracy. Not applied to a new factor's ``P^{-1} b``.
 
         Returns
         -------
@@ -264,9 +270,13 @@ class KeptFactorSolver:
         converged = False
         if (self._factor is not None and self._factor[1] == len(b)
                 and (self.budget is None or self._excess() < self.budget)):
-            if start is None and history:
+            if start is None and history:                # a new array
                 weights = EXTRAPOLATION[min(len(history) - 1, self.extrapolation)]
                 start = sum(w * x for w, x in zip(weights, reversed(history)))
+            elif start is not None and smooth is not None:
+                start = np.array(start, dtype=float)     # the caller's start stays as it is
+            if smooth is not None and start is not None:
+                smooth(start, b)
             before = self.iterations
             x, converged = self._iterate(apply, b, start)
             self._kept.append(self.iterations - before)

@@ -223,6 +223,73 @@ def test_kept_factor_matches_a_direct_solve_along_a_moving_surface(surface, dual
     assert (blocks.iterations > solver.iterations) == (method == "cg")   # LU: the whole
 
 
+def test_gauss_seidel_sweep_of_the_pinned_system():
+    """One sweep over the rows ``lo:hi`` of ``P K P + I - P`` (the potential's start):
+    the forward substitution ``x_R = (D + L)^{-1} (b_R - U x_R - K_RS x_S)`` on those
+    rows ``R`` (``S`` the others, ``D + L`` the lower triangle of ``K_RR``, ``U`` its
+    strict upper one) with the pinned entries zero, the other rows and the pinned ones
+    untouched; the returned sum is that of the squared residuals each row had just
+    before its update; a row without a diagonal entry is refused by name."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import spsolve_triangular
+
+    from ddfv.tangential_kernels import pinned_gauss_seidel_kernel
+
+    V, F = icosphere(1)
+    mesh, T, geom, chi = _setup(V, F)
+    K = neumann_stiffness(Assembler(mesh), geom).tocsr()
+    n, n_f = K.shape[0], mesh.n_f
+    keep = np.ones(n)
+    keep[[0, n_f]] = 0.0
+    rng = np.random.default_rng(7)
+    b, x = rng.standard_normal(n) * keep, rng.standard_normal(n) * keep
+    A = (sp.diags(keep) @ K @ sp.diags(keep) + sp.diags(1.0 - keep)).tocsr()
+    R = np.arange(n_f + 1, n)                       # the T-rows after the pinned one
+    ARR = A[R][:, R]
+    rhs = b[R] - sp.triu(ARR, 1) @ x[R] - A[R][:, np.r_[:n_f + 1]] @ x[:n_f + 1]
+    expected = x.copy()
+    expected[R] = spsolve_triangular(sp.tril(ARR).tocsr(), rhs, lower=True)
+    before = (b[R] - sp.tril(ARR, -1) @ expected[R] - sp.triu(ARR) @ x[R]
+              - A[R][:, np.r_[:n_f + 1]] @ x[:n_f + 1])
+    got = x.copy()
+    total = pinned_gauss_seidel_kernel(K.indptr, K.indices, K.data, keep, b, got, n_f, n)
+    np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12)
+    np.testing.assert_array_equal(got[:n_f + 1], x[:n_f + 1])
+    squares = np.sum(before ** 2)                    # the residuals before each update
+    assert total == pytest.approx(squares, rel=1e-12) and total > 0.0
+    empty = sp.csr_matrix((np.ones(1), ([0], [1])), shape=(2, 2))
+    with pytest.raises(ValueError, match="no diagonal entry"):
+        pinned_gauss_seidel_kernel(empty.indptr.astype(np.int32),
+                                   empty.indices.astype(np.int32), empty.data,
+                                   np.ones(2), np.ones(2), np.zeros(2), 0, 2)
+    with pytest.raises(ValueError, match="not within the matrix"):
+        pinned_gauss_seidel_kernel(K.indptr, K.indices, K.data, keep, b, got, 0, n + 1)
+
+def test_flow_with_the_kept_potential_is_the_direct_solves_flow(monkeypatch):
+    """40 steps of the redistributing flow on a bumped sphere (level 3): the potential
+    solved with the kept blocks' factor from the smoothed, extrapolated start to the
+    default residual 1e-4 moves every vertex to within 2e-6 mean edge lengths of the
+    flow whose potential is a direct solve to 1e-12 (measured 5.3e-7; the same without
+    the smoothing; the redistribution itself moves points by 1e-2 of an edge), with
+    fewer CG iterations than without the smoothing (measured 45 against 49)."""
+    V, F = icosphere(3)
+    V = V * (1.0 + 0.05 * np.sin(3.0 * V[:, [0]]) * V[:, [1]])
+    h = np.linalg.norm(V[F[:, 0]] - V[F[:, 1]], axis=1).mean()
+
+    def run(direct=False, **options):
+        flow = Flow(V, F, 0.001, **options)
+        if direct:
+            flow._potential = TangentialPotential(flow._mesh, rtol=1e-12, blocks=False)
+        traj = simulate(flow, 40, save_every=40, solver=Solver(rtol=1e-13, maxiter=1000))
+        return traj.frames["vertices"][-1], flow._potential
+
+    exact, _ = run(direct=True, **CARRIED)
+    kept, potential = run(**CARRIED)
+    assert np.abs(kept - exact).max() <= 2e-6 * h
+    assert np.abs(run(**variant_options("chord-carried"))[0] - exact).max() >= 1e-3 * h
+    monkeypatch.setattr("ddfv.redistribution.T_SWEEPS", 0)
+    assert run(**CARRIED)[1].iterations > potential.iterations
+
 @pytest.mark.parametrize("surface", ["sphere", "plane"])
 @pytest.mark.parametrize("peclet", [np.inf, 0.1])
 def test_drift_system_is_the_weighted_flux_form(surface, peclet):
@@ -407,7 +474,10 @@ def test_flow_invariant_under_rigid_motion(bumpy, variant):
 
 
 @pytest.mark.parametrize("variant", ["redistribute", "chord-redistribute-carried"])
-def test_flow_invariant_under_relabelling(bumpy, variant):
+def test_flow_invariant_under_relabelling(bumpy, variant, monkeypatch):
+    """The same flow up to rounding under a relabelling of vertices and triangles without
+    the Gauss-Seidel sweeps of the potential's start (their order is the numbering's);
+    with them, the same to the potential's tolerance (measured 2.3e-9)."""
     V, F = bumpy
     rng = np.random.default_rng(5)
     pv, pt = rng.permutation(len(V)), rng.permutation(len(F))
@@ -415,6 +485,10 @@ def test_flow_invariant_under_relabelling(bumpy, variant):
     new_index[pv] = np.arange(len(V))
     F2 = np.roll(new_index[F[pt]], 1, axis=1)
     opts = variant_options(variant)
+    (F0, T0), (F1, T1) = _run(V, F, **opts), _run(V[pv], F2, **opts)
+    np.testing.assert_allclose(F1, F0[:, pv], atol=1e-8)
+    np.testing.assert_allclose(T1, T0[:, pt], atol=1e-8)
+    monkeypatch.setattr("ddfv.redistribution.T_SWEEPS", 0)
     (F0, T0), (F1, T1) = _run(V, F, **opts), _run(V[pv], F2, **opts)
     np.testing.assert_allclose(F1, F0[:, pv], atol=1e-10)
     np.testing.assert_allclose(T1, T0[:, pt], atol=1e-10)

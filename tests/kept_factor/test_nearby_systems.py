@@ -127,6 +127,40 @@ def test_quadratic_extrapolation():
         KeptFactorSolver(extrapolation=3)
 
 
+
+def test_smoothing_of_the_start():
+    """``smooth`` acts on the start of the kept factor's iteration, never on the
+    caller's array: a smoothing to the exact solution leaves no iteration, one that
+    ruins the start (zeroes it) costs iterations but not accuracy; a new factor's
+    ``P^{-1} b`` is not smoothed."""
+    A, b = _matrix(0), _rhs(0)
+    exact = spla.spsolve(A.tocsc(), b)
+    calls = []
+
+    def to_exact(x, rhs):
+        calls.append(rhs)
+        x[:] = exact
+
+    solver = KeptFactorSolver(rtol=1e-10)
+    _solve(solver, A, b, smooth=to_exact)          # factorised: not smoothed
+    assert calls == [] and solver.factorisations == 1
+    start = np.zeros(len(V))
+    before = solver.iterations
+    x = _solve(solver, A, b, start=start, smooth=to_exact)
+    assert solver.iterations == before and len(calls) == 1 and calls[0] is b
+    assert not start.any()                          # the caller's start untouched
+    np.testing.assert_array_equal(x, exact)
+    plain = KeptFactorSolver(rtol=1e-10, max_iterations=50)
+    ruined = KeptFactorSolver(rtol=1e-10, max_iterations=50)
+    for k in range(4):
+        A, b = _matrix(k), _rhs(k)
+        y = _solve(plain, A, b, sequence="x")
+        z = _solve(ruined, A, b, sequence="x", smooth=lambda x, rhs: x.fill(0.0))
+        for w in (y, z):
+            assert np.linalg.norm(b - A @ w) <= 1e-10 * np.linalg.norm(b)
+    assert ruined.iterations > plain.iterations
+    assert ruined.factorisations == plain.factorisations == 1
+
 def test_budget_factorises_once_the_extra_iterations_reach_it():
     """A drifting sequence whose solves take several CG iterations each with the first
     factor: without a budget one factorisation serves them all; with ``budget`` the
