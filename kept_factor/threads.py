@@ -1,10 +1,10 @@
-"""Threads of the compiled kernels: a kernel's ``parallel=True`` copy
-(:func:`threaded`), the choice between the two (:func:`for_threads`) and the
-check of a thread count (:func:`check_threads`).
+"""Threads of the compiled kernels: a kernel's parallel copy (:func:`threaded`), the
+choice between the two (:func:`for_threads`) and the check of a thread count
+(:func:`check_threads`).
 
-Apart from :mod:`ddfv.kernels`, which compiles (or loads from numba's cache)
-every DDFV kernel when imported: the shared solver of the harness and the
-baselines' runs check and use threads without paying for the DDFV kernels.
+Below both scheme packages (``ddfv`` and ``baselines`` may not import each other) and
+the harness's solver, which all thread their kernels with it. Imports numba and numpy
+only (no scheme's kernels: a vertex scheme's run does not load DDFV's).
 """
 
 import functools
@@ -13,15 +13,26 @@ import types
 import numba
 import numpy as np
 
+PRANGE_ONLY = {"prange": True, "comprehension": False, "reduction": False,
+               "inplace_binop": False, "setitem": False, "numpy": False, "stencil": False,
+               "fusion": False}
+"""numba's ``parallel`` options of a threaded copy: its ``prange`` loops only. With
+``parallel=True`` numba also turns array expressions and slice assignments into
+parallel regions, wherever they are: the solver's residual zeroes three small arrays
+per row of a coupled system (``ax[:] = 0.0``), and BGN's two-thread step opened three
+regions per row of its 3n rows (level 7: 622 ms against 54 ms on one thread, idle
+machine; level 5 under load: a residual 1.3 s against 1.3 ms)."""
+
 
 @functools.cache
 def threaded(kernel, **callees):
-    """``kernel`` compiled again with ``parallel=True``: its ``prange`` loops are
-    split into one block of iterations per thread, their sums and minima
-    reduced per block.
+    """``kernel`` compiled again with its ``prange`` loops parallel
+    (:data:`PRANGE_ONLY`): each split into one block of iterations per thread,
+    their sums and minima reduced per block.
 
-    One source for both versions. The copy has its own name, hence its own
-    entry in numba's cache; it is built and compiled on first use, so a
+    One source for both versions. The copy has its own name (``NAME_prange``),
+    hence its own entry in numba's cache (whose index does not key on the
+    compile options); it is built and compiled on first use, so a
     one-thread run never compiles it. ``callees`` replace the compiled
     functions the kernel calls, by name (their threaded copies); numba's
     cache does not key on them, so each kernel has one set of callees (one
@@ -39,10 +50,10 @@ def threaded(kernel, **callees):
     """
     py = kernel.py_func
     clone = types.FunctionType(py.__code__, {**py.__globals__, **callees},
-                               f"{py.__name__}_threaded", py.__defaults__, py.__closure__)
+                               f"{py.__name__}_prange", py.__defaults__, py.__closure__)
     clone.__qualname__, clone.__doc__ = clone.__name__, py.__doc__
     options = {k: v for k, v in kernel.targetoptions.items() if k != "nopython"}
-    return numba.njit(parallel=True, cache=True, **options)(clone)
+    return numba.njit(parallel=PRANGE_ONLY, cache=True, **options)(clone)
 
 
 def check_threads(threads):
