@@ -419,42 +419,42 @@ def bgn_system(L_data, indptr, diag_slots, mass, omega, X, tau, fixed, scaled, a
     n = len(mass)
     nnz = indptr[n]
     bare = 0
-    for row in prange(3 * n):             # rows apart: split over threads, bitwise
-        c, i = row // n, row % n
-        start = c * (nnz + 2 * n) + indptr[i] + 2 * i
-        lo, hi = indptr[i], indptr[i + 1]
-        length = hi - lo
-        if c == 0 and not fixed[i] and not mass[i] > 0.0:
-            bare += 1
-        if fixed[i] or not mass[i] > 0.0:
-            for p in range(start, start + length + 2):
-                A_data[p] = 0.0
-            # the identity row (X^m): for alpha > 0 within an ulp, rounded as the
-            # numpy assembly of (D4) rounded it (DeTurck's states bit for bit)
-            A_data[start + c + diag_slots[i] - lo] = 1.0 - alpha + alpha
-            b[c, i] = X[c, i] - alpha * X[c, i] + alpha * X[c, i]
-            continue
-        coef = 1.0 if scaled else mass[i] / tau
-        s = tau / mass[i] if scaled else 1.0
-        wc = omega[i, c]
-        # couplings: d < c before the block of L, d > c after it
-        q = start
-        for d in range(3):
-            if d == c:
-                q = start + c + length
+    for c in range(3):
+        for i in prange(n):               # rows apart: split over threads, bitwise
+            start = c * (nnz + 2 * n) + indptr[i] + 2 * i
+            lo, hi = indptr[i], indptr[i + 1]
+            length = hi - lo
+            if c == 0 and not fixed[i] and not mass[i] > 0.0:
+                bare += 1
+            if fixed[i] or not mass[i] > 0.0:
+                for p in range(start, start + length + 2):
+                    A_data[p] = 0.0
+                # the identity row (X^m): for alpha > 0 within an ulp, rounded as the
+                # numpy assembly of (D4) rounded it (DeTurck's states bit for bit)
+                A_data[start + c + diag_slots[i] - lo] = 1.0 - alpha + alpha
+                b[c, i] = X[c, i] - alpha * X[c, i] + alpha * X[c, i]
                 continue
-            v = coef * wc * omega[i, d]
-            A_data[q] = v - alpha * v
-            q += 1
-        base = start + c
-        for p in range(lo, hi):
-            A_data[base + p - lo] = L_data[p] * s
-        v = coef * wc * wc
-        diagonal = base + diag_slots[i] - lo
-        A_data[diagonal] = A_data[diagonal] + v - alpha * v + alpha * coef
-        normal = omega[i, 0] * X[0, i] + omega[i, 1] * X[1, i] + omega[i, 2] * X[2, i]
-        v = coef * wc * normal
-        b[c, i] = v - alpha * v + alpha * coef * X[c, i]
+            coef = 1.0 if scaled else mass[i] / tau
+            s = tau / mass[i] if scaled else 1.0
+            wc = omega[i, c]
+            # couplings: d < c before the block of L, d > c after it
+            q = start
+            for d in range(3):
+                if d == c:
+                    q = start + c + length
+                    continue
+                v = coef * wc * omega[i, d]
+                A_data[q] = v - alpha * v
+                q += 1
+            base = start + c
+            for p in range(lo, hi):
+                A_data[base + p - lo] = L_data[p] * s
+            v = coef * wc * wc
+            diagonal = base + diag_slots[i] - lo
+            A_data[diagonal] = A_data[diagonal] + v - alpha * v + alpha * coef
+            normal = omega[i, 0] * X[0, i] + omega[i, 1] * X[1, i] + omega[i, 2] * X[2, i]
+            v = coef * wc * normal
+            b[c, i] = v - alpha * v + alpha * coef * X[c, i]
     return bare
 
 

@@ -137,25 +137,25 @@ def state_pass(V, F, face_label, labels, neighbours, split, skip, N, area, box, 
     return total, tangent, _folds(N, neighbours, split, skip)
 
 
-@numba.njit(**_OPTIONS)
-def state_pass_split(V, F, face_label, labels, neighbours, split, skip, N, area, box,
-                     diameter, twice, tangents):
-    """:func:`state_pass` with its pass over the triangles in two, for threads
-    (:func:`kept_factor.threads.for_threads` with the callees ``_triangle_terms`` and
-    ``_folds``): each triangle's normal, twice its area and the tangent of its smallest
-    angle into ``N``, ``twice`` and ``tangents`` (m,), triangles apart; then their sums
-    and minimum in triangle order, one thread (:func:`_triangle_sums`). The same
-    arithmetic in the same order as :func:`state_pass`: bitwise its results."""
-    m = F.shape[0]
-    N[m, :] = 0.0
-    _triangle_terms(V, F, N, twice, tangents)
+def state_pass_threads(threads, V, F, face_label, labels, neighbours, split, skip, N, area,
+                       box, diameter, twice, tangents):
+    """:func:`state_pass` on ``threads`` threads (:func:`kept_factor.threads.for_threads`),
+    its pass over the triangles in two: each triangle's normal, twice its area and the
+    tangent of its smallest angle into ``N``, ``twice`` and ``tangents`` ((m,) scratch),
+    triangles apart; then their sums and minimum in triangle order on one thread; the
+    fold count triangles apart. The same arithmetic in the same order as
+    :func:`state_pass`: bitwise its results."""
+    from kept_factor.threads import for_threads
+
+    N[F.shape[0], :] = 0.0
+    for_threads(_triangle_terms, threads)(V, F, N, twice, tangents)
     total, tangent = _triangle_sums(face_label, twice, tangents, area)
     _boxes(V, labels, box, diameter)
-    return total, tangent, _folds(N, neighbours, split, skip)
+    return total, tangent, for_threads(_folds, threads)(N, neighbours, split, skip)
 
 
 # the three passes of state_pass: one compiled function each (in one, the fold count
-# ran several times slower); the first in two for threads (state_pass_split)
+# ran several times slower); the first in two for threads (state_pass_threads)
 @numba.njit(**_OPTIONS)
 def _triangles(V, F, face_label, N, area):
     area[:] = 0.0

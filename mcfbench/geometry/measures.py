@@ -105,7 +105,7 @@ class StateMeasures:
     faces : (m, 3) int array
         Consistently oriented triangles.
     threads : int
-        Threads of the pass (:func:`mcfbench.geometry.kernels.state_pass_split`; one:
+        Threads of the pass (:func:`mcfbench.geometry.kernels.state_pass_threads`; one:
         :func:`mcfbench.geometry.kernels.state_pass`), the same numbers bit for bit.
 
     Attributes
@@ -164,11 +164,8 @@ class StateMeasures:
         if self.threads == 1:
             area, tangent, folded = kernels.state_pass(*arguments)
         else:
-            from kept_factor.threads import for_threads
-
             m = len(self.faces)
-            area, tangent, folded = for_threads(
-                kernels.state_pass_split, self.threads, _triangle_terms=kernels._triangle_terms,
-                _folds=kernels._folds)(*arguments, np.empty(m), np.empty(m))
+            area, tangent, folded = kernels.state_pass_threads(self.threads, *arguments,
+                                                               np.empty(m), np.empty(m))
         return Measured(float(area), float(np.degrees(np.arctan(tangent))), int(folded),
                         self._area, self._diameter)

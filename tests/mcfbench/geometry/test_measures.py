@@ -147,7 +147,7 @@ def test_the_fold_count_is_the_quality_monitors_on_noisy_states(mesh):
 
 @pytest.mark.parametrize("name, V0, F, V", states(), ids=[s[0] for s in states()])
 def test_two_threads_measure_a_state_bit_for_bit_as_one(name, V0, F, V):
-    """The pass split for threads (state_pass_split: the triangles' terms apart, their
+    """The pass split for threads (state_pass_threads: the triangles' terms apart, their
     sums in triangle order) gives state_pass's numbers, NaN states and folds too."""
     one, two = StateMeasures(V0, F)(V), StateMeasures(V0, F, threads=2)(V)
     assert two.folded == one.folded
