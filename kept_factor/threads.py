@@ -12,6 +12,7 @@ import types
 
 import numba
 import numpy as np
+from numba.core.cpu import ParallelOptions
 
 PRANGE_ONLY = {"prange": True, "comprehension": False, "reduction": False,
                "inplace_binop": False, "setitem": False, "numpy": False, "stencil": False,
@@ -53,7 +54,10 @@ def threaded(kernel, **callees):
                                f"{py.__name__}_prange", py.__defaults__, py.__closure__)
     clone.__qualname__, clone.__doc__ = clone.__name__, py.__doc__
     options = {k: v for k, v in kernel.targetoptions.items() if k != "nopython"}
-    return numba.njit(parallel=PRANGE_ONLY, cache=True, **options)(clone)
+    # not the dict itself: numba pops the keys of a dict of options at each compilation,
+    # and a second one (other argument types) from the emptied dict has every option on
+    return numba.njit(parallel=ParallelOptions(dict(PRANGE_ONLY)), cache=True,
+                      **options)(clone)
 
 
 def check_threads(threads):

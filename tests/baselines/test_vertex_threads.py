@@ -10,6 +10,9 @@ from baselines.cotan import CotanFlow
 from baselines.laplacian import CotanAssembler
 from baselines.mesh import edge_mesh
 from mcfbench.geometry.spheres import icosphere
+from mcfbench.running.driver import simulate
+from mcfbench.running.schemes import get_scheme
+from mcfbench.running.solver import Solver
 
 
 def noisy_sphere(level=2, seed=0):
@@ -54,3 +57,17 @@ def test_bad_thread_counts_are_refused():
     V, F = icosphere(1)
     with pytest.raises(ValueError, match="threads"):
         CotanFlow(V, F, 1e-3, threads=0)
+
+
+@pytest.mark.parametrize("name", ["cotan", "bgn"])
+def test_a_run_whose_passes_take_two_threads_is_the_one_thread_run_bit_for_bit(name):
+    """The flow's passes and the driver's checks on two threads, the solve on one (whose
+    threaded inner products are summed in another order): every step bitwise."""
+    V, F = icosphere(3)
+    flows = [get_scheme(name).make(V, F, 1e-3, threads=t) for t in (1, 2)]
+    trajectories = [simulate(flow, 4, solver=Solver(), save_every=1) for flow in flows]
+    assert all(traj.ok and traj.steps_done == 4 for traj in trajectories)
+    assert flows[1].threads == 2
+    np.testing.assert_array_equal(trajectories[1].iterations, trajectories[0].iterations)
+    np.testing.assert_array_equal(flows[1].X, flows[0].X)
+    assert np.abs(flows[0].X - np.asarray(V).T).max() > 1e-3        # the flow moved

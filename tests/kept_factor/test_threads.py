@@ -3,6 +3,7 @@
 import numba
 import numpy as np
 import pytest
+from numba.core.cpu import ParallelOptions
 
 from kept_factor.threads import PRANGE_ONLY, check_threads, for_threads, threaded
 
@@ -22,17 +23,19 @@ def _sum_and_shift(x, out):
 
 
 def test_a_threaded_copy_splits_its_prange_loops_only():
-    """Only the prange loops are parallel (PRANGE_ONLY): BGN's two-thread solve once
-    opened three regions per row in the residual's slice assignments."""
+    """Only the prange loops are parallel (PRANGE_ONLY), for every argument type it is
+    compiled for: BGN's two-thread solve once opened three regions per row in the
+    residual's slice assignments, and numba empties a dict of options as it compiles."""
     kernel = threaded(_sum_and_shift)
-    assert kernel.targetoptions["parallel"] == PRANGE_ONLY
-    assert {k for k, v in PRANGE_ONLY.items() if v} == {"prange"}
     assert kernel.py_func.__name__ == "_sum_and_shift_prange"
-    x = np.arange(1.0, 1001.0)
-    out = np.empty_like(x)
-    assert for_threads(_sum_and_shift, 2)(x, out) == 500500.0
-    np.testing.assert_array_equal(out, 2 * x)
     assert for_threads(_sum_and_shift, 1) is _sum_and_shift
+    for dtype in (np.float64, np.float32):           # two compilations
+        x = np.arange(1.0, 1001.0, dtype=dtype)
+        out = np.empty_like(x)
+        assert for_threads(_sum_and_shift, 2)(x, out) == 500500.0
+        np.testing.assert_array_equal(out, 2 * x)
+        assert kernel.targetoptions["parallel"] == ParallelOptions(dict(PRANGE_ONLY))
+    assert {k for k, v in PRANGE_ONLY.items() if v} == {"prange"} and len(PRANGE_ONLY) == 8
 
 
 @pytest.mark.parametrize("threads", [0, -1, 2.0, True, 10**6])
