@@ -65,9 +65,11 @@ system (C3) and fewer iterations (measured in ``baselines/README.md``).
 import numpy as np
 import scipy.sparse as sp
 
-from .vertex_flow import VertexFlow
-from .kernels import bgn_system, vertex_normals
+from kept_factor.threads import for_threads
+
+from .kernels import bgn_system
 from .laplacian import with_values
+from .vertex_flow import VertexFlow
 
 SCALINGS = ("mass", "none")
 
@@ -121,6 +123,8 @@ class BGNFlow(VertexFlow):
     tau : float
     scaling : {"mass", "none"}
         Row scaling of (B4) passed to the solver (see module docstring).
+    threads : int
+        Threads of the assembly and the checks (:class:`baselines.vertex_flow.VertexFlow`).
 
     Examples
     --------
@@ -135,11 +139,11 @@ class BGNFlow(VertexFlow):
     """The weight of the identity in the matrix of the normal velocity, ``Omega_k =
     alpha I + (1 - alpha) omega_k omega_k^T``: 0 here (B4), DeTurck's ``alpha`` (D4)."""
 
-    def __init__(self, vertices, faces, tau, *, scaling="mass"):
+    def __init__(self, vertices, faces, tau, *, scaling="mass", threads=1):
         if scaling not in SCALINGS:
             raise ValueError(f"unknown scaling {scaling!r}; choose one of {', '.join(SCALINGS)}")
         self.scaling = scaling
-        super().__init__(vertices, faces, tau, mass="barycentric")
+        super().__init__(vertices, faces, tau, mass="barycentric", threads=threads)
         self._indptr, self._indices = block_pattern(self.assembler.pattern)
         n = 3 * self.mesh.n_vertices                 # a step's matrix: with_values of it
         self._pattern = sp.csr_matrix((np.zeros(len(self._indices)), self._indices,
@@ -152,9 +156,7 @@ class BGNFlow(VertexFlow):
 
     def _normals(self, geometry):
         """(n, 3) the normals (B3) of the surface of ``geometry``."""
-        omega = np.empty((self.mesh.n_vertices, 3))
-        vertex_normals(self.faces, geometry.area_vectors, self.mesh.n_vertices, omega)
-        return omega
+        return self.assembler.normals(geometry.area_vectors, self.threads)
 
     def _laplacian_data(self, geometry):
         """Values of the stiffness in (B4) (``A``, in the pattern of ``L``) at the surface
@@ -201,7 +203,7 @@ class BGNFlow(VertexFlow):
         g, p, n = self.geometry_at(at), self.assembler.pattern, self.mesh.n_vertices
         data = np.empty(len(self._indices))
         b = np.empty((3, n))
-        bgn_system(self._laplacian_data(g), p.indptr, p.diag_slots, g.mass, self._normals(g),
-                   np.ascontiguousarray(base), dt, self.fixed, scaling == "mass", self.alpha,
-                   data, b)
+        for_threads(bgn_system, self.threads)(
+            self._laplacian_data(g), p.indptr, p.diag_slots, g.mass, self._normals(g),
+            np.ascontiguousarray(base), dt, self.fixed, scaling == "mass", self.alpha, data, b)
         return with_values(self._pattern, data), b

@@ -62,7 +62,6 @@ import numpy as np
 
 from kept_factor import as_csr
 
-from .kernels import vertex_normals
 from .tangential_kernels import drifted_system, normal_parts
 from .laplacian import cotangent_laplacian, lumped_mass, row_scaled_matrix
 from .redistribution import (OMEGA, PECLET, REDISTRIBUTIONS, PotentialSolver, drift_laplacian,
@@ -121,7 +120,8 @@ class CotanFlow(VertexFlow):
     """
 
     def __init__(self, vertices, faces, tau, *, mass="barycentric", assembly="cached",
-                 redistribution=None, omega=OMEGA, peclet=PECLET, target="vertex"):
+                 redistribution=None, omega=OMEGA, peclet=PECLET, target="vertex",
+                 threads=1):
         if assembly not in ASSEMBLIES:
             raise ValueError(f"unknown assembly {assembly!r}; choose one of "
                              f"{', '.join(ASSEMBLIES)}")
@@ -144,7 +144,7 @@ class CotanFlow(VertexFlow):
         self._potential_solver = PotentialSolver()
         self.psi = None
         """The potential of the last step's tangential velocity (R2), (n,)."""
-        super().__init__(vertices, faces, tau, mass=mass)
+        super().__init__(vertices, faces, tau, mass=mass, threads=threads)
         self.timings["potential"] = 0.0
 
     def _needs_laplacian(self):
@@ -202,7 +202,7 @@ class CotanFlow(VertexFlow):
                                          self.fixed), base
             g = self.geometry_at(at)
             return self.assembler.row_scaled(self._laplacian_data(g), g.mass, dt,
-                                             self.fixed), base
+                                             self.fixed, self.threads), base
         L = as_csr(self.laplacian(at))
         mass = self._system_mass(at)
         psi = self._potential(at, L, mass)                                            # (R2)
@@ -214,10 +214,7 @@ class CotanFlow(VertexFlow):
 
     def _vertex_normals(self, at):
         """(n, 3) the area-weighted vertex normals of ``at``, not normalised."""
-        normals = np.empty((self.mesh.n_vertices, 3))
-        vertex_normals(self.faces, self.geometry_at(at).area_vectors, self.mesh.n_vertices,
-                       normals)
-        return normals
+        return self.assembler.normals(self.geometry_at(at).area_vectors, self.threads)
 
     def _drifted_system(self, at, base, dt, L, mass, psi):
         """``(A, b)`` of a redistributing step with the cached assembly: ``A = I + dt

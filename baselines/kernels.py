@@ -35,7 +35,7 @@ corner ``k`` and area vector ``N = (x_1 - x_0) x (x_2 - x_0)``:
 """
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 
 @njit(cache=True)
@@ -134,6 +134,150 @@ def cotan_geometry(V, faces, corner_slots, diag_slots, voronoi, with_laplacian,
     return degenerate, first
 
 
+@njit(cache=True)
+def triangle_terms(V, faces, voronoi, half_cot, corner_mass, area_vectors, live):
+    """What each triangle adds in :func:`cotan_geometry`, kept per triangle for
+    :func:`gather_geometry` (the two passes of a threaded assembly: no two threads
+    add into one vertex's entries).
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    faces : (m, 3) int64 array
+    voronoi : bool
+    half_cot : (m, 3) float64 array, output
+        ``cot_k / 2`` at each corner (the weight of the edge opposite it).
+    corner_mass : (m, 3) float64 array, output
+        The lumped mass the triangle gives each corner (barycentric or Voronoi).
+    area_vectors : (m, 3) float64 array, output
+    live : (m,) bool array, output
+        False for a triangle with ``|N_t| = 0`` or not finite (it adds nothing).
+
+    Returns
+    -------
+    degenerate, first : int
+        As :func:`cotan_geometry` (``first = m`` read as ``-1`` by the caller).
+    """
+    m = faces.shape[0]
+    degenerate = 0
+    first = m
+    for t in prange(m):                   # triangles apart
+        i0, i1, i2 = faces[t, 0], faces[t, 1], faces[t, 2]
+        ax, ay, az = V[i1, 0] - V[i0, 0], V[i1, 1] - V[i0, 1], V[i1, 2] - V[i0, 2]
+        bx, by, bz = V[i2, 0] - V[i0, 0], V[i2, 1] - V[i0, 1], V[i2, 2] - V[i0, 2]
+        cx, cy, cz = V[i2, 0] - V[i1, 0], V[i2, 1] - V[i1, 1], V[i2, 2] - V[i1, 2]
+        nx, ny, nz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+        area_vectors[t, 0], area_vectors[t, 1], area_vectors[t, 2] = nx, ny, nz
+        dbl = np.sqrt(nx * nx + ny * ny + nz * nz)
+        ok = dbl > 0.0 and np.isfinite(dbl)
+        live[t] = ok
+        if not ok:
+            degenerate += 1
+            first = min(first, t)
+            continue
+        d0 = ax * bx + ay * by + az * bz
+        d1 = -(cx * ax + cy * ay + cz * az)
+        d2 = cx * bx + cy * by + cz * bz
+        half_cot[t, 0] = 0.5 * d0 / dbl
+        half_cot[t, 1] = 0.5 * d1 / dbl
+        half_cot[t, 2] = 0.5 * d2 / dbl
+        if not voronoi:
+            third = dbl / 6.0
+            corner_mass[t, 0] = corner_mass[t, 1] = corner_mass[t, 2] = third
+            continue
+        s0 = cx * cx + cy * cy + cz * cz
+        s1 = bx * bx + by * by + bz * bz
+        s2 = ax * ax + ay * ay + az * az
+        if d0 < 0.0:
+            q0, q1, q2 = 0.25 * dbl, 0.125 * dbl, 0.125 * dbl
+        elif d1 < 0.0:
+            q0, q1, q2 = 0.125 * dbl, 0.25 * dbl, 0.125 * dbl
+        elif d2 < 0.0:
+            q0, q1, q2 = 0.125 * dbl, 0.125 * dbl, 0.25 * dbl
+        else:
+            c0, c1, c2 = d0 / dbl, d1 / dbl, d2 / dbl
+            q0 = (s1 * c1 + s2 * c2) / 8.0
+            q1 = (s2 * c2 + s0 * c0) / 8.0
+            q2 = (s0 * c0 + s1 * c1) / 8.0
+        corner_mass[t, 0], corner_mass[t, 1], corner_mass[t, 2] = q0, q1, q2
+    return degenerate, first
+
+
+@njit(cache=True)
+def gather_geometry(corners_ptr, corners, corner_slots, indptr, diag_slots, half_cot,
+                    corner_mass, live, with_laplacian, L_data, mass):
+    """``L_data`` and ``mass`` of :func:`cotan_geometry` from :func:`triangle_terms`,
+    one vertex (one row of ``L``) at a time: every entry summed over the vertex's
+    triangles in triangle order, as the scatter adds into it, hence bitwise its
+    values, with rows apart for the threads.
+
+    Parameters
+    ----------
+    corners_ptr : (n + 1,) int64 array
+    corners : (3 m,) int64 array
+        The corners ``3 t + c`` at each vertex, ``t`` increasing
+        (:meth:`baselines.laplacian.CotanAssembler.corners`).
+    corner_slots, indptr, diag_slots
+        The pattern of ``L`` (:class:`baselines.mesh.LaplacianPattern`).
+    half_cot, corner_mass : (m, 3) float64 arrays
+    live : (m,) bool array
+    with_laplacian : bool
+    L_data : (nnz,) float64 array, output
+    mass : (n,) float64 array, output
+    """
+    for i in prange(len(mass)):           # vertices apart
+        lo, hi = indptr[i], indptr[i + 1]
+        if with_laplacian:
+            for p in range(lo, hi):
+                L_data[p] = 0.0
+        diagonal = 0.0
+        total = 0.0
+        for q in range(corners_ptr[i], corners_ptr[i + 1]):
+            t, c = corners[q] // 3, corners[q] % 3
+            if not live[t]:
+                continue
+            if with_laplacian:
+                for k in range(3):        # the edges at i: those opposite its other corners
+                    if k == c:
+                        continue
+                    w = half_cot[t, k]
+                    slot = corner_slots[t, k, 0]
+                    if slot < lo or slot >= hi:
+                        slot = corner_slots[t, k, 1]
+                    L_data[slot] -= w
+                    diagonal += w
+            total += corner_mass[t, c]
+        if with_laplacian:
+            L_data[diag_slots[i]] = diagonal
+        mass[i] = total
+
+
+@njit(cache=True)
+def gather_normals(corners_ptr, corners, area_vectors, omega):
+    """:func:`vertex_normals` one vertex at a time (the corners of
+    :func:`gather_geometry`): the same sums in triangle order, bitwise, vertices apart
+    for the threads. Returns the number of vertices whose triangles all have zero
+    area (their ``omega`` zero)."""
+    bare = 0
+    for i in prange(omega.shape[0]):
+        ox = oy = oz = weight = 0.0
+        for q in range(corners_ptr[i], corners_ptr[i + 1]):
+            t = corners[q] // 3
+            nx, ny, nz = area_vectors[t, 0], area_vectors[t, 1], area_vectors[t, 2]
+            ox += nx
+            oy += ny
+            oz += nz
+            weight += np.sqrt(nx * nx + ny * ny + nz * nz)
+        if not weight > 0.0:
+            omega[i, 0] = omega[i, 1] = omega[i, 2] = 0.0
+            bare += 1
+            continue
+        omega[i, 0] = ox / weight
+        omega[i, 1] = oy / weight
+        omega[i, 2] = oz / weight
+    return bare
+
+
 @njit(cache=True, inline="always")
 def add_at_corners(faces, t, out, x, y, z, weight, w):
     """Add the vector ``(x, y, z)`` to the rows of ``out`` and ``w`` to ``weight`` at
@@ -214,7 +358,7 @@ def row_scaled_system(L_data, indptr, diag_slots, mass, tau, fixed, A_data):
         Number of rows with zero mass (never a division by zero here).
     """
     bare = 0
-    for i in range(len(mass)):
+    for i in prange(len(mass)):           # rows apart: split over threads, bitwise
         lo, hi = indptr[i], indptr[i + 1]
         if not mass[i] > 0.0 and not fixed[i]:
             bare += 1
@@ -276,7 +420,7 @@ def bgn_system(L_data, indptr, diag_slots, mass, omega, X, tau, fixed, scaled, a
     nnz = indptr[n]
     bare = 0
     for c in range(3):
-        for i in range(n):
+        for i in prange(n):               # rows apart: split over threads, bitwise
             start = c * (nnz + 2 * n) + indptr[i] + 2 * i
             lo, hi = indptr[i], indptr[i + 1]
             length = hi - lo
@@ -442,7 +586,7 @@ def neighbour_cosines(area_vectors, face_neighbours, cosine, double_areas):
     double_areas : (m,) float64 array, output
         ``|N_t| = 2 |t|``.
     """
-    for t in range(area_vectors.shape[0]):
+    for t in prange(area_vectors.shape[0]):   # triangles apart
         sx, sy, sz = 0.0, 0.0, 0.0
         for k in range(3):
             s = face_neighbours[t, k]

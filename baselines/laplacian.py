@@ -19,12 +19,16 @@ Dirichlet rows (:func:`dirichlet_rows`).
 
 import copy
 from dataclasses import dataclass
+from functools import cached_property
 
 import igl
 import numpy as np
 import scipy.sparse as sp
 
-from .kernels import cotan_geometry, row_scaled_system
+from kept_factor.threads import for_threads
+
+from .kernels import (cotan_geometry, gather_geometry, gather_normals, row_scaled_system,
+                      triangle_terms, vertex_normals)
 from .mesh import laplacian_pattern
 
 MASS_TYPES = {"barycentric": igl.MASSMATRIX_TYPE_BARYCENTRIC,
@@ -146,7 +150,17 @@ class CotanAssembler:
     def shape(self):
         return self.pattern.shape
 
-    def geometry(self, vertices, with_laplacian=True):
+    @cached_property
+    def corners(self):
+        """``(corners_ptr, corners)``: the corners ``3 t + c`` of the triangles at each
+        vertex, ``t`` increasing, as CSR ((n + 1,) and (3 m,) int64 arrays): the
+        threaded assembly's gathers (:func:`baselines.kernels.gather_geometry`)."""
+        faces = self.mesh.faces.ravel()
+        counts = np.bincount(faces, minlength=self.mesh.n_vertices)
+        return (np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
+                np.argsort(faces, kind="stable").astype(np.int64))
+
+    def geometry(self, vertices, with_laplacian=True, threads=1):
         """Stiffness, lumped mass and area vectors of ``vertices``.
 
         Parameters
@@ -154,6 +168,11 @@ class CotanAssembler:
         vertices : (n, 3) float array
         with_laplacian : bool
             Compute ``L`` (False: ``L_data`` is None).
+        threads : int
+            One: :func:`baselines.kernels.cotan_geometry`'s scatter over the
+            triangles. More: its two passes split over the threads, the triangles'
+            terms then each vertex's sums (:func:`baselines.kernels.triangle_terms`,
+            :func:`baselines.kernels.gather_geometry`), bitwise the same numbers.
 
         Returns
         -------
@@ -166,12 +185,34 @@ class CotanAssembler:
         # Fortran order: the flows' (n, 3) views of their (3, n) states as they are (a
         # C-ordered copy of them took 15 us of a 110 us pass at 3 000 vertices), one
         # compiled version for every caller
-        degenerate, first = cotan_geometry(
-            np.asfortranarray(vertices, dtype=np.float64), mesh.faces, p.corner_slots,
-            p.diag_slots, self.mass_type == "voronoi", with_laplacian, L_data, mass,
-            area_vectors)
+        V = np.asfortranarray(vertices, dtype=np.float64)
+        voronoi = self.mass_type == "voronoi"
+        if threads == 1:
+            degenerate, first = cotan_geometry(V, mesh.faces, p.corner_slots, p.diag_slots,
+                                               voronoi, with_laplacian, L_data, mass,
+                                               area_vectors)
+        else:
+            m = mesh.n_faces
+            half_cot, corner_mass, live = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, bool)
+            degenerate, first = for_threads(triangle_terms, threads)(
+                V, mesh.faces, voronoi, half_cot, corner_mass, area_vectors, live)
+            first = -1 if first == m else first
+            for_threads(gather_geometry, threads)(
+                *self.corners, p.corner_slots, p.indptr, p.diag_slots, half_cot,
+                corner_mass, live, with_laplacian, L_data, mass)
         return SurfaceGeometry(L_data if with_laplacian else None, mass, area_vectors,
                                int(degenerate), int(first))
+
+    def normals(self, area_vectors, threads=1):
+        """(n, 3) mass-lumped vertex normals ``sum N_t / sum |N_t|`` of the triangles'
+        ``area_vectors`` (:func:`baselines.kernels.vertex_normals`; with more than one
+        thread :func:`baselines.kernels.gather_normals`, bitwise the same)."""
+        omega = np.empty((self.mesh.n_vertices, 3))
+        if threads == 1:
+            vertex_normals(self.mesh.faces, area_vectors, self.mesh.n_vertices, omega)
+        else:
+            for_threads(gather_normals, threads)(*self.corners, area_vectors, omega)
+        return omega
 
     def csr(self, data):
         """A CSR matrix with the pattern of ``L`` and values ``data`` (not copied):
@@ -182,7 +223,7 @@ class CotanAssembler:
         """``L`` (C2) as CSR from :attr:`SurfaceGeometry.L_data`."""
         return self.csr(L_data)
 
-    def row_scaled(self, L_data, mass, tau, fixed):
+    def row_scaled(self, L_data, mass, tau, fixed, threads=1):
         """``I + tau diag(1/M) L`` (C3) as CSR; rows ``fixed`` = identity.
 
         Parameters
@@ -191,10 +232,13 @@ class CotanAssembler:
         mass : (n,) float array
         tau : float
         fixed : (n,) bool array
+        threads : int
+            The rows split over them (bitwise the same values).
         """
         p = self.pattern
         data = np.empty(p.nnz)
-        row_scaled_system(L_data, p.indptr, p.diag_slots, mass, float(tau), fixed, data)
+        for_threads(row_scaled_system, threads)(L_data, p.indptr, p.diag_slots, mass,
+                                                float(tau), fixed, data)
         return self.csr(data)
 
 

@@ -14,6 +14,8 @@ from functools import cached_property
 
 import numpy as np
 
+from kept_factor.threads import check_threads, for_threads
+
 from .kernels import neighbour_cosines
 from .laplacian import CotanAssembler
 from .mesh import edge_mesh
@@ -40,6 +42,10 @@ class VertexFlow:
         Time step, positive and finite.
     mass : {"barycentric", "voronoi"}
         Lumped mass of :class:`CotanAssembler`.
+    threads : int
+        Threads of the compiled passes over the triangles and vertices (the
+        geometry, the system's rows, the checks; :mod:`kept_factor.threads`): the
+        same numbers bit for bit on any count.
 
     Attributes
     ----------
@@ -51,7 +57,9 @@ class VertexFlow:
         adds ``"solve"``.
     """
 
-    def __init__(self, vertices, faces, tau, *, mass="barycentric"):
+    def __init__(self, vertices, faces, tau, *, mass="barycentric", threads=1):
+        check_threads(threads)
+        self.threads = threads
         if not (np.isfinite(tau) and tau > 0):
             raise ValueError(f"tau must be a positive finite number, got {tau!r}")
         V = np.asarray(vertices, dtype=np.float64)
@@ -121,7 +129,8 @@ class VertexFlow:
         at the extrapolated state) the checks and weights of the state need only the
         mass and the area vectors, and :meth:`geometry_at` completes it on demand."""
         return self.assembler.geometry(self._X.T,
-                                       self._needs_laplacian() and self._assembles_here)
+                                       self._needs_laplacian() and self._assembles_here,
+                                       self.threads)
 
     def _needs_laplacian(self):
         return True
@@ -136,9 +145,9 @@ class VertexFlow:
         """:class:`SurfaceGeometry` of the state ``at`` (3, n) (the cached one of the
         current state when ``at`` is it)."""
         if at is not self._X:
-            return self.assembler.geometry(at.T, self._needs_laplacian())
+            return self.assembler.geometry(at.T, self._needs_laplacian(), self.threads)
         if self.geometry.L_data is None and self._needs_laplacian():
-            self.geometry = self.assembler.geometry(at.T)       # the stiffness too
+            self.geometry = self.assembler.geometry(at.T, True, self.threads)  # and L
         return self.geometry
 
     def system(self, at=None, base=None, dt=None, **options):
@@ -186,8 +195,8 @@ class VertexFlow:
         (:func:`baselines.kernels.neighbour_cosines`)."""
         m = self.mesh.n_faces
         cosine, double_areas = np.empty(m), np.empty(m)
-        neighbour_cosines(self.geometry.area_vectors, self.mesh.face_neighbours, cosine,
-                          double_areas)
+        for_threads(neighbour_cosines, self.threads)(
+            self.geometry.area_vectors, self.mesh.face_neighbours, cosine, double_areas)
         return cosine, double_areas
 
     def _normal_agreement(self):

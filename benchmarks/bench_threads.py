@@ -14,6 +14,12 @@ ratio, in one process.
   add the threads' up), the best of the repeats. Printed: both, the speedup ``S =
   ms_1 / ms_2`` and ``S / R`` (the issue's target: at least 0.8).
 
+* ``--passes``: instead, each threaded part of a vertex scheme's step on its own
+  (``--schemes`` cotan, bgn), one thread against two on the same state, interleaved,
+  the best of ``--repeats`` each: the assembly (``flow.system(at=X)``: the geometry and
+  the system's rows), the flow's triangle checks, the driver's measuring pass
+  (:class:`mcfbench.geometry.measures.StateMeasures`) and the solve from the state.
+
 Not pinned (two threads need both cores); every other thread pool at one thread. A
 second core only helps when nobody else uses it: the load average is printed with
 every measurement, and the numbers mean something only near an idle machine (load
@@ -22,7 +28,7 @@ below 1).
 Usage::
 
     python benchmarks/bench_threads.py [--levels 8] [--schemes cotan bgn ddfv-chord-carried]
-        [--steps 3] [--repeats 3] [--triad-mb 512]
+        [--steps 3] [--repeats 3] [--triad-mb 512] [--passes]
 """
 
 import argparse
@@ -72,6 +78,44 @@ def triad_ratio(megabytes, repeats):
     return 24.0 * n / best[1], 24.0 * n / best[2]
 
 
+def passes(name, level, repeats):
+    """``{part: (ms on one thread, ms on two)}`` for the threaded parts of a vertex
+    scheme's step (module docstring), the best of ``repeats`` interleaved calls."""
+    from mcfbench.geometry.measures import StateMeasures
+    from mcfbench.geometry.spheres import icosphere
+    from mcfbench.running.locality import locality_order
+    from mcfbench.running.problems import get_problem
+    from mcfbench.running.schemes import get_scheme
+    from mcfbench.running.solver import Solver
+
+    V, F = icosphere(level)
+    renumbered = locality_order(V, F)
+    V, F = (V, F) if renumbered is None else renumbered.mesh(V, F)
+    tau = get_problem("sphere").tau(level)
+    flows = {t: get_scheme(name).make(V, F, tau, threads=t) for t in (1, 2)}
+    measures = {t: StateMeasures(V, F, threads=t) for t in (1, 2)}
+    X = np.array(flows[1].state)
+    A, b = flows[1].system()
+    parts = {
+        "assembly": lambda t: flows[t].system(at=X),
+        "triangle checks": lambda t: (flows[t].__dict__.pop("_triangle_checks", None),
+                                      flows[t]._triangle_checks),
+        "measuring pass": lambda t: measures[t](V),
+        "solve": lambda t: Solver(threads=t)(A, b, X),
+    }
+    best = {}
+    for part, call in parts.items():
+        for t in (1, 2):
+            call(t)                       # compile or load, first touch
+        for r in range(repeats):
+            for t in (1, 2) if r % 2 == 0 else (2, 1):
+                start = time.perf_counter()
+                call(t)
+                ms = 1e3 * (time.perf_counter() - start)
+                best[part, t] = min(best.get((part, t), np.inf), ms)
+    return {part: (best[part, 1], best[part, 2]) for part in parts}
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--levels", type=int, nargs="+", default=[8])
@@ -80,6 +124,8 @@ def main(argv=None):
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--triad-mb", type=float, default=512.0)
     parser.add_argument("--triad-repeats", type=int, default=10)
+    parser.add_argument("--passes", action="store_true",
+                        help="each threaded part of cotan's or BGN's step on its own")
     args = parser.parse_args(argv)
     from mcfbench.storage.memory import tune_malloc
 
@@ -91,6 +137,17 @@ def main(argv=None):
     print(f"triad: B_1 = {B1 / 1e9:.2f} GB/s, B_2 = {B2 / 1e9:.2f} GB/s, R = B_2 / B_1 = "
           f"{R:.2f} (3 x {args.triad_mb:g} MB, best of {args.triad_repeats}; load "
           f"{load:.2f})", flush=True)
+    if args.passes:
+        print(f"{'scheme':>8} {'level':>5} {'part':>16} {'1 thread ms':>11} "
+              f"{'2 threads ms':>12} {'S':>5} {'S / R':>6} {'load':>5}")
+        for level in args.levels:
+            for name in args.schemes:
+                load = os.getloadavg()[0]
+                for part, (one, two) in passes(name, level, args.repeats).items():
+                    print(f"{name:>8} {level:>5} {part:>16} {one:>11.2f} {two:>12.2f} "
+                          f"{one / two:>5.2f} {one / two / R:>6.2f} {load:>5.2f}", flush=True)
+        print(f"the best of {args.repeats} interleaved calls each; S = ms_1 / ms_2")
+        return
     for name in args.schemes:                 # compile and load every kernel first
         for threads in (1, 2):
             measure(name, 1, 2, threads=threads)

@@ -199,7 +199,7 @@ class Assembler:
     def _matrix(self, geom, scale, shift, threads=1):
         """``diag(scale) K + shift I`` in CSR (:func:`ddfv.kernels.system_kernel`)."""
         from .kernels import system_kernel
-        from .threads import for_threads
+        from kept_factor.threads import for_threads
 
         n_d = self._slots.shape[0]
         factors = []

@@ -36,9 +36,10 @@ from functools import cached_property
 
 import numpy as np
 
+from kept_factor.threads import check_threads
+
 from .assembly import Assembler
 from .geometry import diamond_geometry, t_barycentric, vertex_normals
-from .threads import check_threads
 from .redistribution import (OMEGA, PECLET, TangentialPotential, carry_t_vertices,
                              drift_system, potential_operators, redistribution_source,
                              surface_components, vertex_gradients)
@@ -113,7 +114,7 @@ class Flow:
         or the chord (see :func:`ddfv.geometry.diamond_geometry`).
     threads : int
         Threads of the compiled passes (geometry, covolumes, matrix fill, T
-        monitor; :func:`ddfv.threads.for_threads`).
+        monitor; :func:`kept_factor.threads.for_threads`).
 
     Attributes
     ----------

@@ -114,7 +114,7 @@ def diamond_geometry(mesh, F, T, dual_length="broken", threads=1, vectors=True,
         ``|gamma|`` as the paper's broken line through ``S`` (2.5), or as the
         chord (``|gamma^T| = |v|``, ``|gamma^F| = |u|``).
     threads : int
-        Threads of the pass (:func:`ddfv.threads.threaded`).
+        Threads of the pass (:func:`kept_factor.threads.threaded`).
     vectors : bool
         Also keep ``u``, ``v``, ``e`` (otherwise None: the scheme needs
         them only for the vertex normals of (3.6)).
@@ -131,7 +131,7 @@ def diamond_geometry(mesh, F, T, dual_length="broken", threads=1, vectors=True,
         raise ValueError(f"unknown dual_length {dual_length!r}; choose one of "
                          f"{', '.join(DUAL_LENGTHS)}")
     from . import kernels as k
-    from .threads import for_threads
+    from kept_factor.threads import for_threads
 
     F, T = _coordinates(F, mesh.n_f, "F"), _coordinates(T, mesh.n_t, "T")
     diamonds = _diamond_indices(mesh)
@@ -180,7 +180,7 @@ def covolume_areas(mesh, geom, threads=1):
         Views of one (n_f + n_t,) buffer, F-vertices first.
     """
     from .kernels import covolume_kernel
-    from .threads import for_threads
+    from kept_factor.threads import for_threads
 
     diamonds = _diamond_indices(mesh)
     quarters = _diamond_array(geom.quarters, (4, diamonds.shape[1]), "quarters")
@@ -243,7 +243,7 @@ def t_barycentric(F, T, faces, return_min=False, threads=1):
         Also return the smallest coordinate (``out.min()``, computed in the
         same pass).
     threads : int
-        Threads of the pass (:func:`ddfv.threads.threaded`).
+        Threads of the pass (:func:`kept_factor.threads.threaded`).
 
     Returns
     -------
@@ -251,7 +251,7 @@ def t_barycentric(F, T, faces, return_min=False, threads=1):
         With ``return_min``: ``(coordinates, smallest)``.
     """
     from .kernels import t_barycentric_kernel, unsigned
-    from .threads import for_threads
+    from kept_factor.threads import for_threads
 
     faces = np.asarray(faces)
     if faces.ndim != 2 or faces.shape[1] != 3 or not np.issubdtype(faces.dtype, np.integer):

@@ -8,7 +8,7 @@ conventions) the only module of ``ddfv`` that compiles with numba (loading its
 kernels from numba's cache takes about 0.1 s: a run that does not step DDFV
 never imports it); :mod:`ddfv.geometry` and :mod:`ddfv.assembly` import it on
 first use, so ``import ddfv`` does not pay for it. Their threaded copies are made by
-:mod:`ddfv.threads`.
+:mod:`kept_factor.threads`.
 
 Conventions
 -----------
@@ -25,7 +25,7 @@ Conventions
   default ``__pycache__`` next to this file) and loaded from it afterwards.
 - Loops over independent elements are ``prange`` loops: plain loops in
   these kernels, split over numba's threads in their
-  :func:`ddfv.threads.threaded` copies (``threads > 1``).
+  :func:`kept_factor.threads.threaded` copies (``threads > 1``).
 """
 
 import numba

@@ -110,7 +110,8 @@ def _common(parser, default_solver):
                         help="an invalid state (T-vertex escaped, triangle inverted, mesh "
                              "degenerated) ends the run (stop, default) or is recorded")
     parser.add_argument("--threads", type=_level, default=1,
-                        help="threads of the solver and of DDFV's per-element passes "
+                        help="threads of the solver, of the schemes' compiled passes "
+                             "(DDFV, cotan's and BGN's families) and of the checks "
                              "(default: 1)")
     parser.add_argument("--force", action="store_true",
                         help="run even when the run's estimated memory is above the "

@@ -137,34 +137,78 @@ def state_pass(V, F, face_label, labels, neighbours, split, skip, N, area, box, 
     return total, tangent, _folds(N, neighbours, split, skip)
 
 
+def state_pass_threads(threads, V, F, face_label, labels, neighbours, split, skip, N, area,
+                       box, diameter, twice, tangents):
+    """:func:`state_pass` on ``threads`` threads (:func:`kept_factor.threads.for_threads`),
+    its pass over the triangles in two: each triangle's normal, twice its area and the
+    tangent of its smallest angle into ``N``, ``twice`` and ``tangents`` ((m,) scratch),
+    triangles apart; then their sums and minimum in triangle order on one thread; the
+    fold count triangles apart. The same arithmetic in the same order as
+    :func:`state_pass`: bitwise its results."""
+    from kept_factor.threads import for_threads
+
+    N[F.shape[0], :] = 0.0
+    for_threads(_triangle_terms, threads)(V, F, N, twice, tangents)
+    total, tangent = _triangle_sums(face_label, twice, tangents, area)
+    _boxes(V, labels, box, diameter)
+    return total, tangent, for_threads(_folds, threads)(N, neighbours, split, skip)
+
+
 # the three passes of state_pass: one compiled function each (in one, the fold count
-# ran several times slower)
+# ran several times slower); the first in two for threads (state_pass_threads)
 @numba.njit(**_OPTIONS)
 def _triangles(V, F, face_label, N, area):
     area[:] = 0.0
     total = 0.0
     tangent = np.inf
     for t in range(F.shape[0]):
-        a0, a1, a2, b0, b1, b2, c0, c1, c2, n0, n1, n2 = _triangle(V, F, t)
-        N[t, 0] = n0
-        N[t, 1] = n1
-        N[t, 2] = n2
-        twice = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+        twice, tan = _terms(V, F, N, t)
         total += 0.5 * twice
         area[face_label[t]] += 0.5 * twice
-        la = a0 * a0 + a1 * a1 + a2 * a2
-        lb = b0 * b0 + b1 * b1 + b2 * b2
-        lc = c0 * c0 + c1 * c1 + c2 * c2
-        # the two sides at the smallest angle: the two longest (all three dot
-        # products, then one chosen: no branch to mispredict)
-        d0 = -(a0 * c0 + a1 * c1 + a2 * c2)     # corner 0: a and -c
-        d1 = -(a0 * b0 + a1 * b1 + a2 * b2)     # corner 1: -a and b
-        d2 = -(b0 * c0 + b1 * c1 + b2 * c2)     # corner 2: -b and c
-        dot = d0 if (lb <= la) & (lb <= lc) else (d1 if lc <= la else d2)
-        tan = twice / dot if dot > 0 else (0.0 if twice == twice else twice)
         if tangent == tangent and (tan < tangent or tan != tan):
             tangent = tan
     return total, tangent
+
+
+@numba.njit(**_OPTIONS)
+def _triangle_terms(V, F, N, twice, tangents):
+    for t in numba.prange(F.shape[0]):    # triangles apart
+        twice[t], tangents[t] = _terms(V, F, N, t)
+
+
+@numba.njit(**_OPTIONS)
+def _triangle_sums(face_label, twice, tangents, area):
+    area[:] = 0.0
+    total = 0.0
+    tangent = np.inf
+    for t in range(twice.shape[0]):
+        total += 0.5 * twice[t]
+        area[face_label[t]] += 0.5 * twice[t]
+        tan = tangents[t]
+        if tangent == tangent and (tan < tangent or tan != tan):
+            tangent = tan
+    return total, tangent
+
+
+@numba.njit(inline="always", **_OPTIONS)
+def _terms(V, F, N, t):
+    """Triangle ``t``'s normal into ``N[t]``; twice its area and the tangent of its
+    smallest angle (NaN propagated)."""
+    a0, a1, a2, b0, b1, b2, c0, c1, c2, n0, n1, n2 = _triangle(V, F, t)
+    N[t, 0] = n0
+    N[t, 1] = n1
+    N[t, 2] = n2
+    twice = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+    la = a0 * a0 + a1 * a1 + a2 * a2
+    lb = b0 * b0 + b1 * b1 + b2 * b2
+    lc = c0 * c0 + c1 * c1 + c2 * c2
+    # the two sides at the smallest angle: the two longest (all three dot
+    # products, then one chosen: no branch to mispredict)
+    d0 = -(a0 * c0 + a1 * c1 + a2 * c2)     # corner 0: a and -c
+    d1 = -(a0 * b0 + a1 * b1 + a2 * b2)     # corner 1: -a and b
+    d2 = -(b0 * c0 + b1 * c1 + b2 * c2)     # corner 2: -b and c
+    dot = d0 if (lb <= la) & (lb <= lc) else (d1 if lc <= la else d2)
+    return twice, twice / dot if dot > 0 else (0.0 if twice == twice else twice)
 
 
 @numba.njit(**_OPTIONS)
@@ -189,7 +233,7 @@ def _boxes(V, labels, box, diameter):
 @numba.njit(**_OPTIONS)
 def _folds(N, neighbours, split, skip):
     folded = 0
-    for t in range(N.shape[0] - 1):
+    for t in numba.prange(N.shape[0] - 1):    # triangles apart; a count: any order
         r0, r1, r2 = _neighbour_sum(N, neighbours, split, t)
         d = (N[t, 0] * r0 + N[t, 2] * r2) + N[t, 1] * r1
         if d < 0 and skip[t] == 0:

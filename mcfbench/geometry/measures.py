@@ -104,6 +104,9 @@ class StateMeasures:
         The initial state: its folded triangles are not counted later.
     faces : (m, 3) int array
         Consistently oriented triangles.
+    threads : int
+        Threads of the pass (:func:`mcfbench.geometry.kernels.state_pass_threads`; one:
+        :func:`mcfbench.geometry.kernels.state_pass`), the same numbers bit for bit.
 
     Attributes
     ----------
@@ -131,8 +134,9 @@ class StateMeasures:
     array([6.9282])
     """
 
-    def __init__(self, vertices, faces):
+    def __init__(self, vertices, faces, threads=1):
         V = np.asarray(vertices, dtype=float)
+        self.threads = threads
         self.faces = np.ascontiguousarray(faces, dtype=np.int64)
         self.count, labels = vertex_components(self.faces, len(V))
         self.labels = np.ascontiguousarray(labels, dtype=np.int64)
@@ -149,15 +153,19 @@ class StateMeasures:
 
     def __call__(self, vertices):
         """The :class:`Measured` of the state ``vertices`` (n, 3)."""
-        from mcfbench.geometry.kernels import state_pass  # numba on first use
+        from mcfbench.geometry import kernels  # numba on first use
 
         # Fortran order: the (n, 3) views of the schemes' (3, n) states as they are (a
         # C-ordered copy of them took 15 us of a 100 us pass at 3 000 vertices), one
         # compiled version for every caller
         V = np.asfortranarray(vertices, dtype=np.float64)
-        area, tangent, folded = state_pass(V, self.faces, self.face_label, self.labels,
-                                           self._table, self._split, self._skip,
-                                           self._normals, self._area, self._box,
-                                           self._diameter)
+        arguments = (V, self.faces, self.face_label, self.labels, self._table, self._split,
+                     self._skip, self._normals, self._area, self._box, self._diameter)
+        if self.threads == 1:
+            area, tangent, folded = kernels.state_pass(*arguments)
+        else:
+            m = len(self.faces)
+            area, tangent, folded = kernels.state_pass_threads(self.threads, *arguments,
+                                                               np.empty(m), np.empty(m))
         return Measured(float(area), float(np.degrees(np.arctan(tangent))), int(folded),
                         self._area, self._diameter)

@@ -147,6 +147,12 @@ def simulate(flow, steps, *, solver=None, integrator="euler", warm_start="extrap
     return stepping.go(replace(solver) if isinstance(solver, Solver) else solver, progress)
 
 
+def _threads(flow):
+    """The threads a flow was made with (``Scheme.make``'s ``threads``; 1 for a flow
+    without them): those of the driver's measuring pass of its states."""
+    return getattr(flow, "threads", 1)
+
+
 class _Stepping:
     """The state of one :func:`simulate` between its steps: the flow, its integrator
     (with ``X^{n-1}, ...``), the checks, the observers, the frames and defects so
@@ -170,7 +176,7 @@ class _Stepping:
         self.full = None
         self.seen = set()
         # one compiled measuring pass per state serves both checks
-        self.measures = StateMeasures(flow.vertices, flow.faces) \
+        self.measures = StateMeasures(flow.vertices, flow.faces, _threads(flow)) \
             if collapse or invariants else None
         self.collapsed = CollapseCheck(flow.vertices, flow.faces, measures=self.measures,
                                        tau=flow.tau) if collapse else None
@@ -247,7 +253,7 @@ class _Stepping:
         self.kept_faces = np.arange(len(self.faces))
         self.stepper = get_integrator(self.stepper.name, warm_start=self.stepper.warm_start)
         if self.measures is not None:
-            self.measures = StateMeasures(new.vertices, new.faces)
+            self.measures = StateMeasures(new.vertices, new.faces, _threads(new))
         if check is not None:
             self.collapsed = CollapseCheck(new.vertices, new.faces, measures=self.measures,
                                            tau=new.tau, area_tol=check.area_tol,
@@ -344,7 +350,7 @@ class _Stepping:
         self.kept_faces = np.r_[self.kept_faces[kept_faces], np.full(added_f, -1)]
         self.flow = new
         self.stepper = get_integrator(self.stepper.name, warm_start=self.stepper.warm_start)
-        self.measures = StateMeasures(new.vertices, new.faces) \
+        self.measures = StateMeasures(new.vertices, new.faces, _threads(new)) \
             if self.measures is not None else None
         if check is not None:
             collapsed = CollapseCheck(new.vertices, new.faces, measures=self.measures,

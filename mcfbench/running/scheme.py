@@ -199,8 +199,10 @@ class Scheme:
         """The flow of ``(vertices, faces)`` with time step ``tau``.
 
         ``options`` override the entry's own. ``threads`` goes to a flow
-        class that takes it (DDFV's per-element passes); the others run on
-        one thread (their linear solves take the solver's threads).
+        class that takes it (DDFV's per-element passes; the assembly and checks of
+        cotan's and BGN's classes and of their subclasses that keep their
+        constructor); the others run on one thread (their linear solves take the
+        solver's threads), and the driver's checks take the flow's.
         """
         cls = self.flow_class
         if "threads" in inspect.signature(cls).parameters:

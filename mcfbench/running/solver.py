@@ -281,7 +281,7 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
         the returned solution (or the last iterate).
     threads : int
         Threads of the BiCGStab methods' products and vector updates (row
-        blocks, :func:`ddfv.threads.for_threads`), at most
+        blocks, :func:`kept_factor.threads.for_threads`), at most
         ``numba.config.NUMBA_NUM_THREADS``. With more than one the inner
         products are summed in another order: the iterates agree to
         round-off, not bitwise.
@@ -304,7 +304,7 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
     """
     import scipy.sparse as sp
 
-    from ddfv.threads import check_threads, for_threads
+    from kept_factor.threads import check_threads, for_threads
     from mcfbench.running import krylov
 
     if method not in METHODS:
@@ -548,7 +548,7 @@ class Solver:
         return cls(**flat) if spec is None else cls(method=spec, **flat)
 
     def __post_init__(self):
-        from ddfv.threads import check_threads
+        from kept_factor.threads import check_threads
 
         if self.method not in METHODS:
             raise ValueError(f"unknown solver method {self.method!r}; choose one of "

@@ -174,7 +174,7 @@ def _kernel_values(assembler, geom, scale, shift, threads, first_touch):
     of NaN with the flagged slots (no entry may depend on what the array held), else
     summed into a zeroed array (identity set first) with the slots unflagged, as the
     kernel did before it flagged the first write into each entry."""
-    from ddfv.threads import for_threads
+    from kept_factor.threads import for_threads
 
     if first_touch:
         data = np.full(assembler.nnz, np.nan)

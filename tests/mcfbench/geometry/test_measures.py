@@ -143,3 +143,13 @@ def test_the_fold_count_is_the_quality_monitors_on_noisy_states(mesh):
         assert measures(W).folded == expected
         counts.append(expected)
     assert counts[-1] > 0
+
+
+@pytest.mark.parametrize("name, V0, F, V", states(), ids=[s[0] for s in states()])
+def test_two_threads_measure_a_state_bit_for_bit_as_one(name, V0, F, V):
+    """The pass split for threads (state_pass_threads: the triangles' terms apart, their
+    sums in triangle order) gives state_pass's numbers, NaN states and folds too."""
+    one, two = StateMeasures(V0, F)(V), StateMeasures(V0, F, threads=2)(V)
+    assert two.folded == one.folded
+    for field in ("area", "angle", "component_area", "diameter"):
+        np.testing.assert_array_equal(getattr(two, field), getattr(one, field))
