@@ -148,6 +148,18 @@ def test_a_pinched_neck_that_was_not_cut_is_opened_there(barbell):
     assert 0 < opened.area_removed < 2 * np.pi * 0.3 * 2.0
 
 
+def test_a_piece_cut_on_both_sides_goes_with_the_cuts(barbell):
+    """Necks on the rod's axis at x = +-0.45, a reach of h: the opening cuts the rod at
+    both ends and its middle, a piece thinner than the opening between the cuts (three
+    components otherwise), goes too: two components (the balls), nothing left near the
+    rod's middle, more area removed than the middle's side (|x| < 0.3)."""
+    V, F, h = barbell
+    opened, reason = open_surface(V, F, h, necks=[[-0.45, 0, 0], [0.45, 0, 0]], reach=1.0)
+    assert reason == "" and (opened.components_before, opened.components_after) == (1, 2)
+    assert not (np.abs(opened.vertices[:, 0]) < 0.3).any()
+    assert opened.area_removed > 2 * np.pi * 0.3 * 0.6
+
+
 def test_a_vanishing_small_part_is_removed_and_the_run_goes_on(sphere):
     """The unit sphere with a small sphere of radius 0.25 h beside it (its max H h = 8):
     bgn+surgery removes the small one at step 0 and flows the unit sphere on, status
