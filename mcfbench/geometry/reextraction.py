@@ -50,8 +50,9 @@ rod, a handle not yet about to fold) stay for the flow to thin. The surfaces
 ``GRID h`` padded by ``epsilon`` and two cells, the distances libigl's
 (``igl.signed_distance``, exact to the triangles); outside the region the result is
 the surface re-extracted on the grid, within its ``O(GRID^2 h^2)`` of the input.
-The pieces of a thin part that the opening cut on both sides are removed with it
-(:func:`without_fragments`). The caller remeshes the result to the run's edge
+The components of the result thinner than the opening everywhere are removed with
+it (:func:`without_fragments`: the pieces of a thin part that the opening cut on both
+sides, marching cubes' bubbles of a part thinner than its grid). The caller remeshes the result to the run's edge
 (:func:`mcfbench.geometry.remeshing.remesh`). An opening that would
 leave nothing (no point of the solid deeper than ``epsilon``) is refused: the flow
 takes a surface thinner than the mesh everywhere to its own extinction (round:
@@ -252,7 +253,7 @@ def open_surface(vertices, faces, h, *, necks=(), opening=OPENING, grid=GRID,
         U, G = isosurface(local, lower, upper, resolution)
     except ValueError as err:
         return None, f"marching cubes of the locally opened solid: {err}"
-    U, G = without_fragments(U, G, eroded[0], seeds, reach * h + 2 * spacing)
+    U, G = without_fragments(U, G, eroded[0])
     after = vertex_components(G, len(U))[0]
     return Reextraction(U, G, where.copy(), float(H[v]), int(before), int(after),
                         area_off((V, F), (U, G), spacing / 2)
@@ -260,11 +261,12 @@ def open_surface(vertices, faces, h, *, necks=(), opening=OPENING, grid=GRID,
                         float(volume0 - metrics.volume(U, G))), ""
 
 
-def without_fragments(vertices, faces, deep, seeds, radius):
-    """The surface without its fragments: the components that come within ``radius``
-    of the ``seeds`` and hold none of the points ``deep`` (the eroded solid's surface:
-    a component thinner than the opening everywhere, a piece of a thin part between two
-    of the opening's cuts, which the flow would take away within ``h^2 / 2``).
+def without_fragments(vertices, faces, deep):
+    """The surface without its fragments: the components that hold none of the points
+    ``deep`` (the eroded solid's surface), thinner than the opening everywhere, which
+    the flow would take away within ``h^2 / 2``: a piece of a thin part between two of
+    the opening's cuts, or a bubble that marching cubes leaves of a part thinner than
+    its grid (the raw fox's, at step 0: 4 vertices, degenerate a step later).
 
     A point inside one of several disjoint, non-nested closed components is nearer to
     that component's surface than to any other's (the segment to another crosses its
@@ -276,8 +278,6 @@ def without_fragments(vertices, faces, deep, seeds, radius):
     vertices : (n, 3) float array
     faces : (m, 3) int array
     deep : (k, 3) float array
-    seeds : (s, 3) float array
-    radius : float
 
     Returns
     -------
@@ -285,18 +285,15 @@ def without_fragments(vertices, faces, deep, seeds, radius):
     faces : (m', 3) int array
     """
     import igl  # on first use
-    from scipy.spatial import cKDTree
 
     U, G = np.asarray(vertices, dtype=float), np.asarray(faces, dtype=np.int64)
     count, labels = vertex_components(G, len(U))
-    if count == 1 or not len(seeds):
+    if count == 1:
         return U, G
     held = np.zeros(count, bool)
     held[labels[G[igl.point_mesh_squared_distance(np.asarray(deep, float), U, G)[1], 0]]] \
         = True
-    near = np.zeros(count, bool)
-    near[labels[cKDTree(seeds).query(U)[0] < radius]] = True
-    keep = ~(near & ~held)[labels]
+    keep = held[labels]
     number = np.cumsum(keep) - 1
     return U[keep], number[G[keep[G[:, 0]]]]
 
