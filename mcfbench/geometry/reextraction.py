@@ -52,10 +52,11 @@ rod, a handle not yet about to fold) stay for the flow to thin. The surfaces
 the surface re-extracted on the grid, within its ``O(GRID^2 h^2)`` of the input.
 The components of the result thinner than the opening everywhere are removed with
 it (:func:`without_fragments`: the pieces of a thin part that the opening cut on both
-sides, marching cubes' bubbles of a part thinner than its grid). The caller remeshes the result to the run's edge
-(:func:`mcfbench.geometry.remeshing.remesh`). An opening that would
-leave nothing (no point of the solid deeper than ``epsilon``) is refused: the flow
-takes a surface thinner than the mesh everywhere to its own extinction (round:
+sides, marching cubes' bubbles of a part thinner than its grid). The caller remeshes
+the result to the run's edge (:func:`mcfbench.geometry.remeshing.remesh`). An
+opening that would leave nothing (no point of the solid deeper than ``epsilon``) is
+refused: the flow takes a surface thinner than the mesh everywhere to its own
+extinction (round:
 ``extinct``, a point, a circle or a curve: :mod:`mcfbench.geometry.collapse`; the raw
 corpus's CAD tubes vanish round to a circle within 1-2 steps).
 

@@ -207,15 +207,15 @@ class Reextractor:
     step), or a neck has pinched that :class:`Surgeon` did not cut (a handle's), the
     surface is re-extracted without its parts thinner than the mesh near those
     vertices (:func:`mcfbench.geometry.reextraction.open_surface`), remeshed to the
-    run's edge (the ``remesh`` strategy's :func:`~mcfbench.geometry.remeshing.remesh`) and the
-    scheme's flow rebuilt there (:func:`mcfbench.running.continuation.rebuilt_flow`'s
-    carry-over); at most once per step (the remeshed surface's sharpness is about 2,
-    below the criterion: the raw corpus's fox, ant and cow). Not on an open mesh (its
-    inside is not defined): its run goes on as the scheme's own; a re-extraction
-    refused (the whole surface thinner than the opening: the flow's to take to its
-    extinction; marching cubes' failure, too large a grid) is a ``"refused"`` event,
-    the first time, and the run goes on without it, not asked again until its mesh
-    changes.
+    run's edge (the ``remesh`` strategy's
+    :func:`~mcfbench.geometry.remeshing.remesh`) and the scheme's flow rebuilt there
+    (:func:`mcfbench.running.continuation.rebuilt_flow`'s carry-over); at most once
+    per step (a thin part's cut stump may trigger it again at the next). Not on an
+    open mesh (its inside is not defined): its run goes on as the scheme's own; a
+    re-extraction refused (the whole surface thinner than the opening: the flow's to
+    take to its extinction; marching cubes' failure, too large a grid) is a
+    ``"refused"`` event, the first time, and the run goes on without it, not asked
+    again until its mesh changes.
 
     Parameters
     ----------
