@@ -23,7 +23,7 @@ Extinction
 ----------
 A closed component that vanishes *round* has reached the flow's end, not a
 breakdown (issue #44, item 3; issue #45, item 2): status ``extinct``
-(:class:`Collapse`). Two ways to vanish round, each with the time it has left
+(:class:`Collapse`). Three ways to vanish round, each with the time it has left
 under the velocity ``H n`` (``H`` the sum of the principal curvatures):
 
 *a point*
@@ -40,6 +40,18 @@ under the velocity ``H n`` (``H`` the sum of the principal curvatures):
     :data:`ROUND_TUBE` of it): the torus (2, 0.5) collapsing onto its core
     circle. A round tube thin against its circle shrinks as a cylinder,
     ``r' = -1 / r``: ``r^2 / 2`` left, with ``r = 2 V / A``.
+*a curve*
+    A torus-like component that is no round tube about a planar circle but one
+    about a curve in space (a knotted tube: the raw corpus's quadknot): its mean
+    curvature ``|H n|`` (:func:`mean_curvature_vectors`) within :data:`ROUND_TUBE`
+    of ``1 / r`` at every vertex, ``r = 2 V / A`` (Weyl's tube formula gives
+    ``A = 2 pi r L`` and ``V = pi r^2 L`` about any closed curve of length ``L``; a
+    tube of radius ``r`` about a curve of curvature ``kappa`` has ``H = 1 / r +
+    kappa cos(theta) / (1 - r kappa cos(theta))``, so the bound also asks the tube to
+    be thin against its curve, ``r kappa`` below about a third). It shrinks as the
+    circle's, ``r^2 / 2`` left, while its core moves by the curvature ``kappa``, slower:
+    the level-set flow's tube vanishes onto the curve (Evans and Spruck 1991; Altschuler,
+    Angenent and Giga 1995 for the circle).
 
 A closed component is tested once its area fell below :data:`WATCH` of its initial
 one (its volume is measured then, in numpy, only for such states). It is
@@ -113,7 +125,8 @@ class Collapse(NamedTuple):
     components : tuple of int
         The components found (extinct ones for ``"extinct"``).
     kinds : tuple of str
-        ``"point"``, ``"circle"`` (round) or ``"line"``, ``"point"`` of each.
+        ``"point"``, ``"circle"``, ``"curve"`` (round) or ``"line"``, ``"point"`` of
+        each.
     areas, volumes, times : tuple of float
         Area, enclosed volume and extinction time (the state's time plus the
         time the round component has left; NaN when not round or no time given)
@@ -176,6 +189,27 @@ def component_volumes(vertices, faces, face_label, count):
     a, b, c = (np.asarray(vertices, dtype=float)[np.asarray(faces)[:, k]] for k in range(3))
     return np.bincount(face_label, np.einsum("ij,ij->i", a, np.cross(b, c)) / 6.0,
                        minlength=count)
+
+
+def mean_curvature_vectors(vertices, faces):
+    """``H n = -M^{-1} L X`` at every vertex (libigl's cotangent Laplacian ``L`` and
+    Voronoi mass ``M``): ``2 / R`` times the inward normal on a sphere of radius ``R``.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+
+    Returns
+    -------
+    (n, 3) float array
+    """
+    import igl  # on first use
+
+    V, F = np.asarray(vertices, dtype=float), np.asarray(faces, dtype=np.int64)
+    L = igl.cotmatrix(V, F)
+    mass = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
+    return (L @ V) / mass[:, None]
 
 
 def tube_fit(points):
@@ -365,4 +399,8 @@ class CollapseCheck:
             tube = 2.0 * volume / area
             if spread <= ROUND_TUBE and abs(tube / r - 1.0) <= ROUND_TUBE and r < R:
                 return "circle", tube ** 2 / 2.0
+            H = np.linalg.norm(mean_curvature_vectors(V, self.measures.faces)[
+                self.labels == c], axis=1)
+            if np.abs(H * tube - 1.0).max() <= ROUND_TUBE:
+                return "curve", tube ** 2 / 2.0
         return None, math.nan

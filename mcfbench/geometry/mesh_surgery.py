@@ -72,7 +72,8 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from mcfbench.geometry import metrics
-from mcfbench.geometry.collapse import component_topology, component_volumes
+from mcfbench.geometry.collapse import (component_topology, component_volumes,
+                                        mean_curvature_vectors)
 from mcfbench.geometry.measures import vertex_components
 
 NECK_RESOLUTION = 0.5
@@ -157,27 +158,6 @@ class Surgery(NamedTuple):
     area_removed: float
     volume_removed: float
     band_area: float
-
-
-def mean_curvature_vectors(vertices, faces):
-    """``H n = -M^{-1} L X`` at every vertex (libigl's cotangent Laplacian ``L`` and
-    Voronoi mass ``M``): ``2 / R`` times the inward normal on a sphere of radius ``R``.
-
-    Parameters
-    ----------
-    vertices : (n, 3) float array
-    faces : (m, 3) int array
-
-    Returns
-    -------
-    (n, 3) float array
-    """
-    import igl  # on first use
-
-    V, F = np.asarray(vertices, dtype=float), np.asarray(faces, dtype=np.int64)
-    L = igl.cotmatrix(V, F)
-    mass = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
-    return (L @ V) / mass[:, None]
 
 
 def angle_defects(vertices, faces):

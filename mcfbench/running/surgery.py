@@ -204,17 +204,18 @@ class Reextractor:
 
     Once the surface's sharpness ``max H h`` exceeds
     :data:`~mcfbench.geometry.reextraction.SHARPNESS` (a part about to fold within a
-    step), the surface is re-extracted without its parts thinner than the mesh
-    (:func:`mcfbench.geometry.reextraction.open_surface`), remeshed to the run's edge
-    (the ``remesh`` strategy's :func:`~mcfbench.geometry.remeshing.remesh`) and the
-    scheme's flow rebuilt there (:func:`mcfbench.running.continuation.rebuilt_flow`'s
-    carry-over); at most once per step (the remeshed surface's sharpness is about 2,
-    below the criterion: the raw corpus's fox, ant and cow). Not on an open mesh (its
-    inside is not defined): its run goes on as the scheme's own; a re-extraction
-    refused (the whole surface thinner than the opening: the flow's to take to its
-    extinction; marching cubes' failure, too large a grid) is a ``"refused"`` event,
-    the first time, and the run goes on without it, not asked again until its mesh
-    changes.
+    step), or a neck has pinched that :class:`Surgeon` did not cut (a handle's), the
+    surface is re-extracted without its parts thinner than the mesh near those
+    vertices (:func:`mcfbench.geometry.reextraction.open_surface`), remeshed to the
+    run's edge (the ``remesh`` strategy's
+    :func:`~mcfbench.geometry.remeshing.remesh`) and the scheme's flow rebuilt there
+    (:func:`mcfbench.running.continuation.rebuilt_flow`'s carry-over); at most once
+    per step (a thin part's cut stump may trigger it again at the next). Not on an
+    open mesh (its inside is not defined): its run goes on as the scheme's own; a
+    re-extraction refused (the whole surface thinner than the opening: the flow's to
+    take to its extinction; marching cubes' failure, too large a grid) is a
+    ``"refused"`` event, the first time, and the run goes on without it, not asked
+    again until its mesh changes.
 
     Parameters
     ----------
@@ -253,15 +254,19 @@ class Reextractor:
         if self.open or flow.n == self.last_step or len(V) == self.unchanged:
             return None
         sharp, v = sharpness(V, F, self.h)
-        if sharp <= SHARPNESS:
+        neck = find_neck(V, F)
+        necks = V[neck.ring] if pinched(neck, self.h) else ()   # a neck the cut refused
+        if sharp <= SHARPNESS and not len(necks):
             return None
         t = flow.n * flow.tau
-        where = f"at {np.round(V[v], 4).tolist()} (max H h = {sharp:.3g} > {SHARPNESS:g})"
+        where = (f"at {np.round(V[v], 4).tolist()} (max H h = {sharp:.3g} > {SHARPNESS:g})"
+                 if sharp > SHARPNESS else f"at the uncut neck at "
+                 f"{np.round(V[neck.vertex], 4).tolist()} (radius {neck.radius:.3g})")
         reason = why_not(self.scheme, self.integrator)
         if reason:
             raise ValueError(f"a thin part is about to fold {where} and the run cannot go "
                              f"on: {reason}")
-        opened, reason = open_surface(V, F, self.h)
+        opened, reason = open_surface(V, F, self.h, necks=necks)
         if reason:
             self.unchanged = len(V)          # not asked again until the mesh changes
             return refusal(self, flow, CutRefused(

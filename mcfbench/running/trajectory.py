@@ -48,7 +48,8 @@ class Trajectory:
         ``extinct``: one ``{"event": "extinct", "step", "time", "component",
         "kind", "area", "volume", "extinction_time"}`` per component that vanished
         round (:mod:`mcfbench.geometry.collapse`): ``time`` the state's, ``kind``
-        ``"point"`` or ``"circle"``, ``area`` and ``volume`` the component's then,
+        ``"point"``, ``"circle"`` or ``"curve"``, ``area`` and ``volume`` the
+        component's then,
         ``extinction_time`` the state's time plus the time the round component
         had left; the mesh strategies' (``simulate``'s ``remesh``): ``"remeshed"``
         (:meth:`~mcfbench.running.remeshing.Remesher.remeshed`), ``"rolled_back"`` and

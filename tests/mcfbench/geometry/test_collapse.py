@@ -121,6 +121,51 @@ def test_a_flattened_tube_is_not_a_circle():
     assert CollapseCheck(C, G, tau=1.0)(0.01 * C).status == "degenerated"
 
 
+def trefoil_tube(r, along=120, around=8):
+    """A tube of radius ``r`` about the trefoil knot ``(sin s + 2 sin 2s, cos s - 2 cos 2s,
+    -sin 3s)`` (its Frenet frame; curvature radius at least 0.5), outward oriented."""
+    s = 2 * np.pi * np.arange(along) / along
+    c = np.stack([np.sin(s) + 2 * np.sin(2 * s), np.cos(s) - 2 * np.cos(2 * s),
+                  -np.sin(3 * s)], axis=1)
+    d1 = np.stack([np.cos(s) + 4 * np.cos(2 * s), -np.sin(s) + 4 * np.sin(2 * s),
+                   -3 * np.cos(3 * s)], axis=1)
+    d2 = np.stack([-np.sin(s) - 8 * np.sin(2 * s), -np.cos(s) + 8 * np.cos(2 * s),
+                   9 * np.sin(3 * s)], axis=1)
+    T = d1 / np.linalg.norm(d1, axis=1)[:, None]
+    N = d2 - (d2 * T).sum(axis=1)[:, None] * T
+    N /= np.linalg.norm(N, axis=1)[:, None]
+    B = np.cross(T, N)
+    theta = 2 * np.pi * np.arange(around) / around
+    V = (c[:, None] + r * (np.cos(theta)[None, :, None] * N[:, None]
+                           + np.sin(theta)[None, :, None] * B[:, None])).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(along), np.arange(around), indexing="ij")
+    a, b = i * around + j, i * around + (j + 1) % around
+    c2, d = (i + 1) % along * around + j, (i + 1) % along * around + (j + 1) % around
+    F = np.concatenate([np.stack([a, c2, d], -1), np.stack([a, d, b], -1)]).reshape(-1, 3)
+    return V, (F if metrics.volume(V, F) > 0 else F[:, ::-1])
+
+
+def test_a_thin_round_tube_about_a_knot_vanishes_to_a_curve():
+    """A tube of radius 0.05 about the trefoil (20 % of the area of the same tube of
+    radius 0.25): no planar circle fits it, but its mean curvature is 1 / r within
+    ROUND_TUBE, r = 2 V / A (0.92 of the octagons' radius): extinct, to a curve, with
+    r^2 / 2 left; squashed to an ellipse of axes 3:1 it is not round."""
+    V0, F = trefoil_tube(0.25)
+    V, _ = trefoil_tube(0.05)
+    assert metrics.area(V, F) / metrics.area(V0, F) < WATCH
+    tube = 2 * metrics.volume(V, F) / metrics.area(V, F)
+    assert tube_fit(V)[1] > 10 * tube          # no planar circle: far from the best one
+    assert tube == pytest.approx(0.92 * 0.05, rel=0.01)
+    found = CollapseCheck(V0, F, tau=0.51 * tube ** 2 / 2)(V, t=0.1)
+    assert found.status == "extinct" and found.kinds == ("curve",), str(found)
+    assert found.times[0] == pytest.approx(0.1 + tube ** 2 / 2, rel=1e-9)
+    assert "vanished round, to a curve" in str(found)
+    assert CollapseCheck(V0, F, tau=0.49 * tube ** 2 / 2)(V, t=0.1) is None
+    centre = np.repeat(trefoil_tube(1e-9)[0].reshape(-1, 8, 3).mean(axis=1), 8, axis=0)
+    flat = centre + (V - centre) * [1.0, 1.0, 1 / 3]     # not round about its curve
+    assert CollapseCheck(V0, F, tau=1.0)(flat, t=0.1) is None
+
+
 def test_euler_characteristics_of_the_components():
     V, F = two_spheres()
     T, G = torus(2.0, 0.5, 16, 4)
