@@ -21,12 +21,9 @@ coordinate x, y, z) from an initial guess ``x0``:
   ``x0[-A.rows:]`` (``direct`` factorises ``A.shared`` once for its rows),
   ``[A.substitute(y, b); y]`` returned; iterations, residual and stopping
   test are the shared system's (the substituted rows' residual is round-off).
-  ``A.preconditioner``, when not None, is an incomplete LU of ``A.shared`` (or
-  of a nearby matrix) that the system keeps (``L``, ``U``, ``perm_r``,
-  ``perm_c``, as ``spilu``'s): plain ``bicgstab`` takes it as its right
-  preconditioner (``ilu-bicgstab`` with it: the same residual and stopping
-  test, ``SolveInfo.method`` says which ran; KLL's ``S`` on meshes whose
-  diagonal spreads, ``baselines.kll.SPREAD``).
+  An ``A.preconditioner`` (an incomplete LU, as ``spilu``'s, that the system keeps:
+  KLL's ``S`` where its diagonal spreads, ``baselines.kll.SPREAD``) turns plain
+  ``bicgstab`` into ``ilu-bicgstab`` with it (``SolveInfo.method`` says which ran).
 
 Iteration count
 ---------------
@@ -117,13 +114,12 @@ Methods (:data:`METHODS`)
     ``jacobi-bicgstab``, then ``direct`` from ``x0`` if that fails (:data:`ROBUST`):
     it converges wherever ``direct`` does (iterations: Jacobi's, failed included).
 
-Right preconditioning leaves the residual, hence the stopping test, unchanged.
-On cotangent systems of bad meshes (perturbed, random-point, anisotropic,
-marching-cubes surfaces, 6k-16k vertices, ``tau`` = 1, 100, 10^4 times the mean
-vertex area, ``rtol = 1e-9``, ``maxiter = 1000``) ``bicgstab`` converged in 20 of
-36, ``jacobi-bicgstab`` in 33, the others in all 36. On well-shaped meshes
-``bicgstab`` is by far the cheapest (level-5 sphere: 13 ms a step against 0.4-1 s
-for the factorizations).
+Right preconditioning leaves the residual, hence the stopping test, unchanged. On
+cotangent systems of bad meshes (perturbed, random-point, anisotropic, marching-cubes
+surfaces, 6k-16k vertices, ``tau`` = 1, 100, 10^4 times the mean vertex area, ``rtol =
+1e-9``, ``maxiter = 1000``) ``bicgstab`` converged in 20 of 36, ``jacobi-bicgstab`` in
+33, the others in all 36. On well-shaped meshes ``bicgstab`` is by far the cheapest
+(level-5 sphere: 13 ms a step against 0.4-1 s for the factorizations).
 """
 
 import math
@@ -134,8 +130,8 @@ import numpy as np
 from mcfbench.running.factorizations import (LU_ORDERINGS, NO_FLOAT, factorize, ilu_arrays,
                                              ilu_factor, isotropic_ilu_factor, unsigned)
 
-# scipy.sparse, the compiled kernels (numba) and ddfv's thread checks are imported
-# on first use: the command line reads METHODS and ROBUST for its help in 0.1 s.
+# scipy.sparse, the compiled kernels (numba) and the thread checks are imported on
+# first use: the command line reads METHODS and ROBUST for its help in 0.1 s.
 
 METHODS = ("bicgstab", "jacobi-bicgstab", "coupled-jacobi-bicgstab", "ilu-bicgstab",
            "kept-ilu-bicgstab", "direct", "jacobi-direct")
@@ -177,15 +173,6 @@ class SolveInfo:
     status: str = "converged"
     method: str = "bicgstab"
     detail: str = ""
-
-
-# ---------------------------------------------------------------------------
-# Compiled kernels. Vectors are (k, m) C-contiguous blocks: for a shared
-# (n, n) matrix the (k, n) block itself (the k = 3 rows go through A together,
-# in one pass over its entries), for a coupled (3n, 3n) matrix
-# ``b.reshape(1, 3n)``. Index arrays are passed as unsigned views (uint32 or
-# uint64): numba then emits no negative-index wraparound in the inner loops
-# (measured: 2x on the sparse product).
 
 
 # ---------------------------------------------------------------------------
