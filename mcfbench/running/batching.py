@@ -53,16 +53,18 @@ a kind not measured: ``"dual-mdr"`` and ``"ddfv, tangential"``, kinds since
 own time fits are 4.7 and 2.8 x those kinds' at level 5)."""
 
 
-MESH_FILE_SECONDS = 7.0
+MESH_FILE_SECONDS = 9.0
 """Estimated CPU seconds of a run on a user's mesh file per megabyte of the file
 (:func:`spec_seconds`): the survival study's runs (every scheme, ``+remesh``,
-``+surgery``) took 1.35 s a run on ``cowhead`` (0.23 MB, 4 537 vertices: 6 s/MB) and
-6.1 s on ``face`` (0.86 MB, 17 157 vertices: 7 s/MB; its remeshed runs 11-15 s), 0.1
-s on the files below 0.06 MB (230855d, 2026-12-08). A file's size follows its vertex
-count within a factor 5 over the raw corpus (37-270 bytes a vertex): it tells the
-heavy files, whose runs fill several batches that the two cores share, from the
-light ones, packed together (before, one batch per file, all of equal priority:
-``face``'s 57 runs one job, started whenever Snakemake chose)."""
+``+surgery``) took 1.30 s a run on ``cowhead`` (0.23 MB, 4 537 vertices: 5.7 s/MB),
+2.5 s on ``blub_open`` (0.29 MB, 5 857 vertices: 8.5 s/MB) and 9.9 s on ``face``
+(0.86 MB, 17 157 vertices, its first 36 runs: 11.6 s/MB; its remeshed runs 11-15 s),
+0.02-0.13 s on the files below 0.06 MB (230855d, 2026-12-08). A file's size follows
+its vertex count within a factor 5 over the raw corpus (37-270 bytes a vertex): it
+tells the heavy files, whose runs fill several batches that the two cores share,
+from the light ones, packed together (before, one batch per file, all of equal
+priority: ``face``'s 57 runs, about 9 CPU minutes, one job, started whenever
+Snakemake chose)."""
 
 
 def spec_seconds(spec):
