@@ -168,6 +168,29 @@ def angle_defects(vertices, faces):
     return 2 * np.pi - np.bincount(F.ravel(), angles.ravel(), minlength=len(vertices))
 
 
+class Curvature(NamedTuple):
+    """The curvature of one mesh state that the neck (:func:`find_neck`) and the
+    sharpness (:func:`mcfbench.geometry.reextraction.sharpness`) read
+    (:func:`curvature`).
+
+    Attributes
+    ----------
+    vectors : (n, 3) float array
+        ``H n`` (:func:`mean_curvature_vectors`).
+    defects : (n,) float array
+        The angle defects (:func:`angle_defects`).
+    """
+
+    vectors: np.ndarray
+    defects: np.ndarray
+
+
+def curvature(vertices, faces):
+    """The :class:`Curvature` of the mesh ``(vertices, faces)``: its one cotangent
+    Laplacian and Voronoi mass."""
+    return Curvature(mean_curvature_vectors(vertices, faces), angle_defects(vertices, faces))
+
+
 def _adjacency(n, pairs):
     """The symmetric (n, n) adjacency of the index ``pairs`` (k, 2)."""
     i, j = pairs[:, 0], pairs[:, 1]
@@ -178,7 +201,7 @@ def _edges(F):
     return F[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
 
 
-def find_neck(vertices, faces):
+def find_neck(vertices, faces, known=None):
     """The neck of a closed mesh (module docstring), or None when no vertex has a
     negative angle defect (and a finite, nonzero ``|H|``) or the neck vertex's ring is
     no ring (fewer than :data:`MIN_RING` vertices, or not around the axis: a dimple, a
@@ -188,16 +211,18 @@ def find_neck(vertices, faces):
     ----------
     vertices : (n, 3) float array
     faces : (m, 3) int array
+    known : Curvature, optional
+        The mesh's :func:`curvature` when computed already (default: computed here).
 
     Returns
     -------
     Neck or None
     """
     V, F = np.asarray(vertices, dtype=float), np.asarray(faces, dtype=np.int64)
-    Hn = mean_curvature_vectors(V, F)
+    Hn, defects = curvature(V, F) if known is None else known
     H = np.linalg.norm(Hn, axis=1)
     H = np.where(np.isfinite(H), H, 0.0)    # a vertex of no area (a raw mesh's) is no neck
-    saddle = (angle_defects(V, F) < 0) & (H > 0)
+    saddle = (defects < 0) & (H > 0)
     if not saddle.any():
         return None
     v0 = int(np.flatnonzero(saddle)[np.argmax(H[saddle])])

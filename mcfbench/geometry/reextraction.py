@@ -129,7 +129,7 @@ class Reextraction(NamedTuple):
     volume_removed: float
 
 
-def signed_mean_curvature(vertices, faces):
+def signed_mean_curvature(vertices, faces, vectors=None):
     """``H = -(Delta X) . n`` at every vertex (module docstring): ``2 / R`` on a sphere
     of radius ``R`` with outward triangles, negative at a concave vertex.
 
@@ -137,6 +137,9 @@ def signed_mean_curvature(vertices, faces):
     ----------
     vertices : (n, 3) float array
     faces : (m, 3) int array
+    vectors : (n, 3) float array, optional
+        The mesh's ``H n`` (:func:`mcfbench.geometry.mesh_surgery.mean_curvature_vectors`)
+        when computed already.
 
     Returns
     -------
@@ -147,27 +150,30 @@ def signed_mean_curvature(vertices, faces):
 
     V, F = np.asarray(vertices, dtype=float), np.asarray(faces, dtype=np.int64)
     normals = igl.per_vertex_normals(V, F, igl.PER_VERTEX_NORMALS_WEIGHTING_TYPE_AREA)
-    return -np.einsum("ij,ij->i", mean_curvature_vectors(V, F), normals)
+    vectors = mean_curvature_vectors(V, F) if vectors is None else vectors
+    return -np.einsum("ij,ij->i", vectors, normals)
 
 
-def convex_sharpness(vertices, faces, h):
+def convex_sharpness(vertices, faces, h, known=None):
     """``H h`` at every vertex of positive angle defect, ``-inf`` at the others (module
-    docstring).
+    docstring); ``known`` the mesh's :func:`mcfbench.geometry.mesh_surgery.curvature`
+    when computed already.
 
     Returns
     -------
     (n,) float array
     """
-    from mcfbench.geometry.mesh_surgery import angle_defects
+    from mcfbench.geometry.mesh_surgery import curvature
 
-    H = signed_mean_curvature(vertices, faces) * h
-    return np.where(np.isfinite(H) & (angle_defects(vertices, faces) > 0), H, -np.inf)
+    vectors, defects = curvature(vertices, faces) if known is None else known
+    H = signed_mean_curvature(vertices, faces, vectors) * h
+    return np.where(np.isfinite(H) & (defects > 0), H, -np.inf)
 
 
-def sharpness(vertices, faces, h):
+def sharpness(vertices, faces, h, known=None):
     """``(max H h, the vertex where it is)`` over the vertices of positive angle defect
-    (module docstring), ``(-inf, 0)`` without one."""
-    H = convex_sharpness(vertices, faces, h)
+    (module docstring), ``(-inf, 0)`` without one; ``known`` as :func:`convex_sharpness`'s."""
+    H = convex_sharpness(vertices, faces, h, known)
     v = int(np.argmax(H))
     return float(H[v]), v
 

@@ -5,12 +5,14 @@ other (:func:`mcfbench.running.batch.run_batch`).
 A spec two studies ask for is in exactly one batch. The specs are grouped by
 problem and by the studies that ask for them (a study's target then runs no
 batch of specs that only others asked for), then into series (one scheme; a user's
-mesh file: every scheme on it), and the series packed by their estimated cost
-(:func:`spec_seconds`, :func:`pack` by :data:`BATCH_SECONDS`), a heavy one alone.
+mesh file: one scheme on it, the file's schemes one after the other), and the
+series packed by their estimated cost (:func:`spec_seconds`, :func:`pack` by
+:data:`BATCH_SECONDS`), a heavy one alone.
 Which batch a run falls in does not decide whether it is computed: a batch
 reads the runs that the store holds with the same spec key and code digest.
 """
 
+import os
 from dataclasses import dataclass
 
 from mcfbench.running.batch import GALLERY_PROBLEM
@@ -51,19 +53,38 @@ a kind not measured: ``"dual-mdr"`` and ``"ddfv, tangential"``, kinds since
 own time fits are 4.7 and 2.8 x those kinds' at level 5)."""
 
 
+MESH_FILE_SECONDS = 9.0
+"""Estimated CPU seconds of a run on a user's mesh file per megabyte of the file
+(:func:`spec_seconds`): the survival study's runs (every scheme, ``+remesh``,
+``+surgery``) took 1.30 s a run on ``cowhead`` (0.23 MB, 4 537 vertices: 5.7 s/MB),
+2.5 s on ``blub_open`` (0.29 MB, 5 857 vertices: 8.5 s/MB) and 9.9 s on ``face``
+(0.86 MB, 17 157 vertices, its first 36 runs: 11.6 s/MB; its remeshed runs 11-15 s),
+0.02-0.13 s on the files below 0.06 MB (230855d, 2026-12-08). A file's size follows
+its vertex count within a factor 5 over the raw corpus (37-270 bytes a vertex): it
+tells the heavy files, whose runs fill several batches that the two cores share,
+from the light ones, packed together (before, one batch per file, all of equal
+priority: ``face``'s 57 runs, about 9 CPU minutes, one job, started whenever
+Snakemake chose)."""
+
+
 def spec_seconds(spec):
     """Estimated CPU seconds of one spec: :data:`RUN_SECONDS` and the time steps' CPU
     seconds of the cost model (:func:`mcfbench.running.cost.estimate`; the problem's
     first level is built once per process to know its size) times the factor of the
     scheme's kind (:data:`MATRIX_FACTORS`). The order of magnitude only: it tells the
     heavy series from the cheap ones. A user's mesh file (not read while planning)
-    counts as :data:`BATCH_SECONDS`."""
+    counts by its size, :data:`MESH_FILE_SECONDS` a megabyte (:data:`BATCH_SECONDS`
+    when it cannot be found)."""
     from mcfbench.running.cost import cost_class, estimate, size
     from mcfbench.running.problems import get_problem
     from mcfbench.running.schemes import get_scheme
 
     if spec.problem == GALLERY_PROBLEM:
-        return BATCH_SECONDS
+        try:
+            megabytes = os.path.getsize(spec.mesh_file) / 1e6
+        except (OSError, TypeError):
+            return BATCH_SECONDS
+        return RUN_SECONDS + MESH_FILE_SECONDS * megabytes
     entry, problem = get_scheme(spec.scheme), get_problem(spec.problem)
     if spec.tau_edge is not None:
         problem = problem.with_settings(tau_1=spec.tau_edge, steps=spec.steps)
@@ -119,7 +140,7 @@ def batches(requests, cost=spec_seconds):
                 askers[spec].append(study)
     groups = {}          # (problem, studies) -> series key -> specs
     for spec, studies in askers.items():
-        series = spec.mesh_file if spec.mesh_file is not None else spec.scheme
+        series = spec.scheme if spec.mesh_file is None else (spec.mesh_file, spec.scheme)
         groups.setdefault((spec.problem, tuple(sorted(studies))), {}).setdefault(
             series, []).append(spec)
     out = []

@@ -44,7 +44,7 @@ from mcfbench.geometry.remeshing import (
 from mcfbench.running.continuation import rebuilt_flow
 from mcfbench.running.rollback import Rollback
 from mcfbench.running.scheme import parse_name
-from mcfbench.running.surgery import NeckWait, Reextractor, Surgeon
+from mcfbench.running.surgery import NeckWait, Reextractor, StateCurvature, Surgeon
 
 
 class Remesher:
@@ -150,10 +150,11 @@ class Strategies:
 
     def __init__(self, scheme, mesh, *, integrator=None, threads=1, options=None):
         kwargs = {"integrator": integrator, "threads": threads, "options": options}
-        surgeon = Surgeon(scheme, mesh, strict=False, **kwargs)
+        state = StateCurvature()             # one curvature a state for the three
+        surgeon = Surgeon(scheme, mesh, strict=False, state=state, **kwargs)
         remesher = Remesher(scheme, mesh, **kwargs)
-        self.parts = (surgeon, Reextractor(scheme, mesh, **kwargs),
-                      NeckWait(remesher, surgeon.h))
+        self.parts = (surgeon, Reextractor(scheme, mesh, state=state, **kwargs),
+                      NeckWait(remesher, surgeon.h, state))
         self.rollback = remesher.rollback         # the remesher's (Remesher.rollback)
 
 

@@ -173,7 +173,8 @@ def _result(timed, scheme, problem, level, nF, h, tau, steps, method, integrator
         max_flipped=_worst(np.max, q["flipped"]), metrics=_metric_values(timed, problem),
         series={"t": monitor.t, "t_min_barycentric": monitor.t_monitor, **q},
         timing_repeats=repeats, removed_area_share=traj.removed_area_share,
-        surgery_exceeded=exceeded(traj.removed_area_share))
+        surgery_exceeded=exceeded(traj.removed_area_share),
+        rollbacks=sum(event["event"] == "rolled_back" for event in traj.events))
 
 
 def problem_mesh(problem, level):

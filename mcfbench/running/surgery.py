@@ -21,7 +21,8 @@ imports) so that only a ``NAME+surgery`` run's code identity holds
 import numpy as np
 
 from mcfbench.geometry import metrics
-from mcfbench.geometry.mesh_surgery import NECK_RESOLUTION, cut_neck, find_neck, pinched
+from mcfbench.geometry.mesh_surgery import (
+    NECK_RESOLUTION, curvature, cut_neck, find_neck, pinched)
 from mcfbench.geometry.reextraction import SHARPNESS, open_surface, sharpness
 from mcfbench.geometry.remeshing import boundary_vertices, remesh, remesh_change, target_edge
 from mcfbench.running.continuation import rebuilt_flow, why_not
@@ -66,7 +67,44 @@ def escaped_t_vertices(flow):
     return np.flatnonzero(~(np.asarray(barycentric).min(axis=1) >= 0.0))
 
 
-def neck_surgery(scheme, flow, *, h, integrator=None, threads=1, **options):
+class StateCurvature:
+    """The :func:`~mcfbench.geometry.mesh_surgery.curvature` and the neck
+    (:func:`~mcfbench.geometry.mesh_surgery.find_neck`) of a flow's current state,
+    each computed once per state and shared by ``NAME+surgery``'s hooks: the neck cut
+    (:class:`Surgeon`), the re-extraction's sharpness (:class:`Reextractor`) and the
+    remesh's wait (:class:`NeckWait`) ask about the same state at every step, which
+    took libigl's cotangent Laplacian and Voronoi mass three times a step. A state is
+    its vertices and faces, compared by value (DDFV's vertices are a new array at each
+    call; a rolled back or operated flow is a new state).
+    """
+
+    def __init__(self):
+        self.mesh, self.known, self.neck_of = None, None, None
+
+    def _state(self, V, F):
+        """``(V, F)`` as arrays; what was known of another state forgotten."""
+        V, F = np.asarray(V, dtype=float), np.asarray(F, dtype=np.int64)
+        if self.mesh is None or not (np.array_equal(V, self.mesh[0])
+                                     and np.array_equal(F, self.mesh[1])):
+            self.mesh, self.known, self.neck_of = (V.copy(), F.copy()), None, None
+        return V, F
+
+    def curvature(self, V, F):
+        """The state's :class:`~mcfbench.geometry.mesh_surgery.Curvature`."""
+        V, F = self._state(V, F)
+        if self.known is None:
+            self.known = curvature(V, F)
+        return self.known
+
+    def neck(self, V, F):
+        """The state's neck (a :class:`~mcfbench.geometry.mesh_surgery.Neck` or None)."""
+        V, F = self._state(V, F)
+        if self.neck_of is None:             # a 1-tuple: a state without a neck is known
+            self.neck_of = (find_neck(V, F, self.curvature(V, F)),)
+        return self.neck_of[0]
+
+
+def neck_surgery(scheme, flow, *, h, integrator=None, threads=1, state=None, **options):
     """The cut of a ``NAME+surgery`` run (:class:`Surgeon`'s): None while no neck of
     ``flow``'s mesh has pinched (below ``h / 2``, or below :data:`ESCAPED_RESOLUTION`
     ``h`` with T-vertices out of their triangles in the part the cut removes and
@@ -81,6 +119,8 @@ def neck_surgery(scheme, flow, *, h, integrator=None, threads=1, **options):
         The run's resolution (its initial mesh's mean edge length).
     integrator, threads, **options
         As :func:`sub_flow`'s.
+    state : StateCurvature, optional
+        The neck shared with the run's other hooks (default: found here).
 
     Returns
     -------
@@ -93,7 +133,7 @@ def neck_surgery(scheme, flow, *, h, integrator=None, threads=1, **options):
         rebuilt (:func:`~mcfbench.running.continuation.why_not`).
     """
     V, F = np.asarray(flow.vertices), np.asarray(flow.faces)
-    neck = find_neck(V, F)
+    neck = (state or StateCurvature()).neck(V, F)
     early = not pinched(neck, h) and pinched(neck, h, ESCAPED_RESOLUTION)
     escaped = escaped_t_vertices(flow) if early else None      # asked near a pinch only
     early = early and len(escaped) > 0
@@ -134,6 +174,8 @@ class Surgeon:
         without it, the first refusal an event (False: ``NAME+surgery``'s
         :class:`mcfbench.running.remeshing.Strategies`, where the re-extraction may
         still take the thin part).
+    state : StateCurvature, optional
+        Shared with the run's other hooks (default: its own).
 
     Attributes
     ----------
@@ -146,8 +188,9 @@ class Surgeon:
     before_checks = True
 
     def __init__(self, scheme, mesh, *, integrator=None, threads=1, options=None,
-                 strict=True):
+                 strict=True, state=None):
         self.scheme, self.integrator, self.threads = scheme, integrator, threads
+        self.state = state or StateCurvature()
         self.options = dict(options or {})
         self.h = metrics.mean_edge_length(*mesh)
         self.initial_area = metrics.area(*mesh)
@@ -173,7 +216,7 @@ class Surgeon:
         """
         try:
             done = neck_surgery(self.scheme, flow, h=self.h, integrator=self.integrator,
-                                threads=self.threads, **self.options)
+                                threads=self.threads, state=self.state, **self.options)
         except CutRefused as err:
             if not self.strict:
                 return refusal(self, flow, err)
@@ -219,7 +262,8 @@ class Reextractor:
 
     Parameters
     ----------
-    As :class:`Surgeon`'s.
+    scheme, mesh, integrator, threads, options, state
+        As :class:`Surgeon`'s.
 
     Attributes
     ----------
@@ -232,8 +276,9 @@ class Reextractor:
     before_checks = False
     kept = None
 
-    def __init__(self, scheme, mesh, *, integrator=None, threads=1, options=None):
+    def __init__(self, scheme, mesh, *, integrator=None, threads=1, options=None, state=None):
         self.scheme, self.integrator, self.threads = scheme, integrator, threads
+        self.state = state or StateCurvature()
         self.options = {k: v for k, v in dict(options or {}).items() if k != "T0"}
         self.h = metrics.mean_edge_length(*mesh)
         self.edge = target_edge(*mesh)
@@ -253,8 +298,8 @@ class Reextractor:
         V, F = np.asarray(flow.vertices), np.asarray(flow.faces)
         if self.open or flow.n == self.last_step or len(V) == self.unchanged:
             return None
-        sharp, v = sharpness(V, F, self.h)
-        neck = find_neck(V, F)
+        sharp, v = sharpness(V, F, self.h, self.state.curvature(V, F))
+        neck = self.state.neck(V, F)
         necks = V[neck.ring] if pinched(neck, self.h) else ()   # a neck the cut refused
         if sharp <= SHARPNESS and not len(necks):
             return None
@@ -301,16 +346,19 @@ class NeckWait:
     remesher : mcfbench.running.remeshing.Remesher
     h : float
         The run's resolution.
+    state : StateCurvature, optional
+        Shared with the run's other hooks (default: its own).
     """
 
     before_checks = False
     kept = None
 
-    def __init__(self, remesher, h):
+    def __init__(self, remesher, h, state=None):
         self.remesher, self.h = remesher, h
+        self.state = state or StateCurvature()
 
     def __call__(self, flow):
-        neck = find_neck(np.asarray(flow.vertices), np.asarray(flow.faces))
+        neck = self.state.neck(flow.vertices, flow.faces)
         if pinched(neck, self.h, WAIT):
             return None
         return self.remesher(flow)

@@ -92,6 +92,10 @@ class RunResult:
         :data:`mcfbench.running.continuation.MAX_REMOVED_SHARE` of the area: the run
         does not count as reaching its end, whatever its status. Both optional in a
         record (:data:`DEFAULTS`): 0 and False before they existed.
+    rollbacks : int
+        The steps that folded and were rolled back (a mesh strategy's second chance:
+        the run's ``rolled_back`` events, :mod:`mcfbench.running.rollback`); 0 for a
+        run without a mesh strategy. Optional in a record: 0 before it existed.
     """
 
     scheme: str
@@ -123,6 +127,7 @@ class RunResult:
     timing_repeats: int = 1
     removed_area_share: float = 0.0
     surgery_exceeded: bool = False
+    rollbacks: int = 0
 
     def to_dict(self, series=True):
         """Fields as a flat dict: the metrics as top-level keys; ``series=False``

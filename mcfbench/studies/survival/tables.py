@@ -9,13 +9,14 @@ from mcfbench.presentation.tables import Table, markdown
 from mcfbench.storage.statuses import reached
 
 RUN_COLUMNS = ["mesh", "kind", "thin_features", "scheme", "status", "steps_done", "steps",
-               "reached", "through", "removed_area_share", "t_failed", "t_end",
+               "reached", "through", "removed_area_share", "rollbacks", "t_failed", "t_end",
                "defect_fraction", "min_angle", "cpu_seconds", "message"]
 """The columns of :func:`runs_table`."""
 
 SUMMARY_COLUMNS = ["scheme", "meshes", "reached", "share", "plain_meshes", "plain_reached",
                    "plain_share", "thin_meshes", "thin_reached", "thin_share", "thin_through",
-                   "defect_fraction_q1", "defect_fraction_median", "defect_fraction_q3"]
+                   "rollbacks", "rolled_back_runs", "defect_fraction_q1",
+                   "defect_fraction_median", "defect_fraction_q3"]
 """The columns of :func:`survival_table`: ``plain`` the meshes without thin features."""
 
 
@@ -38,7 +39,8 @@ def runs_table(records, meshes):
         (``NAME+surgery``) removing at most
         :data:`mcfbench.running.continuation.MAX_REMOVED_SHARE` of the area;
         ``through`` when it ended so after a continuation removed some area, whatever
-        the share (``removed_area_share``, the record's);
+        the share (``removed_area_share``, the record's); ``rollbacks`` the steps that
+        folded and were rolled back (the record's, 0 in a record written before it);
         ``defect_fraction`` the time of its first defect over the run's final time
         (NaN when it reached the end).
     """
@@ -56,7 +58,8 @@ def runs_table(records, meshes):
                      "scheme": r["scheme"], "status": r["status"], "steps_done": done,
                      "steps": steps, "reached": bool(end),
                      "through": bool(ended and removed > 0),
-                     "removed_area_share": removed, "t_failed": r["t_failed"],
+                     "removed_area_share": removed,
+                     "rollbacks": int(r.get("rollbacks", 0)), "t_failed": r["t_failed"],
                      "t_end": t_end,
                      "defect_fraction": np.nan if end else float(r["t_failed"]) / t_end,
                      "min_angle": r["min_angle"], "cpu_seconds": r["cpu_seconds"],
@@ -73,8 +76,10 @@ def survival_table(runs, schemes):
         :data:`SUMMARY_COLUMNS`: the meshes run and reached, over all, without thin
         features (``plain``) and with them (``thin``), the shares (NaN without such
         meshes), ``thin_through`` the meshes with thin features whose run ended after a
-        continuation removed some area (counted as reached or not), and the quartiles of the first defect's time over the final time
-        among the runs that did not reach the end.
+        continuation removed some area (counted as reached or not), ``rollbacks`` the
+        steps rolled back in all its runs and ``rolled_back_runs`` the runs with one or
+        more, and the quartiles of the first defect's time over the final time among
+        the runs that did not reach the end.
     """
     import pandas as pd
 
@@ -91,7 +96,8 @@ def survival_table(runs, schemes):
         rows.append(dict(zip(SUMMARY_COLUMNS, (
             scheme, *share(own), *share(own[~own["thin_features"]]),
             *share(own[own["thin_features"]]),
-            int((own["through"] & own["thin_features"]).sum()), q1, median, q3))))
+            int((own["through"] & own["thin_features"]).sum()), int(own["rollbacks"].sum()),
+            int((own["rollbacks"] > 0).sum()), q1, median, q3))))
     return pd.DataFrame(rows, columns=SUMMARY_COLUMNS)
 
 
@@ -109,6 +115,8 @@ def survival_markdown(summary, plan):
         "with thin features": [count(*v) for v in zip(
             summary["thin_reached"], summary["thin_meshes"], summary["thin_share"])],
         "all": [count(*v) for v in zip(summary["reached"], summary["meshes"], summary["share"])],
+        "rollbacks (runs)": [f"{k} ({n})" for k, n in zip(summary["rollbacks"],
+                                                          summary["rolled_back_runs"])],
         "first defect (t / t_end: q1, median, q3)": [
             ", ".join(formatted(v, ".2f") for v in q) if np.isfinite(q[1]) else "–"
             for q in zip(summary["defect_fraction_q1"], summary["defect_fraction_median"],
@@ -120,7 +128,9 @@ def survival_markdown(summary, plan):
              f"{plan['rtol']:g}). Reached: every step done, or the flow's extinction, the "
              "invariants (the area never grows, no fold) holding at every step. Thin "
              "features: the corpus manifest's verdict (share of area thinner than 2 h "
-             "above 2 %), decided before any run."]
+             "above 2 %), decided before any run. Rollbacks: the steps that folded and "
+             "were rolled back, the state before them remeshed (NAME+remesh, NAME+surgery), "
+             "over all the scheme's runs, and (in brackets) its runs with one or more."]
     paired = paired_markdown(summary, plan.get("strategies", []))
     return (f"# Survival on raw meshes\n\n{markdown(Table.of_frame(view, notes=notes))}\n"
             + (f"\n## Every scheme beside its variants\n\n{paired}\n" if paired else ""))

@@ -285,3 +285,25 @@ def test_real_closed_meshes_shrink_to_their_extinction(name, scheme, kind, step)
     [event] = traj.events
     assert event["kind"] == kind and f"vanished round, to a {kind}" in traj.message
     assert 0 < event["extinction_time"] - event["time"] < 2 * tau
+
+
+def test_component_topology_counts_each_components_euler_characteristic():
+    """A sphere (chi 2), a torus (0) and a hemisphere with its rim open (1, not closed)
+    in one mesh, their vertices numbered in a shuffled order: each component's own."""
+    from mcfbench.geometry.collapse import component_topology
+    from mcfbench.geometry.measures import vertex_components
+    from mcfbench.geometry.surfaces import make_surface
+
+    parts = [icosphere(2), torus(16, 8), make_surface("hemisphere", rings=4, radius=1.0)]
+    V = np.vstack([p[0] for p in parts])
+    offsets = np.cumsum([0] + [len(p[0]) for p in parts])
+    F = np.vstack([p[1] + o for p, o in zip(parts, offsets)])
+    order = np.random.default_rng(1).permutation(len(V))
+    new = np.empty_like(order)
+    new[order] = np.arange(len(V))
+    V, F = V[order], new[F]
+    count, labels = vertex_components(F, len(V))
+    chi, closed = component_topology(F, labels, count)
+    of = [labels[new[o]] for o in offsets[:-1]]           # each part's component
+    assert count == 3 and chi[of].tolist() == [2, 0, 1]
+    assert closed[of].tolist() == [True, True, False]

@@ -114,3 +114,42 @@ def test_a_remeshed_run_of_a_user_mesh_is_stored_with_its_frames_own_faces(tmp_p
     assert "l2_weights" not in frames
     first, last = frame_mesh(frames, 0), frame_mesh(frames, -1)
     assert len(first[0]) == len(V) and not np.array_equal(first[1], last[1])
+
+
+def test_a_mesh_file_is_read_once_per_process_and_again_when_it_changes(tmp_path,
+                                                                         monkeypatch):
+    """Every scheme of a survival batch runs on one file: it is read once (the
+    specs get the same mesh, each its own copy); a file whose bytes changed is read
+    again, its spec's SHA-256 checked first."""
+    import igl
+
+    from mcfbench.geometry import mesh_files
+    from mcfbench.geometry.spheres import icosphere
+    from mcfbench.running import batch
+    from mcfbench.running.batch import mesh_spec
+    from mcfbench.storage.run_store import mesh_sha256
+
+    reads = []
+    real = mesh_files.read_mesh
+    monkeypatch.setattr(mesh_files, "read_mesh", lambda p: reads.append(p) or real(p))
+    V, F = icosphere(1)
+    path = tmp_path / "sphere.obj"
+    igl.write_triangle_mesh(str(path), V, F)
+
+    def spec(scheme):
+        return mesh_spec(scheme, str(path), mesh_sha256(path), tau_edge=0.1, steps=2,
+                         solver=SOLVER, frames=2)
+
+    (V1, F1, _), tau1, _ = batch._user_mesh(spec("cotan"))
+    (V2, F2, _), tau2, _ = batch._user_mesh(spec("bgn"))
+    assert len(reads) == 1 and tau1 == tau2 and V1 is not V2
+    np.testing.assert_array_equal(V1, V2)
+    np.testing.assert_array_equal(F1, F2)
+    V1[0] = 0.0                                         # a run's copy, not the kept mesh
+    assert batch._user_mesh(spec("cotan"))[0][0][0, 0] == V2[0, 0]
+    old = spec("cotan")
+    igl.write_triangle_mesh(str(path), 2 * V, F)
+    with pytest.raises(ValueError, match="the file changed after the plan was made"):
+        batch._user_mesh(old)
+    (V3, _, _), tau3, _ = batch._user_mesh(spec("cotan"))
+    assert len(reads) == 2 and tau3 == pytest.approx(4 * tau1)

@@ -60,3 +60,33 @@ def test_spec_seconds_scale_the_cost_model_by_the_kind_of_scheme(monkeypatch):
                                 sphere("cotan", 1)]})
     assert [b.specs for b in found if b.problem == "catenoid"][0] == tuple(specs["bgn"])
     assert calibrated["bgn"] >= BATCH_SECONDS
+
+
+def test_mesh_files_are_packed_by_their_size_a_large_one_split(tmp_path):
+    """A user's mesh file counts MESH_FILE_SECONDS a megabyte: the runs on small files
+    share a batch, a large file's runs (one series per scheme) fill several, the
+    costliest batches first by their estimate (runs.smk's priority)."""
+    from mcfbench.running import batching
+    from mcfbench.running.batch import mesh_spec
+
+    schemes = [f"s{k}" for k in range(20)]
+    files = {}
+    for name, megabytes in (("tiny1", 0.001), ("tiny2", 0.002), ("large", 1.0)):
+        files[name] = tmp_path / f"{name}.ply"
+        files[name].write_bytes(b"x" * int(megabytes * 1e6))
+    specs = [mesh_spec(s, str(path), "0" * 64, tau_edge=0.1, steps=40, solver=SOLVER,
+                       frames=2) for path in files.values() for s in schemes]
+    per_run = batching.RUN_SECONDS + batching.MESH_FILE_SECONDS
+    assert batching.spec_seconds(specs[-1]) == pytest.approx(per_run)
+    assert batching.spec_seconds(specs[0]) == pytest.approx(
+        batching.RUN_SECONDS + 0.001 * batching.MESH_FILE_SECONDS)
+    found = batches({"survival": specs})
+    assert sorted(s.key for b in found for s in b.specs) == sorted(s.key for s in specs)
+    holding = {name: [b for b in found if str(path) in {s.mesh_file for s in b.specs}]
+               for name, path in files.items()}
+    assert len(holding["tiny1"]) == 1 and holding["tiny1"] == holding["tiny2"]
+    assert len(holding["large"]) >= 20 * per_run // BATCH_SECONDS >= 2
+    assert all(b.seconds < BATCH_SECONDS + per_run for b in found)
+    missing = mesh_spec("s0", str(tmp_path / "gone.ply"), "0" * 64, tau_edge=0.1, steps=40,
+                        solver=SOLVER, frames=2)
+    assert batching.spec_seconds(missing) == BATCH_SECONDS

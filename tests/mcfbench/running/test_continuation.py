@@ -118,6 +118,35 @@ def test_no_surgery_before_the_neck_pinches(pinched_dumbbell):
     assert neck_surgery(entry, entry.make(V, F, 0.004), h=mean_edge_length(V, F)) is None
 
 
+def test_the_surgery_hooks_share_one_curvature_a_state(monkeypatch, pinched_dumbbell):
+    """NAME+surgery's neck cut, re-extraction and remesh's wait all ask about every state:
+    ``H n`` (libigl's cotangent Laplacian and mass) is computed once a state, 11 times in
+    10 steps of cotan+surgery on a sphere (no neck, nothing sharp, no remesh); before,
+    3 times a state. The shared neck is the one found alone, and a new state's is new."""
+    from mcfbench.geometry import mesh_surgery
+    from mcfbench.running.remeshing import mesh_hook
+    from mcfbench.running.surgery import StateCurvature
+
+    calls = []
+    real = mesh_surgery.mean_curvature_vectors
+    monkeypatch.setattr(mesh_surgery, "mean_curvature_vectors",
+                        lambda V, F: calls.append(len(V)) or real(V, F))
+    V, F = icosphere(2)
+    scheme = get_scheme("cotan+surgery")
+    traj = simulate(scheme.make(V, F, 0.1 * mean_edge_length(V, F) ** 2), 10,
+                    remesh=mesh_hook(scheme, (V, F)))
+    assert traj.status == "ok" and traj.events == [] and len(calls) == 11
+    V, F, _ = pinched_dumbbell
+    state, alone = StateCurvature(), find_neck(V, F)        # the 12th
+    shared = state.neck(V, F)                                 # the 13th
+    assert (shared.vertex, shared.radius) == (alone.vertex, alone.radius)
+    assert state.neck(V.copy(), F.copy()) is shared and len(calls) == 13
+    assert state.curvature(V, F) is state.curvature(V.copy(), F) and len(calls) == 13
+    moved = V * 1.5                            # another state: its own neck, radius x 1.5
+    assert state.neck(moved, F).radius == pytest.approx(1.5 * alone.radius)
+    assert len(calls) == 14
+
+
 @pytest.mark.parametrize("scheme", ["cotan+surgery", "bgn+surgery",
                                     "ddfv-chord-carried+surgery"])
 def test_the_flow_is_rebuilt_on_the_cut_mesh_at_its_time_level(pinched_dumbbell, scheme):

@@ -158,3 +158,30 @@ def test_the_surgery_strategy_rolls_back_through_its_remesher():
     hook = mesh_hook(get_scheme("cotan+surgery"), (V, F))
     remesher = hook.parts[-1].remesher
     assert hook.rollback is remesher.rollback and remesher.rollback.remesher is remesher
+
+
+def test_a_runs_record_counts_its_rollbacks(tmp_path):
+    """The record's ``rollbacks`` is the run's number of ``rolled_back`` events: the raw
+    ``cat_head`` (131 vertices) with ``ddfv+remesh`` reaches step 40 after 2; a record
+    written before the key existed reads as 0."""
+    import json
+
+    from mcfbench.geometry.committed_meshes import RAW_DIR
+    from mcfbench.geometry.mesh_files import read_mesh
+    from mcfbench.running.problem import Problem
+    from mcfbench.running.run import run
+    from mcfbench.storage.records import checksum, read_record, write_record
+
+    V, F, _ = read_mesh(RAW_DIR / "cat_head.obj")
+    tau = 0.1 * metrics.mean_edge_length(V, F) ** 2
+    result, traj = run("ddfv+remesh", Problem.user_mesh("cat_head", 40, 0.1), 1,
+                       mesh=(V, F), tau=tau)
+    assert result.status == "ok" and result.steps_done == 40, result.message
+    assert result.rollbacks == 2 == [e["event"] for e in traj.events].count("rolled_back")
+    path = tmp_path / "run.json"
+    record = write_record(path, result, {})
+    assert read_record(path)["rollbacks"] == 2
+    del record["rollbacks"]
+    record["checksum"] = checksum(record)
+    path.write_text(json.dumps(record))
+    assert read_record(path)["rollbacks"] == 0

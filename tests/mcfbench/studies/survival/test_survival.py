@@ -106,6 +106,25 @@ def test_the_findings_name_the_schemes_that_go_through_the_thin_parts():
     assert "no scheme here goes through a pinch" not in words
 
 
+def test_the_tables_count_the_rollbacks_of_each_scheme():
+    """runs.csv carries each record's ``rollbacks`` (0 for a record written before
+    the key); survival.csv and .md the scheme's total and its runs with one or more."""
+    records = [("a", {**_record("x+remesh", "ok", 40), "rollbacks": 3}),
+               ("b", {**_record("x+remesh", "inverted", 7, 0.07), "rollbacks": 10}),
+               ("c", {**_record("x+remesh", "ok", 40), "rollbacks": 0}),
+               ("a", _record("x", "inverted", 2, 0.02))]
+    runs = survival_tables.runs_table(records, MESHES)
+    assert runs["rollbacks"].tolist() == [3, 10, 0, 0]
+    summary = survival_tables.survival_table(runs, ["x", "x+remesh"]).set_index("scheme")
+    assert summary.loc["x+remesh", ["rollbacks", "rolled_back_runs"]].tolist() == [13, 2]
+    assert summary.loc["x", ["rollbacks", "rolled_back_runs"]].tolist() == [0, 0]
+    text = survival_tables.survival_markdown(summary.reset_index(), {
+        "meshes": MESHES, "refused": [], "steps": 40, "C": 0.1, "solver": "direct",
+        "rtol": 1e-9})
+    assert "| x+remesh | 1/2 (50 %) | 1/1 (100 %) | 2/3 (67 %) | 13 (2) |" in text
+    assert "| x | 0/1 (0 %) | – | 0/1 (0 %) | 0 (0) |" in text
+
+
 def test_every_scheme_is_paired_with_its_variants_once():
     chosen = survival_plan.plan({"schemes": ["bgn", "mdr+remesh", "mdr", "bgn"],
                                  "strategies": ["remesh", "surgery"]})["schemes"]
