@@ -55,9 +55,12 @@ def threaded(kernel, **callees):
     clone.__qualname__, clone.__doc__ = clone.__name__, py.__doc__
     options = {k: v for k, v in kernel.targetoptions.items() if k != "nopython"}
     # not the dict itself: numba pops the keys of a dict of options at each compilation,
-    # and a second one (other argument types) from the emptied dict has every option on
-    return numba.njit(parallel=ParallelOptions(dict(PRANGE_ONLY)), cache=True,
-                      **options)(clone)
+    # and a second one (other argument types) from the emptied dict has every option on;
+    # a kernel without a prange loop of its own (the solver's iteration, which calls the
+    # threaded products) is compiled serial: parallel would find nothing, and warn
+    parallel = (ParallelOptions(dict(PRANGE_ONLY)) if "prange" in py.__code__.co_names
+                else False)
+    return numba.njit(parallel=parallel, cache=True, **options)(clone)
 
 
 def check_threads(threads):

@@ -334,8 +334,8 @@ def solve(A, b, x0=None, *, method="bicgstab", rtol=1e-9, maxiter=1000,
                         return to_block(x), _failed(method, "breakdown", detail)
                 dinv, lu = factor
             # else: kind 0, the kernel reports the non-finite input
-        kernel = for_threads(krylov.bicgstab_kernel, threads, spmv=krylov.spmv,
-                             residual=krylov.residual)
+        # the residual pass stays serial: its threaded copy had no loop numba could split
+        kernel = for_threads(krylov.bicgstab_kernel, threads, spmv=krylov.spmv)
         code, dcode, it, rnorm, ref = kernel(
             *csr, b, x, cmean, cfull, float(rtol), int(maxiter), int(stagnation_window),
             kind, dinv, *(lu or ilu_arrays(None)))
